@@ -1,0 +1,83 @@
+#include "acquisition/scan.hpp"
+
+#include <cassert>
+#include <cmath>
+
+namespace scanbench::acquisition {
+
+Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color) {
+  assert(rows >= 0 && columns >= 0 && "scan dimensions must be non-negative");
+  Scan scan;
+  scan.rows = rows;
+  scan.columns = columns;
+  const std::size_t n = scan.pixel_count();
+  scan.range_m.assign(n, 0.0f);
+  scan.valid.assign(n, 0);
+  if (with_intensity) scan.intensity.assign(n, 0.0f);
+  if (with_color) scan.rgb.assign(3 * n, 0);
+  return scan;
+}
+
+Eigen::Vector3d direction_precise(const Scan& scan, int row, int col) {
+  assert(row >= 0 && row < scan.rows && col >= 0 && col < scan.columns);
+  if (const auto* spherical = std::get_if<SphericalAngles>(&scan.angles)) {
+    const double az = spherical->azimuth_start_rad + col * spherical->azimuth_step_rad;
+    const double el = spherical->elevation_start_rad + row * spherical->elevation_step_rad;
+    const double cos_el = std::cos(el);
+    return {cos_el * std::cos(az), cos_el * std::sin(az), std::sin(el)};
+  }
+  const Eigen::Vector3d d =
+      std::get<PerPixelDirections>(scan.angles).directions[scan.index(row, col)].cast<double>();
+  const double norm = d.norm();
+  return norm > 0.0 ? Eigen::Vector3d(d / norm) : Eigen::Vector3d::Zero();
+}
+
+Eigen::Vector3f direction(const Scan& scan, int row, int col) {
+  if (scan.is_spherical()) return direction_precise(scan, row, col).cast<float>();
+  return std::get<PerPixelDirections>(scan.angles).directions[scan.index(row, col)];
+}
+
+Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col) {
+  return scan.range_m[scan.index(row, col)] * direction(scan, row, col);
+}
+
+Eigen::Vector3d point_in_world(const Scan& scan, int row, int col) {
+  const double range = scan.range_m[scan.index(row, col)];
+  return scan.T_world_scan * (range * direction_precise(scan, row, col));
+}
+
+std::size_t count_valid(const Scan& scan) {
+  std::size_t count = 0;
+  for (const std::uint8_t v : scan.valid) count += v != 0;
+  return count;
+}
+
+std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan) {
+  Eigen::AlignedBox3d box;  // starts empty
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      if (scan.valid[scan.index(row, col)]) box.extend(point_in_world(scan, row, col));
+    }
+  }
+  if (box.isEmpty()) return std::nullopt;
+  return box;
+}
+
+std::string check_consistency(const Scan& scan) {
+  if (scan.rows < 0 || scan.columns < 0) return "negative dimensions";
+  const std::size_t n = scan.pixel_count();
+  if (scan.range_m.size() != n) return "range channel size differs from rows x columns";
+  if (scan.valid.size() != n) return "validity mask size differs from rows x columns";
+  if (!scan.intensity.empty() && scan.intensity.size() != n) {
+    return "intensity channel size differs from rows x columns";
+  }
+  if (!scan.rgb.empty() && scan.rgb.size() != 3 * n) {
+    return "rgb channel size differs from 3 x rows x columns";
+  }
+  if (const auto* per_pixel = std::get_if<PerPixelDirections>(&scan.angles)) {
+    if (per_pixel->directions.size() != n) return "direction count differs from rows x columns";
+  }
+  return {};
+}
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,108 @@
+// The organized scan grid: the one data type every later stage reads.
+//
+// A scan is a rows × columns grid stored as parallel arrays in row-major
+// order (pixel (row, col) is element row * columns + col). Points are not
+// stored: a point in the scan frame is range × direction(row, col), where the
+// direction comes from the scan's angle model. The pose T_world_scan is kept
+// in double precision because georeferenced scans sit at 10^5–10^6 m, where a
+// float would lose millimetres.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace scanbench::acquisition {
+
+// The regular panoramic grid of a scanner such as the RIEGL LMS-Z360:
+// column `col` looks at azimuth  azimuth_start_rad + col * azimuth_step_rad,
+// row `row`   looks at elevation elevation_start_rad + row * elevation_step_rad.
+// Steps are signed; the grid convention of the source file is kept as it is.
+// Direction in the scan frame (z up):
+//   (cos(el) cos(az), cos(el) sin(az), sin(el)).
+struct SphericalAngles {
+  double azimuth_start_rad = 0.0;
+  double azimuth_step_rad = 0.0;
+  double elevation_start_rad = 0.0;
+  double elevation_step_rad = 0.0;
+
+  friend bool operator==(const SphericalAngles&, const SphericalAngles&) = default;
+};
+
+// Irregular grids (structured light, resampled clouds): one unit direction per
+// pixel, row-major, in the scan frame. A pixel whose direction is unknown (no
+// return and no model to predict it) holds the zero vector.
+struct PerPixelDirections {
+  std::vector<Eigen::Vector3f> directions;
+
+  friend bool operator==(const PerPixelDirections&, const PerPixelDirections&) = default;
+};
+
+using AngleModel = std::variant<SphericalAngles, PerPixelDirections>;
+
+struct ScannerMetadata {
+  std::string name;         // scanner model or instrument id; empty when unknown
+  std::string source_file;  // file the scan was imported from (UTF-8 path)
+  // Registered scanner position in the world frame [m], as the source file gives it.
+  Eigen::Vector3d position_world = Eigen::Vector3d::Zero();
+};
+
+struct Scan {
+  std::string name;
+  int rows = 0;
+  int columns = 0;
+
+  // Channels, all rows * columns long (rgb three times that), row-major.
+  std::vector<float> range_m;        // distance from the scanner [m]; meaningful where valid
+  std::vector<std::uint8_t> valid;   // 1 = a return, 0 = no return (sky, dropout, "0 0 0")
+  std::vector<float> intensity;      // empty when the source has none; else as the source gives it
+  std::vector<std::uint8_t> rgb;     // empty when the source has none; else 8-bit R, G, B per pixel
+
+  AngleModel angles = SphericalAngles{};
+  Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();
+  ScannerMetadata scanner;
+
+  std::size_t pixel_count() const { return static_cast<std::size_t>(rows) * columns; }
+  std::size_t index(int row, int col) const {
+    return static_cast<std::size_t>(row) * columns + col;
+  }
+  bool has_intensity() const { return !intensity.empty(); }
+  bool has_color() const { return !rgb.empty(); }
+  bool is_spherical() const { return std::holds_alternative<SphericalAngles>(angles); }
+};
+
+// Allocates every channel of a rows × columns scan: range 0, all pixels
+// invalid, intensity / rgb only when requested. Asserts rows, columns ≥ 0.
+Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color);
+
+// Unit viewing direction of pixel (row, col) in the scan frame. For per-pixel
+// grids this is the stored direction (zero when unknown).
+Eigen::Vector3f direction(const Scan& scan, int row, int col);
+
+// The same direction in double precision, normalised in double (per-pixel
+// directions are re-normalised), for exporters and world coordinates.
+Eigen::Vector3d direction_precise(const Scan& scan, int row, int col);
+
+// Point of pixel (row, col) in the scan frame [m]; meaningless where !valid.
+Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col);
+
+// Point of pixel (row, col) in the world frame [m], in double precision.
+Eigen::Vector3d point_in_world(const Scan& scan, int row, int col);
+
+std::size_t count_valid(const Scan& scan);
+
+// Axis-aligned bounds of the valid points in the world frame [m]; empty
+// optional when the scan has no valid point.
+std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan);
+
+// Checks the channel sizes against rows × columns and the angle model; used by
+// writers and the project before storing. Returns an empty string when the
+// scan is consistent, else a description of the first inconsistency.
+std::string check_consistency(const Scan& scan);
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,30 @@
+// One entry point for every raw-scan format: the format follows from the file
+// name, and every reader streams its scans to a callback.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "acquisition/ptx_reader.hpp"
+#include "acquisition/scan.hpp"
+
+namespace scanbench::acquisition {
+
+enum class ScanFileFormat { kPtx, kTriplet, kOrganizedPcd };
+
+// By extension, case-insensitive: .ptx, .json (an image triplet's sidecar),
+// .pcd. Throws InputError naming the file for any other extension.
+ScanFileFormat scan_file_format(const std::filesystem::path& path);
+
+struct ScanFileSettings {
+  PtxReadSettings ptx;
+};
+
+// Reads every scan of `path` and hands each to `on_scan`, in file order.
+// Throws InputError (see the format's reader) on bad input; scans delivered
+// before the error stay delivered.
+void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& settings,
+                    const std::function<void(Scan&&)>& on_scan);
+
+}  // namespace scanbench::acquisition

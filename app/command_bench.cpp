@@ -1,0 +1,44 @@
+// scanbench bench SUITE [--json] [--smoke]
+#include <fmt/core.h>
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.hpp"
+#include "bench/bench_suites.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct BenchCommandOptions {
+  std::string suite;
+  bool json = false;
+  bench::BenchOptions bench;
+};
+
+void run_bench(const BenchCommandOptions& options) {
+  const nlohmann::json result = bench::run_suite(options.suite, options.bench);
+  if (options.json) {
+    fmt::print("{}\n", result.dump());
+    return;
+  }
+  for (const auto& [key, value] : result.items()) fmt::print("{:<34} {}\n", key, value.dump());
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto options = std::make_shared<BenchCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "bench", "Measure a stage: accuracy against ground truth and speed against PCL, one run.");
+  command->add_option("suite", options->suite, "Suite to run")
+      ->required()
+      ->check(CLI::IsMember(bench::suite_names()));
+  command->add_flag("--json", options->json, "Print one JSON object");
+  command->add_flag("--smoke", options->bench.smoke,
+                    "Tiny inputs: checks the suite runs; figures are not meaningful");
+  command->callback([options] { run_bench(*options); });
+}
+
+}  // namespace scanbench::app

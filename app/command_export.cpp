@@ -1,0 +1,91 @@
+// scanbench export PROJECT --format ptx|ply|csv|triplet [--scan ID] -o OUT
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "acquisition/input_error.hpp"
+#include "acquisition/point_export.hpp"
+#include "acquisition/ptx_writer.hpp"
+#include "acquisition/triplet_writer.hpp"
+#include "app/commands.hpp"
+#include "modeling/project.hpp"
+
+namespace scanbench::app {
+namespace {
+
+enum class ExportFormat { kPtx, kPly, kCsv, kTriplet };
+
+struct ExportOptions {
+  std::string project;
+  ExportFormat format = ExportFormat::kPtx;
+  std::optional<std::int64_t> scan_id;
+  std::string output;
+};
+
+std::vector<acquisition::Scan> load_scans(const modeling::Project& project,
+                                          std::optional<std::int64_t> scan_id) {
+  std::vector<acquisition::Scan> scans;
+  if (scan_id) {
+    scans.push_back(project.load_scan(*scan_id));
+    return scans;
+  }
+  for (const auto& stored : project.scans()) scans.push_back(project.load_scan(stored.id));
+  return scans;
+}
+
+void write_scans(const ExportOptions& options, const std::vector<acquisition::Scan>& scans) {
+  switch (options.format) {
+    case ExportFormat::kPtx:
+      return acquisition::write_ptx(options.output, scans);
+    case ExportFormat::kPly:
+      return acquisition::write_ply(options.output, scans);
+    case ExportFormat::kCsv:
+      return acquisition::write_csv(options.output, scans);
+    case ExportFormat::kTriplet:
+      if (scans.size() != 1) {
+        throw acquisition::InputError(options.project, {},
+                                      "a triplet holds one scan: choose it with --scan ID");
+      }
+      return acquisition::write_triplet(scans.front(), options.output);
+  }
+}
+
+void run_export(const ExportOptions& options) {
+  const modeling::Project project = modeling::Project::open(options.project);
+  const std::vector<acquisition::Scan> scans = load_scans(project, options.scan_id);
+  write_scans(options, scans);
+  std::size_t points = 0;
+  for (const auto& scan : scans) points += acquisition::count_valid(scan);
+  fmt::print("exported {} scan(s), {} valid points, to {}\n", scans.size(), points, options.output);
+}
+
+}  // namespace
+
+void add_export_command(CLI::App& app) {
+  auto options = std::make_shared<ExportOptions>();
+  CLI::App* command = app.add_subcommand(
+      "export",
+      "Export scans: PTX (scan frame + pose, lossless), binary PLY or CSV (valid points in world "
+      "coordinates, double precision), or an image triplet (one scan).");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  const std::map<std::string, ExportFormat> formats{{"ptx", ExportFormat::kPtx},
+                                                    {"ply", ExportFormat::kPly},
+                                                    {"csv", ExportFormat::kCsv},
+                                                    {"triplet", ExportFormat::kTriplet}};
+  command->add_option("--format", options->format, "ptx, ply, csv or triplet")
+      ->required()
+      ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
+  command->add_option("--scan", options->scan_id, "Export only the scan with this id");
+  command->add_option("-o,--output", options->output, "Output file (triplet: the .json sidecar)")
+      ->required();
+  command->callback([options] { run_export(*options); });
+}
+
+}  // namespace scanbench::app

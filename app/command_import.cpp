@@ -1,0 +1,49 @@
+// scanbench import PROJECT FILE...
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "app/progress_bar.hpp"
+#include "modeling/import_scans.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct ImportOptions {
+  std::string project;
+  std::vector<std::string> files;
+};
+
+void run_import(const ImportOptions& options) {
+  const std::vector<std::filesystem::path> files(options.files.begin(), options.files.end());
+  ProgressBar progress("import");
+  modeling::ImportSettings settings;
+  settings.on_scan_stored = [&progress](const modeling::ImportProgress& p) {
+    progress.update(p.file_index + 1, p.file_count, "stored " + p.scan_name);
+  };
+  const modeling::ImportResult result =
+      modeling::import_scan_files(options.project, files, settings);
+  fmt::print("{} {} scan(s) from {} file(s) into {} in {:.2f} s\n",
+             result.created_project ? "created project; imported" : "imported",
+             result.scan_ids.size(), files.size(), options.project, result.seconds);
+}
+
+}  // namespace
+
+void add_import_command(CLI::App& app) {
+  auto options = std::make_shared<ImportOptions>();
+  CLI::App* command = app.add_subcommand(
+      "import",
+      "Import raw scans (Leica .ptx, image-triplet .json sidecars, organized .pcd) into a "
+      "project, creating it when missing. All files of one call go in one transaction: "
+      "on any error the project is left unchanged.");
+  command->add_option("project", options->project, "Project file (.sbproj)")->required();
+  command->add_option("files", options->files, "Scan files")->required()->check(CLI::ExistingFile);
+  command->callback([options] { run_import(*options); });
+}
+
+}  // namespace scanbench::app

@@ -1,0 +1,43 @@
+// scanbench command line: one subcommand per pipeline stage
+// (import → info → export today; geometry, register, merge, segment, render
+// join as their stages land).
+#include <fmt/core.h>
+
+#include <CLI/CLI.hpp>
+#include <exception>
+
+#include "acquisition/input_error.hpp"
+#include "app/commands.hpp"
+
+namespace {
+
+int report_error(const char* kind, const char* message, int exit_code) {
+  fmt::print(stderr, "scanbench: {}: {}\n", kind, message);
+  return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace sb = scanbench::app;
+  CLI::App app{"scanbench: a workbench for terrestrial laser scans", "scanbench"};
+  app.set_version_flag("--version", "scanbench 0.1.0");
+  app.require_subcommand(1, 1);
+  sb::add_import_command(app);
+  sb::add_info_command(app);
+  sb::add_export_command(app);
+  sb::add_bench_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return sb::kExitBadInput;
+  } catch (const scanbench::acquisition::InputError& e) {
+    return report_error("bad input", e.what(), sb::kExitBadInput);
+  } catch (const std::exception& e) {
+    return report_error("error", e.what(), sb::kExitFailure);
+  }
+  return sb::kExitOk;
+}

@@ -1,0 +1,131 @@
+#include "bench/bench_io.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <unistd.h>
+
+#include "acquisition/pcd_reader.hpp"
+#include "acquisition/ptx_reader.hpp"
+#include "acquisition/ptx_writer.hpp"
+#include "modeling/project.hpp"
+
+namespace scanbench::bench {
+namespace {
+
+using acquisition::Scan;
+
+// Range from the scanner at (0, 0, 1.5) to the inside of a 30 × 20 × 8 m box.
+float room_range(const Eigen::Vector3d& d) {
+  const Eigen::Vector3d origin(0.0, 0.0, 1.5);
+  const Eigen::Vector3d lo(-12.0, -7.0, 0.0), hi(18.0, 13.0, 8.0);
+  double best = 1e9;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(d[axis]) < 1e-12) continue;
+    const double wall = d[axis] > 0 ? hi[axis] : lo[axis];
+    best = std::min(best, (wall - origin[axis]) / d[axis]);
+  }
+  return static_cast<float>(best);
+}
+
+Scan synthetic_scan(int rows, int columns) {
+  Scan scan = acquisition::make_empty_scan(rows, columns, true, true);
+  scan.name = "bench-room";
+  const double step = 2.0 * std::numbers::pi / columns;
+  scan.angles = acquisition::SphericalAngles{0.0, step, 50.0 * std::numbers::pi / 180.0, -step};
+  scan.T_world_scan.translation() = Eigen::Vector3d(512345.678, 5412345.678, 312.5);
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      scan.valid[i] = row >= rows / 20;  // a band of missing returns at the top
+      scan.range_m[i] = scan.valid[i] ? room_range(direction_precise(scan, row, col)) : 0.0f;
+      scan.intensity[i] = 0.25f + 0.5f * static_cast<float>((row * 7 + col * 13) % 100) / 100.0f;
+      for (int c = 0; c < 3; ++c) scan.rgb[3 * i + c] = static_cast<std::uint8_t>((row + col * c) & 255);
+    }
+  }
+  return scan;
+}
+
+// ASCII organized PCD with x y z intensity: the same points as the PTX.
+void write_ascii_pcd(const std::filesystem::path& path, const Scan& scan) {
+  std::ofstream out(path);
+  out << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\n"
+      << "COUNT 1 1 1 1\nWIDTH " << scan.columns << "\nHEIGHT " << scan.rows
+      << "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << scan.pixel_count() << "\nDATA ascii\n";
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (!scan.valid[i]) {
+        out << "nan nan nan 0\n";
+        continue;
+      }
+      const Eigen::Vector3f p = acquisition::point_in_scan(scan, row, col);
+      out << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << scan.intensity[i] << '\n';
+    }
+  }
+}
+
+double best_seconds(int repeats, const std::function<void()>& work) {
+  double best = 1e30;
+  for (int r = 0; r < repeats; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+}  // namespace
+
+nlohmann::json run_io_bench(const BenchOptions& options) {
+  const int rows = options.smoke ? 90 : 900, columns = options.smoke ? 360 : 3600;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("scanbench-bench-io-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const Scan scan = synthetic_scan(rows, columns);
+  const int repeats = options.smoke ? 1 : 3;
+
+  const std::filesystem::path ptx = dir / "room.ptx", pcd = dir / "room.pcd";
+  const double write_s = best_seconds(repeats, [&] { acquisition::write_ptx(ptx, {&scan, 1}); });
+  write_ascii_pcd(pcd, scan);
+  const double ptx_bytes = static_cast<double>(std::filesystem::file_size(ptx));
+  const double pcd_bytes = static_cast<double>(std::filesystem::file_size(pcd));
+  const double read_s = best_seconds(repeats, [&] { acquisition::read_ptx(ptx); });
+  const double pcl_s = best_seconds(repeats, [&] { acquisition::read_organized_pcd(pcd); });
+
+  const std::filesystem::path project_path = dir / "bench.sbproj";
+  double store_s = 0.0;
+  {
+    modeling::Project project = modeling::Project::create(project_path);
+    store_s = best_seconds(1, [&] {
+      auto transaction = project.begin();
+      project.insert_scan(scan);
+      transaction.commit();
+    });
+  }
+  const std::int64_t id = modeling::Project::open(project_path).scans().front().id;
+  const double load_s = best_seconds(repeats, [&] { modeling::Project::open(project_path).load_scan(id); });
+  const double project_bytes = static_cast<double>(std::filesystem::file_size(project_path));
+  std::filesystem::remove_all(dir);
+
+  const double points = static_cast<double>(scan.pixel_count());
+  return {{"suite", "io"},
+          {"rows", rows},
+          {"columns", columns},
+          {"points", scan.pixel_count()},
+          {"ptx_bytes", ptx_bytes},
+          {"ptx_read_mb_per_s", ptx_bytes / 1e6 / read_s},
+          {"ptx_read_points_per_s", points / read_s},
+          {"ptx_write_mb_per_s", ptx_bytes / 1e6 / write_s},
+          {"pcl_pcd_ascii_read_mb_per_s", pcd_bytes / 1e6 / pcl_s},
+          {"ptx_read_speedup_vs_pcl", pcl_s / read_s},
+          {"project_store_seconds", store_s},
+          {"project_load_seconds", load_s},
+          {"project_bytes_per_point", project_bytes / points}};
+}
+
+}  // namespace scanbench::bench

@@ -1,0 +1,17 @@
+#include "bench/bench_suites.hpp"
+
+#include <cassert>
+
+#include "bench/bench_io.hpp"
+
+namespace scanbench::bench {
+
+std::vector<std::string> suite_names() { return {"io"}; }
+
+nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
+  if (name == "io") return run_io_bench(options);
+  assert(false && "unknown bench suite");
+  return {};
+}
+
+}  // namespace scanbench::bench

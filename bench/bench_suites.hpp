@@ -1,0 +1,23 @@
+// Benchmark suites behind `scanbench bench SUITE`. Each suite measures
+// accuracy and/or speed, peers (PCL) side by side in the same run, and
+// returns one JSON object with the field names its issue specifies.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace scanbench::bench {
+
+struct BenchOptions {
+  // Small inputs for the test suite's smoke run: same code paths, seconds
+  // instead of minutes, figures not meaningful.
+  bool smoke = false;
+};
+
+std::vector<std::string> suite_names();
+
+// Runs one suite. Asserts `name` is one of suite_names() (the CLI checks it).
+nlohmann::json run_suite(const std::string& name, const BenchOptions& options);
+
+}  // namespace scanbench::bench

@@ -1,0 +1,20 @@
+# One place for the compile settings of every scanbench target: C++20, strict
+# warnings as errors, and the sanitizers when SCANBENCH_SANITIZE is on.
+function(scanbench_target_settings target)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
+  if(SCANBENCH_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# A module library: sources beside headers, includes rooted at the repository
+# so that every include names its module ("acquisition/scan.hpp").
+function(scanbench_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  scanbench_target_settings(${name})
+endfunction()
