@@ -17,7 +17,8 @@ constexpr std::uint64_t kMinPointLineBytes = 8;  // "0 0 0 0\n"
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+    s.remove_suffix(1);
   return s;
 }
 
@@ -62,7 +63,8 @@ void read_pose(TextLineReader& reader, Scan& scan) {
     read_fixed_line(reader, values, "transform");
     for (int row = 0; row < 4; ++row) m(row, column) = values[row];
   }
-  if (const std::string problem = rigid_transform_problem(m); !problem.empty()) reader.fail(problem);
+  if (const std::string problem = rigid_transform_problem(m); !problem.empty())
+    reader.fail(problem);
   scan.T_world_scan = to_isometry(m);
   scan.scanner.position_world = Eigen::Vector3d(position[0], position[1], position[2]);
 }
@@ -99,7 +101,8 @@ void read_points(TextLineReader& reader, Scan& scan, std::vector<Eigen::Vector3d
       reader.fail("point line has " + std::to_string(fields) + " fields, the scan's first has " +
                   std::to_string(expected_fields) + " (or the header dimensions are wrong)");
     }
-    const std::size_t i = scan.index(static_cast<int>(k % scan.rows), static_cast<int>(k / scan.rows));
+    const std::size_t i =
+        scan.index(static_cast<int>(k % scan.rows), static_cast<int>(k / scan.rows));
     points[i] = Eigen::Vector3d(v[0], v[1], v[2]);
     const double range = points[i].norm();
     scan.valid[i] = range > 0.0;

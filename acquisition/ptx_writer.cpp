@@ -33,7 +33,8 @@ void write_header(std::string& out, const Scan& scan) {
 void append_point(std::string& out, const Scan& scan, int row, int col) {
   const std::size_t i = scan.index(row, col);
   if (scan.valid[i]) {
-    const Eigen::Vector3d p = static_cast<double>(scan.range_m[i]) * direction_precise(scan, row, col);
+    const Eigen::Vector3d p =
+        static_cast<double>(scan.range_m[i]) * direction_precise(scan, row, col);
     append_number(out, p.x());
     out += ' ';
     append_number(out, p.y());

@@ -11,7 +11,8 @@ std::string rigid_transform_problem(const Eigen::Matrix4d& m) {
     return "transform is not affine (last row must be 0 0 0 1)";
   }
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
-  const double orthogonality = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthogonality > kRigidTolerance) {
     return "transform is not rigid (rotation block is not orthonormal: scale or shear)";
   }

@@ -58,10 +58,10 @@ struct Scan {
   int columns = 0;
 
   // Channels, all rows * columns long (rgb three times that), row-major.
-  std::vector<float> range_m;        // distance from the scanner [m]; meaningful where valid
-  std::vector<std::uint8_t> valid;   // 1 = a return, 0 = no return (sky, dropout, "0 0 0")
-  std::vector<float> intensity;      // empty when the source has none; else as the source gives it
-  std::vector<std::uint8_t> rgb;     // empty when the source has none; else 8-bit R, G, B per pixel
+  std::vector<float> range_m;       // distance from the scanner [m]; meaningful where valid
+  std::vector<std::uint8_t> valid;  // 1 = a return, 0 = no return (sky, dropout, "0 0 0")
+  std::vector<float> intensity;     // empty when the source has none; else as the source gives it
+  std::vector<std::uint8_t> rgb;    // empty when the source has none; else 8-bit R, G, B per pixel
 
   AngleModel angles = SphericalAngles{};
   Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();

@@ -17,6 +17,8 @@ ScanSummary summarize(const Scan& scan) {
   return summary;
 }
 
-const char* angle_model_name(bool spherical) { return spherical ? "spherical" : "per_pixel"; }
+const char* angle_model_name(bool spherical) {
+  return spherical ? "spherical" : "per_pixel";
+}
 
 }  // namespace scanbench::acquisition

@@ -31,8 +31,8 @@ struct Sample {
 
 // Robust step along one grid axis: the median difference of the angle between
 // valid neighbours along that axis (azimuths wrapped).
-double median_step(const std::vector<double>& angle, std::span<const std::uint8_t> valid,
-                   int rows, int columns, bool along_columns, bool wrap) {
+double median_step(const std::vector<double>& angle, std::span<const std::uint8_t> valid, int rows,
+                   int columns, bool along_columns, bool wrap) {
   std::vector<double> steps;
   const int row_stop = along_columns ? rows : rows - 1;
   const int col_stop = along_columns ? columns - 1 : columns;
@@ -118,7 +118,8 @@ SphericalFitResult fit_spherical_angles(int rows, int columns,
   for (const Sample& s : samples) {
     const std::size_t i = static_cast<std::size_t>(s.row) * columns + s.col;
     const double range = points_scan[i].norm();
-    const double deviation = (range * model_direction(angles, s.row, s.col) - points_scan[i]).norm();
+    const double deviation =
+        (range * model_direction(angles, s.row, s.col) - points_scan[i]).norm();
     result.max_deviation_m = std::max(result.max_deviation_m, deviation);
   }
   result.regular = result.max_deviation_m <= settings.max_deviation_m;

@@ -10,12 +10,13 @@ namespace {
 constexpr std::size_t kChunkBytes = 4u << 20;
 constexpr std::size_t kMaxLineBytes = 64u << 10;  // a PTX line is < 100 bytes
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r';
+}
 
 }  // namespace
 
-TextLineReader::TextLineReader(const std::filesystem::path& path)
-    : file_name_(path.string()) {
+TextLineReader::TextLineReader(const std::filesystem::path& path) : file_name_(path.string()) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) {
     throw InputError(file_name_, {}, "is a directory, not a file");

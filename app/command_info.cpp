@@ -40,7 +40,8 @@ std::vector<Entry> project_entries(const std::filesystem::path& path) {
 std::vector<Entry> file_entries(const std::filesystem::path& path) {
   std::vector<Entry> entries;
   acquisition::read_scan_file(path, {}, [&entries](acquisition::Scan&& scan) {
-    entries.push_back({static_cast<std::int64_t>(entries.size() + 1), acquisition::summarize(scan)});
+    entries.push_back(
+        {static_cast<std::int64_t>(entries.size() + 1), acquisition::summarize(scan)});
   });
   return entries;
 }

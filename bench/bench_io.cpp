@@ -1,5 +1,7 @@
 #include "bench/bench_io.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -7,7 +9,6 @@
 #include <fstream>
 #include <functional>
 #include <numbers>
-#include <unistd.h>
 
 #include "acquisition/pcd_reader.hpp"
 #include "acquisition/ptx_reader.hpp"
@@ -44,7 +45,8 @@ Scan synthetic_scan(int rows, int columns) {
       scan.valid[i] = row >= rows / 20;  // a band of missing returns at the top
       scan.range_m[i] = scan.valid[i] ? room_range(direction_precise(scan, row, col)) : 0.0f;
       scan.intensity[i] = 0.25f + 0.5f * static_cast<float>((row * 7 + col * 13) % 100) / 100.0f;
-      for (int c = 0; c < 3; ++c) scan.rgb[3 * i + c] = static_cast<std::uint8_t>((row + col * c) & 255);
+      for (int c = 0; c < 3; ++c)
+        scan.rgb[3 * i + c] = static_cast<std::uint8_t>((row + col * c) & 255);
     }
   }
   return scan;
@@ -74,7 +76,8 @@ double best_seconds(int repeats, const std::function<void()>& work) {
   for (int r = 0; r < repeats; ++r) {
     const auto start = std::chrono::steady_clock::now();
     work();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    best = std::min(
+        best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return best;
 }
@@ -108,7 +111,8 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
     });
   }
   const std::int64_t id = modeling::Project::open(project_path).scans().front().id;
-  const double load_s = best_seconds(repeats, [&] { modeling::Project::open(project_path).load_scan(id); });
+  const double load_s =
+      best_seconds(repeats, [&] { modeling::Project::open(project_path).load_scan(id); });
   const double project_bytes = static_cast<double>(std::filesystem::file_size(project_path));
   std::filesystem::remove_all(dir);
 

@@ -6,7 +6,9 @@
 
 namespace scanbench::bench {
 
-std::vector<std::string> suite_names() { return {"io"}; }
+std::vector<std::string> suite_names() {
+  return {"io"};
+}
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "io") return run_io_bench(options);

@@ -13,10 +13,10 @@
 namespace scanbench::modeling {
 
 struct ImportProgress {
-  std::size_t file_index = 0;   // 0-based index into the file list
+  std::size_t file_index = 0;  // 0-based index into the file list
   std::size_t file_count = 0;
-  std::string scan_name;        // the scan just stored
-  std::size_t scans_stored = 0; // so far in this import
+  std::string scan_name;         // the scan just stored
+  std::size_t scans_stored = 0;  // so far in this import
 };
 
 struct ImportSettings {

@@ -17,8 +17,8 @@ std::filesystem::path fixture(const std::string& relative) {
 
 ScratchDir::ScratchDir() {
   static std::atomic<int> counter{0};
-  const std::string name = "scanbench test é " + std::to_string(::getpid()) + "-" +
-                           std::to_string(counter.fetch_add(1));
+  const std::string name =
+      "scanbench test é " + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
   path_ = std::filesystem::temp_directory_path() / name;
   std::filesystem::remove_all(path_);
   std::filesystem::create_directories(path_);

@@ -1,0 +1,226 @@
+#include "modeling/project_schema.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <fstream>
+#include <sstream>
+
+#include "acquisition/input_error.hpp"
+#include "modeling/project.hpp"
+#include "modeling/sqlite_statement.hpp"
+
+namespace scanbench::modeling::schema {
+
+namespace {
+
+// Double-valued columns are declared without a type on purpose: a REAL
+// column lets SQLite store integral values as integers, which turns -0.0 into
+// +0.0, and load_scan promises bit-identical poses and angles. The CHECKs keep
+// the columns honest instead (SQLite binds NaN as NULL, so NaN is refused).
+constexpr const char* kCreateVersion1 = R"sql(
+CREATE TABLE meta (
+  key TEXT PRIMARY KEY NOT NULL,
+  value TEXT NOT NULL
+);
+CREATE TABLE scans (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL,
+  rows INTEGER NOT NULL CHECK (rows >= 0),
+  columns INTEGER NOT NULL CHECK (columns >= 0),
+  angle_model TEXT NOT NULL CHECK (angle_model IN ('spherical', 'per_pixel')),
+  azimuth_start_rad CHECK (typeof(azimuth_start_rad) IN ('real', 'null')),
+  azimuth_step_rad CHECK (typeof(azimuth_step_rad) IN ('real', 'null')),
+  elevation_start_rad CHECK (typeof(elevation_start_rad) IN ('real', 'null')),
+  elevation_step_rad CHECK (typeof(elevation_step_rad) IN ('real', 'null')),
+  T_world_scan BLOB NOT NULL CHECK (length(T_world_scan) = 128),
+  scanner_name TEXT NOT NULL,
+  source_file TEXT NOT NULL,
+  scanner_x NOT NULL CHECK (typeof(scanner_x) = 'real'),
+  scanner_y NOT NULL CHECK (typeof(scanner_y) = 'real'),
+  scanner_z NOT NULL CHECK (typeof(scanner_z) = 'real'),
+  valid_points INTEGER NOT NULL CHECK (valid_points >= 0),
+  has_color INTEGER NOT NULL CHECK (has_color IN (0, 1)),
+  has_intensity INTEGER NOT NULL CHECK (has_intensity IN (0, 1)),
+  bbox_min_x CHECK (typeof(bbox_min_x) IN ('real', 'null')),
+  bbox_min_y CHECK (typeof(bbox_min_y) IN ('real', 'null')),
+  bbox_min_z CHECK (typeof(bbox_min_z) IN ('real', 'null')),
+  bbox_max_x CHECK (typeof(bbox_max_x) IN ('real', 'null')),
+  bbox_max_y CHECK (typeof(bbox_max_y) IN ('real', 'null')),
+  bbox_max_z CHECK (typeof(bbox_max_z) IN ('real', 'null')),
+  created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+  CHECK ((angle_model = 'spherical') =
+         (azimuth_start_rad IS NOT NULL AND azimuth_step_rad IS NOT NULL AND
+          elevation_start_rad IS NOT NULL AND elevation_step_rad IS NOT NULL)),
+  CHECK ((bbox_min_x IS NULL) = (bbox_max_z IS NULL))
+);
+CREATE TABLE scan_channels (
+  scan_id INTEGER NOT NULL REFERENCES scans (id) ON DELETE CASCADE,
+  channel TEXT NOT NULL
+    CHECK (channel IN ('range_m', 'valid', 'intensity', 'rgb', 'directions')),
+  element_count INTEGER NOT NULL CHECK (element_count >= 0),
+  codec TEXT NOT NULL CHECK (codec = 'zstd'),
+  data BLOB NOT NULL,
+  PRIMARY KEY (scan_id, channel)
+);
+)sql";
+
+constexpr const char* kRecordCreation = R"sql(
+INSERT INTO meta (key, value) VALUES
+  ('created_by', 'scanbench'),
+  ('created_at', strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+  ('created_schema_version', ?1)
+)sql";
+
+constexpr std::array<const char*, 3> kRequiredTables = {"meta", "scans", "scan_channels"};
+
+[[noreturn]] void refuse(const std::string& file, const std::string& problem) {
+  throw acquisition::InputError(file, {}, problem);
+}
+
+std::uint32_t big_endian_u32(const char* bytes) {
+  std::uint32_t value = 0;
+  for (int i = 0; i < 4; ++i) value = (value << 8) | static_cast<unsigned char>(bytes[i]);
+  return value;
+}
+
+// The same rules apply to the raw header and to what SQLite reports.
+void check_identity(std::uint32_t application_id, std::int64_t version, const std::string& file) {
+  if (application_id != kProjectApplicationId) {
+    std::ostringstream id;
+    id << std::hex << "0x" << application_id;
+    refuse(file,
+           "not a scanbench project (SQLite database of another application, "
+           "application_id " +
+               id.str() + ")");
+  }
+  if (version > kProjectSchemaVersion) {
+    refuse(file, "project schema version " + std::to_string(version) +
+                     " is newer than this scanbench (" + std::to_string(kProjectSchemaVersion) +
+                     "); upgrade scanbench");
+  }
+  if (version < 1) refuse(file, "project has no schema version (damaged or unfinished project)");
+}
+
+std::int64_t pragma_value(sqlite3* db, const char* pragma, const std::string& file) {
+  sqlite::Statement statement(db, pragma, file);
+  if (!statement.step()) refuse(file, std::string("no result from ") + pragma);
+  return statement.column_int(0);
+}
+
+void check_tables(sqlite3* db, const std::string& file) {
+  for (const char* table : kRequiredTables) {
+    sqlite::Statement statement(
+        db, "SELECT 1 FROM sqlite_schema WHERE type = 'table' AND name = ?1", file);
+    statement.bind_text(1, table);
+    if (!statement.step()) {
+      refuse(file, std::string("project is damaged: table \"") + table + "\" is missing");
+    }
+  }
+}
+
+// Upgrades the schema from `version` to version + 1 inside the caller's
+// transaction. Version 1 is the first schema, so there is nothing to do yet.
+void migrate_step([[maybe_unused]] sqlite3* db, int version,
+                  [[maybe_unused]] const std::string& file) {
+  switch (version) {
+    default:
+      assert(false && "no migration step from this schema version");
+  }
+}
+
+// Runs `steps` inside a transaction that ends with the project identity at
+// the current version, or rolls everything back.
+template <typename Steps>
+void in_versioned_transaction(sqlite3* db, const std::string& file, Steps steps) {
+  const std::string identity = "PRAGMA application_id = " + std::to_string(kProjectApplicationId) +
+                               "; PRAGMA user_version = " + std::to_string(kProjectSchemaVersion);
+  sqlite::execute(db, "BEGIN IMMEDIATE", file);
+  try {
+    steps();
+    sqlite::execute(db, identity.c_str(), file);
+    sqlite::execute(db, "COMMIT", file);
+  } catch (...) {
+    sqlite3_exec(db, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
+void migrate_from(sqlite3* db, int from_version, const std::string& file) {
+  for (int version = from_version; version < kProjectSchemaVersion; ++version) {
+    migrate_step(db, version, file);
+  }
+}
+
+void enable_wal(sqlite3* db, const std::string& file) {
+  sqlite::Statement statement(db, "PRAGMA journal_mode = WAL", file);
+  if (!statement.step() || statement.column_text(0) != "wal") {
+    refuse(file, "cannot use write-ahead logging for this file (network file system?)");
+  }
+}
+
+}  // namespace
+
+void check_file_header(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (!std::filesystem::exists(status)) refuse(name, "project file does not exist");
+  if (std::filesystem::is_directory(status)) refuse(name, "is a directory, not a project file");
+  if (!std::filesystem::is_regular_file(status)) refuse(name, "is not a regular file");
+
+  std::array<char, 100> header{};
+  std::ifstream in(file, std::ios::binary);
+  if (!in) refuse(name, "cannot read the project file");
+  in.read(header.data(), header.size());
+  const auto got = in.gcount();
+  if (got == 0) refuse(name, "file is empty, not a scanbench project");
+  constexpr char kMagic[16] = "SQLite format 3";  // with its terminating NUL: 16 bytes
+  if (got < static_cast<std::streamsize>(header.size()) ||
+      !std::equal(kMagic, kMagic + 16, header.begin())) {
+    refuse(name, "not a scanbench project (not an SQLite database)");
+  }
+  // SQLite file format: user_version at byte 60, application_id at byte 68,
+  // both big-endian.
+  check_identity(big_endian_u32(header.data() + 68),
+                 static_cast<std::int32_t>(big_endian_u32(header.data() + 60)), name);
+}
+
+void configure_connection(sqlite3* db, const std::string& file) {
+  const int code = sqlite3_busy_timeout(db, kBusyTimeoutMs);
+  if (code != SQLITE_OK) sqlite::throw_error(db, code, file, "setting the busy timeout");
+  // FULL rather than NORMAL: in WAL mode NORMAL can lose the last commits on
+  // power loss, and a user's edit must stay saved once reported as saved.
+  sqlite::execute(db, "PRAGMA foreign_keys = ON; PRAGMA synchronous = FULL", file);
+}
+
+// New projects take the same path as old ones: the version 1 script, then
+// every migration step, so each migration runs in every test that creates a
+// project.
+void create_schema(sqlite3* db, const std::string& file) {
+  in_versioned_transaction(db, file, [&] {
+    sqlite::execute(db, kCreateVersion1, file);
+    migrate_from(db, 1, file);
+    sqlite::Statement record(db, kRecordCreation, file);
+    record.bind_text(1, std::to_string(kProjectSchemaVersion)).run();
+  });
+  enable_wal(db, file);
+}
+
+void check_and_migrate(sqlite3* db, const std::string& file) {
+  const auto application_id =
+      static_cast<std::uint32_t>(pragma_value(db, "PRAGMA application_id", file));
+  const int version = read_schema_version(db, file);
+  check_identity(application_id, version, file);
+  check_tables(db, file);
+  enable_wal(db, file);
+  if (version < kProjectSchemaVersion) {
+    in_versioned_transaction(db, file, [&] { migrate_from(db, version, file); });
+  }
+}
+
+int read_schema_version(sqlite3* db, const std::string& file) {
+  return static_cast<int>(pragma_value(db, "PRAGMA user_version", file));
+}
+
+}  // namespace scanbench::modeling::schema

@@ -1,0 +1,185 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "acquisition/input_error.hpp"
+#include "acquisition/pcd_reader.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+using test::fixture;
+using test::ScratchDir;
+
+const std::vector<Eigen::Vector3f>& directions(const Scan& scan) {
+  return std::get<PerPixelDirections>(scan.angles).directions;
+}
+
+// The reader computes in double and stores float; so does the expectation.
+Eigen::Vector3f unit(double x, double y, double z) {
+  const Eigen::Vector3d p(x, y, z);
+  return (p / p.norm()).cast<float>();
+}
+
+std::vector<std::uint8_t> rgb_of(const Scan& scan, std::size_t i) {
+  return {scan.rgb[3 * i], scan.rgb[3 * i + 1], scan.rgb[3 * i + 2]};
+}
+
+TEST(PcdReader, ReadsHandWrittenOrganizedAsciiWithExactValues) {
+  const Scan scan = read_organized_pcd(fixture("good/pcd/organized_ascii.pcd"));
+  ASSERT_EQ(scan.rows, 3);
+  ASSERT_EQ(scan.columns, 4);
+  ASSERT_FALSE(scan.is_spherical());
+  ASSERT_TRUE(check_consistency(scan).empty()) << check_consistency(scan);
+  EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{1, 1, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1}));
+  EXPECT_EQ(scan.range_m, (std::vector<float>{1, 2, 3, 5, 0, 0, 3, 2, 0.5f, 0.5f, 10, 1}));
+  EXPECT_EQ(directions(scan)[0], Eigen::Vector3f(1, 0, 0));
+  EXPECT_EQ(directions(scan)[2], Eigen::Vector3f(0, 0, -1));
+  EXPECT_EQ(directions(scan)[3], unit(3, 4, 0));
+  EXPECT_EQ(directions(scan)[6], unit(1, 2, 2));
+  EXPECT_EQ(directions(scan)[10], unit(6, 0, 8));
+  // (row 1, col 0) is NaN and (row 1, col 1) is (0, 0, 0): no return, no direction.
+  EXPECT_EQ(directions(scan)[scan.index(1, 0)], Eigen::Vector3f::Zero());
+  EXPECT_EQ(directions(scan)[scan.index(1, 1)], Eigen::Vector3f::Zero());
+  EXPECT_EQ(rgb_of(scan, 0), (std::vector<std::uint8_t>{255, 0, 0}));
+  EXPECT_EQ(rgb_of(scan, 1), (std::vector<std::uint8_t>{0, 255, 0}));
+  EXPECT_EQ(rgb_of(scan, 2), (std::vector<std::uint8_t>{0, 0, 255}));
+  EXPECT_EQ(rgb_of(scan, 3), (std::vector<std::uint8_t>{10, 20, 30}));
+  EXPECT_EQ(rgb_of(scan, 6), (std::vector<std::uint8_t>{16, 32, 48}));
+  EXPECT_EQ(scan.intensity, (std::vector<float>{0.5f, 0.25f, 1, 0, 0, 0.75f, 0.125f, 1, 0.0625f,
+                                                0.375f, 0.875f, 0.5f}));
+}
+
+TEST(PcdReader, TakesPoseFromViewpointAndNameFromStem) {
+  const Scan scan = read_organized_pcd(fixture("good/pcd/organized_ascii.pcd"));
+  // VIEWPOINT 1 2 3 0.70710678 0 0 0.70710678: 90 degrees about z.
+  EXPECT_EQ(scan.T_world_scan.translation(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_TRUE((scan.T_world_scan.linear() * Eigen::Vector3d::UnitX())
+                  .isApprox(Eigen::Vector3d::UnitY(), 1e-7));
+  EXPECT_EQ(scan.scanner.position_world, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(scan.scanner.name, "");
+  EXPECT_EQ(scan.name, "organized_ascii");
+  EXPECT_NE(scan.scanner.source_file.find("organized_ascii.pcd"), std::string::npos);
+}
+
+// organized_binary.pcd was written by PCL from a 3 x 2 PointXYZRGB cloud:
+// points (1,0,0) (0,-2,0) NaN / (0,0,4) (3,0,4) (0,0,0), colors
+// (40i+5, 250-30i, 17i), origin (0.5, -1, 2), 180 degrees about x.
+void expect_pcl_written_cloud(const Scan& scan) {
+  ASSERT_EQ(scan.rows, 2);
+  ASSERT_EQ(scan.columns, 3);
+  EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{1, 1, 0, 1, 1, 0}));
+  EXPECT_EQ(scan.range_m, (std::vector<float>{1, 2, 0, 4, 5, 0}));
+  EXPECT_EQ(directions(scan)[1], Eigen::Vector3f(0, -1, 0));
+  EXPECT_EQ(directions(scan)[4], unit(3, 0, 4));
+  EXPECT_EQ(directions(scan)[2], Eigen::Vector3f::Zero());
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(rgb_of(scan, i), (std::vector<std::uint8_t>{static_cast<std::uint8_t>(40 * i + 5),
+                                                          static_cast<std::uint8_t>(250 - 30 * i),
+                                                          static_cast<std::uint8_t>(17 * i)}));
+  }
+  EXPECT_FALSE(scan.has_intensity());
+  Eigen::Matrix4d pose;
+  pose << 1, 0, 0, 0.5, 0, -1, 0, -1, 0, 0, -1, 2, 0, 0, 0, 1;
+  EXPECT_EQ(scan.T_world_scan.matrix(), pose);
+}
+
+TEST(PcdReader, ReadsBinaryWrittenByPcl) {
+  expect_pcl_written_cloud(read_organized_pcd(fixture("good/pcd/organized_binary.pcd")));
+}
+
+TEST(PcdReader, ReadsBinaryCompressedWrittenByPcl) {
+  expect_pcl_written_cloud(read_organized_pcd(fixture("good/pcd/organized_compressed.pcd")));
+}
+
+TEST(PcdReader, ReadsPathWithSpacesAndNonAscii) {
+  const ScratchDir dir;  // its name already holds a space and an é
+  const auto copy = dir / "capture ü 1.pcd";
+  std::filesystem::copy_file(fixture("good/pcd/organized_binary.pcd"), copy);
+  const Scan scan = read_organized_pcd(copy);
+  EXPECT_EQ(scan.name, "capture ü 1");
+  expect_pcl_written_cloud(scan);
+}
+
+TEST(PcdReader, MissingFileIsAnInputError) {
+  const ScratchDir dir;
+  EXPECT_THROW(read_organized_pcd(dir / "absent.pcd"), InputError);
+}
+
+TEST(PcdReader, NonNumericValueReportsItsLine) {
+  try {
+    read_organized_pcd(fixture("bad/pcd_non_numeric.pcd"));
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    ASSERT_TRUE(e.position().line.has_value()) << e.what();
+    EXPECT_EQ(*e.position().line, 17u) << e.what();
+  }
+}
+
+// A compressed body whose size word claims 4 GB must be refused before PCL
+// allocates for it.
+TEST(PcdReader, RefusesCompressedBodyWhoseSizeWordLies) {
+  const ScratchDir dir;
+  std::string bytes = test::read_file_bytes(fixture("good/pcd/organized_compressed.pcd"));
+  const std::string data_line = "DATA binary_compressed\n";
+  const std::size_t body = bytes.find(data_line) + data_line.size();
+  ASSERT_LT(body + 8, bytes.size());
+  std::memset(&bytes[body + 4], 0xff, 4);  // uncompressed size
+  const auto path = dir / "lying.pcd";
+  std::ofstream(path, std::ios::binary) << bytes;
+  try {
+    read_organized_pcd(path);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(e.problem().find("disagrees"), std::string::npos) << e.what();
+  }
+}
+
+struct BadPcd {
+  const char* fixture;  // fixtures/bad/<fixture>.pcd
+  const char* problem;  // word(s) describing the problem
+};
+
+class PcdBadInput : public testing::TestWithParam<BadPcd> {};
+
+TEST_P(PcdBadInput, ThrowsInputErrorNamingFileAndProblem) {
+  const BadPcd& c = GetParam();
+  const std::string name = std::string(c.fixture) + ".pcd";
+  try {
+    read_organized_pcd(fixture("bad/" + name));
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    EXPECT_NE(e.problem().find(c.problem), std::string::npos) << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, PcdBadInput,
+    testing::Values(BadPcd{"pcd_empty", "empty file"}, BadPcd{"pcd_not_pcd", "not a PCD file"},
+                    BadPcd{"pcd_unorganized", "not an organized point cloud (height 1)"},
+                    BadPcd{"pcd_missing_xyz", "missing field z"},
+                    BadPcd{"pcd_truncated_ascii", "truncated ASCII body"},
+                    BadPcd{"pcd_truncated_binary", "truncated binary body"},
+                    BadPcd{"pcd_truncated_compressed", "truncated compressed body"},
+                    BadPcd{"pcd_non_numeric", "'abc' is not a number"},
+                    BadPcd{"pcd_wrong_value_count", "4 values, the header says 5"},
+                    BadPcd{"pcd_extra_points", "more points"},
+                    BadPcd{"pcd_points_mismatch", "disagrees with POINTS"},
+                    BadPcd{"pcd_absurd_width", "absurd dimensions"},
+                    BadPcd{"pcd_unknown_data_type", "unknown DATA type"},
+                    BadPcd{"pcd_viewpoint_nan", "VIEWPOINT has a non-finite value"},
+                    BadPcd{"pcd_viewpoint_garbage", "'zero' is not a number"},
+                    BadPcd{"pcd_viewpoint_short", "VIEWPOINT needs 7 numbers"},
+                    BadPcd{"pcd_viewpoint_non_unit", "quaternion is not unit"}),
+    [](const testing::TestParamInfo<BadPcd>& info) {
+      return std::string(info.param.fixture).substr(std::strlen("pcd_"));
+    });
+
+}  // namespace
+}  // namespace scanbench::acquisition

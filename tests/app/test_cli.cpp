@@ -1,0 +1,204 @@
+// End-to-end tests of the scanbench executable: exit codes, JSON output, and
+// that refused input leaves a project untouched.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "support/test_support.hpp"
+
+namespace scanbench {
+namespace {
+
+using test::fixture;
+using test::ScratchDir;
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string shell_quote(const std::string& arg) {
+  std::string quoted = "'";
+  for (const char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+CliResult run_cli(const ScratchDir& dir, const std::vector<std::string>& args) {
+  std::string command = shell_quote(SCANBENCH_BINARY);
+  for (const std::string& arg : args) command += " " + shell_quote(arg);
+  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  command += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+  const int status = std::system(command.c_str());
+  CliResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.out = test::read_file_bytes(out);
+  result.err = test::read_file_bytes(err);
+  return result;
+}
+
+nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& path) {
+  const CliResult info = run_cli(dir, {"info", path.string(), "--json"});
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  return nlohmann::json::parse(info.out);
+}
+
+TEST(Cli, HelpSucceedsForEverySubcommand) {
+  ScratchDir dir;
+  for (const char* command : {"import", "info", "export", "bench"}) {
+    const CliResult help = run_cli(dir, {command, "--help"});
+    EXPECT_EQ(help.exit_code, 0) << command;
+    EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
+  }
+}
+
+TEST(Cli, UsageErrorsExitWithTwo) {
+  ScratchDir dir;
+  EXPECT_EQ(run_cli(dir, {}).exit_code, 2);
+  EXPECT_EQ(run_cli(dir, {"frobnicate"}).exit_code, 2);
+  EXPECT_EQ(run_cli(dir, {"export", "x.sbproj", "--format", "obj", "-o", "y"}).exit_code, 2);
+}
+
+TEST(Cli, ImportThenInfoJsonDescribesEveryScan) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "site é.sbproj";
+  const CliResult import =
+      run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string(),
+                    fixture("good/ptx/tiny_color.ptx").string()});
+  ASSERT_EQ(import.exit_code, 0) << import.err;
+  const nlohmann::json info = info_json(dir, project);
+  ASSERT_EQ(info["scans"].size(), 3u);
+  const nlohmann::json& geo = info["scans"][1];
+  EXPECT_EQ(geo["name"], "two_scans-2");
+  EXPECT_EQ(geo["rows"], 2);
+  EXPECT_EQ(geo["columns"], 2);
+  EXPECT_EQ(geo["valid_points"], 4);
+  EXPECT_EQ(geo["has_color"], false);
+  EXPECT_EQ(geo["has_intensity"], true);
+  EXPECT_EQ(geo["angle_model"], "spherical");
+  EXPECT_EQ(geo["T_world_scan"].size(), 16u);
+  EXPECT_EQ(geo["T_world_scan"][3], 512000.5);  // row-major: translation x
+  EXPECT_EQ(info["scans"][2]["has_color"], true);
+  for (int k : {0, 1, 2}) EXPECT_LE(geo["bbox_world"][0][k], geo["bbox_world"][1][k]);
+}
+
+TEST(Cli, InfoReadsRawScanFilesWithoutAProject) {
+  ScratchDir dir;
+  const nlohmann::json info = info_json(dir, fixture("good/ptx/two_scans.ptx"));
+  EXPECT_EQ(info["scans"].size(), 2u);
+}
+
+TEST(Cli, RefusedImportLeavesTheProjectUnchanged) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  const nlohmann::json before = info_json(dir, project);
+  // A good file followed by a bad one: neither may be stored.
+  const CliResult bad =
+      run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string(),
+                    fixture("bad/ptx_truncated_body.ptx").string()});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("ptx_truncated_body.ptx: line 14"), std::string::npos) << bad.err;
+  EXPECT_EQ(info_json(dir, project), before);
+}
+
+TEST(Cli, RefusedImportIntoANewProjectCreatesNoFile) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "new.sbproj";
+  EXPECT_EQ(run_cli(dir, {"import", project.string(), fixture("bad/ptx_nan_field.ptx").string()})
+                .exit_code,
+            2);
+  EXPECT_FALSE(std::filesystem::exists(project));
+}
+
+TEST(Cli, UnknownScanFileTypeIsBadInput) {
+  ScratchDir dir;
+  const std::filesystem::path odd = dir / "scan.xyz";
+  std::FILE* f = std::fopen(odd.c_str(), "w");
+  std::fputs("1 2 3\n", f);
+  std::fclose(f);
+  const CliResult result = run_cli(dir, {"import", (dir / "p.sbproj").string(), odd.string()});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("unknown scan file type"), std::string::npos) << result.err;
+}
+
+TEST(Cli, ForeignFileIsNotTreatedAsAProject) {
+  ScratchDir dir;
+  const std::filesystem::path fake = dir / "notes.sbproj";
+  std::filesystem::copy_file(fixture("good/ptx/tiny_color.ptx"), fake);
+  const std::string bytes = test::read_file_bytes(fake);
+  EXPECT_EQ(run_cli(dir, {"info", fake.string()}).exit_code, 2);
+  EXPECT_EQ(run_cli(dir, {"import", fake.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            2);
+  EXPECT_EQ(test::read_file_bytes(fake), bytes);
+}
+
+TEST(Cli, ExportPtxRoundTripsThroughASecondProject) {
+  ScratchDir dir;
+  const std::filesystem::path first = dir / "a.sbproj", second = dir / "b.sbproj";
+  const std::filesystem::path ptx = dir / "export.ptx";
+  ASSERT_EQ(run_cli(dir, {"import", first.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(
+      run_cli(dir, {"export", first.string(), "--format", "ptx", "-o", ptx.string()}).exit_code, 0);
+  ASSERT_EQ(run_cli(dir, {"import", second.string(), ptx.string()}).exit_code, 0);
+  nlohmann::json a = info_json(dir, first), b = info_json(dir, second);
+  for (auto* info : {&a, &b}) {
+    for (auto& scan : (*info)["scans"]) {
+      scan.erase("source_file");
+      scan.erase("name");
+      scan.erase("bbox_world");  // recomputed from refitted angles: equal to ~1e-12 m
+    }
+  }
+  EXPECT_EQ(a, b);
+}
+
+TEST(Cli, ExportCsvWritesOneLinePerValidPoint) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj", csv = dir / "points.csv";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli(dir, {"export", project.string(), "--format", "csv", "--scan", "1", "-o",
+                          csv.string()})
+                .exit_code,
+            0);
+  const std::string text = test::read_file_bytes(csv);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "x,y,z,intensity,r,g,b");
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 5);  // header + 5 valid points
+}
+
+TEST(Cli, ExportOfAMissingScanIdIsBadInput) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  const CliResult result = run_cli(dir, {"export", project.string(), "--format", "ply", "--scan",
+                                         "9", "-o", (dir / "x.ply").string()});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.ply"));
+}
+
+TEST(Cli, BenchIoSmokeRunPrintsOneJsonObject) {
+  ScratchDir dir;
+  const CliResult result = run_cli(dir, {"bench", "io", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  for (const char* field : {"ptx_read_mb_per_s", "ptx_write_mb_per_s",
+                            "pcl_pcd_ascii_read_mb_per_s", "ptx_read_speedup_vs_pcl", "points"}) {
+    EXPECT_TRUE(bench.contains(field)) << field;
+  }
+}
+
+}  // namespace
+}  // namespace scanbench

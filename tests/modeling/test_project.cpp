@@ -1,0 +1,271 @@
+// Project: creation, scan round trips, summaries and transactions. Refusals
+// and crash safety are in test_project_files.cpp.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <tuple>
+
+#include "acquisition/input_error.hpp"
+#include "acquisition/scan_summary.hpp"
+#include "modeling/project.hpp"
+#include "modeling/project_test_support.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using acquisition::InputError;
+using test::expect_identical;
+using test::RawDatabase;
+using test::ScratchDir;
+using test::tiny_scan;
+using ::testing::HasSubstr;
+
+std::int64_t insert_committed(Project& project, const acquisition::Scan& scan) {
+  auto transaction = project.begin();
+  const std::int64_t id = project.insert_scan(scan);
+  transaction.commit();
+  return id;
+}
+
+TEST(Project, CreateMakesAnEmptyProjectOfTheCurrentSchema) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  {
+    const Project project = Project::create(file);
+    EXPECT_EQ(project.path(), file);
+    EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
+    EXPECT_TRUE(project.scans().empty());
+  }
+  RawDatabase raw(file);
+  EXPECT_EQ(raw.text("PRAGMA application_id"), std::to_string(kProjectApplicationId));
+  EXPECT_EQ(raw.text("PRAGMA user_version"), "1");
+  EXPECT_EQ(raw.text("PRAGMA journal_mode"), "wal");
+  EXPECT_EQ(raw.text("SELECT value FROM meta WHERE key = 'created_by'"), "scanbench");
+  EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
+}
+
+TEST(Project, OpenFindsWhatCreateLeft) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  { Project::create(file); }
+  EXPECT_TRUE(test::no_side_files(file));  // the last close checkpoints the WAL away
+  const Project project = Project::open(file);
+  EXPECT_EQ(project.schema_version(), 1);
+  EXPECT_TRUE(project.scans().empty());
+}
+
+TEST(Project, OpenOrCreateCreatesOnceThenOpens) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  {
+    Project project = Project::open_or_create(file);
+    insert_committed(project, tiny_scan(true, false, false));
+  }
+  EXPECT_EQ(Project::open_or_create(file).scans().size(), 1u);
+}
+
+TEST(Project, CreateRefusesAnExistingFileAndLeavesItAlone) {
+  const ScratchDir dir;
+  const auto file = dir / "notes.sbproj";
+  {
+    Project project = Project::create(file);
+    insert_committed(project, tiny_scan(true, true, true));
+  }
+  const std::string before = test::read_file_bytes(file);
+  try {
+    Project::create(file);
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.file(), file.string());
+    EXPECT_THAT(error.what(), HasSubstr("already exists"));
+  }
+  EXPECT_EQ(test::read_file_bytes(file), before);
+  EXPECT_EQ(Project::open(file).scans().size(), 1u);
+}
+
+TEST(Project, CreateInAMissingFolderIsAnInputError) {
+  const ScratchDir dir;
+  EXPECT_THROW(Project::create(dir / "no such folder" / "site.sbproj"), InputError);
+}
+
+// (spherical, intensity, color)
+class ProjectRoundTrip : public ::testing::TestWithParam<std::tuple<bool, bool, bool>> {};
+
+TEST_P(ProjectRoundTrip, LoadReturnsTheInsertedScanBitForBit) {
+  const auto [spherical, intensity, color] = GetParam();
+  const acquisition::Scan scan = tiny_scan(spherical, intensity, color);
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  std::int64_t id = 0;
+  {
+    Project project = Project::create(file);
+    id = insert_committed(project, scan);
+    expect_identical(project.load_scan(id), scan);  // same connection
+  }
+  expect_identical(Project::open(file).load_scan(id), scan);  // after reopening
+}
+
+INSTANTIATE_TEST_SUITE_P(AngleModelsAndChannels, ProjectRoundTrip,
+                         ::testing::Combine(::testing::Bool(), ::testing::Bool(),
+                                            ::testing::Bool()));
+
+TEST(Project, EmptyGridRoundTrips) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "site.sbproj");
+  for (const bool spherical : {true, false}) {
+    const acquisition::Scan scan = tiny_scan(spherical, false, false, 0, 0);
+    expect_identical(project.load_scan(insert_committed(project, scan)), scan);
+  }
+}
+
+TEST(Project, ScansListsSummariesInIdOrder) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "site.sbproj");
+  acquisition::Scan first = tiny_scan(true, true, false);
+  acquisition::Scan empty = tiny_scan(false, false, true);
+  empty.name = "no returns";
+  std::fill(empty.valid.begin(), empty.valid.end(), 0);
+  const std::int64_t first_id = insert_committed(project, first);
+  const std::int64_t empty_id = insert_committed(project, empty);
+
+  const auto stored = project.scans();
+  ASSERT_EQ(stored.size(), 2u);
+  EXPECT_EQ(stored[0].id, first_id);
+  EXPECT_EQ(stored[1].id, empty_id);
+  EXPECT_LT(first_id, empty_id);
+
+  const acquisition::ScanSummary expected = acquisition::summarize(first);
+  const acquisition::ScanSummary& got = stored[0].summary;
+  EXPECT_EQ(got.name, "station 1 é");
+  EXPECT_EQ(got.rows, 2);
+  EXPECT_EQ(got.columns, 3);
+  EXPECT_EQ(got.valid_points, 3u);
+  EXPECT_TRUE(got.has_intensity);
+  EXPECT_FALSE(got.has_color);
+  EXPECT_TRUE(got.spherical);
+  EXPECT_TRUE(test::same_bytes(Eigen::Matrix4d(got.T_world_scan.matrix()),
+                               Eigen::Matrix4d(first.T_world_scan.matrix())));
+  ASSERT_TRUE(got.bbox_world.has_value());
+  EXPECT_EQ(got.bbox_world->min(), expected.bbox_world->min());
+  EXPECT_EQ(got.bbox_world->max(), expected.bbox_world->max());
+  EXPECT_EQ(got.scanner.name, "RIEGL LMS-Z360");
+  EXPECT_EQ(got.scanner.source_file, first.scanner.source_file);
+  EXPECT_EQ(got.scanner.position_world, first.scanner.position_world);
+
+  EXPECT_EQ(stored[1].summary.valid_points, 0u);
+  EXPECT_FALSE(stored[1].summary.bbox_world.has_value());
+  EXPECT_FALSE(stored[1].summary.spherical);
+  EXPECT_TRUE(stored[1].summary.has_color);
+}
+
+TEST(Project, LoadingAMissingIdIsAnInputError) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  const Project project = Project::create(file);
+  try {
+    project.load_scan(42);
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.file(), file.string());
+    EXPECT_THAT(error.what(), HasSubstr("no scan with id 42"));
+  }
+}
+
+TEST(Project, AnExceptionInsideATransactionLeavesNoScan) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "site.sbproj");
+  const auto import_then_fail = [&] {
+    auto transaction = project.begin();
+    project.insert_scan(tiny_scan(true, true, true));
+    throw std::runtime_error("reader failed on the second file");
+  };
+  EXPECT_THROW(import_then_fail(), std::runtime_error);
+  EXPECT_TRUE(project.scans().empty());
+  // The connection is usable again after the rollback.
+  EXPECT_EQ(project.load_scan(insert_committed(project, tiny_scan(true, false, false))).rows, 2);
+}
+
+TEST(Project, TwoInsertsInOneTransactionAreAllOrNothing) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  Project project = Project::create(file);
+  {
+    auto transaction = project.begin();
+    project.insert_scan(tiny_scan(true, false, false));
+    project.insert_scan(tiny_scan(false, true, true));
+    EXPECT_EQ(project.scans().size(), 2u);  // visible inside the transaction
+  }                                         // not committed
+  EXPECT_TRUE(project.scans().empty());
+  EXPECT_TRUE(Project::open(file).scans().empty());  // nor to another connection
+
+  auto transaction = project.begin();
+  project.insert_scan(tiny_scan(true, false, false));
+  project.insert_scan(tiny_scan(false, true, true));
+  transaction.commit();
+  EXPECT_FALSE(transaction.active());
+  EXPECT_EQ(Project::open(file).scans().size(), 2u);
+}
+
+TEST(Project, MovedTransactionAndProjectKeepWorking) {
+  const ScratchDir dir;
+  Project original = Project::create(dir / "site.sbproj");
+  Project project = std::move(original);
+  auto first = project.begin();
+  Project::Transaction moved = std::move(first);
+  EXPECT_FALSE(first.active());
+  EXPECT_TRUE(moved.active());
+  project.insert_scan(tiny_scan(true, false, false));
+  moved.commit();
+  EXPECT_EQ(project.scans().size(), 1u);
+}
+
+TEST(Project, ADamagedChannelNamesTheScanAndChannel) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  std::int64_t id = 0;
+  {
+    Project project = Project::create(file);
+    id = insert_committed(project, tiny_scan(true, true, false));
+  }
+  {
+    RawDatabase raw(file);
+    raw.execute("UPDATE scan_channels SET data = substr(data, 1, 10) WHERE channel = 'intensity'");
+  }
+  const Project project = Project::open(file);
+  EXPECT_EQ(project.scans().size(), 1u);  // summaries do not touch channel data
+  try {
+    project.load_scan(id);
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.file(), file.string());
+    EXPECT_EQ(error.position().detail, "scan " + std::to_string(id) + ", channel intensity");
+  }
+}
+
+TEST(Project, AMissingChannelIsAnInputError) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  std::int64_t id = 0;
+  {
+    Project project = Project::create(file);
+    id = insert_committed(project, tiny_scan(false, false, false));
+  }
+  { RawDatabase(file).execute("DELETE FROM scan_channels WHERE channel = 'directions'"); }
+  EXPECT_THROW(Project::open(file).load_scan(id), InputError);
+}
+
+TEST(ProjectDeathTest, InsertingOutsideATransactionIsAProgrammerError) {
+#ifdef NDEBUG
+  GTEST_SKIP() << "assertions are compiled out in this build";
+#else
+  const ScratchDir dir;
+  Project project = Project::create(dir / "site.sbproj");
+  EXPECT_DEATH(project.insert_scan(tiny_scan(true, false, false)),
+               "insert_scan needs an open Project::Transaction");
+#endif
+}
+
+}  // namespace
+}  // namespace scanbench::modeling

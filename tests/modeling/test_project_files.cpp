@@ -1,0 +1,241 @@
+// Project: files that must be refused untouched, and crash safety.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <random>
+
+#include "acquisition/input_error.hpp"
+#include "modeling/project.hpp"
+#include "modeling/project_test_support.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using acquisition::InputError;
+using test::RawDatabase;
+using test::ScratchDir;
+using test::tiny_scan;
+using ::testing::HasSubstr;
+
+void write_file(const std::filesystem::path& file, const std::string& bytes) {
+  std::ofstream(file, std::ios::binary) << bytes;
+}
+
+// Opens `file` expecting a refusal whose message contains `problem`; the file
+// must keep every byte and gain no SQLite side files. open_or_create must
+// refuse it the same way rather than overwrite it.
+void expect_refused(const std::filesystem::path& file, const std::string& problem) {
+  const std::string before = test::read_file_bytes(file);
+  for (const auto opener : {&Project::open, &Project::open_or_create}) {
+    try {
+      opener(file);
+      ADD_FAILURE() << "expected InputError for " << file;
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.file(), file.string());
+      EXPECT_THAT(error.what(), HasSubstr(problem));
+    }
+    EXPECT_EQ(test::read_file_bytes(file), before);
+    EXPECT_TRUE(test::no_side_files(file));
+  }
+}
+
+void make_foreign_database(const std::filesystem::path& file, const char* journal_mode) {
+  RawDatabase raw(file);
+  raw.execute(std::string("PRAGMA journal_mode = ") + journal_mode);
+  raw.execute("PRAGMA application_id = 1179537988; PRAGMA user_version = 1");
+  raw.execute("CREATE TABLE scans (id INTEGER PRIMARY KEY, payload TEXT)");
+  raw.execute("INSERT INTO scans (payload) VALUES ('not ours')");
+}
+
+TEST(ProjectFiles, RefusesATextFile) {
+  const ScratchDir dir;
+  const auto file = dir / "x.sbproj";
+  write_file(file, "this is a shopping list, not a project\n");
+  expect_refused(file, "not an SQLite database");
+}
+
+TEST(ProjectFiles, RefusesAnEmptyFile) {
+  const ScratchDir dir;
+  const auto file = dir / "empty.sbproj";
+  write_file(file, "");
+  expect_refused(file, "file is empty");
+}
+
+TEST(ProjectFiles, RefusesADirectory) {
+  const ScratchDir dir;
+  const auto folder = dir / "folder.sbproj";
+  std::filesystem::create_directory(folder);
+  EXPECT_THROW(Project::open(folder), InputError);
+  EXPECT_THROW(Project::open_or_create(folder), InputError);
+  EXPECT_TRUE(std::filesystem::is_empty(folder));
+}
+
+TEST(ProjectFiles, RefusesAMissingFileWithoutCreatingIt) {
+  const ScratchDir dir;
+  const auto file = dir / "gone.sbproj";
+  EXPECT_THROW(Project::open(file), InputError);
+  EXPECT_FALSE(std::filesystem::exists(file));
+}
+
+TEST(ProjectFiles, RefusesAnotherApplicationsDatabase) {
+  for (const char* journal_mode : {"DELETE", "WAL"}) {
+    const ScratchDir dir;
+    const auto file = dir / "other.sbproj";
+    make_foreign_database(file, journal_mode);
+    expect_refused(file, "another application, application_id 0x464e5244");
+  }
+}
+
+TEST(ProjectFiles, RefusesAPlainSqliteDatabase) {
+  const ScratchDir dir;
+  const auto file = dir / "plain.sbproj";
+  { RawDatabase(file).execute("CREATE TABLE t (x)"); }
+  expect_refused(file, "application_id 0x0");
+}
+
+TEST(ProjectFiles, RefusesANewerSchema) {
+  const ScratchDir dir;
+  const auto file = dir / "future.sbproj";
+  { Project project = Project::create(file); }
+  { RawDatabase(file).execute("PRAGMA user_version = 7"); }
+  expect_refused(file,
+                 "project schema version 7 is newer than this scanbench (1); upgrade scanbench");
+}
+
+// The version bump sits only in the -wal file while another connection keeps
+// it from being checkpointed: the header check passes, SQLite's must refuse.
+TEST(ProjectFiles, RefusesANewerSchemaThatIsOnlyInTheLog) {
+  const ScratchDir dir;
+  const auto file = dir / "future.sbproj";
+  { Project project = Project::create(file); }
+  RawDatabase newer(file);
+  newer.execute("PRAGMA wal_autocheckpoint = 0; PRAGMA user_version = 7");
+  const std::string before = test::read_file_bytes(file);
+  try {
+    Project::open(file);
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("project schema version 7 is newer"));
+  }
+  EXPECT_EQ(test::read_file_bytes(file), before);
+}
+
+TEST(ProjectFiles, RefusesADamagedProjectUntouched) {
+  const ScratchDir dir;
+  const auto file = dir / "damaged.sbproj";
+  {
+    Project project = Project::create(file);
+    auto transaction = project.begin();
+    project.insert_scan(tiny_scan(true, true, true));
+    transaction.commit();
+  }
+  std::string bytes = test::read_file_bytes(file);
+  ASSERT_GT(bytes.size(), 400u);
+  // Page 1 past the 100-byte file header: the root of the schema table.
+  std::fill(bytes.begin() + 100, bytes.begin() + 400, '\xab');
+  write_file(file, bytes);
+  expect_refused(file, "project file is damaged");
+}
+
+TEST(ProjectFiles, RefusesTheCommittedBadFixtures) {
+  const ScratchDir dir;
+  for (const std::string name : {"project_not_sqlite.sbproj", "project_foreign_sqlite.sbproj"}) {
+    const auto fixture = test::fixture("bad/" + name);
+    ASSERT_TRUE(std::filesystem::exists(fixture));
+    // Refused from a copy, so that a regression cannot damage the fixture.
+    const auto copy = dir / name;
+    std::filesystem::copy_file(fixture, copy);
+    expect_refused(copy, "not a scanbench project");
+    EXPECT_EQ(test::read_file_bytes(copy), test::read_file_bytes(fixture));
+  }
+}
+
+// Large and incompressible enough (about 5 MB) to overflow SQLite's page
+// cache, so uncommitted pages reach the -wal file before the kill.
+acquisition::Scan large_scan() {
+  acquisition::Scan scan = tiny_scan(true, true, false, 1024, 1024);
+  std::mt19937 bits(7);
+  for (float& range : scan.range_m) range = static_cast<float>(bits() % 100000) * 1.0e-3f;
+  scan.name = "killed mid-import";
+  return scan;
+}
+
+// Child: open, begin, insert, report 'K' through the pipe, then wait to be
+// killed with the transaction open. Never returns.
+[[noreturn]] void child_insert_and_wait(const std::filesystem::path& file, int report_fd) {
+  char status = 'E';
+  try {
+    Project project = Project::open(file);
+    auto transaction = project.begin();
+    project.insert_scan(large_scan());
+    status = 'K';
+    [[maybe_unused]] const auto ignored = ::write(report_fd, &status, 1);
+    for (;;) ::pause();
+  } catch (...) {
+    [[maybe_unused]] const auto ignored = ::write(report_fd, &status, 1);
+  }
+  ::_exit(1);
+}
+
+void kill_during_insert(const std::filesystem::path& file) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(fds[0]);
+    child_insert_and_wait(file, fds[1]);
+  }
+  ::close(fds[1]);
+  char status = 0;
+  EXPECT_EQ(::read(fds[0], &status, 1), 1);
+  ::close(fds[0]);
+  ::kill(child, SIGKILL);
+  int wait_status = 0;
+  ASSERT_EQ(::waitpid(child, &wait_status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(wait_status) && WTERMSIG(wait_status) == SIGKILL);
+  ASSERT_EQ(status, 'K') << "the child failed before the kill";
+}
+
+class ProjectKill : public ::testing::TestWithParam<int> {};
+
+TEST_P(ProjectKill, SigkillMidTransactionLeavesTheCommittedStateOnly) {
+  const ScratchDir dir;
+  const auto file = dir / "site.sbproj";
+  std::vector<std::int64_t> ids_before;
+  {
+    Project project = Project::create(file);
+    for (int i = 0; i < GetParam(); ++i) {
+      auto transaction = project.begin();
+      ids_before.push_back(project.insert_scan(tiny_scan(i % 2 == 0, true, true)));
+      transaction.commit();
+    }
+  }
+  kill_during_insert(file);
+  EXPECT_GT(std::filesystem::file_size(file.string() + "-wal"), 0u)
+      << "the kill should leave uncommitted pages in the log";
+
+  Project project = Project::open(file);
+  std::vector<std::int64_t> ids_after;
+  for (const auto& stored : project.scans()) ids_after.push_back(stored.id);
+  EXPECT_EQ(ids_after, ids_before);
+  EXPECT_EQ(RawDatabase(file).text("PRAGMA integrity_check"), "ok");
+  for (const std::int64_t id : ids_before) {
+    test::expect_identical(project.load_scan(id), tiny_scan(id % 2 == 1, true, true));
+  }
+  // The dead writer's lock is gone: a new transaction commits.
+  auto transaction = project.begin();
+  project.insert_scan(tiny_scan(true, false, false));
+  transaction.commit();
+  EXPECT_EQ(project.scans().size(), ids_before.size() + 1);
+}
+
+INSTANTIATE_TEST_SUITE_P(ScansBefore, ProjectKill, ::testing::Values(0, 1));
+
+}  // namespace
+}  // namespace scanbench::modeling
