@@ -122,11 +122,10 @@ TEST(TripletReader, NameDefaultsToStemAndPositionToPoseTranslation) {
 
 // Writes a good triplet, then points `key` at an image made of `bytes`.
 std::filesystem::path triplet_with_image(const ScratchDir& dir, const std::string& key,
-                                         const std::string& file, const std::string& bytes,
-                                         bool create = true) {
+                                         const std::string& file, const std::string& bytes) {
   const auto sidecar = dir / "scan.json";
   write_triplet(make_scan(), sidecar);
-  if (create) write_bytes(dir / file, bytes);
+  write_bytes(dir / file, bytes);
   nlohmann::json j = read_json(sidecar);
   j[key]["file"] = file;
   write_json(sidecar, j);
@@ -314,30 +313,20 @@ TEST(TripletReader, MissingSidecarIsAnInputError) {
   EXPECT_THROW(read_triplet(dir / "nothing here.json"), InputError);
 }
 
-// ---- malformed images: built at run time, one case each -----------------
+// ---- malformed images: one fixture folder each -------------------------
 
 struct BadImage {
-  const char* name;
-  const char* key;  // sidecar entry pointed at the bad image
-  const char* file;
-  std::string bytes;
-  const char* problem;
-  bool create = true;  // false: the sidecar names a file that does not exist
+  const char* name;     // fixtures/bad/triplet_image_<name>/scan.json
+  const char* file;     // the bad image the sidecar names; must appear in e.file()
+  const char* problem;  // word(s) describing the problem
 };
 
 class TripletBadImage : public testing::TestWithParam<BadImage> {};
 
 TEST_P(TripletBadImage, ThrowsInputErrorNamingTheImage) {
   const BadImage& c = GetParam();
-  const ScratchDir dir;
-  const auto sidecar = triplet_with_image(dir, c.key, c.file, c.bytes, c.create);
-  if (std::string(c.name) == "range_float_image_for_uint16") {
-    nlohmann::json j = read_json(sidecar);
-    j["range"] = {{"file", c.file}, {"encoding", "uint16"}, {"scale_m", 0.001}};
-    write_json(sidecar, j);
-  }
   try {
-    read_triplet(sidecar);
+    read_triplet(fixture(std::string("bad/triplet_image_") + c.name + "/scan.json"));
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(e.file().find(c.file), std::string::npos) << e.what();
@@ -345,31 +334,19 @@ TEST_P(TripletBadImage, ThrowsInputErrorNamingTheImage) {
   }
 }
 
-const std::vector<int> k6 = {1, 2, 3, 4, 5, 6};
-const std::vector<int> k18(18, 7);
-const std::vector<float> k6f = {1, 2, 3, 4, 5, 6};
-
 INSTANTIATE_TEST_SUITE_P(
     Cases, TripletBadImage,
-    testing::Values(
-        BadImage{"corrupt_png", "range", "bad.png", "\x89PNG\r\n\x1a\ngarbage", "unreadable"},
-        BadImage{"empty_image_file", "color", "empty.png", "", "unreadable"},
-        BadImage{"missing_intensity_image", "intensity", "gone.png", "", "missing", false},
-        BadImage{"range_8bit", "range", "r.pgm", netpbm("P5", 2, 3, 255, k6), "wrong image type"},
-        BadImage{"range_3_channels", "range", "r.ppm", netpbm("P6", 2, 3, 255, k18),
-                 "wrong image type"},
-        BadImage{"range_float_image_for_uint16", "range", "r.pfm", pfm("Pf", 2, 3, k6f),
-                 "wrong image type"},
-        BadImage{"color_grayscale", "color", "c.pgm", netpbm("P5", 2, 3, 255, k6),
-                 "wrong image type"},
-        BadImage{"color_32bit_float", "color", "c.pfm",
-                 pfm("PF", 2, 3, std::vector<float>(18, 0.5f)), "wrong image type"},
-        BadImage{"intensity_3_channels", "intensity", "i.ppm", netpbm("P6", 2, 3, 255, k18),
-                 "wrong image type"},
-        BadImage{"intensity_32bit_float", "intensity", "i.pfm", pfm("Pf", 2, 3, k6f),
-                 "wrong image type"},
-        BadImage{"size_mismatch", "intensity", "i.pgm",
-                 netpbm("P5", 3, 3, 65535, std::vector<int>(9, 1)), "differs"}),
+    testing::Values(BadImage{"corrupt_png", "bad.png", "unreadable"},
+                    BadImage{"empty_image_file", "empty.png", "unreadable"},
+                    BadImage{"missing_intensity_image", "gone.png", "missing"},
+                    BadImage{"range_8bit", "r.pgm", "wrong image type"},
+                    BadImage{"range_3_channels", "r.ppm", "wrong image type"},
+                    BadImage{"range_float_image_for_uint16", "r.pfm", "wrong image type"},
+                    BadImage{"color_grayscale", "c.pgm", "wrong image type"},
+                    BadImage{"color_32bit_float", "c.pfm", "wrong image type"},
+                    BadImage{"intensity_3_channels", "i.ppm", "wrong image type"},
+                    BadImage{"intensity_32bit_float", "i.pfm", "wrong image type"},
+                    BadImage{"size_mismatch", "i.pgm", "differs"}),
     [](const testing::TestParamInfo<BadImage>& info) { return std::string(info.param.name); });
 
 }  // namespace
