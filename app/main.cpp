@@ -1,5 +1,5 @@
 // scanbench command line: one subcommand per pipeline stage
-// (import → info → export today; geometry, register, merge, segment, render
+// (simulate → import → info → export today; geometry, register, merge, segment, render
 // join as their stages land).
 #include <fmt/core.h>
 
@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   sb::add_import_command(app);
   sb::add_info_command(app);
   sb::add_export_command(app);
+  sb::add_simulate_command(app);
   sb::add_bench_command(app);
   try {
     app.parse(argc, argv);

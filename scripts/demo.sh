@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # The main job, end to end: installs what is missing, builds, then runs the
-# pipeline on the bundled sample scans and prints what it made.
-#   import  PTX (multi-scan, georeferenced), image triplet, organized PCD
-#   info    table and JSON
-#   export  PTX (lossless), PLY and CSV (world coordinates)
-#   bench   raw-scan I/O throughput against PCL's reader
-# Output goes to DEMO_OUT (default: out/demo/). Later stages (simulate,
-# geometry, register, merge, segment, render) join this script as they land.
+# pipeline and prints what it made.
+#   simulate  a 4-scan campaign of the campus site with exact ground truth
+#   import    the simulated scans, then the bundled real-format samples
+#             (multi-scan georeferenced PTX, image triplet, organized PCD)
+#   info      table and JSON
+#   export    PTX (lossless), PLY and CSV (world coordinates)
+#   bench     raw-scan I/O throughput against PCL's reader
+# Output goes to DEMO_OUT (default: out/demo/). Later stages (geometry,
+# register, merge, segment, render) join this script as they land.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/build.sh"
@@ -19,19 +21,25 @@ project="$out/demo.sbproj"
 
 phase() { printf '\n== %s ==\n' "$1"; }
 
+phase "simulate"
+"$scanbench" simulate --site campus --seed 1 --out "$out/campus"
+
 phase "import"
-"$scanbench" import "$project" "$fixtures/ptx/two_scans.ptx" "$fixtures/ptx/tiny_color.ptx" \
+"$scanbench" import "$project" "$out"/campus/campus_scan_*.json
+samples="$out/samples.sbproj"
+"$scanbench" import "$samples" "$fixtures/ptx/two_scans.ptx" "$fixtures/ptx/tiny_color.ptx" \
   "$fixtures/triplet/small.json" "$fixtures/pcd/organized_ascii.pcd"
 
 phase "info"
 "$scanbench" info "$project"
+"$scanbench" info "$samples"
 "$scanbench" info "$project" --json >"$out/info.json"
 echo "JSON description: $out/info.json"
 
 phase "export"
-"$scanbench" export "$project" --format ptx -o "$out/all_scans.ptx"
-"$scanbench" export "$project" --format ply -o "$out/all_scans.ply"
-"$scanbench" export "$project" --format csv -o "$out/all_scans.csv"
+"$scanbench" export "$project" --format ply --scan 1 -o "$out/campus_scan_1.ply"
+"$scanbench" export "$samples" --format ptx -o "$out/samples.ptx"
+"$scanbench" export "$samples" --format csv -o "$out/samples.csv"
 
 phase "bench io"
 "$scanbench" bench io

@@ -50,7 +50,7 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
-  for (const char* command : {"import", "info", "export", "bench"}) {
+  for (const char* command : {"import", "info", "export", "bench", "simulate"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
@@ -198,6 +198,50 @@ TEST(Cli, BenchIoSmokeRunPrintsOneJsonObject) {
                             "pcl_pcd_ascii_read_mb_per_s", "ptx_read_speedup_vs_pcl", "points"}) {
     EXPECT_TRUE(bench.contains(field)) << field;
   }
+}
+
+TEST(Cli, SimulateThenImportThenInfoOnTheCampusSite) {
+  ScratchDir dir;
+  const CliResult sim = run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
+                                      "--scans", "2", "--columns", "360", "--rows", "90"});
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const std::filesystem::path project = dir / "campus.sbproj";
+  const CliResult import = run_cli(dir, {"import", project.string(), (dir / "sim/campus_scan_01.json").string(),
+                                         (dir / "sim/campus_scan_02.json").string()});
+  ASSERT_EQ(import.exit_code, 0) << import.err;
+  const nlohmann::json info = info_json(dir, project);
+  ASSERT_EQ(info["scans"].size(), 2u);
+  EXPECT_EQ(info["scans"][0]["rows"], 90);
+  EXPECT_EQ(info["scans"][0]["columns"], 360);
+  const nlohmann::json truth = nlohmann::json::parse(test::read_file_bytes(dir / "sim/truth.json"));
+  EXPECT_EQ(info["scans"][1]["T_world_scan"], truth["scans"][1]["T_world_scan"]);
+}
+
+TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {
+  ScratchDir dir;
+  const std::filesystem::path view = dir / "view.json", png = dir / "truth.png";
+  std::FILE* f = std::fopen(view.c_str(), "w");
+  std::fputs(R"({"position": [0, -30, 2], "look_at": [0, 0, 5], "vertical_fov_deg": 50,
+                 "width": 64, "height": 48})", f);
+  std::fclose(f);
+  const CliResult ok = run_cli(dir, {"simulate", "--site", "street", "--render-view", view.string(),
+                                     "-o", png.string()});
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_TRUE(std::filesystem::exists(png));
+  EXPECT_TRUE(std::filesystem::exists(dir / "truth_object_id.png"));
+  f = std::fopen(view.c_str(), "w");
+  std::fputs(R"({"position": [0, 0, 2], "look_at": [0, 0, 2], "vertical_fov_deg": 50, "width": 64, "height": 48})", f);
+  std::fclose(f);
+  const CliResult bad = run_cli(dir, {"simulate", "--site", "street", "--render-view", view.string(),
+                                      "-o", png.string()});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("look_at"), std::string::npos) << bad.err;
+}
+
+TEST(Cli, SimulateWithoutAnOutputFolderIsAUsageError) {
+  ScratchDir dir;
+  EXPECT_EQ(run_cli(dir, {"simulate", "--site", "campus"}).exit_code, 2);
+  EXPECT_EQ(run_cli(dir, {"simulate", "--site", "moon", "--out", dir.path().string()}).exit_code, 2);
 }
 
 }  // namespace

@@ -1,0 +1,75 @@
+#include "acquisition/simulation/truth_images.hpp"
+
+#include <cassert>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+#include "acquisition/input_error.hpp"
+
+namespace scanbench::acquisition::sim {
+namespace {
+
+void write_image(const std::filesystem::path& path, const cv::Mat& image) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path.string(), image);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error(path.string() + ": cannot write image: " + e.what());
+  }
+  if (!ok) throw std::runtime_error(path.string() + ": cannot write image");
+}
+
+cv::Mat read_image(const std::filesystem::path& path, int type, int rows, int columns) {
+  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (image.empty()) throw InputError(path.string(), {}, "missing or unreadable truth image");
+  if (image.type() != type) throw InputError(path.string(), {}, "truth image has the wrong type");
+  if (image.rows != rows || image.cols != columns) {
+    throw InputError(path.string(), {}, "truth image size differs from the scan's rows x columns");
+  }
+  return image;
+}
+
+}  // namespace
+
+void write_truth_images(const ScanTruth& truth, int rows, int columns, const TruthFiles& files) {
+  [[maybe_unused]] const std::size_t n = static_cast<std::size_t>(rows) * columns;
+  assert(truth.object_id.size() == n && truth.normal_scan.size() == n && truth.range_m.size() == n &&
+         truth.mixed.size() == n);
+  cv::Mat ids(rows, columns, CV_16UC1), normals(rows, columns, CV_32FC3);
+  cv::Mat range(rows, columns, CV_32FC1), mixed(rows, columns, CV_8UC1);
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < columns; ++col) {
+      const std::size_t i = static_cast<std::size_t>(row) * columns + col;
+      ids.at<std::uint16_t>(row, col) = truth.object_id[i];
+      const Eigen::Vector3f& normal = truth.normal_scan[i];
+      normals.at<cv::Vec3f>(row, col) = cv::Vec3f(normal.x(), normal.y(), normal.z());
+      range.at<float>(row, col) = truth.range_m[i];
+      mixed.at<std::uint8_t>(row, col) = truth.mixed[i] ? 255 : 0;
+    }
+  }
+  write_image(files.object_id, ids);
+  write_image(files.normal, normals);
+  write_image(files.range, range);
+  write_image(files.mixed, mixed);
+}
+
+ScanTruth read_truth_images(const TruthFiles& files, int rows, int columns) {
+  const cv::Mat ids = read_image(files.object_id, CV_16UC1, rows, columns);
+  const cv::Mat normals = read_image(files.normal, CV_32FC3, rows, columns);
+  const cv::Mat range = read_image(files.range, CV_32FC1, rows, columns);
+  const cv::Mat mixed = read_image(files.mixed, CV_8UC1, rows, columns);
+  ScanTruth truth;
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < columns; ++col) {
+      truth.object_id.push_back(ids.at<std::uint16_t>(row, col));
+      const cv::Vec3f n = normals.at<cv::Vec3f>(row, col);
+      truth.normal_scan.emplace_back(n[0], n[1], n[2]);
+      truth.range_m.push_back(range.at<float>(row, col));
+      truth.mixed.push_back(mixed.at<std::uint8_t>(row, col) != 0);
+    }
+  }
+  return truth;
+}
+
+}  // namespace scanbench::acquisition::sim
