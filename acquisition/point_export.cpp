@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cstring>
 
 #include "acquisition/number_format.hpp"
@@ -15,26 +16,35 @@ static_assert(std::endian::native == std::endian::little, "PLY export writes nat
 struct Channels {
   bool intensity = true;
   bool color = true;
+  bool geometry = true;
 };
 
-Channels common_channels(std::span<const Scan> scans) {
+Channels common_channels(std::span<const Scan> scans,
+                         std::span<const ScanGeometry* const> geometry) {
+  assert((geometry.empty() || geometry.size() == scans.size()) && "one geometry entry per scan");
   Channels channels;
-  for (const Scan& scan : scans) {
-    channels.intensity = channels.intensity && scan.has_intensity();
-    channels.color = channels.color && scan.has_color();
+  channels.geometry = !geometry.empty();
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    channels.intensity = channels.intensity && scans[s].has_intensity();
+    channels.color = channels.color && scans[s].has_color();
+    channels.geometry = channels.geometry && geometry[s] != nullptr;
   }
   return channels;
 }
 
-// Calls visit(scan, pixel index, world point) for every valid pixel, scan
-// after scan, row-major.
+// Calls visit(scan index, pixel index, world point) for every exported pixel
+// (valid, and not a mixed pixel when geometry is exported), scan after scan,
+// row-major.
 template <typename Visit>
-void for_each_valid_point(std::span<const Scan> scans, Visit&& visit) {
-  for (const Scan& scan : scans) {
+void for_each_point(std::span<const Scan> scans, std::span<const ScanGeometry* const> geometry,
+                    Channels channels, Visit&& visit) {
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    const Scan& scan = scans[s];
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.columns; ++col) {
         const std::size_t i = scan.index(row, col);
-        if (scan.valid[i]) visit(scan, i, point_in_world(scan, row, col));
+        if (!scan.valid[i] || (channels.geometry && geometry[s]->is_mixed(i))) continue;
+        visit(s, i, point_in_world(scan, row, col));
       }
     }
   }
@@ -53,49 +63,66 @@ std::string ply_header(std::size_t vertices, Channels channels) {
   header += "property double x\nproperty double y\nproperty double z\n";
   if (channels.intensity) header += "property float intensity\n";
   if (channels.color) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (channels.geometry) {
+    header += "property float nx\nproperty float ny\nproperty float nz\nproperty float radius\n";
+  }
   return header + "end_header\n";
 }
 
 }  // namespace
 
-void write_ply(const std::filesystem::path& path, std::span<const Scan> scans) {
-  const Channels channels = common_channels(scans);
+void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const ScanGeometry* const> geometry) {
+  const Channels channels = common_channels(scans, geometry);
   std::size_t vertices = 0;
-  for (const Scan& scan : scans) vertices += count_valid(scan);
+  for_each_point(scans, geometry, channels,
+                 [&](std::size_t, std::size_t, const Eigen::Vector3d&) { ++vertices; });
   OutputFile file(path);
   file.write(ply_header(vertices, channels));
-  for_each_valid_point(scans, [&](const Scan& scan, std::size_t i, const Eigen::Vector3d& p) {
-    std::string& out = file.buffer();
-    for (int axis = 0; axis < 3; ++axis) append_binary(out, p[axis]);
-    if (channels.intensity) append_binary(out, scan.intensity[i]);
-    if (channels.color) out.append(reinterpret_cast<const char*>(&scan.rgb[3 * i]), 3);
-    file.flush_if_full();
-  });
+  for_each_point(scans, geometry, channels,
+                 [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
+                   const Scan& scan = scans[s];
+                   std::string& out = file.buffer();
+                   for (int axis = 0; axis < 3; ++axis) append_binary(out, p[axis]);
+                   if (channels.intensity) append_binary(out, scan.intensity[i]);
+                   if (channels.color)
+                     out.append(reinterpret_cast<const char*>(&scan.rgb[3 * i]), 3);
+                   if (channels.geometry) {
+                     const Eigen::Vector3f n =
+                         (scan.T_world_scan.linear().cast<float>() * geometry[s]->normal[i]);
+                     for (int axis = 0; axis < 3; ++axis) append_binary(out, n[axis]);
+                     append_binary(out, geometry[s]->footprint_m[i]);
+                   }
+                   file.flush_if_full();
+                 });
   file.commit();
 }
 
-void write_csv(const std::filesystem::path& path, std::span<const Scan> scans) {
-  const Channels channels = common_channels(scans);
+void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const ScanGeometry* const> geometry) {
+  const Channels channels = common_channels(scans, geometry);
   OutputFile file(path);
   file.write(std::string("x,y,z") + (channels.intensity ? ",intensity" : "") +
              (channels.color ? ",r,g,b" : "") + "\n");
-  for_each_valid_point(scans, [&](const Scan& scan, std::size_t i, const Eigen::Vector3d& p) {
-    std::string& out = file.buffer();
-    for (int axis = 0; axis < 3; ++axis) {
-      if (axis > 0) out += ',';
-      append_number(out, p[axis]);
-    }
-    if (channels.intensity) {
-      out += ',';
-      append_number(out, scan.intensity[i]);
-    }
-    for (int c = 0; channels.color && c < 3; ++c) {
-      out += ',';
-      out += std::to_string(scan.rgb[3 * i + c]);
-    }
-    out += '\n';
-    file.flush_if_full();
-  });
+  for_each_point(scans, geometry, channels,
+                 [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
+                   const Scan& scan = scans[s];
+                   std::string& out = file.buffer();
+                   for (int axis = 0; axis < 3; ++axis) {
+                     if (axis > 0) out += ',';
+                     append_number(out, p[axis]);
+                   }
+                   if (channels.intensity) {
+                     out += ',';
+                     append_number(out, scan.intensity[i]);
+                   }
+                   for (int c = 0; channels.color && c < 3; ++c) {
+                     out += ',';
+                     out += std::to_string(scan.rgb[3 * i + c]);
+                   }
+                   out += '\n';
+                   file.flush_if_full();
+                 });
   file.commit();
 }
 

@@ -7,18 +7,27 @@
 #include <span>
 
 #include "acquisition/scan.hpp"
+#include "acquisition/scan_geometry.hpp"
 
 namespace scanbench::acquisition {
 
+// `geometry`, when not empty, holds one entry per scan (nullptr where a scan
+// has none). When every scan has geometry, its mixed pixels are left out —
+// they float between surfaces and belong to no model — and the PLY gains the
+// normals and footprints.
+
 // Binary little-endian PLY: double x y z, then float intensity when every scan
-// has intensity, then uchar red green blue when every scan has colour.
-// (Normals and footprints join once the geometry stage computes them.)
-// All-or-nothing output; throws std::runtime_error naming `path` on write errors.
-void write_ply(const std::filesystem::path& path, std::span<const Scan> scans);
+// has intensity, then uchar red green blue when every scan has colour, then
+// float nx ny nz (unit, world frame; 0 0 0 where invalid) and float radius
+// (the footprint [m]) when every scan has geometry. All-or-nothing output;
+// throws std::runtime_error naming `path` on write errors.
+void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const ScanGeometry* const> geometry = {});
 
 // CSV with a header line "x,y,z[,intensity][,r,g,b]" (channel columns as for
 // PLY), one valid point per line, shortest exact decimals. All-or-nothing
 // output; throws std::runtime_error naming `path` on write errors.
-void write_csv(const std::filesystem::path& path, std::span<const Scan> scans);
+void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const ScanGeometry* const> geometry = {});
 
 }  // namespace scanbench::acquisition

@@ -38,14 +38,30 @@ std::vector<acquisition::Scan> load_scans(const modeling::Project& project,
   return scans;
 }
 
-void write_scans(const ExportOptions& options, const std::vector<acquisition::Scan>& scans) {
+// The stored geometry of each scan (nullptr where `scanbench geometry` has
+// not run), for the exports that leave mixed pixels out and carry normals.
+std::vector<std::optional<acquisition::ScanGeometry>> load_geometry(
+    const modeling::Project& project, std::optional<std::int64_t> scan_id) {
+  std::vector<std::optional<acquisition::ScanGeometry>> geometry;
+  if (scan_id) {
+    geometry.push_back(project.load_geometry(*scan_id));
+    return geometry;
+  }
+  for (const auto& stored : project.scans()) geometry.push_back(project.load_geometry(stored.id));
+  return geometry;
+}
+
+void write_scans(const ExportOptions& options, const std::vector<acquisition::Scan>& scans,
+                 const std::vector<std::optional<acquisition::ScanGeometry>>& geometry) {
+  std::vector<const acquisition::ScanGeometry*> pointers;
+  for (const auto& g : geometry) pointers.push_back(g ? &*g : nullptr);
   switch (options.format) {
     case ExportFormat::kPtx:
       return acquisition::write_ptx(options.output, scans);
     case ExportFormat::kPly:
-      return acquisition::write_ply(options.output, scans);
+      return acquisition::write_ply(options.output, scans, pointers);
     case ExportFormat::kCsv:
-      return acquisition::write_csv(options.output, scans);
+      return acquisition::write_csv(options.output, scans, pointers);
     case ExportFormat::kTriplet:
       if (scans.size() != 1) {
         throw acquisition::InputError(options.project, {},
@@ -58,7 +74,7 @@ void write_scans(const ExportOptions& options, const std::vector<acquisition::Sc
 void run_export(const ExportOptions& options) {
   const modeling::Project project = modeling::Project::open(options.project);
   const std::vector<acquisition::Scan> scans = load_scans(project, options.scan_id);
-  write_scans(options, scans);
+  write_scans(options, scans, load_geometry(project, options.scan_id));
   std::size_t points = 0;
   for (const auto& scan : scans) points += acquisition::count_valid(scan);
   fmt::print("exported {} scan(s), {} valid points, to {}\n", scans.size(), points, options.output);
@@ -71,7 +87,8 @@ void add_export_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "export",
       "Export scans: PTX (scan frame + pose, lossless), binary PLY or CSV (valid points in world "
-      "coordinates, double precision), or an image triplet (one scan).");
+      "coordinates, double precision; after `scanbench geometry`, without mixed pixels and, in "
+      "PLY, with normals and footprints), or an image triplet (one scan).");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);

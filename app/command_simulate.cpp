@@ -27,10 +27,12 @@ struct SimulateOptions {
 };
 
 void run_campaign(SimulateOptions& options) {
-  if (options.out_dir.empty()) throw CLI::ValidationError("--out", "is required (the output folder)");
+  if (options.out_dir.empty())
+    throw CLI::ValidationError("--out", "is required (the output folder)");
   ProgressBar progress("simulate");
   options.campaign.on_scan_written = [&progress](int k, int count) {
-    progress.update(static_cast<std::size_t>(k + 1), static_cast<std::size_t>(count), "scans written");
+    progress.update(static_cast<std::size_t>(k + 1), static_cast<std::size_t>(count),
+                    "scans written");
   };
   const sim::CampaignResult result = sim::simulate_campaign(options.campaign, options.out_dir);
   fmt::print("simulated {} scan(s) of {} (seed {}, {} x {}) in {:.1f} s ({:.1f} s ray casting)\n",
@@ -42,10 +44,12 @@ void run_campaign(SimulateOptions& options) {
 }
 
 void run_render_view(const SimulateOptions& options) {
-  if (options.output_png.empty()) throw CLI::ValidationError("-o", "is required with --render-view");
+  if (options.output_png.empty())
+    throw CLI::ValidationError("-o", "is required with --render-view");
   const sim::CameraView view = sim::read_camera_view(options.render_view);
   const sim::Site site = sim::make_site(options.campaign.site, options.campaign.seed, 1);
-  const sim::TruthImage image = sim::render_truth_view(site.scene, view, options.campaign.simulation);
+  const sim::TruthImage image =
+      sim::render_truth_view(site.scene, view, options.campaign.simulation);
   sim::write_truth_image(image, options.output_png);
   fmt::print("rendered {} x {} truth view of {} to {}\n", view.width, view.height,
              options.campaign.site, options.output_png);
@@ -60,9 +64,13 @@ void add_simulate_command(CLI::App& app) {
       "Scan a procedural site with the virtual panoramic scanner and write the scans with their "
       "exact ground truth, or ray-cast a ground-truth picture of the site (--render-view).");
   sim::CampaignSettings& campaign = options->campaign;
-  command->add_option("--site", campaign.site, "Site")->required()->check(CLI::IsMember(sim::site_names()));
+  command->add_option("--site", campaign.site, "Site")
+      ->required()
+      ->check(CLI::IsMember(sim::site_names()));
   command->add_option("--out", options->out_dir, "Output folder for scans and truth");
-  command->add_option("--scans", campaign.scans, "Scan positions")->check(CLI::Range(1, 64))->capture_default_str();
+  command->add_option("--scans", campaign.scans, "Scan positions")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   command->add_option("--columns", campaign.scanner.columns, "Azimuth samples over 360°")
       ->check(CLI::Range(8, 36000))
       ->capture_default_str();
@@ -71,13 +79,16 @@ void add_simulate_command(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--seed", campaign.seed, "Seed: the same seed gives byte-identical output")
       ->capture_default_str();
-  const std::map<std::string, sim::CampaignFormat> formats{{"ptx", sim::CampaignFormat::kPtx},
-                                                           {"triplet", sim::CampaignFormat::kTriplet},
-                                                           {"both", sim::CampaignFormat::kBoth}};
+  const std::map<std::string, sim::CampaignFormat> formats{
+      {"ptx", sim::CampaignFormat::kPtx},
+      {"triplet", sim::CampaignFormat::kTriplet},
+      {"both", sim::CampaignFormat::kBoth}};
   command->add_option("--format", campaign.format, "ptx, triplet or both (default triplet)")
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   command->add_option("--threads", campaign.simulation.threads, "Worker threads (0 = all cores)");
-  command->add_option("--render-view", options->render_view, "Camera view JSON: render a truth picture")
+  command
+      ->add_option("--render-view", options->render_view,
+                   "Camera view JSON: render a truth picture")
       ->check(CLI::ExistingFile);
   command->add_option("-o,--output", options->output_png, "Truth picture (PNG) for --render-view");
   command->callback([options] {

@@ -17,5 +17,6 @@ void add_info_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_geometry_command(CLI::App& app);
 
 }  // namespace scanbench::app

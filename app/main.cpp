@@ -1,5 +1,5 @@
 // scanbench command line: one subcommand per pipeline stage
-// (simulate → import → info → export today; geometry, register, merge, segment, render
+// (simulate → import → geometry → info → export today; geometry, register, merge, segment, render
 // join as their stages land).
 #include <fmt/core.h>
 
@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1, 1);
   sb::add_import_command(app);
   sb::add_info_command(app);
+  sb::add_geometry_command(app);
   sb::add_export_command(app);
   sb::add_simulate_command(app);
   sb::add_bench_command(app);

@@ -2,16 +2,18 @@
 
 #include <cassert>
 
+#include "bench/bench_geometry.hpp"
 #include "bench/bench_io.hpp"
 
 namespace scanbench::bench {
 
 std::vector<std::string> suite_names() {
-  return {"io"};
+  return {"io", "geometry"};
 }
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "io") return run_io_bench(options);
+  if (name == "geometry") return run_geometry_bench(options);
   assert(false && "unknown bench suite");
   return {};
 }

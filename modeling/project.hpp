@@ -17,9 +17,11 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include "acquisition/scan.hpp"
+#include "acquisition/scan_geometry.hpp"
 #include "acquisition/scan_summary.hpp"
 
 struct sqlite3;
@@ -32,7 +34,7 @@ inline constexpr std::uint32_t kProjectApplicationId = 0x53424E43;
 
 // PRAGMA user_version written by this build. Older projects are migrated on
 // open; newer ones are refused.
-inline constexpr int kProjectSchemaVersion = 1;
+inline constexpr int kProjectSchemaVersion = 2;  // 2: scan_geometry
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
@@ -94,6 +96,18 @@ class Project {
   // when SQLite fails (disk full, blob larger than SQLite's 1 GB limit); the
   // caller's Transaction then rolls everything back.
   std::int64_t insert_scan(const acquisition::Scan& scan);
+
+  // Stores (replacing any earlier) the geometry of scan `id`, with the
+  // settings that produced it as JSON text. Asserts a Transaction is open and
+  // the arrays match the scan's pixel count; throws acquisition::InputError
+  // when there is no such scan or SQLite fails.
+  void store_geometry(std::int64_t id, const acquisition::GeometryResult& geometry,
+                      const std::string& settings_json);
+
+  // The stored geometry of scan `id`, or none when `scanbench geometry` has
+  // not run on it. Throws acquisition::InputError naming the scan when the
+  // stored data is damaged.
+  std::optional<acquisition::ScanGeometry> load_geometry(std::int64_t id) const;
 
  private:
   struct CloseConnection {

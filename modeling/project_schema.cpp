@@ -119,11 +119,30 @@ void check_tables(sqlite3* db, const std::string& file) {
   }
 }
 
+// Version 2: per-point geometry (footprint, normal, confidence, flags) of
+// each scan, from `scanbench geometry`, with the settings that produced it.
+constexpr const char* kMigrate1To2 = R"sql(
+CREATE TABLE scan_geometry (
+  scan_id INTEGER PRIMARY KEY REFERENCES scans (id) ON DELETE CASCADE,
+  settings TEXT NOT NULL,
+  normals INTEGER NOT NULL CHECK (normals >= 0),
+  mixed_pixels INTEGER NOT NULL CHECK (mixed_pixels >= 0),
+  edge_pixels INTEGER NOT NULL CHECK (edge_pixels >= 0),
+  footprint_m BLOB NOT NULL,
+  normal BLOB NOT NULL,
+  confidence BLOB NOT NULL,
+  flags BLOB NOT NULL,
+  computed_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+);
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
-// transaction. Version 1 is the first schema, so there is nothing to do yet.
-void migrate_step([[maybe_unused]] sqlite3* db, int version,
-                  [[maybe_unused]] const std::string& file) {
+// transaction.
+void migrate_step(sqlite3* db, int version, const std::string& file) {
   switch (version) {
+    case 1:
+      sqlite::execute(db, kMigrate1To2, file);
+      return;
     default:
       assert(false && "no migration step from this schema version");
   }

@@ -4,11 +4,12 @@
 #   simulate  a 4-scan campaign of the campus site with exact ground truth
 #   import    the simulated scans, then the bundled real-format samples
 #             (multi-scan georeferenced PTX, image triplet, organized PCD)
+#   geometry  per-point footprints, normals and mixed-pixel flags
 #   info      table and JSON
 #   export    PTX (lossless), PLY and CSV (world coordinates)
 #   bench     raw-scan I/O throughput against PCL's reader
-# Output goes to DEMO_OUT (default: out/demo/). Later stages (geometry,
-# register, merge, segment, render) join this script as they land.
+# Output goes to DEMO_OUT (default: out/demo/). Later stages (register,
+# merge, segment, render) join this script as they land.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/build.sh"
@@ -29,6 +30,10 @@ phase "import"
 samples="$out/samples.sbproj"
 "$scanbench" import "$samples" "$fixtures/ptx/two_scans.ptx" "$fixtures/ptx/tiny_color.ptx" \
   "$fixtures/triplet/small.json" "$fixtures/pcd/organized_ascii.pcd"
+
+phase "geometry"
+"$scanbench" geometry "$project"
+"$scanbench" geometry "$samples" --window 2 --edge-window 1
 
 phase "info"
 "$scanbench" info "$project"

@@ -25,7 +25,9 @@ TruthFiles truth_files(const fs::path& dir, const std::string& scan_name) {
           base / (scan_name + "_range.tiff"), base / (scan_name + "_mixed.png")};
 }
 
-json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+json vector_json(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 json lighting_json(const ScanLighting& l) {
   return {{"sun_direction_world", vector_json(l.sun_direction_world)},
@@ -135,7 +137,8 @@ CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::pat
     result.simulate_seconds += seconds_since(cast_start);
     sim.scan.name = scan_name(settings.site, k);
     scans.push_back(write_scan(sim, settings, out_dir, lighting, result));
-    if (settings.on_scan_written) settings.on_scan_written(k, static_cast<int>(site.scan_poses.size()));
+    if (settings.on_scan_written)
+      settings.on_scan_written(k, static_cast<int>(site.scan_poses.size()));
   }
   result.truth_json = out_dir / "truth.json";
   write_json(result.truth_json, {{"format", "scanbench-truth"},

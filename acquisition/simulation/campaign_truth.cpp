@@ -40,8 +40,8 @@ class TruthJson {
   }
 
   [[noreturn]] void fail(const char* key, const std::string& problem) const {
-    throw InputError(path_.string(), {std::nullopt, std::nullopt, std::string("key \"") + key + "\""},
-                     problem);
+    throw InputError(path_.string(),
+                     {std::nullopt, std::nullopt, std::string("key \"") + key + "\""}, problem);
   }
 
   fs::path resolve(const std::string& relative) const { return path_.parent_path() / relative; }
@@ -54,14 +54,16 @@ class TruthJson {
 TruthScan load_scan(const TruthJson& file, const json& entry, int rows, int columns) {
   TruthScan scan;
   scan.name = file.get<std::string>(entry, "name");
-  const Eigen::Matrix4d m = matrix_from_row_major(file.get<std::array<double, 16>>(entry, "T_world_scan"));
+  const Eigen::Matrix4d m =
+      matrix_from_row_major(file.get<std::array<double, 16>>(entry, "T_world_scan"));
   if (const std::string problem = rigid_transform_problem(m); !problem.empty()) {
     file.fail("T_world_scan", problem);
   }
   scan.T_world_scan = to_isometry(m);
   const json files = file.get<json>(entry, "files");
   for (const char* format : {"ptx", "triplet"}) {
-    if (files.contains(format)) scan.scan_files.push_back(file.resolve(file.get<std::string>(files, format)));
+    if (files.contains(format))
+      scan.scan_files.push_back(file.resolve(file.get<std::string>(files, format)));
   }
   const json truth = file.get<json>(entry, "truth");
   const TruthFiles images{file.resolve(file.get<std::string>(truth, "object_id")),
@@ -77,7 +79,8 @@ TruthScan load_scan(const TruthJson& file, const json& entry, int rows, int colu
 CampaignTruth load_campaign_truth(const fs::path& truth_json) {
   const TruthJson file(truth_json);
   const json& root = file.root();
-  if (file.get<std::string>(root, "format") != "scanbench-truth") file.fail("format", "is not scanbench-truth");
+  if (file.get<std::string>(root, "format") != "scanbench-truth")
+    file.fail("format", "is not scanbench-truth");
   if (file.get<int>(root, "version") != 1) file.fail("version", "is not 1");
   CampaignTruth campaign;
   campaign.site = file.get<std::string>(root, "site");
@@ -85,7 +88,8 @@ CampaignTruth load_campaign_truth(const fs::path& truth_json) {
   const json scanner = file.get<json>(root, "scanner");
   campaign.rows = file.get<int>(scanner, "rows");
   campaign.columns = file.get<int>(scanner, "columns");
-  if (campaign.rows <= 0 || campaign.columns <= 0) file.fail("scanner", "rows and columns must be positive");
+  if (campaign.rows <= 0 || campaign.columns <= 0)
+    file.fail("scanner", "rows and columns must be positive");
   for (const json& entry : file.get<json>(root, "scans")) {
     campaign.scans.push_back(load_scan(file, entry, campaign.rows, campaign.columns));
   }

@@ -34,8 +34,8 @@ cv::Mat read_image(const std::filesystem::path& path, int type, int rows, int co
 
 void write_truth_images(const ScanTruth& truth, int rows, int columns, const TruthFiles& files) {
   [[maybe_unused]] const std::size_t n = static_cast<std::size_t>(rows) * columns;
-  assert(truth.object_id.size() == n && truth.normal_scan.size() == n && truth.range_m.size() == n &&
-         truth.mixed.size() == n);
+  assert(truth.object_id.size() == n && truth.normal_scan.size() == n &&
+         truth.range_m.size() == n && truth.mixed.size() == n);
   cv::Mat ids(rows, columns, CV_16UC1), normals(rows, columns, CV_32FC3);
   cv::Mat range(rows, columns, CV_32FC1), mixed(rows, columns, CV_8UC1);
   for (int row = 0; row < rows; ++row) {

@@ -43,7 +43,8 @@ Eigen::Vector3d vector_at(const fs::path& file, const json& root, const std::str
 Eigen::Isometry3d look_at_pose(const fs::path& file, const json& root) {
   const Eigen::Vector3d position = vector_at(file, root, "position");
   const Eigen::Vector3d target = vector_at(file, root, "look_at");
-  const Eigen::Vector3d up = root.contains("up") ? vector_at(file, root, "up") : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up =
+      root.contains("up") ? vector_at(file, root, "up") : Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d z = target - position;
   if (z.norm() < 1e-9) fail(file, "look_at", "equals the position");
   const Eigen::Vector3d x = z.cross(up);
@@ -94,8 +95,8 @@ CameraView read_camera_view(const fs::path& view_json) {
   view.width = number_at(view_json, root, "width", 1, 16384);
   view.height = number_at(view_json, root, "height", 1, 16384);
   view.vertical_fov_deg = number_at(view_json, root, "vertical_fov_deg", 1.0, 170.0);
-  view.T_world_camera =
-      root.contains("T_world_camera") ? matrix_pose(view_json, root) : look_at_pose(view_json, root);
+  view.T_world_camera = root.contains("T_world_camera") ? matrix_pose(view_json, root)
+                                                        : look_at_pose(view_json, root);
   return view;
 }
 
@@ -107,14 +108,16 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
   const std::size_t n = static_cast<std::size_t>(view.width) * view.height;
   image.rgb.assign(3 * n, 0);
   image.object_id.assign(n, 0);
-  const double focal = 0.5 * view.height / std::tan(0.5 * view.vertical_fov_deg * std::numbers::pi / 180.0);
+  const double focal =
+      0.5 * view.height / std::tan(0.5 * view.vertical_fov_deg * std::numbers::pi / 180.0);
   const ScanLighting lighting = reference_lighting();
   const auto render_row = [&](int v) {
     for (int u = 0; u < view.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * view.width + u;
       const Eigen::Vector3d d_camera((u + 0.5 - 0.5 * view.width) / focal,
                                      (v + 0.5 - 0.5 * view.height) / focal, 1.0);
-      const Ray ray{view.T_world_camera.translation(), view.T_world_camera.linear() * d_camera.normalized()};
+      const Ray ray{view.T_world_camera.translation(),
+                    view.T_world_camera.linear() * d_camera.normalized()};
       const std::optional<Hit> hit = scene.intersect(ray, 0.0, 1e5);
       if (!hit) {
         for (int c = 0; c < 3; ++c) image.rgb[3 * i + c] = kSky[c];
@@ -130,9 +133,10 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
   };
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, view.height), [&](const tbb::blocked_range<int>& rows) {
-      for (int v = rows.begin(); v < rows.end(); ++v) render_row(v);
-    });
+    tbb::parallel_for(tbb::blocked_range<int>(0, view.height),
+                      [&](const tbb::blocked_range<int>& rows) {
+                        for (int v = rows.begin(); v < rows.end(); ++v) render_row(v);
+                      });
   });
   return image;
 }
@@ -142,13 +146,15 @@ void write_truth_image(const TruthImage& image, const fs::path& png) {
   for (int v = 0; v < image.height; ++v) {
     for (int u = 0; u < image.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * image.width + u;
-      bgr.at<cv::Vec3b>(v, u) = cv::Vec3b(image.rgb[3 * i + 2], image.rgb[3 * i + 1], image.rgb[3 * i]);
+      bgr.at<cv::Vec3b>(v, u) =
+          cv::Vec3b(image.rgb[3 * i + 2], image.rgb[3 * i + 1], image.rgb[3 * i]);
       ids.at<std::uint16_t>(v, u) = image.object_id[i];
     }
   }
   const fs::path id_png = png.parent_path() / (png.stem().string() + "_object_id.png");
   for (const auto& [path, mat] : {std::pair{png, bgr}, std::pair{id_png, ids}}) {
-    if (!cv::imwrite(path.string(), mat)) throw std::runtime_error(path.string() + ": cannot write image");
+    if (!cv::imwrite(path.string(), mat))
+      throw std::runtime_error(path.string() + ": cannot write image");
   }
 }
 

@@ -64,7 +64,8 @@ CleanSample cast_beam(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
   sample.normal_scan = (T_world_scan.linear().transpose() * hit->normal).cast<float>();
   const Eigen::Vector3d point = ray.origin + hit->distance_m * ray.direction;
   const double cos_incidence = std::abs(hit->normal.dot(ray.direction));
-  const double pixel_angle = std::max(std::abs(angles.azimuth_step_rad), std::abs(angles.elevation_step_rad));
+  const double pixel_angle =
+      std::max(std::abs(angles.azimuth_step_rad), std::abs(angles.elevation_step_rad));
   const double footprint = footprint_radius(hit->distance_m, pixel_angle, cos_incidence);
   sample.radiance = shade(scene, *hit, point, lighting, model.shadows, footprint);
   sample.intensity = clean_intensity(scene, *hit, cos_incidence, footprint, model);
@@ -72,8 +73,8 @@ CleanSample cast_beam(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
 }
 
 bool is_gap(float a, float b, const ScannerModel& model) {
-  const double gap = std::max(model.discontinuity_min_gap_m,
-                              model.discontinuity_relative_gap * std::min(a, b));
+  const double gap =
+      std::max(model.discontinuity_min_gap_m, model.discontinuity_relative_gap * std::min(a, b));
   return std::abs(a - b) > gap;
 }
 
@@ -117,8 +118,9 @@ bool mixed_echo(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
     if (!s.hit) continue;
     const Eigen::Vector3d point = s.range_m * direction_at(angles, r, c);
     const double off_plane = std::abs(normal.dot(point - centre_point));
-    straddles = straddles || off_plane > std::max(model.discontinuity_min_gap_m,
-                                                  model.discontinuity_relative_gap * centre.range_m);
+    straddles =
+        straddles || off_plane > std::max(model.discontinuity_min_gap_m,
+                                          model.discontinuity_relative_gap * centre.range_m);
     echo.range_m += s.range_m;
     echo.intensity += s.intensity;
     echo.radiance += s.radiance;
@@ -143,18 +145,21 @@ void parallel_rows(int rows, const SimulationSettings& settings, Body&& body) {
 
 }  // namespace
 
-ScanLighting reference_lighting() { return ScanLighting{}; }
+ScanLighting reference_lighting() {
+  return ScanLighting{};
+}
 
 ScanLighting random_lighting(std::uint64_t seed) {
   Random rng(hash_combine(seed, 0x116417));
   const double elevation = rng.uniform(20.0, 65.0) * kDeg;
   const double azimuth = rng.uniform(0.0, 360.0) * kDeg;
   ScanLighting lighting;
-  lighting.sun_direction_world = Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
-                                                 std::cos(elevation) * std::sin(azimuth),
-                                                 std::sin(elevation));
+  lighting.sun_direction_world =
+      Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                      std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
   lighting.exposure = rng.uniform(0.45, 0.8);
-  for (int c = 0; c < 3; ++c) lighting.white_balance[c] = static_cast<float>(rng.uniform(0.88, 1.12));
+  for (int c = 0; c < 3; ++c)
+    lighting.white_balance[c] = static_cast<float>(rng.uniform(0.88, 1.12));
   return lighting;
 }
 
@@ -171,10 +176,12 @@ Eigen::Vector3f shade(const Scene& scene, const Hit& hit, const Eigen::Vector3d&
     const bool lit = !shadows || !scene.intersect(to_sun, 0.0, 1e4).has_value();
     sun = lit ? lighting.sun_irradiance * facing : 0.0;
   }
-  return surface_albedo(scene, hit, footprint_m) * static_cast<float>(lighting.sky_irradiance + sun);
+  return surface_albedo(scene, hit, footprint_m) *
+         static_cast<float>(lighting.sky_irradiance + sun);
 }
 
-Eigen::Matrix<std::uint8_t, 3, 1> expose(const Eigen::Vector3f& radiance, const ScanLighting& lighting) {
+Eigen::Matrix<std::uint8_t, 3, 1> expose(const Eigen::Vector3f& radiance,
+                                         const ScanLighting& lighting) {
   Eigen::Matrix<std::uint8_t, 3, 1> rgb;
   for (int c = 0; c < 3; ++c) {
     const double linear =
@@ -220,7 +227,8 @@ SimulatedScan simulate_scan(const Scene& scene, const Eigen::Isometry3d& T_world
       if (!centre.hit) continue;
       Random rng(hash_combine(seed, i));
       CleanSample measured = centre;
-      if (at_discontinuity(clean, model, row, col) && rng.uniform() < model.mixed_pixel_probability) {
+      if (at_discontinuity(clean, model, row, col) &&
+          rng.uniform() < model.mixed_pixel_probability) {
         CleanSample echo;
         if (mixed_echo(scene, T_world_scan, angles, row, col, model, lighting, centre, echo)) {
           measured = echo;

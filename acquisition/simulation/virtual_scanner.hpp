@@ -45,7 +45,8 @@ struct ScannerModel {
 // Lighting of one scan's colour image. Each scan of a campaign gets its own,
 // so scans of the same wall disagree in colour (seed 004 §4.5).
 struct ScanLighting {
-  Eigen::Vector3d sun_direction_world = Eigen::Vector3d(0.3, 0.2, 0.93).normalized();  // towards the sun
+  Eigen::Vector3d sun_direction_world =
+      Eigen::Vector3d(0.3, 0.2, 0.93).normalized();  // towards the sun
   double sun_irradiance = 2.5;  // linear units; albedo 1 facing the sun → 2.5 · exposure
   double sky_irradiance = 0.6;  // ambient, unshadowed
   double exposure = 0.6;
@@ -61,10 +62,11 @@ ScanLighting random_lighting(std::uint64_t seed);
 
 // Per-pixel truth, rows × columns, row-major like the scan.
 struct ScanTruth {
-  std::vector<ObjectId> object_id;          // object under the beam centre; 0 = no return
-  std::vector<Eigen::Vector3f> normal_scan;  // unit, scan frame, facing the scanner; zero where no return
-  std::vector<float> range_m;               // noise-free range of the beam centre; 0 where no return
-  std::vector<std::uint8_t> mixed;          // 1 = mixed pixel (its range is a blend)
+  std::vector<ObjectId> object_id;  // object under the beam centre; 0 = no return
+  std::vector<Eigen::Vector3f>
+      normal_scan;                  // unit, scan frame, facing the scanner; zero where no return
+  std::vector<float> range_m;       // noise-free range of the beam centre; 0 where no return
+  std::vector<std::uint8_t> mixed;  // 1 = mixed pixel (its range is a blend)
 };
 
 struct SimulationSettings {
@@ -89,7 +91,8 @@ SimulatedScan simulate_scan(const Scene& scene, const Eigen::Isometry3d& T_world
 
 // Linear radiance → 8-bit sRGB display value, with exposure and white
 // balance applied; shared by scans and truth images.
-Eigen::Matrix<std::uint8_t, 3, 1> expose(const Eigen::Vector3f& radiance, const ScanLighting& lighting);
+Eigen::Matrix<std::uint8_t, 3, 1> expose(const Eigen::Vector3f& radiance,
+                                         const ScanLighting& lighting);
 
 // Linear radiance leaving the surface at `hit` towards the viewer under
 // `lighting`: albedo · (sky + sun · max(0, n·s) · visible), where `visible`

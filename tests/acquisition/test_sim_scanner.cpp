@@ -26,8 +26,8 @@ ScannerModel small_model() {
 // One small campus scan, shared by the tests of this file.
 struct CampusScan {
   Site site = make_site("campus", 7, 2);
-  SimulatedScan sim = simulate_scan(site.scene, site.scan_poses[0], small_model(),
-                                    random_lighting(11), 11);
+  SimulatedScan sim =
+      simulate_scan(site.scene, site.scan_poses[0], small_model(), random_lighting(11), 11);
 };
 
 const CampusScan& campus() {
@@ -66,7 +66,8 @@ TEST(SimScanner, TruthIdsAndRangesMatchThePrimitivesOfThatObject) {
       double nearest = 1e30;
       for (const Primitive& p : c.site.scene.primitives()) {
         if (p.object != id) continue;
-        if (const auto hit = intersect_shape(p.shape, ray, 0.0, 1e4)) nearest = std::min(nearest, hit->distance_m);
+        if (const auto hit = intersect_shape(p.shape, ray, 0.0, 1e4))
+          nearest = std::min(nearest, hit->distance_m);
       }
       ASSERT_NEAR(nearest, c.sim.truth.range_m[i], 1e-4) << "row " << row << " col " << col;
       ++checked;
@@ -126,8 +127,8 @@ TEST(SimScanner, ResultDoesNotDependOnTheThreadCount) {
 
 TEST(SimScanner, ScansOfTheSameWallDisagreeInColourButNotInGeometry) {
   const CampusScan& c = campus();
-  const SimulatedScan relit = simulate_scan(c.site.scene, c.site.scan_poses[0], small_model(),
-                                            random_lighting(99), 11);
+  const SimulatedScan relit =
+      simulate_scan(c.site.scene, c.site.scan_poses[0], small_model(), random_lighting(99), 11);
   EXPECT_EQ(relit.truth.range_m, c.sim.truth.range_m);
   EXPECT_NE(relit.scan.rgb, c.sim.scan.rgb);
 }
@@ -145,7 +146,8 @@ TEST(SimScanner, TruthViewAndScanAgreeOnObjectIds) {
   // Look horizontally along the scan frame's x axis (camera z forward, y down).
   const Eigen::Vector3d forward = scan.T_world_scan.linear().col(0);
   const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
-  view.T_world_camera.linear() << right, Eigen::Vector3d(forward.cross(right)).normalized(), forward;
+  view.T_world_camera.linear() << right, Eigen::Vector3d(forward.cross(right)).normalized(),
+      forward;
   const TruthImage image = render_truth_view(c.site.scene, view);
   const double focal = 0.5 * view.height / std::tan(0.5 * view.vertical_fov_deg * M_PI / 180.0);
   const auto& angles = std::get<SphericalAngles>(scan.angles);
@@ -153,12 +155,17 @@ TEST(SimScanner, TruthViewAndScanAgreeOnObjectIds) {
   for (int v = 0; v < view.height; ++v) {
     for (int u = 0; u < view.width; ++u) {
       const Eigen::Vector3d d_world = view.T_world_camera.linear() *
-          Eigen::Vector3d((u + 0.5 - 0.5 * view.width) / focal, (v + 0.5 - 0.5 * view.height) / focal, 1.0);
+                                      Eigen::Vector3d((u + 0.5 - 0.5 * view.width) / focal,
+                                                      (v + 0.5 - 0.5 * view.height) / focal, 1.0);
       const Eigen::Vector3d d = scan.T_world_scan.linear().transpose() * d_world.normalized();
       const double az = std::atan2(d.y(), d.x()), el = std::asin(d.z());
-      const int col = static_cast<int>(std::lround(std::remainder(az - angles.azimuth_start_rad, 2 * M_PI) /
-                                                   angles.azimuth_step_rad + scan.columns)) % scan.columns;
-      const int row = static_cast<int>(std::lround((el - angles.elevation_start_rad) / angles.elevation_step_rad));
+      const int col =
+          static_cast<int>(std::lround(std::remainder(az - angles.azimuth_start_rad, 2 * M_PI) /
+                                           angles.azimuth_step_rad +
+                                       scan.columns)) %
+          scan.columns;
+      const int row = static_cast<int>(
+          std::lround((el - angles.elevation_start_rad) / angles.elevation_step_rad));
       if (row < 0 || row >= scan.rows) continue;
       ++compared;
       agreed += image.object_id[static_cast<std::size_t>(v) * view.width + u] ==
@@ -184,7 +191,8 @@ TEST(SimCampaign, SameSeedGivesByteIdenticalFiles) {
   for (const auto& entry : std::filesystem::recursive_directory_iterator(a.path())) {
     if (!entry.is_regular_file()) continue;
     const auto relative = std::filesystem::relative(entry.path(), a.path());
-    ASSERT_EQ(test::read_file_bytes(entry.path()), test::read_file_bytes(b.path() / relative)) << relative;
+    ASSERT_EQ(test::read_file_bytes(entry.path()), test::read_file_bytes(b.path() / relative))
+        << relative;
     ++files;
   }
   EXPECT_EQ(files, 1 + 2 * (1 + 4 + 4));  // truth.json; per scan: ptx, triplet (4), truth (4)

@@ -50,7 +50,7 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
-  for (const char* command : {"import", "info", "export", "bench", "simulate"}) {
+  for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
@@ -202,12 +202,14 @@ TEST(Cli, BenchIoSmokeRunPrintsOneJsonObject) {
 
 TEST(Cli, SimulateThenImportThenInfoOnTheCampusSite) {
   ScratchDir dir;
-  const CliResult sim = run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
-                                      "--scans", "2", "--columns", "360", "--rows", "90"});
+  const CliResult sim =
+      run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(), "--scans", "2",
+                    "--columns", "360", "--rows", "90"});
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const std::filesystem::path project = dir / "campus.sbproj";
-  const CliResult import = run_cli(dir, {"import", project.string(), (dir / "sim/campus_scan_01.json").string(),
-                                         (dir / "sim/campus_scan_02.json").string()});
+  const CliResult import =
+      run_cli(dir, {"import", project.string(), (dir / "sim/campus_scan_01.json").string(),
+                    (dir / "sim/campus_scan_02.json").string()});
   ASSERT_EQ(import.exit_code, 0) << import.err;
   const nlohmann::json info = info_json(dir, project);
   ASSERT_EQ(info["scans"].size(), 2u);
@@ -217,23 +219,55 @@ TEST(Cli, SimulateThenImportThenInfoOnTheCampusSite) {
   EXPECT_EQ(info["scans"][1]["T_world_scan"], truth["scans"][1]["T_world_scan"]);
 }
 
+TEST(Cli, GeometryThenPlyExportCarriesNormalsAndLeavesMixedPixelsOut) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
+                          "--scans", "1", "--columns", "720", "--rows", "180"})
+                .exit_code,
+            0);
+  const std::filesystem::path project = dir / "p.sbproj", ply = dir / "model.ply";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), (dir / "sim/campus_scan_01.json").string()})
+                .exit_code,
+            0);
+  const CliResult geometry = run_cli(dir, {"geometry", project.string()});
+  ASSERT_EQ(geometry.exit_code, 0) << geometry.err;
+  EXPECT_NE(geometry.out.find("campus_scan_01"), std::string::npos) << geometry.out;
+  ASSERT_EQ(
+      run_cli(dir, {"export", project.string(), "--format", "ply", "-o", ply.string()}).exit_code,
+      0);
+  const std::string bytes = test::read_file_bytes(ply);
+  const std::string header = bytes.substr(0, bytes.find("end_header"));
+  EXPECT_NE(header.find("property float nx"), std::string::npos);
+  EXPECT_NE(header.find("property float radius"), std::string::npos);
+  const nlohmann::json info = info_json(dir, project);
+  const std::size_t vertices = std::stoul(header.substr(header.find("element vertex ") + 15));
+  EXPECT_LT(vertices,
+            info["scans"][0]["valid_points"].get<std::size_t>());  // mixed pixels left out
+  EXPECT_EQ(
+      run_cli(dir, {"geometry", test::fixture("bad/project_not_sqlite.sbproj").string()}).exit_code,
+      2);
+}
+
 TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {
   ScratchDir dir;
   const std::filesystem::path view = dir / "view.json", png = dir / "truth.png";
   std::FILE* f = std::fopen(view.c_str(), "w");
   std::fputs(R"({"position": [0, -30, 2], "look_at": [0, 0, 5], "vertical_fov_deg": 50,
-                 "width": 64, "height": 48})", f);
+                 "width": 64, "height": 48})",
+             f);
   std::fclose(f);
-  const CliResult ok = run_cli(dir, {"simulate", "--site", "street", "--render-view", view.string(),
-                                     "-o", png.string()});
+  const CliResult ok = run_cli(
+      dir, {"simulate", "--site", "street", "--render-view", view.string(), "-o", png.string()});
   ASSERT_EQ(ok.exit_code, 0) << ok.err;
   EXPECT_TRUE(std::filesystem::exists(png));
   EXPECT_TRUE(std::filesystem::exists(dir / "truth_object_id.png"));
   f = std::fopen(view.c_str(), "w");
-  std::fputs(R"({"position": [0, 0, 2], "look_at": [0, 0, 2], "vertical_fov_deg": 50, "width": 64, "height": 48})", f);
+  std::fputs(
+      R"({"position": [0, 0, 2], "look_at": [0, 0, 2], "vertical_fov_deg": 50, "width": 64, "height": 48})",
+      f);
   std::fclose(f);
-  const CliResult bad = run_cli(dir, {"simulate", "--site", "street", "--render-view", view.string(),
-                                      "-o", png.string()});
+  const CliResult bad = run_cli(
+      dir, {"simulate", "--site", "street", "--render-view", view.string(), "-o", png.string()});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("look_at"), std::string::npos) << bad.err;
 }
@@ -241,7 +275,8 @@ TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {
 TEST(Cli, SimulateWithoutAnOutputFolderIsAUsageError) {
   ScratchDir dir;
   EXPECT_EQ(run_cli(dir, {"simulate", "--site", "campus"}).exit_code, 2);
-  EXPECT_EQ(run_cli(dir, {"simulate", "--site", "moon", "--out", dir.path().string()}).exit_code, 2);
+  EXPECT_EQ(run_cli(dir, {"simulate", "--site", "moon", "--out", dir.path().string()}).exit_code,
+            2);
 }
 
 }  // namespace

@@ -40,7 +40,7 @@ TEST(Project, CreateMakesAnEmptyProjectOfTheCurrentSchema) {
   }
   RawDatabase raw(file);
   EXPECT_EQ(raw.text("PRAGMA application_id"), std::to_string(kProjectApplicationId));
-  EXPECT_EQ(raw.text("PRAGMA user_version"), "1");
+  EXPECT_EQ(raw.text("PRAGMA user_version"), std::to_string(kProjectSchemaVersion));
   EXPECT_EQ(raw.text("PRAGMA journal_mode"), "wal");
   EXPECT_EQ(raw.text("SELECT value FROM meta WHERE key = 'created_by'"), "scanbench");
   EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
@@ -52,7 +52,7 @@ TEST(Project, OpenFindsWhatCreateLeft) {
   { Project::create(file); }
   EXPECT_TRUE(test::no_side_files(file));  // the last close checkpoints the WAL away
   const Project project = Project::open(file);
-  EXPECT_EQ(project.schema_version(), 1);
+  EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
   EXPECT_TRUE(project.scans().empty());
 }
 

@@ -103,8 +103,8 @@ TEST(ProjectFiles, RefusesANewerSchema) {
   const auto file = dir / "future.sbproj";
   { Project project = Project::create(file); }
   { RawDatabase(file).execute("PRAGMA user_version = 7"); }
-  expect_refused(file,
-                 "project schema version 7 is newer than this scanbench (1); upgrade scanbench");
+  expect_refused(file, "project schema version 7 is newer than this scanbench (" +
+                           std::to_string(kProjectSchemaVersion) + "); upgrade scanbench");
 }
 
 // The version bump sits only in the -wal file while another connection keeps

@@ -1,0 +1,302 @@
+// Footprints and normals from pixel adjacency (seed 004 §4.2).
+//
+// Normals of spherical scans come from the gradient of log-range over the
+// angles. With p = r·u(θ, φ) and the orthonormal frame (u, e_θ, e_φ),
+//   ∂p/∂θ = r_θ u + r cos φ e_θ,   ∂p/∂φ = r_φ u + r e_φ,
+//   ∂p/∂θ × ∂p/∂φ ∝ u − (∂ln r/∂θ) / cos φ · e_θ − (∂ln r/∂φ) · e_φ,
+// so a normal needs only the two slopes of ln r, which a least-squares plane
+// fit of ln r over the pixel window gives from ten running window moments
+// (window_moments.hpp): constant time per pixel for any window size. That fit
+// is exact to second order only in a full, symmetric window; windows cut by a
+// depth discontinuity, by invalid pixels or by the grid's border get a
+// covariance fit of their 3D points instead, leaving out the neighbours across
+// the discontinuity. Scans with per-pixel directions have no angle model and
+// always take the covariance fit.
+#include "acquisition/scan_geometry.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+
+#include "acquisition/mixed_pixels.hpp"
+#include "acquisition/window_moments.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+template <typename Body>
+void parallel_rows(int rows, int threads, Body&& body) {
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& r) {
+      for (int row = r.begin(); row < r.end(); ++row) body(row);
+    });
+  });
+}
+
+// Least-squares slopes (per column, per row) of v over a window, from its
+// moments; false when the window does not span two independent directions.
+bool plane_slopes(double n, double sx, double sy, double sxx, double sxy, double syy, double sv,
+                  double sxv, double syv, double& b, double& c) {
+  if (n < 3) return false;
+  const double cxx = sxx - sx * sx / n, cxy = sxy - sx * sy / n, cyy = syy - sy * sy / n;
+  const double cxv = sxv - sx * sv / n, cyv = syv - sy * sv / n;
+  const double det = cxx * cyy - cxy * cxy;
+  if (cxx < 0.5 || cyy < 0.5 || det < 0.25 * cxx * cyy) return false;
+  b = (cyy * cxv - cxy * cyv) / det;
+  c = (cxx * cyv - cxy * cxv) / det;
+  return true;
+}
+
+// 1 where a masked pixel's log-range jumps: its second difference along the
+// row or the column exceeds the threshold of GeometrySettings (noise-aware,
+// capped by depth_jump_relative).
+std::vector<std::uint8_t> jump_map(const Scan& scan, const std::vector<std::uint8_t>& mask,
+                                   const std::vector<float>& v, const GeometrySettings& settings) {
+  std::vector<std::uint8_t> jumps(mask.size(), 0);
+  const int columns = scan.columns;
+  const double noise_factor = settings.depth_jump_sigmas * std::sqrt(6.0);
+  parallel_rows(scan.rows, settings.threads, [&](int r) {
+    for (int c = 0; c < columns; ++c) {
+      const std::size_t i = scan.index(r, c);
+      if (!mask[i]) continue;
+      const double range = scan.range_m[i];
+      const double sigma = settings.range_noise_m + settings.range_noise_per_m * range;
+      const double jump = std::min(settings.depth_jump_relative, noise_factor * sigma / range);
+      const auto jumps_between = [&](std::size_t before, std::size_t after) {
+        return mask[before] && mask[after] && std::abs(v[before] - 2 * v[i] + v[after]) > jump;
+      };
+      jumps[i] = (c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
+                 (r > 0 && r + 1 < scan.rows && jumps_between(i - columns, i + columns));
+    }
+  });
+  return jumps;
+}
+
+// Sines and cosines of every column's azimuth and every row's elevation, so
+// the per-pixel work is free of trigonometry.
+struct AngleTables {
+  std::vector<double> cos_az, sin_az, cos_el, sin_el;
+
+  explicit AngleTables(const Scan& scan) {
+    const auto* a = std::get_if<SphericalAngles>(&scan.angles);
+    if (a == nullptr) return;
+    for (int col = 0; col < scan.columns; ++col) {
+      const double az = a->azimuth_start_rad + col * a->azimuth_step_rad;
+      cos_az.push_back(std::cos(az));
+      sin_az.push_back(std::sin(az));
+    }
+    for (int row = 0; row < scan.rows; ++row) {
+      const double el = a->elevation_start_rad + row * a->elevation_step_rad;
+      cos_el.push_back(std::cos(el));
+      sin_el.push_back(std::sin(el));
+    }
+  }
+
+  // The pixel's unit viewing direction, from the tables when the scan is spherical.
+  Eigen::Vector3f direction(const Scan& scan, int row, int col) const {
+    if (cos_az.empty()) return acquisition::direction(scan, row, col);
+    return Eigen::Vector3d(cos_el[row] * cos_az[col], cos_el[row] * sin_az[col], sin_el[row])
+        .cast<float>();
+  }
+};
+
+// The running-sum plane fits of one window size, and where they are usable:
+// the whole window valid and free of depth discontinuities.
+struct WindowFits {
+  std::vector<WindowMoments> moments;
+  std::vector<std::uint16_t> jumps;
+  double full = 0;
+
+  static double area(int radius) { return (2.0 * radius + 1) * (2.0 * radius + 1); }
+
+  WindowFits() = default;
+  WindowFits(const Scan& scan, int radius, const std::vector<std::uint8_t>& mask,
+             const std::vector<float>& log_range, const std::vector<std::uint8_t>& jump_map,
+             int threads)
+      : moments(window_moments(scan.rows, scan.columns, radius, mask, log_range, threads)),
+        jumps(window_counts(scan.rows, scan.columns, radius, jump_map, threads)),
+        full(area(radius)) {}
+
+  bool clean(std::size_t i) const { return jumps[i] == 0 && moments[i].n == full; }
+  bool slopes(std::size_t i, double& b, double& c) const {
+    const WindowMoments& m = moments[i];
+    return plane_slopes(m.n, m.sx, m.sy, m.sxx, m.sxy, m.syy, m.sv, m.sxv, m.syv, b, c);
+  }
+};
+
+struct GridContext {
+  const Scan& scan;
+  const GeometrySettings& settings;
+  const std::vector<std::uint8_t>& mask;  // valid and not mixed
+  const std::vector<float>& log_range;
+  const AngleTables& tables;
+
+  Eigen::Vector3d point(int row, int col) const {
+    return scan.range_m[scan.index(row, col)] * tables.direction(scan, row, col).cast<double>();
+  }
+};
+
+// Unit normal towards the scanner from the log-range slopes per column (b)
+// and per row (c) at a pixel of a spherical scan.
+Eigen::Vector3f spherical_normal(const SphericalAngles& a, const AngleTables& t, int row, int col,
+                                 double b, double c) {
+  const double ca = t.cos_az[col], sa = t.sin_az[col], ce = t.cos_el[row], se = t.sin_el[row];
+  const Eigen::Vector3d u(ce * ca, ce * sa, se), e_az(-sa, ca, 0.0), e_el(-se * ca, -se * sa, ce);
+  const double g_az = b / a.azimuth_step_rad / std::max(ce, 1e-3);
+  const double g_el = c / a.elevation_step_rad;
+  return (-u + g_az * e_az + g_el * e_el).normalized().cast<float>();
+}
+
+// Covariance fit of the 3D points over the window (per-pixel grids).
+bool covariance_normal(const GridContext& g, int row, int col, Eigen::Vector3f& normal, int& used) {
+  const int k = g.settings.edge_window_radius;
+  const float centre = g.log_range[g.scan.index(row, col)];
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  used = 0;
+  for (int r = std::max(0, row - k); r <= std::min(g.scan.rows - 1, row + k); ++r) {
+    for (int cc = std::max(0, col - k); cc <= std::min(g.scan.columns - 1, col + k); ++cc) {
+      const std::size_t i = g.scan.index(r, cc);
+      const double limit =
+          g.settings.depth_jump_relative * std::max(std::abs(r - row), std::abs(cc - col));
+      if (!g.mask[i] || std::abs(g.log_range[i] - centre) > limit + 1e-12) continue;
+      const Eigen::Vector3d p = g.point(r, cc);
+      sum += p;
+      outer += p * p.transpose();
+      ++used;
+    }
+  }
+  if (used < 3) return false;
+  const Eigen::Vector3d mean = sum / used;
+  const Eigen::Matrix3d covariance = outer / used - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
+  const Eigen::Vector3d& values = solver.eigenvalues();
+  if (values[1] <= 4.0 * values[0]) return false;  // a line or a blob, not a surface
+  Eigen::Vector3d n = solver.eigenvectors().col(0);
+  if (n.dot(g.point(row, col)) > 0) n = -n;
+  normal = n.cast<float>();
+  return true;
+}
+
+float footprint(const Scan& scan, const AngleTables& tables, int row, int col,
+                const Eigen::Vector3f& normal, const GeometrySettings& settings) {
+  const std::size_t i = scan.index(row, col);
+  double spacing_az = 0, spacing_el = 0;
+  if (const auto* a = std::get_if<SphericalAngles>(&scan.angles)) {
+    spacing_az = std::abs(a->azimuth_step_rad) * tables.cos_el[row];
+    spacing_el = std::abs(a->elevation_step_rad);
+  } else {  // angle to the next column and row of the direction grid
+    const Eigen::Vector3f d = direction(scan, row, col);
+    const int c2 = col + 1 < scan.columns ? col + 1 : col - 1,
+              r2 = row + 1 < scan.rows ? row + 1 : row - 1;
+    if (c2 >= 0) spacing_az = std::acos(std::clamp(d.dot(direction(scan, row, c2)), -1.0f, 1.0f));
+    if (r2 >= 0) spacing_el = std::acos(std::clamp(d.dot(direction(scan, r2, col)), -1.0f, 1.0f));
+  }
+  const double gap = scan.range_m[i] * std::sqrt(spacing_az * spacing_az + spacing_el * spacing_el);
+  double cos_incidence = 1.0;
+  if (normal != Eigen::Vector3f::Zero())
+    cos_incidence = std::abs(normal.dot(tables.direction(scan, row, col)));
+  return static_cast<float>(0.5 * gap /
+                            std::max(cos_incidence, 1.0 / settings.max_footprint_stretch));
+}
+
+}  // namespace
+
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
+  assert(check_consistency(scan).empty() && settings.window_radius >= 1 &&
+         settings.edge_window_radius >= 1);
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n = scan.pixel_count();
+  std::vector<std::uint8_t> mixed = settings.flag_mixed_pixels ? detect_mixed_pixels(scan, settings)
+                                                               : std::vector<std::uint8_t>(n, 0);
+  std::vector<std::uint8_t> mask(n);
+  std::vector<float> log_range(n, 0.0f);
+  parallel_rows(scan.rows, settings.threads, [&](int row) {
+    for (std::size_t i = scan.index(row, 0); i < scan.index(row, 0) + scan.columns; ++i) {
+      mask[i] = scan.valid[i] && !mixed[i] && scan.range_m[i] > 0.0f;
+      if (mask[i]) log_range[i] = std::log(scan.range_m[i]);
+    }
+  });
+  const std::vector<std::uint8_t> jumps = jump_map(scan, mask, log_range, settings);
+  const bool spherical = scan.is_spherical();
+  std::vector<WindowFits> scales;  // widest first
+  for (int radius = settings.window_radius; spherical;) {
+    scales.emplace_back(scan, radius, mask, log_range, jumps, settings.threads);
+    if (radius <= settings.edge_window_radius) break;
+    radius =
+        radius / 2 >= 2 * settings.edge_window_radius ? radius / 2 : settings.edge_window_radius;
+  }
+  const AngleTables tables(scan);
+  const GridContext context{scan, settings, mask, log_range, tables};
+  const double edge_window_area = WindowFits::area(settings.edge_window_radius);
+
+  GeometryResult result;
+  ScanGeometry& g = result.geometry;
+  g.footprint_m.assign(n, 0.0f);
+  g.normal.assign(n, Eigen::Vector3f::Zero());
+  g.confidence.assign(n, 0.0f);
+  g.flags.assign(n, 0);
+  parallel_rows(scan.rows, settings.threads, [&](int row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (!scan.valid[i]) continue;
+      std::uint8_t flags = (mixed[i] ? kFlagMixedPixel : 0) | (jumps[i] ? kFlagEdge : 0);
+      Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+      int used = 0;
+      bool ok = false;
+      double area = edge_window_area;
+      if (mask[i] && spherical) {
+        const auto& a = std::get<SphericalAngles>(scan.angles);
+        double b = 0, c = 0;
+        for (const WindowFits& fits : scales) {
+          if (fits.clean(i) && fits.slopes(i, b, c)) {
+            used = static_cast<int>(fits.moments[i].n);
+            area = fits.full;
+            ok = true;
+            break;
+          }
+        }
+        if (!ok) {
+          // A window cut by a discontinuity, an invalid region or the grid's
+          // border is lopsided: the log-range slope of a lopsided window is
+          // biased by the curvature of ln r, a 3D plane fit is not.
+          ok = covariance_normal(context, row, col, normal, used);
+        }
+        if (ok && normal == Eigen::Vector3f::Zero())
+          normal = spherical_normal(a, tables, row, col, b, c);
+      } else if (mask[i]) {
+        ok = covariance_normal(context, row, col, normal, used);
+      }
+      ok = ok && used >= settings.min_neighbours && normal.allFinite();
+      if (ok) {
+        const float cos_incidence = std::abs(normal.dot(tables.direction(scan, row, col)));
+        g.normal[i] = normal;
+        g.confidence[i] =
+            std::max(1e-6f, static_cast<float>(std::min(1.0, used / area)) * cos_incidence);
+      } else {
+        flags |= kFlagNoNormal;
+      }
+      g.flags[i] = flags;
+      g.footprint_m[i] = footprint(scan, tables, row, col, g.normal[i], settings);
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!scan.valid[i]) continue;
+    ++result.valid_points;
+    result.normals += g.has_normal(i);
+    result.mixed_pixels += (g.flags[i] & kFlagMixedPixel) != 0;
+    result.edge_pixels += (g.flags[i] & kFlagEdge) != 0;
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,95 @@
+// Per-point geometry from pixel adjacency (seed 004 §4.2): every pixel of a
+// scan is a point with a size — the footprint that closes the gap to its
+// neighbours — and a normal fitted from its neighbours in the scan grid, plus
+// flags for the points that float between foreground and background at depth
+// edges (mixed pixels, "veils").
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "acquisition/scan.hpp"
+
+namespace scanbench::acquisition {
+
+// Bits of ScanGeometry::flags.
+enum GeometryFlag : std::uint8_t {
+  kFlagMixedPixel = 1u << 0,  // floats between a foreground and a background surface
+  kFlagEdge = 1u << 1,        // next to a depth discontinuity
+  kFlagNoNormal = 1u << 2,    // too few consistent neighbours: normal is invalid
+};
+
+// Parallel arrays, rows × columns, row-major like the scan.
+struct ScanGeometry {
+  // Radius [m] of the disk that closes the gap to the neighbouring samples;
+  // 0 where the pixel is invalid.
+  std::vector<float> footprint_m;
+  // Unit normal in the scan frame pointing towards the scanner; the zero
+  // vector where the normal is invalid (invalid pixel or kFlagNoNormal).
+  std::vector<Eigen::Vector3f> normal;
+  // [0, 1]: the share of the window the fit used times the cosine of the
+  // incidence angle (grazing views estimate normals poorly); 0 where the
+  // normal is invalid.
+  std::vector<float> confidence;
+  std::vector<std::uint8_t> flags;
+
+  bool has_normal(std::size_t i) const { return confidence[i] > 0.0f; }
+  bool is_mixed(std::size_t i) const { return (flags[i] & kFlagMixedPixel) != 0; }
+};
+
+struct GeometrySettings {
+  // Neighbourhood of the plane fit: (2 · window_radius + 1)² pixels, used
+  // wherever that whole window is valid and free of depth discontinuities (a
+  // wide window averages the range noise away on the large surfaces of
+  // outdoor scenes). Where it is not, the fit tries windows of half the
+  // radius, down to edge_window_radius; where even that one is cut (next to
+  // a discontinuity, an invalid region or the grid's border), a covariance
+  // fit of the consistent neighbours in it. The cost per pixel does not
+  // depend on the radii (running box sums).
+  int window_radius = 16;
+  int edge_window_radius = 3;
+  // A depth discontinuity: the second difference of log-range along a row or
+  // column exceeds depth_jump_sigmas times its noise (√6 · σ(range) / range),
+  // or depth_jump_relative, whichever is smaller. A grazing but smooth
+  // surface has a steady range gradient and no second difference.
+  double depth_jump_sigmas = 6.0;
+  // Neighbours whose range differs from the centre's by more than
+  // depth_jump_relative · range · (pixel distance) are across a depth
+  // discontinuity and left out of the covariance fit.
+  double depth_jump_relative = 0.02;
+  // Fewer valid, consistent neighbours than this gives an invalid normal.
+  int min_neighbours = 5;
+  // Largest footprint, in multiples of the grazing-free footprint, so that a
+  // surface seen edge-on does not produce metre-wide splats.
+  double max_footprint_stretch = 4.0;
+  // Detect and flag mixed pixels (they stay in the scan; later stages leave
+  // them out of the model).
+  bool flag_mixed_pixels = true;
+  // The scanner's range noise, σ = range_noise_m + range_noise_per_m · range
+  // (defaults: the RIEGL LMS-Z360 and our virtual scanner). A pixel is a mixed
+  // pixel when, along some grid line, it lies between its neighbours and off
+  // the linear continuation of both sides by more than mixed_pixel_sigmas · σ.
+  double range_noise_m = 0.005;
+  double range_noise_per_m = 5e-5;
+  double mixed_pixel_sigmas = 8.0;
+  // Worker threads; 0 = all cores. Results do not depend on it.
+  int threads = 0;
+};
+
+struct GeometryResult {
+  ScanGeometry geometry;
+  std::size_t valid_points = 0;
+  std::size_t normals = 0;  // valid points given a normal
+  std::size_t mixed_pixels = 0;
+  std::size_t edge_pixels = 0;
+  double seconds = 0.0;
+};
+
+// Computes footprints, normals, confidences and flags for every pixel. Works
+// on spherical and per-pixel-direction scans (for the latter the fit runs on
+// the points themselves). Asserts the scan is consistent.
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings = {});
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,64 @@
+// scanbench geometry PROJECT [--window R] [--edge-window R] [--no-mixed-pixels] [--threads N]
+#include <fmt/core.h>
+
+#include <memory>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/progress_bar.hpp"
+#include "modeling/geometry_stage.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct GeometryOptions {
+  std::string project;
+  modeling::GeometryStageSettings stage;
+  bool no_mixed_pixels = false;
+};
+
+void run_geometry(GeometryOptions& options) {
+  options.stage.geometry.flag_mixed_pixels = !options.no_mixed_pixels;
+  ProgressBar progress("geometry");
+  options.stage.on_scan_done = [&progress](std::size_t done, std::size_t total,
+                                           const std::string& name) {
+    progress.update(done, total, name);
+  };
+  const modeling::GeometryStageResult result =
+      modeling::compute_project_geometry(options.project, options.stage);
+  fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8}\n", "id", "name", "valid", "normals",
+             "mixed", "edges", "seconds");
+  for (const modeling::GeometryStageScan& s : result.scans) {
+    fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8.3f}\n", s.id, s.name, s.valid_points,
+               s.normals, s.mixed_pixels, s.edge_pixels, s.seconds);
+  }
+  fmt::print("geometry of {} scan(s) stored in {} ({:.2f} s)\n", result.scans.size(),
+             options.project, result.seconds);
+}
+
+}  // namespace
+
+void add_geometry_command(CLI::App& app) {
+  auto options = std::make_shared<GeometryOptions>();
+  CLI::App* command = app.add_subcommand(
+      "geometry",
+      "Compute every scan's per-point footprint, normal (from its neighbours in the scan grid), "
+      "confidence and mixed-pixel/edge flags, and store them in the project (one transaction).");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  acquisition::GeometrySettings& g = options->stage.geometry;
+  command->add_option("--window", g.window_radius, "Radius of the widest fitting window [pixels]")
+      ->check(CLI::Range(1, 200))
+      ->capture_default_str();
+  command
+      ->add_option("--edge-window", g.edge_window_radius,
+                   "Radius of the window near edges [pixels]")
+      ->check(CLI::Range(1, 50))
+      ->capture_default_str();
+  command->add_flag("--no-mixed-pixels", options->no_mixed_pixels, "Do not flag mixed pixels");
+  command->add_option("--threads", g.threads, "Worker threads (0 = all cores)");
+  command->callback([options] { run_geometry(*options); });
+}
+
+}  // namespace scanbench::app

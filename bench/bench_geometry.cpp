@@ -1,0 +1,311 @@
+// `scanbench bench geometry` (issue #4): our grid normals and mixed-pixel
+// flags against the simulator's exact per-pixel truth (issue #3), with PCL's
+// estimators fed the same organized clouds in the same run.
+//
+// Accuracy is the sign-agnostic angle to the truth normal. Truth mixed pixels
+// are left out of the error statistics: their range is a blend of two
+// surfaces, so no estimator can be right there — they are scored as
+// detections instead (recall and false rate of kFlagMixedPixel).
+#include "bench/bench_geometry.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "acquisition/scan_geometry.hpp"
+#include "acquisition/simulation/random.hpp"
+#include "acquisition/simulation/sites.hpp"
+#include "acquisition/simulation/virtual_scanner.hpp"
+#include "bench/pcl_normals.hpp"
+
+namespace scanbench::bench {
+namespace {
+
+namespace sim = acquisition::sim;
+using Normals = std::vector<Eigen::Vector3f>;
+
+constexpr std::uint64_t kSiteSeed = 1;
+constexpr int kCampaignScans = 4;  // the site's default campaign; we scan its first poses
+
+// Object kinds built from planes only: their truth normal is constant over
+// the object, so their error isolates the estimator from curvature.
+constexpr std::array<std::string_view, 7> kPlanarKinds = {"wall", "roof",   "door",    "window",
+                                                          "sign", "ground", "low_wall"};
+
+struct Peer {
+  const char* key;
+  PclNormalSettings settings;
+  bool in_issue;  // one of the three peers issue #4 names (goals are judged on these)
+};
+
+// PCL settings. Each issue peer runs with the most accurate setting of a sweep
+// on campus scan 1 at 3600 × 900 (median error over the scored pixels). The
+// median keeps falling as the window grows (most scored pixels lie on large,
+// densely sampled planes, where a wider window only averages more noise),
+// while coverage falls and edges blur, so "most accurate" is the lowest
+// median among settings that keep coverage ≥ 0.9 and a p95 no worse than
+// PCL's common setting (tutorial: depth factor 0.02, smoothing 10; k = 16).
+// Measured (median / p95 / coverage):
+// - Integral image, COVARIANCE_MATRIX: smoothing 10 → 0.50° / 22.5° / 0.943,
+//   20 → 0.16° / 19.5° / 0.924, 30 → 0.093° / 15.2° / 0.905 (chosen),
+//   40 → 0.069° / 15.3° / 0.886. AVERAGE_3D_GRADIENT: 10 → 0.43° / 23.5°,
+//   30 → 0.13° / 16.4° / 0.905 (chosen). Depth factors 0.002–0.01 cut
+//   coverage to 0.5–0.9; depth-dependent smoothing was worse in every case:
+//   PCL reads z as a camera's depth, and on a panorama z is height.
+// - kNN: k = 16 → 2.5° / 13.4°, 30 → 1.3° / 9.2°, 50 → 0.79° / 11.5°
+//   (chosen; the 7 × 7 = 49 pixels of our default window), 80 → 0.52° / 16.6°.
+// Two extra entries run the integral image on our window (7 × 7 pixels) to
+// compare the estimators at equal support.
+std::vector<Peer> pcl_peers(int repeats) {
+  PclNormalSettings covariance;
+  covariance.method = PclNormalMethod::kIntegralCovariance;
+  covariance.max_depth_change_factor = 0.02f;
+  covariance.normal_smoothing_size = 30.0f;
+  covariance.depth_dependent_smoothing = false;
+  PclNormalSettings gradient = covariance;
+  gradient.method = PclNormalMethod::kIntegralAverage3dGradient;
+  PclNormalSettings knn;
+  knn.method = PclNormalMethod::kKnnOmp;
+  knn.k_neighbours = 50;
+  knn.threads = 2;
+  PclNormalSettings covariance_7 = covariance, gradient_7 = gradient;
+  covariance_7.normal_smoothing_size = gradient_7.normal_smoothing_size = 7.0f;
+  std::vector<Peer> peers = {{"pcl_integral_covariance", covariance, true},
+                             {"pcl_integral_average_3d_gradient", gradient, true},
+                             {"pcl_knn_omp", knn, true},
+                             {"pcl_integral_covariance_window_7", covariance_7, false},
+                             {"pcl_integral_average_3d_gradient_window_7", gradient_7, false}};
+  for (Peer& peer : peers) peer.settings.repeats = repeats;
+  return peers;
+}
+
+nlohmann::json settings_json(const PclNormalSettings& s) {
+  if (s.method == PclNormalMethod::kKnnOmp) return {{"k_neighbours", s.k_neighbours}};
+  return {{"max_depth_change_factor", s.max_depth_change_factor},
+          {"normal_smoothing_size", s.normal_smoothing_size},
+          {"depth_dependent_smoothing", s.depth_dependent_smoothing}};
+}
+
+nlohmann::json settings_json(const acquisition::GeometrySettings& s) {
+  return {{"window_radius", s.window_radius},
+          {"depth_jump_relative", s.depth_jump_relative},
+          {"min_neighbours", s.min_neighbours},
+          {"note", "time includes footprints and mixed-pixel flags"}};
+}
+
+// Running totals of one method over all scans.
+struct MethodStats {
+  std::vector<float> errors_deg;         // scored pixels (see file comment)
+  std::vector<float> planar_errors_deg;  // the scored pixels on kPlanarKinds
+  std::size_t valid = 0;                 // valid pixels
+  std::size_t with_normal = 0;           // valid pixels given a normal
+  double seconds = 0.0;                  // best-of-runs time, summed over scans
+};
+
+struct MixedStats {
+  std::size_t truth_mixed = 0;  // valid pixels that are truth mixed pixels
+  std::size_t recalled = 0;     // … and flagged by ours
+  std::size_t clean = 0;        // valid pixels that are not truth mixed pixels
+  std::size_t false_flags = 0;  // … but flagged by ours
+};
+
+// planar[id] = 1 when object `id` is of a planar kind; indexed by ObjectId.
+std::vector<std::uint8_t> planar_objects(const sim::Scene& scene) {
+  std::vector<std::uint8_t> planar(scene.objects().size() + 1, 0);
+  for (const sim::ObjectInfo& info : scene.objects())
+    planar[info.id] = std::ranges::find(kPlanarKinds, info.kind) != kPlanarKinds.end();
+  return planar;
+}
+
+// Methods mark "no normal" with the zero vector; anything non-finite counts too.
+bool has_normal(const Eigen::Vector3f& n) {
+  return n.allFinite() && n.squaredNorm() > 0.25f;
+}
+
+void accumulate(const sim::SimulatedScan& simulated, const Normals& normals,
+                const std::vector<std::uint8_t>& planar, double seconds, MethodStats& stats) {
+  const acquisition::Scan& scan = simulated.scan;
+  const sim::ScanTruth& truth = simulated.truth;
+  constexpr float kDegrees = 180.0f / std::numbers::pi_v<float>;
+  stats.seconds += seconds;
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+    if (!scan.valid[i]) continue;
+    ++stats.valid;
+    if (!has_normal(normals[i])) continue;
+    ++stats.with_normal;
+    if (truth.object_id[i] == 0 || truth.mixed[i]) continue;
+    const float cosine = std::clamp(std::abs(normals[i].dot(truth.normal_scan[i])), 0.0f, 1.0f);
+    const float degrees = std::acos(cosine) * kDegrees;
+    stats.errors_deg.push_back(degrees);
+    if (planar[truth.object_id[i]]) stats.planar_errors_deg.push_back(degrees);
+  }
+}
+
+void accumulate_mixed(const sim::SimulatedScan& simulated, const std::vector<std::uint8_t>& flags,
+                      MixedStats& stats) {
+  for (std::size_t i = 0; i < simulated.scan.pixel_count(); ++i) {
+    if (!simulated.scan.valid[i]) continue;
+    const bool flagged = (flags[i] & acquisition::kFlagMixedPixel) != 0;
+    if (simulated.truth.mixed[i]) {
+      ++stats.truth_mixed;
+      stats.recalled += flagged;
+    } else {
+      ++stats.clean;
+      stats.false_flags += flagged;
+    }
+  }
+}
+
+struct OursRun {
+  Normals normals;  // zero where no normal
+  std::vector<std::uint8_t> flags;
+  double seconds = 0.0;
+};
+
+// compute_geometry with default settings, best of `repeats` wall times.
+OursRun run_ours(const acquisition::Scan& scan, int repeats) {
+  acquisition::GeometryResult result;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < repeats; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    result = acquisition::compute_geometry(scan, acquisition::GeometrySettings{});
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    best = std::min(best, elapsed.count());
+  }
+  OursRun run{Normals(scan.pixel_count(), Eigen::Vector3f::Zero()),
+              std::move(result.geometry.flags), best};
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i)
+    if (result.geometry.has_normal(i)) run.normals[i] = result.geometry.normal[i];
+  return run;
+}
+
+// Scan `k` of the campaign, seeded like `scanbench simulate` seeds it.
+sim::SimulatedScan simulate(const sim::Site& site, const sim::ScannerModel& model, int k) {
+  const std::uint64_t seed = sim::hash_combine(kSiteSeed, static_cast<std::uint64_t>(k) + 1);
+  return sim::simulate_scan(site.scene, site.scan_poses[k], model, sim::random_lighting(seed),
+                            seed);
+}
+
+// The q-quantile (q in [0, 1]) by partial sort; NaN (JSON null) when empty.
+double quantile(std::vector<float>& values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto nth = values.begin() + static_cast<std::ptrdiff_t>(q * (values.size() - 1));
+  std::nth_element(values.begin(), nth, values.end());
+  return *nth;
+}
+
+double ratio(double numerator, double denominator) {
+  return denominator > 0.0 ? numerator / denominator : std::numeric_limits<double>::quiet_NaN();
+}
+
+nlohmann::json method_json(MethodStats& stats, int threads, nlohmann::json settings) {
+  return {
+      {"median_error_deg", quantile(stats.errors_deg, 0.5)},
+      {"p95_error_deg", quantile(stats.errors_deg, 0.95)},
+      {"planar_median_error_deg", quantile(stats.planar_errors_deg, 0.5)},
+      {"coverage", ratio(static_cast<double>(stats.with_normal), static_cast<double>(stats.valid))},
+      {"points_per_second", ratio(static_cast<double>(stats.valid), stats.seconds)},
+      {"seconds", stats.seconds},
+      {"threads", threads},
+      {"settings", std::move(settings)}};
+}
+
+struct BenchTotals {
+  MethodStats ours;
+  MixedStats mixed;
+  std::vector<MethodStats> peers;
+};
+
+void bench_scan(const sim::SimulatedScan& simulated, const std::vector<std::uint8_t>& planar,
+                const std::vector<Peer>& peers, int repeats, BenchTotals& totals) {
+  {
+    const OursRun ours = run_ours(simulated.scan, repeats);
+    accumulate(simulated, ours.normals, planar, ours.seconds, totals.ours);
+    accumulate_mixed(simulated, ours.flags, totals.mixed);
+  }
+  for (std::size_t p = 0; p < peers.size(); ++p) {
+    const PclNormalResult theirs = estimate_pcl_normals(simulated.scan, peers[p].settings);
+    accumulate(simulated, theirs.normal, planar, theirs.seconds, totals.peers[p]);
+  }
+}
+
+nlohmann::json goals_json(const nlohmann::json& report, const std::vector<Peer>& peers) {
+  bool lower_median = true;
+  for (const Peer& peer : peers) {
+    if (!peer.in_issue) continue;
+    const nlohmann::json& theirs = report[peer.key]["median_error_deg"];
+    const nlohmann::json& ours = report["ours"]["median_error_deg"];
+    lower_median = lower_median && ours.is_number() &&
+                   (!theirs.is_number() || ours.get<double>() < theirs.get<double>());
+  }
+  const double speedup =
+      std::min(report["speedup_vs_pcl_integral_covariance"].get<double>(),
+               report["speedup_vs_pcl_integral_average_3d_gradient"].get<double>());
+  const nlohmann::json& ours = report["ours"];
+  return {{"median_below_every_pcl", lower_median},
+          {"speedup_at_least_5x_vs_integral_image", speedup >= 5.0},
+          {"mixed_recall_at_least_0_9_false_rate_at_most_0_01",
+           ours["mixed_pixel_recall"].get<double>() >= 0.9 &&
+               ours["mixed_pixel_false_rate"].get<double>() <= 0.01}};
+}
+
+nlohmann::json report_json(BenchTotals& totals, const std::vector<Peer>& peers) {
+  nlohmann::json report;
+  const acquisition::GeometrySettings ours_settings;
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  report["ours"] =
+      method_json(totals.ours, ours_settings.threads > 0 ? ours_settings.threads : cores,
+                  settings_json(ours_settings));
+  report["ours"]["mixed_pixel_recall"] = ratio(static_cast<double>(totals.mixed.recalled),
+                                               static_cast<double>(totals.mixed.truth_mixed));
+  report["ours"]["mixed_pixel_false_rate"] =
+      ratio(static_cast<double>(totals.mixed.false_flags), static_cast<double>(totals.mixed.clean));
+  report["ours"]["truth_mixed_pixels"] = totals.mixed.truth_mixed;
+  for (std::size_t p = 0; p < peers.size(); ++p) {
+    const PclNormalSettings& s = peers[p].settings;
+    const int threads = s.method == PclNormalMethod::kKnnOmp ? s.threads : 1;
+    report[peers[p].key] = method_json(totals.peers[p], threads, settings_json(s));
+    report[std::string("speedup_vs_") + peers[p].key] =
+        ratio(report["ours"]["points_per_second"].get<double>(),
+              report[peers[p].key]["points_per_second"].get<double>());
+  }
+  report["goals"] = goals_json(report, peers);
+  return report;
+}
+
+}  // namespace
+
+nlohmann::json run_geometry_bench(const BenchOptions& options) {
+  const sim::Site site = sim::make_site("campus", kSiteSeed, kCampaignScans);
+  sim::ScannerModel model;
+  if (options.smoke) {
+    model.columns = 360;
+    model.rows = 90;
+  }
+  const int scans = options.smoke ? 1 : 2;
+  const int repeats = options.smoke ? 1 : 2;
+  const std::vector<std::uint8_t> planar = planar_objects(site.scene);
+  const std::vector<Peer> peers = pcl_peers(repeats);
+  BenchTotals totals;
+  totals.peers.resize(peers.size());
+  for (int k = 0; k < scans; ++k)
+    bench_scan(simulate(site, model, k), planar, peers, repeats, totals);
+
+  nlohmann::json report = report_json(totals, peers);
+  report["suite"] = "geometry";
+  report["site"] = "campus";
+  report["columns"] = model.columns;
+  report["rows"] = model.rows;
+  report["scans"] = scans;
+  report["points"] = totals.ours.valid;
+  return report;
+}
+
+}  // namespace scanbench::bench

@@ -1,0 +1,287 @@
+// Footprints, normals and mixed-pixel flags on hand-built grids with exact answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <random>
+
+#include "acquisition/scan_geometry.hpp"
+#include "acquisition/window_moments.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A spherical scan of `rows` × `columns` at `step_deg`, looking around +x,
+// whose range along a direction comes from `cast` (≤ 0: no return).
+Scan cast_scan(int rows, int columns, double step_deg,
+               const std::function<double(const Eigen::Vector3d&)>& cast) {
+  Scan scan = make_empty_scan(rows, columns, false, false);
+  const double step = step_deg * kDeg;
+  scan.angles = SphericalAngles{0.5 * columns * step, -step, 0.5 * rows * step, -step};
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < columns; ++col) {
+      const double range = cast(direction_precise(scan, row, col));
+      const std::size_t i = scan.index(row, col);
+      scan.valid[i] = range > 0;
+      scan.range_m[i] = range > 0 ? static_cast<float>(range) : 0.0f;
+    }
+  }
+  return scan;
+}
+
+// Distance along d to the plane n·p = offset (n unit), or −1.
+double plane(const Eigen::Vector3d& d, const Eigen::Vector3d& n, double offset) {
+  const double denominator = n.dot(d);
+  if (std::abs(denominator) < 1e-9) return -1;
+  const double t = offset / denominator;
+  return t > 0 ? t : -1;
+}
+
+double angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0f, 1.0f)) / kDeg;
+}
+
+GeometrySettings exact_settings() {
+  GeometrySettings settings;
+  settings.threads = 1;
+  return settings;
+}
+
+TEST(ScanGeometry, TiltedPlaneGetsItsNormalTowardsTheScanner) {
+  const Eigen::Vector3d n = Eigen::Vector3d(1.0, 0.3, -0.2).normalized();
+  const Scan scan =
+      cast_scan(40, 60, 0.2, [&](const Eigen::Vector3d& d) { return plane(d, n, 10.0); });
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  const Eigen::Vector3f expected = (-n).cast<float>();
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      ASSERT_TRUE(result.geometry.has_normal(i)) << row << "," << col;
+      // The log-range slope is exact to second order; the third-order term of
+      // a 33-pixel window at 0.2° steps leaves a few hundredths of a degree.
+      ASSERT_LT(angle_deg(result.geometry.normal[i], expected), 0.05) << row << "," << col;
+      ASSERT_EQ(result.geometry.flags[i], 0) << row << "," << col;
+    }
+  }
+  EXPECT_EQ(result.normals, scan.pixel_count());
+}
+
+TEST(ScanGeometry, FootprintClosesTheGapAndGrowsAtGrazingIncidence) {
+  // A wall facing the scanner at 10 m: spacing = 10 m · 0.2°, at the centre.
+  const Scan facing = cast_scan(21, 21, 0.2, [](const Eigen::Vector3d& d) {
+    return plane(d, Eigen::Vector3d::UnitX(), 10.0);
+  });
+  const GeometryResult a = compute_geometry(facing, exact_settings());
+  const std::size_t centre = facing.index(10, 10);
+  const double spacing = facing.range_m[centre] * 0.2 * kDeg;
+  EXPECT_NEAR(a.geometry.footprint_m[centre], 0.5 * std::sqrt(2.0) * spacing, 1e-3 * spacing);
+  // The same wall turned 60° away: the footprint is twice as large.
+  const Eigen::Vector3d turned(std::cos(60 * kDeg), std::sin(60 * kDeg), 0.0);
+  const Scan grazing =
+      cast_scan(21, 21, 0.2, [&](const Eigen::Vector3d& d) { return plane(d, turned, 10.0); });
+  const GeometryResult b = compute_geometry(grazing, exact_settings());
+  const double spacing_b = grazing.range_m[centre] * 0.2 * kDeg;
+  EXPECT_NEAR(b.geometry.footprint_m[centre], 0.5 * std::sqrt(2.0) * spacing_b / 0.5,
+              0.01 * spacing_b);
+}
+
+TEST(ScanGeometry, BoxCornerGivesEachWallItsOwnNormal) {
+  // Walls x = 10 and y = 3 meeting in a vertical crease: whichever is nearer.
+  const auto corner = [](const Eigen::Vector3d& d) {
+    double best = 1e9;
+    for (const auto& [n, offset] :
+         {std::pair{Eigen::Vector3d::UnitX(), 10.0}, std::pair{Eigen::Vector3d::UnitY(), 3.0}}) {
+      const double t = plane(d, n, offset);
+      if (t > 0) best = std::min(best, t);
+    }
+    return best < 1e8 ? best : -1.0;
+  };
+  const Scan scan = cast_scan(30, 120, 0.25, corner);
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  int checked = 0;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (!result.geometry.has_normal(i)) continue;
+      const Eigen::Vector3f n = result.geometry.normal[i];
+      const double to_x = angle_deg(n, -Eigen::Vector3f::UnitX()),
+                   to_y = angle_deg(n, -Eigen::Vector3f::UnitY());
+      ASSERT_LT(std::min(to_x, to_y), 1.0) << row << "," << col;  // never a blend of both walls
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, static_cast<int>(0.95 * scan.pixel_count()));
+}
+
+TEST(ScanGeometry, SphereNormalsPointFromTheCentre) {
+  const Eigen::Vector3d centre(8.0, 0.0, 0.0);
+  const double radius = 3.0;
+  const auto sphere = [&](const Eigen::Vector3d& d) {
+    const double b = d.dot(centre), c = centre.squaredNorm() - radius * radius, disc = b * b - c;
+    return disc > 0 ? b - std::sqrt(disc) : -1.0;
+  };
+  const Scan scan = cast_scan(60, 60, 0.3, sphere);
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  int checked = 0;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (!scan.valid[i] || !result.geometry.has_normal(i)) continue;
+      const Eigen::Vector3d p = point_in_scan(scan, row, col).cast<double>();
+      const Eigen::Vector3f truth = (p - centre).normalized().cast<float>();
+      if (truth.dot(direction(scan, row, col)) > -0.3f) continue;  // skip the grazing rim
+      // A window cut by the grid's border fits a chord of the sphere: a bias
+      // of about half the window's angle on the sphere.
+      const bool border = std::min({row, col, scan.rows - 1 - row, scan.columns - 1 - col}) < 3;
+      ASSERT_LT(angle_deg(result.geometry.normal[i], truth), border ? 3.0 : 0.5)
+          << row << "," << col;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 500);
+}
+
+// A wall at 10 m in front of a wall at 20 m: the pixels next to the step keep
+// their own wall's normal (neighbours across the step are left out) and are
+// flagged as edges.
+Scan step_scan() {
+  return cast_scan(20, 40, 0.2, [](const Eigen::Vector3d& d) {
+    const Eigen::Vector3d n =
+        d.y() > 0 ? Eigen::Vector3d(1, 0.2, 0).normalized() : Eigen::Vector3d::UnitX();
+    return plane(d, n, d.y() > 0 ? 10.0 : 20.0);
+  });
+}
+
+TEST(ScanGeometry, DepthStepKeepsEachSideClean) {
+  const Scan scan = step_scan();
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  int edges = 0;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      const bool near = direction(scan, row, col).y() > 0;
+      const Eigen::Vector3f truth = near
+                                        ? Eigen::Vector3f(-Eigen::Vector3f(1, 0.2f, 0).normalized())
+                                        : Eigen::Vector3f(-Eigen::Vector3f::UnitX());
+      ASSERT_TRUE(result.geometry.has_normal(i)) << row << "," << col;
+      ASSERT_LT(angle_deg(result.geometry.normal[i], truth), 0.05) << row << "," << col;
+      edges += (result.geometry.flags[i] & kFlagEdge) != 0;
+    }
+  }
+  EXPECT_EQ(edges, 2 * scan.rows);  // one pixel on each side of the step, every row
+}
+
+TEST(ScanGeometry, AMixedPixelAtTheStepIsFlaggedAndLeftOutOfItsNeighboursFits) {
+  Scan scan = step_scan();
+  // Column 19 is the last near pixel of every row; make row 10's a blend.
+  const std::size_t i = scan.index(10, 19);
+  const std::size_t behind = scan.index(10, 20);
+  scan.range_m[i] = 0.5f * (scan.range_m[i] + scan.range_m[behind]);
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  EXPECT_TRUE(result.geometry.is_mixed(i));
+  EXPECT_EQ(result.mixed_pixels, 1u);
+  EXPECT_LT(angle_deg(result.geometry.normal[scan.index(10, 18)],
+                      -Eigen::Vector3f(1, 0.2f, 0).normalized()),
+            0.05);
+}
+
+TEST(ScanGeometry, NoisyPlaneHasFewFalseMixedPixelsAndSmallErrors) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  const Eigen::Vector3d n = Eigen::Vector3d(1.0, -0.4, 0.1).normalized();
+  const Scan scan = cast_scan(
+      100, 200, 0.1, [&](const Eigen::Vector3d& d) { return plane(d, n, 15.0) + noise(rng); });
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  EXPECT_LT(result.mixed_pixels, scan.pixel_count() / 500);
+  std::vector<double> errors;
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+    if (result.geometry.has_normal(i))
+      errors.push_back(angle_deg(result.geometry.normal[i], (-n).cast<float>()));
+  }
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 3.0);
+}
+
+TEST(ScanGeometry, IsolatedPixelGetsAnExplicitlyInvalidNormal) {
+  Scan scan = cast_scan(
+      9, 9, 0.2, [](const Eigen::Vector3d& d) { return plane(d, Eigen::Vector3d::UnitX(), 5.0); });
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) scan.valid[i] = i == scan.index(4, 4);
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  const std::size_t i = scan.index(4, 4);
+  EXPECT_FALSE(result.geometry.has_normal(i));
+  EXPECT_EQ(result.geometry.normal[i], Eigen::Vector3f::Zero());
+  EXPECT_TRUE(result.geometry.flags[i] & kFlagNoNormal);
+  EXPECT_GT(result.geometry.footprint_m[i], 0.0f);
+  EXPECT_EQ(result.geometry.footprint_m[0], 0.0f);  // invalid pixel
+}
+
+TEST(ScanGeometry, PerPixelDirectionGridsUseTheirPoints) {
+  const Eigen::Vector3d n = Eigen::Vector3d(1.0, 0.2, 0.3).normalized();
+  Scan scan = cast_scan(20, 20, 0.5, [&](const Eigen::Vector3d& d) { return plane(d, n, 4.0); });
+  PerPixelDirections per_pixel;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col)
+      per_pixel.directions.push_back(direction(scan, row, col));
+  }
+  scan.angles = per_pixel;
+  const GeometryResult result = compute_geometry(scan, exact_settings());
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+    ASSERT_TRUE(result.geometry.has_normal(i));
+    ASSERT_LT(angle_deg(result.geometry.normal[i], (-n).cast<float>()), 0.01);
+  }
+}
+
+TEST(ScanGeometry, ResultDoesNotDependOnTheThreadCount) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Scan scan = cast_scan(50, 80, 0.2, [&](const Eigen::Vector3d& d) {
+    return plane(d, d.z() > 0 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d(0.5, 0, -1).normalized(),
+                 6.0) +
+           noise(rng);
+  });
+  GeometrySettings two = exact_settings();
+  two.threads = 2;
+  const GeometryResult a = compute_geometry(scan, exact_settings()),
+                       b = compute_geometry(scan, two);
+  EXPECT_EQ(a.geometry.normal, b.geometry.normal);
+  EXPECT_EQ(a.geometry.flags, b.geometry.flags);
+  EXPECT_EQ(a.geometry.footprint_m, b.geometry.footprint_m);
+}
+
+TEST(WindowMoments, MatchBruteForceOnAMaskedGrid) {
+  const int rows = 13, columns = 17, k = 3;
+  std::mt19937 rng(9);
+  std::vector<std::uint8_t> mask(rows * columns);
+  std::vector<float> value(rows * columns);
+  for (int i = 0; i < rows * columns; ++i) {
+    mask[i] = rng() % 4 != 0;
+    value[i] = static_cast<float>(rng() % 1000) / 100.0f;
+  }
+  const std::vector<WindowMoments> m = window_moments(rows, columns, k, mask, value, 1);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < columns; ++c) {
+      double e[9] = {};
+      for (int dy = -k; dy <= k; ++dy) {
+        for (int dx = -k; dx <= k; ++dx) {
+          const int rr = r + dy, cc = c + dx;
+          if (rr < 0 || rr >= rows || cc < 0 || cc >= columns || !mask[rr * columns + cc]) continue;
+          const double v = value[rr * columns + cc];
+          const double terms[9] = {
+              1, 1.0 * dx, 1.0 * dy, 1.0 * dx * dx, 1.0 * dx * dy, 1.0 * dy * dy,
+              v, dx * v,   dy * v};
+          for (int t = 0; t < 9; ++t) e[t] += terms[t];
+        }
+      }
+      const WindowMoments& w = m[r * columns + c];
+      const float got[9] = {w.n, w.sx, w.sy, w.sxx, w.sxy, w.syy, w.sv, w.sxv, w.syv};
+      for (int t = 0; t < 9; ++t)
+        ASSERT_NEAR(got[t], e[t], 1e-3 * (1 + std::abs(e[t]))) << r << "," << c << " term " << t;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace scanbench::acquisition
