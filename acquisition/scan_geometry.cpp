@@ -23,6 +23,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "acquisition/mixed_pixels.hpp"
 #include "acquisition/window_moments.hpp"
@@ -107,27 +108,49 @@ struct AngleTables {
   }
 };
 
-// The running-sum plane fits of one window size, and where they are usable:
-// the whole window valid and free of depth discontinuities.
-struct WindowFits {
-  std::vector<WindowMoments> moments;
-  std::vector<std::uint16_t> jumps;
-  double full = 0;
+// The log-range slopes of the widest clean window of every pixel: widest
+// first, a pixel takes the first window size at which its whole window is
+// valid and free of depth discontinuities.
+struct WindowSlopes {
+  std::vector<float> per_column, per_row;  // d ln r / d col, d ln r / d row
+  std::vector<std::uint16_t> used;         // window pixels; 0 = no clean window
 
-  static double area(int radius) { return (2.0 * radius + 1) * (2.0 * radius + 1); }
+  WindowSlopes(const Scan& scan, const std::vector<std::uint8_t>& mask,
+               const std::vector<float>& log_range, const std::vector<std::uint8_t>& jump_map,
+               const GeometrySettings& settings)
+      : per_column(scan.pixel_count(), 0.0f),
+        per_row(scan.pixel_count(), 0.0f),
+        used(scan.pixel_count(), 0) {
+    for (int radius = settings.window_radius;;) {
+      add_scale(scan, radius, mask, log_range, jump_map, settings.threads);
+      if (radius <= settings.edge_window_radius) break;
+      radius =
+          radius / 2 >= 2 * settings.edge_window_radius ? radius / 2 : settings.edge_window_radius;
+    }
+  }
 
-  WindowFits() = default;
-  WindowFits(const Scan& scan, int radius, const std::vector<std::uint8_t>& mask,
-             const std::vector<float>& log_range, const std::vector<std::uint8_t>& jump_map,
-             int threads)
-      : moments(window_moments(scan.rows, scan.columns, radius, mask, log_range, threads)),
-        jumps(window_counts(scan.rows, scan.columns, radius, jump_map, threads)),
-        full(area(radius)) {}
-
-  bool clean(std::size_t i) const { return jumps[i] == 0 && moments[i].n == full; }
-  bool slopes(std::size_t i, double& b, double& c) const {
-    const WindowMoments& m = moments[i];
-    return plane_slopes(m.n, m.sx, m.sy, m.sxx, m.sxy, m.syy, m.sv, m.sxv, m.syv, b, c);
+ private:
+  void add_scale(const Scan& scan, int radius, const std::vector<std::uint8_t>& mask,
+                 const std::vector<float>& log_range, const std::vector<std::uint8_t>& jump_map,
+                 int threads) {
+    const std::vector<std::uint16_t> jumps =
+        window_counts(scan.rows, scan.columns, radius, jump_map, threads);
+    const float full = static_cast<float>((2 * radius + 1) * (2 * radius + 1));
+    visit_window_moments(
+        scan.rows, scan.columns, radius, mask, log_range, threads,
+        [&](int row, int begin, int end, const WindowMoments* moments) {
+          for (int col = begin; col < end; ++col) {
+            const std::size_t i = scan.index(row, col);
+            const WindowMoments& m = moments[col - begin];
+            if (used[i] || !mask[i] || jumps[i] != 0 || m.n != full) continue;
+            double b = 0, c = 0;
+            if (!plane_slopes(m.n, m.sx, m.sy, m.sxx, m.sxy, m.syy, m.sv, m.sxv, m.syv, b, c))
+              continue;
+            per_column[i] = static_cast<float>(b);
+            per_row[i] = static_cast<float>(c);
+            used[i] = static_cast<std::uint16_t>(m.n);
+          }
+        });
   }
 };
 
@@ -136,11 +159,7 @@ struct GridContext {
   const GeometrySettings& settings;
   const std::vector<std::uint8_t>& mask;  // valid and not mixed
   const std::vector<float>& log_range;
-  const AngleTables& tables;
-
-  Eigen::Vector3d point(int row, int col) const {
-    return scan.range_m[scan.index(row, col)] * tables.direction(scan, row, col).cast<double>();
-  }
+  const std::vector<Eigen::Vector3f>& points;  // scan frame, where masked
 };
 
 // Unit normal towards the scanner from the log-range slopes per column (b)
@@ -157,32 +176,36 @@ Eigen::Vector3f spherical_normal(const SphericalAngles& a, const AngleTables& t,
 // Covariance fit of the 3D points over the window (per-pixel grids).
 bool covariance_normal(const GridContext& g, int row, int col, Eigen::Vector3f& normal, int& used) {
   const int k = g.settings.edge_window_radius;
-  const float centre = g.log_range[g.scan.index(row, col)];
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  const std::size_t centre_index = g.scan.index(row, col);
+  const float centre = g.log_range[centre_index];
+  const Eigen::Vector3f origin = g.points[centre_index];  // sums relative to it stay small
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
   used = 0;
   for (int r = std::max(0, row - k); r <= std::min(g.scan.rows - 1, row + k); ++r) {
     for (int cc = std::max(0, col - k); cc <= std::min(g.scan.columns - 1, col + k); ++cc) {
       const std::size_t i = g.scan.index(r, cc);
-      const double limit =
-          g.settings.depth_jump_relative * std::max(std::abs(r - row), std::abs(cc - col));
-      if (!g.mask[i] || std::abs(g.log_range[i] - centre) > limit + 1e-12) continue;
-      const Eigen::Vector3d p = g.point(r, cc);
+      const float limit = static_cast<float>(g.settings.depth_jump_relative) *
+                          static_cast<float>(std::max(std::abs(r - row), std::abs(cc - col)));
+      if (!g.mask[i] || std::abs(g.log_range[i] - centre) > limit + 1e-7f) continue;
+      const Eigen::Vector3f p = g.points[i] - origin;
       sum += p;
-      outer += p * p.transpose();
+      xx += p.x() * p.x(), xy += p.x() * p.y(), xz += p.x() * p.z();
+      yy += p.y() * p.y(), yz += p.y() * p.z(), zz += p.z() * p.z();
       ++used;
     }
   }
   if (used < 3) return false;
-  const Eigen::Vector3d mean = sum / used;
-  const Eigen::Matrix3d covariance = outer / used - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  const Eigen::Vector3f mean = sum / static_cast<float>(used);
+  Eigen::Matrix3f covariance;
+  covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  covariance = covariance / static_cast<float>(used) - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
   solver.computeDirect(covariance);
-  const Eigen::Vector3d& values = solver.eigenvalues();
-  if (values[1] <= 4.0 * values[0]) return false;  // a line or a blob, not a surface
-  Eigen::Vector3d n = solver.eigenvectors().col(0);
-  if (n.dot(g.point(row, col)) > 0) n = -n;
-  normal = n.cast<float>();
+  const Eigen::Vector3f& values = solver.eigenvalues();
+  if (values[1] <= 4.0f * values[0]) return false;  // a line or a blob, not a surface
+  normal = solver.eigenvectors().col(0).normalized();
+  if (normal.dot(origin) > 0) normal = -normal;
   return true;
 }
 
@@ -217,26 +240,26 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   const std::size_t n = scan.pixel_count();
   std::vector<std::uint8_t> mixed = settings.flag_mixed_pixels ? detect_mixed_pixels(scan, settings)
                                                                : std::vector<std::uint8_t>(n, 0);
+  const AngleTables tables(scan);
   std::vector<std::uint8_t> mask(n);
   std::vector<float> log_range(n, 0.0f);
+  std::vector<Eigen::Vector3f> points(n, Eigen::Vector3f::Zero());
   parallel_rows(scan.rows, settings.threads, [&](int row) {
-    for (std::size_t i = scan.index(row, 0); i < scan.index(row, 0) + scan.columns; ++i) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
       mask[i] = scan.valid[i] && !mixed[i] && scan.range_m[i] > 0.0f;
-      if (mask[i]) log_range[i] = std::log(scan.range_m[i]);
+      if (!mask[i]) continue;
+      log_range[i] = std::log(scan.range_m[i]);
+      points[i] = scan.range_m[i] * tables.direction(scan, row, col);
     }
   });
   const std::vector<std::uint8_t> jumps = jump_map(scan, mask, log_range, settings);
   const bool spherical = scan.is_spherical();
-  std::vector<WindowFits> scales;  // widest first
-  for (int radius = settings.window_radius; spherical;) {
-    scales.emplace_back(scan, radius, mask, log_range, jumps, settings.threads);
-    if (radius <= settings.edge_window_radius) break;
-    radius =
-        radius / 2 >= 2 * settings.edge_window_radius ? radius / 2 : settings.edge_window_radius;
-  }
-  const AngleTables tables(scan);
-  const GridContext context{scan, settings, mask, log_range, tables};
-  const double edge_window_area = WindowFits::area(settings.edge_window_radius);
+  std::optional<WindowSlopes> slopes;
+  if (spherical) slopes.emplace(scan, mask, log_range, jumps, settings);
+  const GridContext context{scan, settings, mask, log_range, points};
+  const double edge_window_area =
+      (2.0 * settings.edge_window_radius + 1) * (2.0 * settings.edge_window_radius + 1);
 
   GeometryResult result;
   ScanGeometry& g = result.geometry;
@@ -253,26 +276,16 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
       int used = 0;
       bool ok = false;
       double area = edge_window_area;
-      if (mask[i] && spherical) {
-        const auto& a = std::get<SphericalAngles>(scan.angles);
-        double b = 0, c = 0;
-        for (const WindowFits& fits : scales) {
-          if (fits.clean(i) && fits.slopes(i, b, c)) {
-            used = static_cast<int>(fits.moments[i].n);
-            area = fits.full;
-            ok = true;
-            break;
-          }
-        }
-        if (!ok) {
-          // A window cut by a discontinuity, an invalid region or the grid's
-          // border is lopsided: the log-range slope of a lopsided window is
-          // biased by the curvature of ln r, a 3D plane fit is not.
-          ok = covariance_normal(context, row, col, normal, used);
-        }
-        if (ok && normal == Eigen::Vector3f::Zero())
-          normal = spherical_normal(a, tables, row, col, b, c);
+      if (mask[i] && spherical && slopes->used[i] > 0) {
+        used = slopes->used[i];
+        area = used;
+        normal = spherical_normal(std::get<SphericalAngles>(scan.angles), tables, row, col,
+                                  slopes->per_column[i], slopes->per_row[i]);
+        ok = true;
       } else if (mask[i]) {
+        // No clean window (cut by a discontinuity, an invalid region or the
+        // grid's border), or no angle model: the log-range slope of a lopsided
+        // window is biased by the curvature of ln r, a 3D plane fit is not.
         ok = covariance_normal(context, row, col, normal, used);
       }
       ok = ok && used >= settings.min_neighbours && normal.allFinite();

@@ -49,7 +49,7 @@ struct GeometrySettings {
   // fit of the consistent neighbours in it. The cost per pixel does not
   // depend on the radii (running box sums).
   int window_radius = 16;
-  int edge_window_radius = 3;
+  int edge_window_radius = 2;
   // A depth discontinuity: the second difference of log-range along a row or
   // column exceeds depth_jump_sigmas times its noise (√6 · σ(range) / range),
   // or depth_jump_relative, whichever is smaller. A grazing but smooth

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <array>
 #include <cassert>
 
@@ -25,22 +26,30 @@ struct Running {
   }
 };
 
-// The six per-row inputs of the vertical pass.
+// The five per-row inputs of the vertical pass.
 enum Horizontal { kM, kMx, kMxx, kV, kVx, kHorizontalCount };
 using RowSums = std::array<float, kHorizontalCount>;
 
+// Column blocks: wide enough that a block's running state stays in cache,
+// many enough for the threads to share the work.
+constexpr int kBlockColumns = 256;
+
 template <typename Body>
-void parallel_ranges(int count, int threads, Body&& body) {
+void parallel_blocks(int columns, int threads, Body&& body) {
+  const int blocks = (columns + kBlockColumns - 1) / kBlockColumns;
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, count, 64),
-                      [&](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); });
+    tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
+      for (int b = r.begin(); b < r.end(); ++b) {
+        body(b * kBlockColumns, std::min(columns, (b + 1) * kBlockColumns));
+      }
+    });
   });
 }
 
-// Sums along one row: m, m·dx, m·dx², m·v, m·dx·v.
-void horizontal_row(int columns, int k, const std::uint8_t* mask, const float* value,
-                    RowSums* out) {
+// Sums along one row for columns [begin, end): m, m·dx, m·dx², m·v, m·dx·v.
+void horizontal_row(int columns, int begin, int end, int k, const std::uint8_t* mask,
+                    const float* value, RowSums* out) {
   Running m, v;
   const auto sample = [&](int c, double& mi, double& vi) {
     mi = vi = 0;
@@ -49,14 +58,14 @@ void horizontal_row(int columns, int k, const std::uint8_t* mask, const float* v
     vi = value[c];
   };
   double mi, vi;
-  for (int c = -k; c <= k; ++c) {  // the window of column 0, built explicitly
-    sample(c, mi, vi);
-    m.s0 += mi, m.s1 += c * mi, m.s2 += c * c * mi;
-    v.s0 += vi, v.s1 += c * vi;
+  for (int d = -k; d <= k; ++d) {  // the window of the first column, built explicitly
+    sample(begin + d, mi, vi);
+    m.s0 += mi, m.s1 += d * mi, m.s2 += d * d * mi;
+    v.s0 += vi, v.s1 += d * vi;
   }
-  for (int c = 0; c < columns; ++c) {
-    out[c] = {static_cast<float>(m.s0), static_cast<float>(m.s1), static_cast<float>(m.s2),
-              static_cast<float>(v.s0), static_cast<float>(v.s1)};
+  for (int c = begin; c < end; ++c) {
+    out[c - begin] = {static_cast<float>(m.s0), static_cast<float>(m.s1), static_cast<float>(m.s2),
+                      static_cast<float>(v.s0), static_cast<float>(v.s1)};
     double mo, vo;
     sample(c - k, mo, vo);
     sample(c + k + 1, mi, vi);
@@ -89,35 +98,82 @@ struct ColumnState {
   }
 };
 
+// The horizontal sums of rows [row − k, row + k + 1] for one column block,
+// kept in a ring of 2k + 2 rows: the vertical pass needs the row leaving and
+// the row entering the window.
+class RowRing {
+ public:
+  RowRing(int rows, int columns, int begin, int end, int k, std::span<const std::uint8_t> mask,
+          std::span<const float> value)
+      : rows_(rows),
+        columns_(columns),
+        begin_(begin),
+        width_(end - begin),
+        k_(k),
+        mask_(mask),
+        value_(value),
+        slots_(2 * k + 2),
+        data_(static_cast<std::size_t>(slots_) * width_) {}
+
+  // Horizontal sums of `row` (zeros outside the grid), computed once per row.
+  const RowSums* row(int r) {
+    RowSums* slot =
+        data_.data() + static_cast<std::size_t>(((r % slots_) + slots_) % slots_) * width_;
+    if (r < 0 || r >= rows_) {
+      std::fill(slot, slot + width_, RowSums{});
+    } else if (r != filled_[((r % slots_) + slots_) % slots_]) {
+      const std::size_t o = static_cast<std::size_t>(r) * columns_;
+      horizontal_row(columns_, begin_, begin_ + width_, k_, mask_.data() + o, value_.data() + o,
+                     slot);
+    }
+    filled_[((r % slots_) + slots_) % slots_] = r;
+    return slot;
+  }
+
+ private:
+  int rows_, columns_, begin_, width_, k_;
+  std::span<const std::uint8_t> mask_;
+  std::span<const float> value_;
+  int slots_;
+  std::vector<RowSums> data_;
+  std::vector<int> filled_ = std::vector<int>(static_cast<std::size_t>(slots_), -1 << 30);
+};
+
 }  // namespace
+
+void visit_window_moments(int rows, int columns, int radius, std::span<const std::uint8_t> mask,
+                          std::span<const float> value, int threads, const MomentsVisitor& visit) {
+  assert(mask.size() == static_cast<std::size_t>(rows) * columns && value.size() == mask.size() &&
+         radius >= 1);
+  parallel_blocks(columns, threads, [&](int begin, int end) {
+    const int width = end - begin;
+    RowRing ring(rows, columns, begin, end, radius, mask, value);
+    std::vector<ColumnState> state(static_cast<std::size_t>(width));
+    for (int dy = -radius; dy <= radius; ++dy) {
+      const RowSums* h = ring.row(dy);
+      for (int c = 0; c < width; ++c) state[c].add(h[c], dy);
+    }
+    std::vector<WindowMoments> out(static_cast<std::size_t>(width));
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < width; ++c) out[c] = state[c].moments();
+      visit(r, begin, end, out.data());
+      const RowSums* leaving = ring.row(r - radius);
+      const RowSums* entering = ring.row(r + radius + 1);
+      for (int c = 0; c < width; ++c) state[c].advance(leaving[c], entering[c], radius);
+    }
+  });
+}
 
 std::vector<WindowMoments> window_moments(int rows, int columns, int radius,
                                           std::span<const std::uint8_t> mask,
                                           std::span<const float> value, int threads) {
-  const std::size_t n = static_cast<std::size_t>(rows) * columns;
-  assert(mask.size() == n && value.size() == n && radius >= 1);
-  std::vector<RowSums> horizontal(n);
-  parallel_ranges(rows, threads, [&](int begin, int end) {
-    for (int r = begin; r < end; ++r) {
-      const std::size_t o = static_cast<std::size_t>(r) * columns;
-      horizontal_row(columns, radius, mask.data() + o, value.data() + o, horizontal.data() + o);
-    }
-  });
-  std::vector<WindowMoments> result(n);
-  const RowSums zero{};
-  const auto row_sums = [&](int r, int c) -> const RowSums& {
-    return r < 0 || r >= rows ? zero : horizontal[static_cast<std::size_t>(r) * columns + c];
-  };
-  parallel_ranges(columns, threads, [&](int begin, int end) {
-    for (int c = begin; c < end; ++c) {
-      ColumnState state;
-      for (int dy = -radius; dy <= radius; ++dy) state.add(row_sums(dy, c), dy);
-      for (int r = 0; r < rows; ++r) {
-        result[static_cast<std::size_t>(r) * columns + c] = state.moments();
-        state.advance(row_sums(r - radius, c), row_sums(r + radius + 1, c), radius);
-      }
-    }
-  });
+  std::vector<WindowMoments> result(static_cast<std::size_t>(rows) * columns);
+  visit_window_moments(rows, columns, radius, mask, value, threads,
+                       [&](int row, int begin, int end, const WindowMoments* moments) {
+                         std::copy(
+                             moments, moments + (end - begin),
+                             result.begin() + static_cast<std::ptrdiff_t>(row) * columns + begin);
+                       });
   return result;
 }
 
@@ -126,28 +182,40 @@ std::vector<std::uint16_t> window_counts(int rows, int columns, int radius,
   const std::size_t n = static_cast<std::size_t>(rows) * columns;
   assert(mask.size() == n && radius >= 1 && (2 * radius + 1) * (2 * radius + 1) < 65536);
   std::vector<std::uint16_t> horizontal(n), counts(n);
-  parallel_ranges(rows, threads, [&](int begin, int end) {
-    for (int r = begin; r < end; ++r) {
-      const std::uint8_t* m = mask.data() + static_cast<std::size_t>(r) * columns;
-      const auto at = [&](int c) { return c < 0 || c >= columns ? 0 : (m[c] ? 1 : 0); };
-      int sum = 0;
-      for (int c = -radius; c <= radius; ++c) sum += at(c);
-      for (int c = 0; c < columns; ++c) {
-        horizontal[static_cast<std::size_t>(r) * columns + c] = static_cast<std::uint16_t>(sum);
-        sum += at(c + radius + 1) - at(c - radius);
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& rr) {
+      for (int r = rr.begin(); r < rr.end(); ++r) {
+        const std::uint8_t* m = mask.data() + static_cast<std::size_t>(r) * columns;
+        const auto at = [&](int c) { return c < 0 || c >= columns ? 0 : (m[c] ? 1 : 0); };
+        int sum = 0;
+        for (int c = -radius; c <= radius; ++c) sum += at(c);
+        for (int c = 0; c < columns; ++c) {
+          horizontal[static_cast<std::size_t>(r) * columns + c] = static_cast<std::uint16_t>(sum);
+          sum += at(c + radius + 1) - at(c - radius);
+        }
+      }
+    });
+  });
+  parallel_blocks(columns, threads, [&](int begin, int end) {
+    std::vector<int> sum(static_cast<std::size_t>(end - begin), 0);
+    const auto row = [&](int r) -> const std::uint16_t* {
+      return r < 0 || r >= rows ? nullptr
+                                : horizontal.data() + static_cast<std::size_t>(r) * columns;
+    };
+    for (int r = -radius; r <= radius; ++r) {
+      if (const std::uint16_t* h = row(r)) {
+        for (int c = begin; c < end; ++c) sum[c - begin] += h[c];
       }
     }
-  });
-  parallel_ranges(columns, threads, [&](int begin, int end) {
-    for (int c = begin; c < end; ++c) {
-      const auto at = [&](int r) {
-        return r < 0 || r >= rows ? 0 : horizontal[static_cast<std::size_t>(r) * columns + c];
-      };
-      int sum = 0;
-      for (int r = -radius; r <= radius; ++r) sum += at(r);
-      for (int r = 0; r < rows; ++r) {
-        counts[static_cast<std::size_t>(r) * columns + c] = static_cast<std::uint16_t>(sum);
-        sum += at(r + radius + 1) - at(r - radius);
+    for (int r = 0; r < rows; ++r) {
+      std::uint16_t* out = counts.data() + static_cast<std::size_t>(r) * columns;
+      for (int c = begin; c < end; ++c) out[c] = static_cast<std::uint16_t>(sum[c - begin]);
+      if (const std::uint16_t* leaving = row(r - radius)) {
+        for (int c = begin; c < end; ++c) sum[c - begin] -= leaving[c];
+      }
+      if (const std::uint16_t* entering = row(r + radius + 1)) {
+        for (int c = begin; c < end; ++c) sum[c - begin] += entering[c];
       }
     }
   });

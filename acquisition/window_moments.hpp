@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -22,10 +23,19 @@ struct WindowMoments {
   float n, sx, sy, sxx, sxy, syy, sv, sxv, syv;
 };
 
-// Moments for every pixel of a rows × columns grid (row-major); `mask` is 0
-// or 1 per pixel, `value` is read only where the mask is 1. `threads` as in
-// the Settings structs (0 = all cores); the result does not depend on it.
-// Asserts the spans hold rows × columns entries and radius ≥ 1.
+// Hands the moments of pixels (row, col_begin … col_end − 1) to `visit`, every
+// row once per column block, blocks in parallel (so `visit` must only touch
+// its own pixels). Nothing of grid size is kept beyond one row of running
+// sums per block. `mask` is 0 or 1 per pixel, `value` is read only where the
+// mask is 1. `threads` as in the Settings structs (0 = all cores); the
+// moments do not depend on it. Asserts the spans hold rows × columns entries
+// and radius ≥ 1.
+using MomentsVisitor =
+    std::function<void(int row, int col_begin, int col_end, const WindowMoments* moments)>;
+void visit_window_moments(int rows, int columns, int radius, std::span<const std::uint8_t> mask,
+                          std::span<const float> value, int threads, const MomentsVisitor& visit);
+
+// All moments at once (rows × columns, row-major), for tests and small grids.
 std::vector<WindowMoments> window_moments(int rows, int columns, int radius,
                                           std::span<const std::uint8_t> mask,
                                           std::span<const float> value, int threads);

@@ -24,6 +24,7 @@
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
 #include "bench/pcl_normals.hpp"
+#include "modeling/geometry_stage.hpp"
 
 namespace scanbench::bench {
 namespace {
@@ -94,13 +95,11 @@ nlohmann::json settings_json(const PclNormalSettings& s) {
 }
 
 nlohmann::json settings_json(const acquisition::GeometrySettings& s) {
-  return {{"window_radius", s.window_radius},
-          {"depth_jump_relative", s.depth_jump_relative},
-          {"min_neighbours", s.min_neighbours},
-          {"note", "time includes footprints and mixed-pixel flags"}};
+  nlohmann::json settings = nlohmann::json::parse(modeling::geometry_settings_json(s));
+  settings["note"] = "time includes footprints and mixed-pixel flags";
+  return settings;
 }
 
-// Running totals of one method over all scans.
 struct MethodStats {
   std::vector<float> errors_deg;         // scored pixels (see file comment)
   std::vector<float> planar_errors_deg;  // the scored pixels on kPlanarKinds

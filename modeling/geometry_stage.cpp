@@ -9,6 +9,8 @@ namespace scanbench::modeling {
 
 std::string geometry_settings_json(const acquisition::GeometrySettings& s) {
   return nlohmann::json{{"window_radius", s.window_radius},
+                        {"edge_window_radius", s.edge_window_radius},
+                        {"depth_jump_sigmas", s.depth_jump_sigmas},
                         {"depth_jump_relative", s.depth_jump_relative},
                         {"min_neighbours", s.min_neighbours},
                         {"max_footprint_stretch", s.max_footprint_stretch},
