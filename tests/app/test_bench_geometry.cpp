@@ -2,41 +2,20 @@
 // tiny scan and reports every field issue #4 names. Its figures are not
 // checked: speed and accuracy are measured by the bench itself, not asserted.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/cli_runner.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench {
 namespace {
 
-struct CliResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-// Runs the scanbench binary with fixed, quote-free arguments; stdout and
-// stderr go through files in `dir`.
-CliResult run_bench_cli(const test::ScratchDir& dir, const std::string& args) {
-  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = std::string("'") + SCANBENCH_BINARY + "' " + args + " >'" +
-                              out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(command.c_str());
-  CliResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.out = test::read_file_bytes(out);
-  result.err = test::read_file_bytes(err);
-  return result;
-}
-
 TEST(BenchGeometry, SmokeRunReportsEveryMethodAndField) {
   test::ScratchDir dir;
-  const CliResult result = run_bench_cli(dir, "bench geometry --json --smoke");
+  const test::CliResult result = test::run_cli(dir, {"bench", "geometry", "--json", "--smoke"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "geometry");

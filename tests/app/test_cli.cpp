@@ -1,7 +1,6 @@
 // End-to-end tests of the scanbench executable: exit codes, JSON output, and
 // that refused input leaves a project untouched.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cli_runner.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench {
@@ -17,30 +17,8 @@ namespace {
 using test::fixture;
 using test::ScratchDir;
 
-struct CliResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string shell_quote(const std::string& arg) {
-  std::string quoted = "'";
-  for (const char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
-CliResult run_cli(const ScratchDir& dir, const std::vector<std::string>& args) {
-  std::string command = shell_quote(SCANBENCH_BINARY);
-  for (const std::string& arg : args) command += " " + shell_quote(arg);
-  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  command += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
-  const int status = std::system(command.c_str());
-  CliResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.out = test::read_file_bytes(out);
-  result.err = test::read_file_bytes(err);
-  return result;
-}
+using test::CliResult;
+using test::run_cli;
 
 nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& path) {
   const CliResult info = run_cli(dir, {"info", path.string(), "--json"});

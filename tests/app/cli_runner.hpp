@@ -1,0 +1,41 @@
+// Runs the scanbench executable for the end-to-end tests: arguments are
+// shell-quoted, stdout and stderr captured through files in a scratch folder.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "support/test_support.hpp"
+
+namespace scanbench::test {
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+inline std::string shell_quote(const std::string& arg) {
+  std::string quoted = "'";
+  for (const char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+inline CliResult run_cli(const ScratchDir& dir, const std::vector<std::string>& args) {
+  std::string command = shell_quote(SCANBENCH_BINARY);
+  for (const std::string& arg : args) command += " " + shell_quote(arg);
+  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  command += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+  const int status = std::system(command.c_str());
+  CliResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.out = read_file_bytes(out);
+  result.err = read_file_bytes(err);
+  return result;
+}
+
+}  // namespace scanbench::test
