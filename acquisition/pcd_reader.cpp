@@ -17,6 +17,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -177,6 +178,7 @@ void check_dimensions(const Source& src, HeaderScan& h) {
   if (height <= 1) {
     src.fail("not an organized point cloud (height " + std::to_string(height) + ")");
   }
+  if (width == 0 || *h.points == 0) src.fail("empty point cloud (no points)");
   if (width > kMaxSide || height > kMaxSide || *h.points > kMaxPoints) {
     src.fail("absurd dimensions (more than 1000000 a side or 2^31 points)");
   }
@@ -379,8 +381,10 @@ Source open_source(const std::filesystem::path& path) {
 
 Scan read_organized_pcd(const std::filesystem::path& path) {
   // Errors reach the caller as InputError; PCL's own console messages would
-  // only repeat them, out of order, on stderr.
-  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  // only repeat them, out of order, on stderr. PCL's verbosity is
+  // process-wide, so it is set once, not raced on by concurrent readers.
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); });
   const Source src = open_source(path);
   HeaderScan header = scan_header(src);
   check_dimensions(src, header);

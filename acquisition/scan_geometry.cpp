@@ -234,8 +234,9 @@ float footprint(const Scan& scan, const AngleTables& tables, int row, int col,
 }  // namespace
 
 GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
-  assert(check_consistency(scan).empty() && settings.window_radius >= 1 &&
-         settings.edge_window_radius >= 1);
+  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
+         settings.window_radius >= settings.edge_window_radius &&
+         settings.window_radius <= kMaxWindowRadius);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t n = scan.pixel_count();
   std::vector<std::uint8_t> mixed = settings.flag_mixed_pixels ? detect_mixed_pixels(scan, settings)

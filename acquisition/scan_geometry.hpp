@@ -39,6 +39,9 @@ struct ScanGeometry {
   bool is_mixed(std::size_t i) const { return (flags[i] & kFlagMixedPixel) != 0; }
 };
 
+// Window counts are 16-bit: (2 · 127 + 1)² < 65536.
+inline constexpr int kMaxWindowRadius = 127;
+
 struct GeometrySettings {
   // Neighbourhood of the plane fit: (2 · window_radius + 1)² pixels, used
   // wherever that whole window is valid and free of depth discontinuities (a
@@ -48,7 +51,7 @@ struct GeometrySettings {
   // a discontinuity, an invalid region or the grid's border), a covariance
   // fit of the consistent neighbours in it. The cost per pixel does not
   // depend on the radii (running box sums).
-  int window_radius = 16;
+  int window_radius = 16;  // at most kMaxWindowRadius
   int edge_window_radius = 2;
   // A depth discontinuity: the second difference of log-range along a row or
   // column exceeds depth_jump_sigmas times its noise (√6 · σ(range) / range),

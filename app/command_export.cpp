@@ -67,6 +67,12 @@ void write_scans(const ExportOptions& options, const std::vector<acquisition::Sc
         throw acquisition::InputError(options.project, {},
                                       "a triplet holds one scan: choose it with --scan ID");
       }
+      if (!scans.front().is_spherical()) {
+        throw acquisition::InputError(options.project,
+                                      {0, 0, "scan \"" + scans.front().name + "\""},
+                                      "a triplet needs the spherical angle model; this scan has "
+                                      "per-pixel directions (export it as ptx, ply or csv)");
+      }
       return acquisition::write_triplet(scans.front(), options.output);
   }
 }

@@ -18,6 +18,10 @@ struct GeometryOptions {
 };
 
 void run_geometry(GeometryOptions& options) {
+  const acquisition::GeometrySettings& g = options.stage.geometry;
+  if (g.edge_window_radius > g.window_radius) {
+    throw CLI::ValidationError("--edge-window", "must not exceed --window");
+  }
   options.stage.geometry.flag_mixed_pixels = !options.no_mixed_pixels;
   ProgressBar progress("geometry");
   options.stage.on_scan_done = [&progress](std::size_t done, std::size_t total,
@@ -49,12 +53,12 @@ void add_geometry_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   acquisition::GeometrySettings& g = options->stage.geometry;
   command->add_option("--window", g.window_radius, "Radius of the widest fitting window [pixels]")
-      ->check(CLI::Range(1, 200))
+      ->check(CLI::Range(1, acquisition::kMaxWindowRadius))
       ->capture_default_str();
   command
       ->add_option("--edge-window", g.edge_window_radius,
                    "Radius of the window near edges [pixels]")
-      ->check(CLI::Range(1, 50))
+      ->check(CLI::Range(1, acquisition::kMaxWindowRadius))
       ->capture_default_str();
   command->add_flag("--no-mixed-pixels", options->no_mixed_pixels, "Do not flag mixed pixels");
   command->add_option("--threads", g.threads, "Worker threads (0 = all cores)");

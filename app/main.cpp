@@ -1,6 +1,6 @@
 // scanbench command line: one subcommand per pipeline stage
-// (simulate → import → geometry → info → export today; geometry, register, merge, segment, render
-// join as their stages land).
+// (simulate → import → geometry → info → export today; register, merge,
+// segment and render join as their stages land).
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>

@@ -10,9 +10,9 @@
 #include <functional>
 #include <numbers>
 
-#include "acquisition/pcd_reader.hpp"
 #include "acquisition/ptx_reader.hpp"
 #include "acquisition/ptx_writer.hpp"
+#include "bench/pcl_io.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::bench {
@@ -71,6 +71,26 @@ void write_ascii_pcd(const std::filesystem::path& path, const Scan& scan) {
   }
 }
 
+// A scratch folder removed with everything in it, also when the bench throws.
+class ScratchFolder {
+ public:
+  ScratchFolder()
+      : path_(std::filesystem::temp_directory_path() /
+              ("scanbench-bench-io-" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 double best_seconds(int repeats, const std::function<void()>& work) {
   double best = 1e30;
   for (int r = 0; r < repeats; ++r) {
@@ -86,9 +106,8 @@ double best_seconds(int repeats, const std::function<void()>& work) {
 
 nlohmann::json run_io_bench(const BenchOptions& options) {
   const int rows = options.smoke ? 90 : 900, columns = options.smoke ? 360 : 3600;
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("scanbench-bench-io-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const ScratchFolder scratch;
+  const std::filesystem::path& dir = scratch.path();
   const Scan scan = synthetic_scan(rows, columns);
   const int repeats = options.smoke ? 1 : 3;
 
@@ -98,7 +117,7 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   const double ptx_bytes = static_cast<double>(std::filesystem::file_size(ptx));
   const double pcd_bytes = static_cast<double>(std::filesystem::file_size(pcd));
   const double read_s = best_seconds(repeats, [&] { acquisition::read_ptx(ptx); });
-  const double pcl_s = best_seconds(repeats, [&] { acquisition::read_organized_pcd(pcd); });
+  const double pcl_s = best_seconds(repeats, [&] { read_pcd_with_pcl(pcd); });
 
   const std::filesystem::path project_path = dir / "bench.sbproj";
   double store_s = 0.0;
@@ -114,7 +133,6 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   const double load_s =
       best_seconds(repeats, [&] { modeling::Project::open(project_path).load_scan(id); });
   const double project_bytes = static_cast<double>(std::filesystem::file_size(project_path));
-  std::filesystem::remove_all(dir);
 
   const double points = static_cast<double>(scan.pixel_count());
   return {{"suite", "io"},

@@ -9,8 +9,10 @@ function(scanbench_target_settings target)
     target_compile_options(${target} PRIVATE -Wno-error=restrict)
   endif()
   if(SCANBENCH_SANITIZE)
+    # -UNDEBUG: the sanitizer pass also checks every programmer-error assert,
+    # at optimised speed (RelWithDebInfo would otherwise define NDEBUG).
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
-                                             -fno-sanitize-recover=undefined)
+                                             -fno-sanitize-recover=undefined -UNDEBUG)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
 endfunction()

@@ -7,14 +7,6 @@
 namespace scanbench::modeling {
 namespace {
 
-// A project this import created holds nothing worth keeping after a failure.
-void remove_project_files(const std::filesystem::path& project_path) {
-  std::error_code ignored;
-  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
-    std::filesystem::remove(project_path.string() + suffix, ignored);
-  }
-}
-
 ImportResult import_into(Project& project, std::span<const std::filesystem::path> files,
                          const ImportSettings& settings) {
   ImportResult result;
@@ -38,15 +30,19 @@ ImportResult import_scan_files(const std::filesystem::path& project_path,
                                const ImportSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   const bool existed = std::filesystem::exists(project_path);
+  // Only a project this call created is removed on failure: if another
+  // process creates the file first, create() refuses and nothing is removed.
+  bool created = false;
   ImportResult result;
   try {
     Project project = existed ? Project::open(project_path) : Project::create(project_path);
+    created = !existed;
     result = import_into(project, files, settings);
   } catch (...) {
-    if (!existed) remove_project_files(project_path);
+    if (created) remove_project_files(project_path);
     throw;
   }
-  result.created_project = !existed;
+  result.created_project = created;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -49,14 +49,14 @@ void create_exclusively(const std::filesystem::path& file) {
   ::close(fd);
 }
 
-void remove_with_sidecars(const std::filesystem::path& file) {
+}  // namespace
+
+void remove_project_files(const std::filesystem::path& file) {
   std::error_code ignored;
   for (const char* suffix : {"", "-journal", "-wal", "-shm"}) {
     std::filesystem::remove(file.string() + suffix, ignored);
   }
 }
-
-}  // namespace
 
 void Project::CloseConnection::operator()(sqlite3* db) const noexcept {
   // Fails only with statements left unfinalized, which RAII rules out.
@@ -90,7 +90,7 @@ Project Project::create(const std::filesystem::path& file) {
     schema::create_schema(project.db(), project.file_name());
     return project;
   } catch (...) {
-    remove_with_sidecars(file);
+    remove_project_files(file);
     throw;
   }
 }

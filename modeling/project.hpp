@@ -16,8 +16,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
-#include <string>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "acquisition/scan.hpp"
@@ -43,6 +43,11 @@ struct StoredScanSummary {
   std::int64_t id = 0;  // the project's id of the scan, stable for the project's life
   acquisition::ScanSummary summary;
 };
+
+// Deletes a project file with its SQLite side files (-journal, -wal, -shm).
+// For a project the caller itself created and must not leave behind; errors
+// are ignored (the files may not exist).
+void remove_project_files(const std::filesystem::path& file);
 
 class Project {
  public:

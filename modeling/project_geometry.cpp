@@ -1,5 +1,7 @@
 // The scan_geometry table (schema version 2): Project::store_geometry and
 // Project::load_geometry.
+#include <sqlite3.h>
+
 #include <cassert>
 
 #include "acquisition/input_error.hpp"
@@ -34,6 +36,7 @@ std::size_t pixel_count(sqlite3* db, const std::string& file, std::int64_t id) {
 
 void Project::store_geometry(std::int64_t id, const acquisition::GeometryResult& result,
                              const std::string& settings_json) {
+  assert(sqlite3_get_autocommit(db()) == 0 && "store_geometry needs an open Transaction");
   const acquisition::ScanGeometry& g = result.geometry;
   [[maybe_unused]] const std::size_t n = pixel_count(db(), file_name(), id);
   assert(g.footprint_m.size() == n && g.normal.size() == n && g.confidence.size() == n &&

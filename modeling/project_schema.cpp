@@ -72,7 +72,10 @@ INSERT INTO meta (key, value) VALUES
   ('created_schema_version', ?1)
 )sql";
 
-constexpr std::array<const char*, 3> kRequiredTables = {"meta", "scans", "scan_channels"};
+// Tables every version has (checked before migrating) and those of later
+// versions (checked after).
+constexpr std::array<const char*, 3> kVersion1Tables = {"meta", "scans", "scan_channels"};
+constexpr std::array<const char*, 1> kLaterTables = {"scan_geometry"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
   throw acquisition::InputError(file, {}, problem);
@@ -108,8 +111,9 @@ std::int64_t pragma_value(sqlite3* db, const char* pragma, const std::string& fi
   return statement.column_int(0);
 }
 
-void check_tables(sqlite3* db, const std::string& file) {
-  for (const char* table : kRequiredTables) {
+template <std::size_t N>
+void check_tables(sqlite3* db, const std::string& file, const std::array<const char*, N>& tables) {
+  for (const char* table : tables) {
     sqlite::Statement statement(
         db, "SELECT 1 FROM sqlite_schema WHERE type = 'table' AND name = ?1", file);
     statement.bind_text(1, table);
@@ -231,11 +235,12 @@ void check_and_migrate(sqlite3* db, const std::string& file) {
       static_cast<std::uint32_t>(pragma_value(db, "PRAGMA application_id", file));
   const int version = read_schema_version(db, file);
   check_identity(application_id, version, file);
-  check_tables(db, file);
+  check_tables(db, file, kVersion1Tables);
   enable_wal(db, file);
   if (version < kProjectSchemaVersion) {
     in_versioned_transaction(db, file, [&] { migrate_from(db, version, file); });
   }
+  check_tables(db, file, kLaterTables);
 }
 
 int read_schema_version(sqlite3* db, const std::string& file) {

@@ -3,6 +3,7 @@
 //
 // Schema history (PRAGMA user_version):
 //   1  meta, scans, scan_channels.
+//   2  scan_geometry (per-point footprint, normal, confidence, flags).
 // To change the schema: bump kProjectSchemaVersion and add a case to
 // migrate_step() in project_schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by

@@ -61,9 +61,9 @@ Statement& Statement::bind_optional_double(int index, std::optional<double> valu
 }
 
 Statement& Statement::bind_text(int index, std::string_view value) {
-  [[maybe_unused]] const int code = sqlite3_bind_text64(
-      statement_, index, value.data(), value.size(), SQLITE_TRANSIENT, SQLITE_UTF8);
-  assert(code == SQLITE_OK && "sqlite bind failed");
+  const int code = sqlite3_bind_text64(statement_, index, value.data(), value.size(),
+                                       SQLITE_TRANSIENT, SQLITE_UTF8);
+  if (code != SQLITE_OK) throw_error(db_, code, file_, "binding a text");
   return *this;
 }
 
@@ -71,9 +71,9 @@ Statement& Statement::bind_blob(int index, std::span<const std::uint8_t> value) 
   // A null pointer would bind NULL instead of an empty blob.
   static constexpr std::uint8_t kEmpty = 0;
   const void* data = value.empty() ? &kEmpty : value.data();
-  [[maybe_unused]] const int code =
-      sqlite3_bind_blob64(statement_, index, data, value.size(), SQLITE_STATIC);
-  assert(code == SQLITE_OK && "sqlite bind failed");
+  const int code = sqlite3_bind_blob64(statement_, index, data, value.size(), SQLITE_STATIC);
+  // SQLITE_TOOBIG is bad data (a channel over SQLite's 1 GB blob limit), not a bug.
+  if (code != SQLITE_OK) throw_error(db_, code, file_, "binding a blob");
   return *this;
 }
 

@@ -163,6 +163,7 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, PcdBadInput,
     testing::Values(BadPcd{"pcd_empty", "empty file"}, BadPcd{"pcd_not_pcd", "not a PCD file"},
                     BadPcd{"pcd_unorganized", "not an organized point cloud (height 1)"},
+                    BadPcd{"pcd_empty_cloud", "empty point cloud"},
                     BadPcd{"pcd_missing_xyz", "missing field z"},
                     BadPcd{"pcd_truncated_ascii", "truncated ASCII body"},
                     BadPcd{"pcd_truncated_binary", "truncated binary body"},

@@ -167,17 +167,6 @@ TEST(Cli, ExportOfAMissingScanIdIsBadInput) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.ply"));
 }
 
-TEST(Cli, BenchIoSmokeRunPrintsOneJsonObject) {
-  ScratchDir dir;
-  const CliResult result = run_cli(dir, {"bench", "io", "--json", "--smoke"});
-  ASSERT_EQ(result.exit_code, 0) << result.err;
-  const nlohmann::json bench = nlohmann::json::parse(result.out);
-  for (const char* field : {"ptx_read_mb_per_s", "ptx_write_mb_per_s",
-                            "pcl_pcd_ascii_read_mb_per_s", "ptx_read_speedup_vs_pcl", "points"}) {
-    EXPECT_TRUE(bench.contains(field)) << field;
-  }
-}
-
 TEST(Cli, SimulateThenImportThenInfoOnTheCampusSite) {
   ScratchDir dir;
   const CliResult sim =

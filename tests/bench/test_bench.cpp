@@ -1,6 +1,7 @@
-// Smoke test of `scanbench bench geometry`: the suite runs end to end on a
-// tiny scan and reports every field issue #4 names. Its figures are not
-// checked: speed and accuracy are measured by the bench itself, not asserted.
+// Smoke tests of `scanbench bench io` and `bench geometry`: each suite runs
+// end to end on a tiny scan and reports the fields its issue names. The
+// figures are not checked: speed and accuracy are measured by the bench
+// itself, never asserted in tests.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -37,6 +38,17 @@ TEST(BenchGeometry, SmokeRunReportsEveryMethodAndField) {
   }
   for (const char* field : {"mixed_pixel_recall", "mixed_pixel_false_rate"})
     EXPECT_TRUE(bench["ours"][field].is_number()) << field;
+}
+
+TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "io", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  for (const char* field : {"ptx_read_mb_per_s", "ptx_write_mb_per_s",
+                            "pcl_pcd_ascii_read_mb_per_s", "ptx_read_speedup_vs_pcl", "points"}) {
+    EXPECT_TRUE(bench.contains(field)) << field;
+  }
 }
 
 }  // namespace
