@@ -7,6 +7,9 @@
 
 namespace scanbench::acquisition {
 
+// Appends `value` to `out`. Integers and finite floats round-trip exactly;
+// NaN and infinities are written as "nan" and "inf" (our writers never pass
+// them: scans hold no non-finite value).
 template <typename Number>
 void append_number(std::string& out, Number value) {
   char text[32];

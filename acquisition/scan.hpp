@@ -53,7 +53,7 @@ struct ScannerMetadata {
 };
 
 struct Scan {
-  std::string name;
+  std::string name;  // UTF-8, for people: the file stem for imported scans; not unique
   int rows = 0;
   int columns = 0;
 
@@ -81,7 +81,8 @@ struct Scan {
 Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color);
 
 // Unit viewing direction of pixel (row, col) in the scan frame. For per-pixel
-// grids this is the stored direction (zero when unknown).
+// grids this is the stored direction (zero when unknown). Every per-pixel
+// accessor below asserts 0 ≤ row < rows and 0 ≤ col < columns.
 Eigen::Vector3f direction(const Scan& scan, int row, int col);
 
 // The same direction in double precision, normalised in double (per-pixel
@@ -94,6 +95,7 @@ Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col);
 // Point of pixel (row, col) in the world frame [m], in double precision.
 Eigen::Vector3d point_in_world(const Scan& scan, int row, int col);
 
+// Number of pixels with a return (valid != 0).
 std::size_t count_valid(const Scan& scan);
 
 // Axis-aligned bounds of the valid points in the world frame [m]; empty

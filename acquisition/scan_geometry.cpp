@@ -233,82 +233,113 @@ float footprint(const Scan& scan, const AngleTables& tables, int row, int col,
 
 }  // namespace
 
-GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
-  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
-         settings.window_radius >= settings.edge_window_radius &&
-         settings.window_radius <= kMaxWindowRadius);
-  const auto start = std::chrono::steady_clock::now();
-  const std::size_t n = scan.pixel_count();
-  std::vector<std::uint8_t> mixed = settings.flag_mixed_pixels ? detect_mixed_pixels(scan, settings)
-                                                               : std::vector<std::uint8_t>(n, 0);
-  const AngleTables tables(scan);
-  std::vector<std::uint8_t> mask(n);
-  std::vector<float> log_range(n, 0.0f);
-  std::vector<Eigen::Vector3f> points(n, Eigen::Vector3f::Zero());
-  parallel_rows(scan.rows, settings.threads, [&](int row) {
-    for (int col = 0; col < scan.columns; ++col) {
-      const std::size_t i = scan.index(row, col);
-      mask[i] = scan.valid[i] && !mixed[i] && scan.range_m[i] > 0.0f;
-      if (!mask[i]) continue;
-      log_range[i] = std::log(scan.range_m[i]);
-      points[i] = scan.range_m[i] * tables.direction(scan, row, col);
-    }
-  });
-  const std::vector<std::uint8_t> jumps = jump_map(scan, mask, log_range, settings);
-  const bool spherical = scan.is_spherical();
-  std::optional<WindowSlopes> slopes;
-  if (spherical) slopes.emplace(scan, mask, log_range, jumps, settings);
-  const GridContext context{scan, settings, mask, log_range, points};
-  const double edge_window_area =
-      (2.0 * settings.edge_window_radius + 1) * (2.0 * settings.edge_window_radius + 1);
+namespace {
 
-  GeometryResult result;
-  ScanGeometry& g = result.geometry;
-  g.footprint_m.assign(n, 0.0f);
-  g.normal.assign(n, Eigen::Vector3f::Zero());
-  g.confidence.assign(n, 0.0f);
-  g.flags.assign(n, 0);
+// The per-pixel inputs every fit reads: which pixels take part (valid, not
+// mixed), their log-range and their scan-frame points.
+struct FitInputs {
+  std::vector<std::uint8_t> mixed, mask, jumps;
+  std::vector<float> log_range;
+  std::vector<Eigen::Vector3f> points;
+};
+
+FitInputs prepare_inputs(const Scan& scan, const AngleTables& tables,
+                         const GeometrySettings& settings) {
+  const std::size_t n = scan.pixel_count();
+  FitInputs in;
+  in.mixed = settings.flag_mixed_pixels ? detect_mixed_pixels(scan, settings)
+                                        : std::vector<std::uint8_t>(n, 0);
+  in.mask.assign(n, 0);
+  in.log_range.assign(n, 0.0f);
+  in.points.assign(n, Eigen::Vector3f::Zero());
   parallel_rows(scan.rows, settings.threads, [&](int row) {
     for (int col = 0; col < scan.columns; ++col) {
       const std::size_t i = scan.index(row, col);
-      if (!scan.valid[i]) continue;
-      std::uint8_t flags = (mixed[i] ? kFlagMixedPixel : 0) | (jumps[i] ? kFlagEdge : 0);
-      Eigen::Vector3f normal = Eigen::Vector3f::Zero();
-      int used = 0;
-      bool ok = false;
-      double area = edge_window_area;
-      if (mask[i] && spherical && slopes->used[i] > 0) {
-        used = slopes->used[i];
-        area = used;
-        normal = spherical_normal(std::get<SphericalAngles>(scan.angles), tables, row, col,
-                                  slopes->per_column[i], slopes->per_row[i]);
-        ok = true;
-      } else if (mask[i]) {
-        // No clean window (cut by a discontinuity, an invalid region or the
-        // grid's border), or no angle model: the log-range slope of a lopsided
-        // window is biased by the curvature of ln r, a 3D plane fit is not.
-        ok = covariance_normal(context, row, col, normal, used);
-      }
-      ok = ok && used >= settings.min_neighbours && normal.allFinite();
-      if (ok) {
-        const float cos_incidence = std::abs(normal.dot(tables.direction(scan, row, col)));
-        g.normal[i] = normal;
-        g.confidence[i] =
-            std::max(1e-6f, static_cast<float>(std::min(1.0, used / area)) * cos_incidence);
-      } else {
-        flags |= kFlagNoNormal;
-      }
-      g.flags[i] = flags;
-      g.footprint_m[i] = footprint(scan, tables, row, col, g.normal[i], settings);
+      in.mask[i] = scan.valid[i] && !in.mixed[i] && scan.range_m[i] > 0.0f;
+      if (!in.mask[i]) continue;
+      in.log_range[i] = std::log(scan.range_m[i]);
+      in.points[i] = scan.range_m[i] * tables.direction(scan, row, col);
     }
   });
-  for (std::size_t i = 0; i < n; ++i) {
+  in.jumps = jump_map(scan, in.mask, in.log_range, settings);
+  return in;
+}
+
+// Normal, confidence, flags and footprint of one valid pixel.
+void fit_pixel(const GridContext& context, const AngleTables& tables, const FitInputs& in,
+               const WindowSlopes* slopes, int row, int col, ScanGeometry& g) {
+  const Scan& scan = context.scan;
+  const GeometrySettings& settings = context.settings;
+  const std::size_t i = scan.index(row, col);
+  std::uint8_t flags = (in.mixed[i] ? kFlagMixedPixel : 0) | (in.jumps[i] ? kFlagEdge : 0);
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+  int used = 0;
+  bool ok = false;
+  double area = (2.0 * settings.edge_window_radius + 1) * (2.0 * settings.edge_window_radius + 1);
+  if (in.mask[i] && slopes != nullptr && slopes->used[i] > 0) {
+    used = slopes->used[i];
+    area = used;
+    normal = spherical_normal(std::get<SphericalAngles>(scan.angles), tables, row, col,
+                              slopes->per_column[i], slopes->per_row[i]);
+    ok = true;
+  } else if (in.mask[i]) {
+    // No clean window (cut by a discontinuity, an invalid region or the
+    // grid's border), or no angle model: the log-range slope of a lopsided
+    // window is biased by the curvature of ln r, a 3D plane fit is not.
+    ok = covariance_normal(context, row, col, normal, used);
+  }
+  ok = ok && used >= settings.min_neighbours && normal.allFinite();
+  if (ok) {
+    const float cos_incidence = std::abs(normal.dot(tables.direction(scan, row, col)));
+    g.normal[i] = normal;
+    g.confidence[i] =
+        std::max(1e-6f, static_cast<float>(std::min(1.0, used / area)) * cos_incidence);
+  } else {
+    flags |= kFlagNoNormal;
+  }
+  g.flags[i] = flags;
+  g.footprint_m[i] = footprint(scan, tables, row, col, g.normal[i], settings);
+}
+
+void count_results(const Scan& scan, GeometryResult& result) {
+  const ScanGeometry& g = result.geometry;
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
     if (!scan.valid[i]) continue;
     ++result.valid_points;
     result.normals += g.has_normal(i);
     result.mixed_pixels += (g.flags[i] & kFlagMixedPixel) != 0;
     result.edge_pixels += (g.flags[i] & kFlagEdge) != 0;
   }
+}
+
+}  // namespace
+
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
+  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
+         settings.window_radius >= settings.edge_window_radius &&
+         settings.window_radius <= kMaxWindowRadius);
+  const auto start = std::chrono::steady_clock::now();
+  const AngleTables tables(scan);
+  const FitInputs in = prepare_inputs(scan, tables, settings);
+  std::optional<WindowSlopes> slopes;
+  if (scan.is_spherical()) slopes.emplace(scan, in.mask, in.log_range, in.jumps, settings);
+  const GridContext context{scan, settings, in.mask, in.log_range, in.points};
+
+  GeometryResult result;
+  ScanGeometry& g = result.geometry;
+  const std::size_t n = scan.pixel_count();
+  g.footprint_m.assign(n, 0.0f);
+  g.normal.assign(n, Eigen::Vector3f::Zero());
+  g.confidence.assign(n, 0.0f);
+  g.flags.assign(n, 0);
+  parallel_rows(scan.rows, settings.threads, [&](int row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      if (scan.valid[scan.index(row, col)]) {
+        fit_pixel(context, tables, in, slopes ? &*slopes : nullptr, row, col, g);
+      }
+    }
+  });
+  count_results(scan, result);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

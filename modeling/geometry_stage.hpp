@@ -41,7 +41,8 @@ struct GeometryStageResult {
 GeometryStageResult compute_project_geometry(const std::filesystem::path& project_path,
                                              const GeometryStageSettings& settings = {});
 
-// The settings as the JSON text stored beside the results.
+// The settings as the JSON text stored beside the results (without
+// `threads`: the results do not depend on it).
 std::string geometry_settings_json(const acquisition::GeometrySettings& settings);
 
 }  // namespace scanbench::modeling
