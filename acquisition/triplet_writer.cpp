@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "acquisition/output_file.hpp"
 #include "acquisition/rigid_transform.hpp"
 
 namespace scanbench::acquisition {
@@ -116,21 +119,17 @@ cv::Mat encode_color(const Scan& scan) {
   return image;
 }
 
-void write_image(const fs::path& path, const cv::Mat& image) {
+// The file bytes of `image` in the format its extension names.
+std::string encode_image(const fs::path& path, const cv::Mat& image) {
+  std::vector<std::uint8_t> bytes;
   bool ok = false;
   try {
-    ok = cv::imwrite(path.string(), image);
+    ok = cv::imencode(path.extension().string(), image, bytes);
   } catch (const cv::Exception& e) {
-    throw std::runtime_error(utf8(path) + ": could not write image (" + e.what() + ")");
+    throw std::runtime_error(utf8(path) + ": could not encode image (" + e.what() + ")");
   }
-  if (!ok) throw std::runtime_error(utf8(path) + ": could not write image");
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(utf8(path) + ": could not write the sidecar");
+  if (!ok) throw std::runtime_error(utf8(path) + ": could not encode image");
+  return std::string(bytes.begin(), bytes.end());
 }
 
 Json range_entry(const std::string& file, const TripletWriteSettings& settings) {
@@ -171,12 +170,23 @@ void write_triplet(const Scan& scan, const std::filesystem::path& sidecar_json,
   const cv::Mat range = float32 ? encode_range_float(scan) : encode_range_uint16(scan, settings);
   const std::string stem = utf8(sidecar_json.stem());
   const fs::path folder = sidecar_json.parent_path();
-  write_image(folder / from_utf8(stem + (float32 ? "_range.tiff" : "_range.png")), range);
-  if (scan.has_intensity()) {
-    write_image(folder / from_utf8(stem + "_intensity.png"), encode_intensity(scan));
+  std::vector<std::pair<fs::path, std::string>> files;
+  const auto add_image = [&](const std::string& name, const cv::Mat& image) {
+    const fs::path path = folder / from_utf8(stem + name);
+    files.emplace_back(path, encode_image(path, image));
+  };
+  add_image(float32 ? "_range.tiff" : "_range.png", range);
+  if (scan.has_intensity()) add_image("_intensity.png", encode_intensity(scan));
+  if (scan.has_color()) add_image("_color.png", encode_color(scan));
+  files.emplace_back(sidecar_json, make_sidecar(scan, stem, settings).dump(2) + "\n");
+  // Every file is written in full beside its target before any replaces it,
+  // the sidecar last: a failure leaves the old triplet (or nothing) behind.
+  std::vector<std::unique_ptr<OutputFile>> outputs;
+  for (const auto& [path, bytes] : files) {
+    outputs.push_back(std::make_unique<OutputFile>(path));
+    outputs.back()->write(bytes);
   }
-  if (scan.has_color()) write_image(folder / from_utf8(stem + "_color.png"), encode_color(scan));
-  write_text(sidecar_json, make_sidecar(scan, stem, settings).dump(2) + "\n");
+  for (auto& output : outputs) output->commit();
 }
 
 }  // namespace scanbench::acquisition
