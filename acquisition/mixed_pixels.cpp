@@ -1,11 +1,9 @@
 #include "acquisition/mixed_pixels.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <cmath>
 #include <cstddef>
+
+#include "acquisition/parallel.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -51,24 +49,18 @@ std::vector<std::uint8_t> detect_mixed_pixels(const Scan& scan, const GeometrySe
   const PaddedRanges padded(scan);
   const std::ptrdiff_t s = padded.stride;
   const std::ptrdiff_t steps[4] = {1, s, s + 1, s - 1};  // row, column, both diagonals
-  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, scan.rows),
-                      [&](const tbb::blocked_range<int>& rows) {
-                        for (int row = rows.begin(); row < rows.end(); ++row) {
-                          for (int col = 0; col < scan.columns; ++col) {
-                            const float* centre = padded.values.data() + padded.at(row, col);
-                            if (*centre < 0) continue;
-                            const auto threshold = static_cast<float>(
-                                settings.mixed_pixel_sigmas *
-                                (settings.range_noise_m + settings.range_noise_per_m * *centre));
-                            bool is_mixed = false;
-                            for (const std::ptrdiff_t step : steps)
-                              is_mixed = is_mixed || mixed_along(centre, step, threshold);
-                            mixed[scan.index(row, col)] = is_mixed;
-                          }
-                        }
-                      });
+  parallel_for_index(scan.rows, settings.threads, [&](int row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const float* centre = padded.values.data() + padded.at(row, col);
+      if (*centre < 0) continue;
+      const auto threshold =
+          static_cast<float>(settings.mixed_pixel_sigmas *
+                             (settings.range_noise_m + settings.range_noise_per_m * *centre));
+      bool is_mixed = false;
+      for (const std::ptrdiff_t step : steps)
+        is_mixed = is_mixed || mixed_along(centre, step, threshold);
+      mixed[scan.index(row, col)] = is_mixed;
+    }
   });
   return mixed;
 }

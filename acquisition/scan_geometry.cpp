@@ -14,10 +14,6 @@
 // always take the covariance fit.
 #include "acquisition/scan_geometry.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cassert>
@@ -26,6 +22,7 @@
 #include <optional>
 
 #include "acquisition/mixed_pixels.hpp"
+#include "acquisition/parallel.hpp"
 #include "acquisition/window_moments.hpp"
 
 namespace scanbench::acquisition {
@@ -33,12 +30,7 @@ namespace {
 
 template <typename Body>
 void parallel_rows(int rows, int threads, Body&& body) {
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 8), [&](const tbb::blocked_range<int>& r) {
-      for (int row = r.begin(); row < r.end(); ++row) body(row);
-    });
-  });
+  parallel_for_index(rows, threads, body, 8);
 }
 
 // Least-squares slopes (per column, per row) of v over a window, from its

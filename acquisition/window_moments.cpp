@@ -1,12 +1,10 @@
 #include "acquisition/window_moments.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <array>
 #include <cassert>
+
+#include "acquisition/parallel.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -37,13 +35,8 @@ constexpr int kBlockColumns = 256;
 template <typename Body>
 void parallel_blocks(int columns, int threads, Body&& body) {
   const int blocks = (columns + kBlockColumns - 1) / kBlockColumns;
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
-      for (int b = r.begin(); b < r.end(); ++b) {
-        body(b * kBlockColumns, std::min(columns, (b + 1) * kBlockColumns));
-      }
-    });
+  parallel_for_index(blocks, threads, [&](int b) {
+    body(b * kBlockColumns, std::min(columns, (b + 1) * kBlockColumns));
   });
 }
 
@@ -182,10 +175,9 @@ std::vector<std::uint16_t> window_counts(int rows, int columns, int radius,
   const std::size_t n = static_cast<std::size_t>(rows) * columns;
   assert(mask.size() == n && radius >= 1 && (2 * radius + 1) * (2 * radius + 1) < 65536);
   std::vector<std::uint16_t> horizontal(n), counts(n);
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& rr) {
-      for (int r = rr.begin(); r < rr.end(); ++r) {
+  parallel_for_index(
+      rows, threads,
+      [&](int r) {
         const std::uint8_t* m = mask.data() + static_cast<std::size_t>(r) * columns;
         const auto at = [&](int c) { return c < 0 || c >= columns ? 0 : (m[c] ? 1 : 0); };
         int sum = 0;
@@ -194,9 +186,8 @@ std::vector<std::uint16_t> window_counts(int rows, int columns, int radius,
           horizontal[static_cast<std::size_t>(r) * columns + c] = static_cast<std::uint16_t>(sum);
           sum += at(c + radius + 1) - at(c - radius);
         }
-      }
-    });
-  });
+      },
+      16);
   parallel_blocks(columns, threads, [&](int begin, int end) {
     std::vector<int> sum(static_cast<std::size_t>(end - begin), 0);
     const auto row = [&](int r) -> const std::uint16_t* {

@@ -1,9 +1,5 @@
 #include "acquisition/simulation/truth_view.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -13,6 +9,7 @@
 #include <stdexcept>
 
 #include "acquisition/input_error.hpp"
+#include "acquisition/parallel.hpp"
 #include "acquisition/rigid_transform.hpp"
 
 namespace scanbench::acquisition::sim {
@@ -131,13 +128,7 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
       for (int c = 0; c < 3; ++c) image.rgb[3 * i + c] = rgb[c];
     }
   };
-  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, view.height),
-                      [&](const tbb::blocked_range<int>& rows) {
-                        for (int v = rows.begin(); v < rows.end(); ++v) render_row(v);
-                      });
-  });
+  parallel_for_index(view.height, settings.threads, render_row);
   return image;
 }
 

@@ -1,14 +1,11 @@
 #include "acquisition/simulation/virtual_scanner.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <numbers>
 
+#include "acquisition/parallel.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/textures.hpp"
 
@@ -135,12 +132,7 @@ bool mixed_echo(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
 
 template <typename Body>
 void parallel_rows(int rows, const SimulationSettings& settings, Body&& body) {
-  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
-      for (int row = range.begin(); row < range.end(); ++row) body(row);
-    });
-  });
+  parallel_for_index(rows, settings.threads, body);
 }
 
 }  // namespace
