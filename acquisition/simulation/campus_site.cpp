@@ -111,9 +111,7 @@ Site make_campus(std::uint64_t seed, int scan_count) {
   for (std::size_t i = 0; i < 3; ++i)
     campaign.gaps_m.push_back((campaign.loop[i + 1] - campaign.loop[i]).norm());
   campaign.target_overlaps = {0.0, 0.0, 0.32};  // only the last gap is searched
-  scene.build();
-  Random scans(hash_combine(seed, 0x7363616e73ull));
-  site.scan_poses = plan_scan_poses(builder, scene, campaign, scan_count, scans);
+  site.scan_poses = finish_site(builder, scene, campaign, seed, scan_count);
   return site;
 }
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -166,6 +167,13 @@ struct CampaignSettings {
 std::vector<Eigen::Isometry3d> plan_scan_poses(const SiteBuilder& builder, const Scene& scene,
                                                const CampaignSettings& settings, int count,
                                                Random& random);
+
+// Builds the scene's BVH (the site is complete), then plans the campaign
+// with the scan-placement random stream of the site's seed: the last step of
+// every site.
+std::vector<Eigen::Isometry3d> finish_site(const SiteBuilder& builder, Scene& scene,
+                                           const CampaignSettings& settings, std::uint64_t seed,
+                                           int count);
 
 // Share of the surface seen from `a` (2° grid, elevations −45°…45°, up to
 // 100 m) that `b` sees too, averaged with the reverse: a coarse overlap of

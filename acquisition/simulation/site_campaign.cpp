@@ -125,6 +125,14 @@ double estimate_overlap(const Scene& scene, const Vector3d& a, const Vector3d& b
   return 0.5 * (seen_fraction(scene, a, b) + seen_fraction(scene, b, a));
 }
 
+std::vector<Eigen::Isometry3d> finish_site(const SiteBuilder& builder, Scene& scene,
+                                           const CampaignSettings& settings, std::uint64_t seed,
+                                           int count) {
+  scene.build();
+  Random scans(hash_combine(seed, 0x7363616e73ull));
+  return plan_scan_poses(builder, scene, settings, count, scans);
+}
+
 std::vector<Eigen::Isometry3d> plan_scan_poses(const SiteBuilder& builder, const Scene& scene,
                                                const CampaignSettings& settings, int count,
                                                Random& random) {

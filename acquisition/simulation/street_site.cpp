@@ -126,9 +126,7 @@ Site make_street(std::uint64_t seed, int scan_count) {
   campaign.loop = {{-60, 0.4}, {75, 0.4}, {75, -0.4}, {-75, -0.4}, {-75, 0.4}};
   campaign.gaps_m = {8.0, 20.0, 45.0};
   campaign.target_overlaps = {0.0, 0.0, 0.32};  // only the last gap is searched
-  scene.build();
-  Random scans(hash_combine(seed, 0x7363616e73ull));
-  site.scan_poses = plan_scan_poses(builder, scene, campaign, scan_count, scans);
+  site.scan_poses = finish_site(builder, scene, campaign, seed, scan_count);
   return site;
 }
 
