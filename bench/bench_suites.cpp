@@ -4,16 +4,20 @@
 
 #include "bench/bench_geometry.hpp"
 #include "bench/bench_io.hpp"
+#include "bench/bench_merge.hpp"
+#include "bench/bench_registration.hpp"
 
 namespace scanbench::bench {
 
 std::vector<std::string> suite_names() {
-  return {"io", "geometry"};
+  return {"io", "geometry", "registration", "merge"};
 }
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "io") return run_io_bench(options);
   if (name == "geometry") return run_geometry_bench(options);
+  if (name == "registration") return run_registration_bench(options);
+  if (name == "merge") return run_merge_bench(options);
   assert(false && "unknown bench suite");
   return {};
 }

@@ -1,4 +1,4 @@
-// Smoke tests of `scanbench bench io` and `bench geometry`: each suite runs
+// Smoke tests of every `scanbench bench` suite: each runs
 // end to end on a tiny scan and reports the fields its issue names. The
 // figures are not checked: speed and accuracy are measured by the bench
 // itself, never asserted in tests.
@@ -38,6 +38,36 @@ TEST(BenchGeometry, SmokeRunReportsEveryMethodAndField) {
   }
   for (const char* field : {"mixed_pixel_recall", "mixed_pixel_false_rate"})
     EXPECT_TRUE(bench["ours"][field].is_number()) << field;
+}
+
+TEST(BenchRegistration, SmokeRunReportsBothMethodsAndEveryField) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "registration", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "registration");
+  for (const char* method : {"ours", "pcl_icp_point_to_plane"}) {
+    ASSERT_TRUE(bench.contains(method)) << method;
+    for (const char* field : {"max_rotation_error_deg", "max_translation_error_m",
+                              "median_rotation_error_deg", "median_translation_error_m", "seconds"})
+      EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+  }
+  EXPECT_TRUE(bench["ours"]["coarse_success_rate"].is_number());
+  EXPECT_EQ(bench["ours"]["trials"], 1);
+}
+
+TEST(BenchMerge, SmokeRunReportsEveryField) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "merge", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "merge");
+  for (const char* field :
+       {"redundant_removed_share", "coverage_before", "coverage_after", "points_per_second"}) {
+    ASSERT_TRUE(bench["ours"][field].is_number()) << field;
+    EXPECT_GE(bench["ours"][field].get<double>(), 0.0) << field;
+  }
+  EXPECT_LE(bench["ours"]["coverage_after"].get<double>(), 1.0);
 }
 
 TEST(BenchIo, SmokeRunPrintsOneJsonObject) {

@@ -1,0 +1,27 @@
+// A site's campaign scanned in memory, with its truth and per-point geometry:
+// the common input of the registration and merge benches.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "acquisition/scan_geometry.hpp"
+#include "acquisition/simulation/virtual_scanner.hpp"
+
+namespace scanbench::bench {
+
+struct SimulatedSite {
+  std::string name;
+  std::vector<acquisition::Scan> scans;  // at their true poses
+  std::vector<acquisition::sim::ScanTruth> truth;
+  std::vector<acquisition::ScanGeometry> geometry;
+  std::vector<Eigen::Isometry3d> true_poses;
+};
+
+// Scans the first `scan_count` positions of site `name` (seed 1) with `model`,
+// then computes every scan's geometry with the default settings.
+SimulatedSite simulate_site(const std::string& name, const acquisition::sim::ScannerModel& model,
+                            int scan_count);
+
+}  // namespace scanbench::bench

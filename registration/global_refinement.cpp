@@ -1,0 +1,120 @@
+// Joint point-to-plane refinement of all poses (a multi-view ICP in the
+// spirit of Pulli 1999), solved in one Ceres problem per association round.
+#include "registration/global_refinement.hpp"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include "registration/association.hpp"
+#include "registration/pair_point_to_plane_residual.hpp"
+#include "registration/pose_parameters.hpp"
+
+namespace scanbench::registration {
+namespace {
+
+std::size_t add_edge_residuals(ceres::Problem& problem, ceres::LossFunction* loss,
+                               const SampleCloud& source, const PreparedScan& target,
+                               const std::vector<Correspondence>& matches, PoseParameters& a,
+                               PoseParameters& b) {
+  for (const Correspondence& c : matches) {
+    const auto k = static_cast<std::size_t>(c.pixel);
+    auto* cost = new ceres::AutoDiffCostFunction<PairPointToPlaneResidual, 1, 4, 3, 4, 3>(
+        new PairPointToPlaneResidual(source.points[c.sample].cast<double>(),
+                                     target.points[k].cast<double>(),
+                                     target.geometry->normal[k].cast<double>()));
+    problem.AddResidualBlock(cost, loss, a.rotation, a.translation, b.rotation, b.translation);
+  }
+  return matches.size();
+}
+
+ceres::Solver::Options solver_options(int threads) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 20;
+  options.num_threads =
+      threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+// One round: associate every edge at the current poses, then solve jointly.
+// Returns the number of correspondences used.
+std::size_t solve_round(std::span<const SampleCloud> samples, std::span<const PreparedScan> scans,
+                        std::span<const ScanEdge> edges, std::vector<PoseParameters>& poses,
+                        double gate_m, const GlobalSettings& settings) {
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::CauchyLoss loss(settings.icp.loss_scale_m);
+  const double min_cos = std::cos(settings.icp.max_normal_angle_deg * std::numbers::pi / 180.0);
+  std::size_t total = 0;
+  for (const ScanEdge& edge : edges) {
+    PoseParameters& a = poses[static_cast<std::size_t>(edge.source)];
+    PoseParameters& b = poses[static_cast<std::size_t>(edge.target)];
+    const Eigen::Isometry3d T_target_source = b.isometry().inverse() * a.isometry();
+    const std::vector<Correspondence> matches =
+        associate_samples(samples[static_cast<std::size_t>(edge.source)],
+                          scans[static_cast<std::size_t>(edge.target)], T_target_source,
+                          {gate_m, min_cos}, settings.icp.threads);
+    if (matches.size() < settings.icp.min_correspondences) continue;
+    total += add_edge_residuals(problem, &loss, samples[static_cast<std::size_t>(edge.source)],
+                                scans[static_cast<std::size_t>(edge.target)], matches, a, b);
+  }
+  for (PoseParameters& pose : poses) {
+    if (!problem.HasParameterBlock(pose.rotation)) continue;
+    problem.SetManifold(pose.rotation, new ceres::EigenQuaternionManifold);
+  }
+  if (problem.HasParameterBlock(poses[0].rotation)) {
+    problem.SetParameterBlockConstant(poses[0].rotation);
+    problem.SetParameterBlockConstant(poses[0].translation);
+  }
+  if (total == 0) return 0;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options(settings.icp.threads), &problem, &summary);
+  return total;
+}
+
+}  // namespace
+
+GlobalResult refine_globally(std::span<const SampleCloud> samples,
+                             std::span<const PreparedScan> scans,
+                             std::vector<Eigen::Isometry3d> T_first_scan,
+                             std::span<const ScanEdge> edges, const GlobalSettings& settings) {
+  assert(samples.size() == scans.size() && T_first_scan.size() == scans.size());
+  assert(!T_first_scan.empty() && T_first_scan[0].isApprox(Eigen::Isometry3d::Identity()) &&
+         "the first scan is the gauge");
+  const auto start = std::chrono::steady_clock::now();
+  GlobalResult result;
+  std::vector<PoseParameters> poses;
+  for (const Eigen::Isometry3d& T : T_first_scan) poses.push_back(PoseParameters::from(T));
+  double gate = settings.initial_gate_m;
+  for (int round = 0; round < settings.max_rounds; ++round) {
+    result.rounds = round + 1;
+    result.correspondences = solve_round(samples, scans, edges, poses, gate, settings);
+    double largest_rotation = 0.0;
+    double largest_translation = 0.0;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const auto [rotation, translation] = pose_change(T_first_scan[i], poses[i].isometry());
+      largest_rotation = std::max(largest_rotation, rotation);
+      largest_translation = std::max(largest_translation, translation);
+      T_first_scan[i] = poses[i].isometry();
+    }
+    gate = std::max(settings.icp.min_gate_m, 0.5 * gate);
+    if (largest_rotation < settings.icp.stop_rotation_rad &&
+        largest_translation < settings.icp.stop_translation_m) {
+      result.converged = true;
+      break;
+    }
+  }
+  result.T_first_scan = std::move(T_first_scan);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace scanbench::registration

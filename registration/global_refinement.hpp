@@ -1,0 +1,48 @@
+// Global refinement: all scan poses adjusted together over every overlapping
+// pair, first scan held fixed, so that registration errors spread over a loop
+// instead of accumulating along a chain of pairwise alignments.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <span>
+#include <vector>
+
+#include "registration/icp.hpp"
+
+namespace scanbench::registration {
+
+// An overlapping pair: samples of `source` are matched into `target`.
+struct ScanEdge {
+  int source = 0;
+  int target = 0;
+};
+
+struct GlobalSettings {
+  // Association is redone this many times at most; each round solves the
+  // joint problem for fixed correspondences.
+  int max_rounds = 8;
+  // Gate of the first round [m] (the pairwise results are already close).
+  double initial_gate_m = 0.1;
+  // Gates, normal test, loss, stop thresholds and threads as in ICP.
+  IcpSettings icp;
+};
+
+struct GlobalResult {
+  // Pose of every scan in the first scan's frame; [0] is the identity.
+  std::vector<Eigen::Isometry3d> T_first_scan;
+  bool converged = false;  // the last round moved no pose beyond the ICP stop thresholds
+  int rounds = 0;
+  std::size_t correspondences = 0;  // over all edges, last round
+  double seconds = 0.0;
+};
+
+// Refines `T_first_scan` (poses of all scans in the first scan's frame;
+// [0] must be the identity, asserted) over `edges`. samples[i] and scans[i]
+// belong to scan i. Edges with too few correspondences in a round add
+// nothing to it.
+GlobalResult refine_globally(std::span<const SampleCloud> samples,
+                             std::span<const PreparedScan> scans,
+                             std::vector<Eigen::Isometry3d> T_first_scan,
+                             std::span<const ScanEdge> edges, const GlobalSettings& settings);
+
+}  // namespace scanbench::registration

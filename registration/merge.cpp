@@ -1,0 +1,136 @@
+// Per-point redundancy test of seed 004 §4.3. For a point p of scan s and
+// another scan o: project p into o's grid (projective association). When o
+// saw a surface at that pixel at p's range (within the noise and o's
+// footprint) with a normal that agrees, both scans sampled the same surface
+// there. The surface area per sample, A = r² Ω / |cos θ| (range r, pixel solid
+// angle Ω, incidence θ), is the inverse sampling rate; A_s / A_o is the
+// Jacobian determinant of the warp from o's range image to s's. p is dropped
+// when some o has A_o < A_s (o samples finer), with ties to the earlier scan.
+#include "registration/merge.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "acquisition/parallel.hpp"
+
+namespace scanbench::registration {
+namespace {
+
+// Everything the test needs about the other scan o, in s's terms.
+struct OtherScan {
+  const PreparedScan* scan = nullptr;
+  int index = 0;          // position in the scan list (tie-break)
+  Eigen::Matrix3f R_o_s;  // rotation s → o
+  Eigen::Vector3f t_o_s;  // translation s → o [m]
+};
+
+struct Thresholds {
+  float range_sigmas;
+  float min_normal_cos;
+  float tie_low;   // A_o < A_s · tie_low: o is finer
+  float tie_high;  // A_o ≤ A_s · tie_high (and not finer): a tie
+  RangeNoise noise;
+};
+
+// True when o sampled the surface of point i of s more finely (or equally
+// finely and o comes first).
+bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const OtherScan& o,
+                     const Thresholds& t) {
+  const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
+  const std::int64_t pixel = associate(*o.scan, p);
+  if (pixel < 0) return false;
+  const auto k = static_cast<std::size_t>(pixel);
+  if (!o.scan->in_model[k]) return false;
+  const float range_p = p.norm();
+  const float range_o = o.scan->scan->range_m[k];
+  const float sigma =
+      static_cast<float>(std::hypot(t.noise.sigma(range_p), t.noise.sigma(s.scan->range_m[i])));
+  const float tolerance = t.range_sigmas * sigma + o.scan->geometry->footprint_m[k];
+  if (std::abs(range_o - range_p) > tolerance) return false;
+  if (s.usable[i] && o.scan->usable[k]) {
+    const Eigen::Vector3f n = o.R_o_s * s.geometry->normal[i];
+    if (n.dot(o.scan->geometry->normal[k]) < t.min_normal_cos) return false;
+  }
+  const float area_s = s.sample_area_m2[i];
+  const float area_o = o.scan->sample_area_m2[k];
+  if (area_o < area_s * t.tie_low) return true;
+  return area_o <= area_s * t.tie_high && o.index < s_index;
+}
+
+void merge_row(std::span<const PreparedScan> scans, int s_index,
+               const std::vector<OtherScan>& others, const Thresholds& t, int row,
+               MergeScanResult& out) {
+  const PreparedScan& s = scans[static_cast<std::size_t>(s_index)];
+  const int columns = s.scan->columns;
+  for (int col = 0; col < columns; ++col) {
+    const std::size_t i = s.scan->index(row, col);
+    if (!s.in_model[i]) continue;
+    bool keep = true;
+    for (const OtherScan& o : others) {
+      if (finer_elsewhere(s, s_index, i, o, t)) {
+        keep = false;
+        break;
+      }
+    }
+    out.keep[i] = keep ? 1 : 0;
+  }
+}
+
+std::vector<OtherScan> others_of(std::span<const PreparedScan> scans,
+                                 std::span<const Eigen::Isometry3d> T_world_scan, int s_index) {
+  std::vector<OtherScan> others;
+  for (int o = 0; o < static_cast<int>(scans.size()); ++o) {
+    if (o == s_index) continue;
+    const Eigen::Isometry3d T_o_s = T_world_scan[static_cast<std::size_t>(o)].inverse() *
+                                    T_world_scan[static_cast<std::size_t>(s_index)];
+    others.push_back({&scans[static_cast<std::size_t>(o)], o, T_o_s.linear().cast<float>(),
+                      T_o_s.translation().cast<float>()});
+  }
+  return others;
+}
+
+void count(const PreparedScan& s, MergeScanResult& out) {
+  for (std::size_t i = 0; i < out.keep.size(); ++i) {
+    if (!s.in_model[i]) continue;
+    ++out.in_model;
+    if (out.keep[i]) {
+      ++out.kept;
+    } else {
+      ++out.redundant;
+    }
+  }
+}
+
+}  // namespace
+
+MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
+                                   std::span<const Eigen::Isometry3d> T_world_scan,
+                                   const MergeSettings& settings) {
+  assert(scans.size() == T_world_scan.size() && "one pose per scan");
+  const auto start = std::chrono::steady_clock::now();
+  const Thresholds thresholds{
+      static_cast<float>(settings.range_sigmas),
+      static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0)),
+      static_cast<float>(1.0 - settings.tie_tolerance),
+      static_cast<float>(1.0 + settings.tie_tolerance), settings.noise};
+  MergeResult result;
+  for (int s = 0; s < static_cast<int>(scans.size()); ++s) {
+    const PreparedScan& scan = scans[static_cast<std::size_t>(s)];
+    const std::vector<OtherScan> others = others_of(scans, T_world_scan, s);
+    MergeScanResult out;
+    out.keep.assign(scan.in_model.size(), 0);
+    acquisition::parallel_for_index(
+        scan.scan->rows, settings.threads,
+        [&](int row) { merge_row(scans, s, others, thresholds, row, out); }, 4);
+    count(scan, out);
+    result.points += out.in_model;
+    result.scans.push_back(std::move(out));
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace scanbench::registration

@@ -1,0 +1,56 @@
+// Merging registered scans by sampling rate (seed 004 §4.3): of the points
+// that sample the same surface from several scans, keep only those of the
+// scan that sampled it most finely. Decided per point, never per tile.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "registration/prepared_scan.hpp"
+
+namespace scanbench::registration {
+
+struct MergeSettings {
+  RangeNoise noise;
+  // Same surface: the ranges along the other scan's beam agree within
+  // range_sigmas combined noise σ plus that beam's footprint (the beam
+  // centre and the point may be half a pixel apart on a slanted surface)...
+  double range_sigmas = 4.0;
+  // ... and the normals agree within this angle [deg] (a thin wall seen
+  // from both sides is two surfaces).
+  double max_normal_angle_deg = 30.0;
+  // Sampling rates within this relative difference count as equal; the scan
+  // listed first then keeps its points. Keeps the decision consistent from
+  // both sides where two scans sample a surface equally finely.
+  double tie_tolerance = 0.05;
+  int threads = 0;  // 0 = all cores; results do not depend on it
+};
+
+struct MergeScanResult {
+  // Per pixel, row-major: 1 = the point belongs to the merged model.
+  std::vector<std::uint8_t> keep;
+  std::size_t in_model = 0;  // valid points that are not mixed pixels
+  std::size_t kept = 0;
+  std::size_t redundant = 0;  // in the model, but another scan sampled the surface more finely
+};
+
+struct MergeResult {
+  std::vector<MergeScanResult> scans;
+  std::size_t points = 0;  // in-model points examined, all scans
+  double seconds = 0.0;
+};
+
+// Decides, for every in-model point of every scan, whether another scan
+// observed the same surface (projection into its grid, range and normal
+// agreement) with a smaller sample area (PreparedScan::sample_area_m2, the
+// Jacobian determinant of the map between the two range images); the point
+// is kept only when none did. `T_world_scan[i]` is scan i's pose (asserted:
+// one per scan). Points without a normal are compared on range alone.
+MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
+                                   std::span<const Eigen::Isometry3d> T_world_scan,
+                                   const MergeSettings& settings);
+
+}  // namespace scanbench::registration

@@ -1,0 +1,59 @@
+// A scan made ready for registration and merging: its points in its own
+// frame, which of them a model may use, how much surface each one samples,
+// and an index that associates any point with one of its pixels.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "acquisition/scan.hpp"
+#include "acquisition/scan_geometry.hpp"
+#include "registration/point_index.hpp"
+#include "registration/spherical_grid.hpp"
+
+namespace scanbench::registration {
+
+// Per-pixel arrays, rows × columns, row-major like the scan.
+struct PreparedScan {
+  // Not owned: scan and geometry must outlive the PreparedScan.
+  const acquisition::Scan* scan = nullptr;
+  const acquisition::ScanGeometry* geometry = nullptr;
+  // Point in the scan frame [m]; zero where the pixel is not in the model.
+  std::vector<Eigen::Vector3f> points;
+  // 1 = the point belongs in a model: valid and not a mixed pixel.
+  std::vector<std::uint8_t> in_model;
+  // 1 = in the model and with a valid normal: usable for plane residuals.
+  std::vector<std::uint8_t> usable;
+  // Surface area [m²] that the sample stands for: range² · the pixel's solid
+  // angle / |cos incidence| (incidence clamped at 87°; head-on where the
+  // normal is invalid). The inverse of the local sampling rate: the Jacobian
+  // determinant of the map between two range images is a ratio of these.
+  std::vector<float> sample_area_m2;
+  // Association: a spherical grid projects, other grids use the kd-tree.
+  std::optional<SphericalGrid> grid;
+  std::unique_ptr<PointIndex> tree;
+};
+
+// Builds the arrays and the index for `scan` with its `geometry` (same pixel
+// count; asserted). `threads` workers, 0 = all cores; the result does not
+// depend on it.
+PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry,
+                          int threads);
+
+// The pixel of `target` associated with `p_target` (a point in the target's
+// scan frame [m]): for spherical grids the pixel on whose beam it lies
+// (projective association, O(1)), otherwise the nearest usable point. -1 when
+// there is none. The pixel may be unusable; callers check.
+std::int64_t associate(const PreparedScan& target, const Eigen::Vector3f& p_target);
+
+// The scanner's range noise, σ(range) = noise_m + noise_per_m · range [m].
+struct RangeNoise {
+  double noise_m = 0.005;
+  double noise_per_m = 5e-5;
+  double sigma(double range_m) const { return noise_m + noise_per_m * range_m; }
+};
+
+}  // namespace scanbench::registration

@@ -1,0 +1,112 @@
+// The registration pipeline: coarse alignment of each scan to the one before
+// it (picked point pairs, or features), point-to-plane ICP on that pair, and
+// a global refinement over every overlapping pair with the first scan fixed.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "registration/feature_alignment.hpp"
+#include "registration/global_refinement.hpp"
+#include "registration/icp.hpp"
+#include "registration/prepared_scan.hpp"
+#include "registration/rigid_fit.hpp"
+
+namespace scanbench::registration {
+
+enum class CoarseMethod {
+  kNone,        // start ICP from the initial poses
+  kPointPairs,  // closed-form fit of user-picked point pairs
+  kFeatures,    // FPFH + RANSAC; ICP also tries the initial pose and keeps the better
+};
+
+// Points picked in scan `source` and scan `target` (indices into the scan
+// list), each in its own scan frame [m].
+struct PickedPairs {
+  int source = 0;
+  int target = 0;
+  std::vector<PointPair> pairs;
+};
+
+struct RegistrationSettings {
+  CoarseMethod coarse = CoarseMethod::kFeatures;
+  // For kPointPairs: for every scan after the first, one entry whose
+  // source is that scan and whose target is an earlier scan.
+  std::vector<PickedPairs> picks;
+  FeatureSettings features;
+  SampleSettings icp_sample;  // the source samples of ICP and global refinement
+  IcpSettings icp;
+  GlobalSettings global;
+  bool refine_globally = true;
+  // A pair is registered only when ICP converges with at least this share
+  // of the source samples matched; otherwise it is reported as failed and
+  // the source scan keeps its initial pose relative to its target.
+  double min_overlap = 0.1;
+  // Pairs matched at least this share at the registered poses join the
+  // global refinement (loop closures included).
+  double min_global_overlap = 0.05;
+};
+
+struct CoarseReport {
+  std::string method;         // "none", "point_pairs" or "features"
+  bool success = false;       // the coarse pose was produced and passed its test
+  double inlier_ratio = 0.0;  // features: RANSAC inliers / samples
+  // Features: share of the ICP samples matched at the coarse pose, within
+  // half the RANSAC inlier distance; below min_overlap the pose is refused.
+  double overlap = 0.0;
+  double rms_m = 0.0;     // point pairs: residual RMS of the fit
+  std::size_t count = 0;  // features: inliers; point pairs: pairs
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();  // when success
+  double seconds = 0.0;
+  std::string failure;
+};
+
+struct PairReport {
+  int source = 0;
+  int target = 0;
+  CoarseReport coarse;
+  IcpResult icp;      // the fine stage from the chosen start
+  std::string start;  // "initial" or "coarse": where ICP started
+  bool registered = false;
+  std::string failure;   // why registered is false
+  double seconds = 0.0;  // coarse stage and every ICP run of the pair
+};
+
+// An overlapping pair measured at the final poses.
+struct EdgeReport {
+  int source = 0;
+  int target = 0;
+  AlignmentQuality quality;
+};
+
+struct RegistrationResult {
+  std::vector<Eigen::Isometry3d> T_world_scan;  // final poses; scan 0 keeps its initial pose
+  std::vector<PairReport> pairs;                // one per scan after the first
+  GlobalResult global;                          // rounds == 0 when not run
+  std::vector<EdgeReport> edges;                // every pair above min_global_overlap
+  // Overall: point-to-plane RMS and share matched over all edges, the sum of
+  // correspondences and iterations, and whether every pair registered and
+  // the global refinement converged.
+  double rms_m = 0.0;
+  double overlap = 0.0;
+  std::size_t correspondences = 0;
+  int iterations = 0;
+  bool converged = false;
+  double coarse_seconds = 0.0;  // sampling, features and RANSAC
+  double fine_seconds = 0.0;    // ICP of every pair and the global refinement
+  double seconds = 0.0;         // everything
+};
+
+// Registers `scans` (prepared, with their pose guesses `initial_T_world_scan`,
+// one per scan; asserted). The first scan is the reference and keeps its
+// pose. For kPointPairs, asserts a pick for every later scan (the caller
+// validates user input first). Non-convergence and failed pairs are fields
+// of the result, not errors.
+RegistrationResult register_scans(std::span<const PreparedScan> scans,
+                                  std::span<const Eigen::Isometry3d> initial_T_world_scan,
+                                  const RegistrationSettings& settings);
+
+}  // namespace scanbench::registration
