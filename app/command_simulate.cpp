@@ -87,6 +87,14 @@ void add_simulate_command(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   command->add_option("--threads", campaign.simulation.threads, "Worker threads (0 = all cores)");
   command
+      ->add_option("--pose-error-deg", campaign.pose_error_deg,
+                   "Rotation error written into the files of scans 2.. (truth keeps true poses)")
+      ->check(CLI::Range(0.0, 180.0));
+  command
+      ->add_option("--pose-error-m", campaign.pose_error_m,
+                   "Translation error written into the files of scans 2.. [m]")
+      ->check(CLI::Range(0.0, 1000.0));
+  command
       ->add_option("--render-view", options->render_view,
                    "Camera view JSON: render a truth picture")
       ->check(CLI::ExistingFile);

@@ -18,5 +18,7 @@ void add_export_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_geometry_command(CLI::App& app);
+void add_register_command(CLI::App& app);
+void add_merge_command(CLI::App& app);
 
 }  // namespace scanbench::app

@@ -1,5 +1,5 @@
 // scanbench command line: one subcommand per pipeline stage
-// (simulate → import → geometry → info → export today; register, merge,
+// (simulate → import → geometry → register → merge → info → export today;
 // segment and render join as their stages land).
 #include <fmt/core.h>
 
@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
   sb::add_import_command(app);
   sb::add_info_command(app);
   sb::add_geometry_command(app);
+  sb::add_register_command(app);
+  sb::add_merge_command(app);
   sb::add_export_command(app);
   sb::add_simulate_command(app);
   sb::add_bench_command(app);

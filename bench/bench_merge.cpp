@@ -74,7 +74,7 @@ bool truth_redundant(const Context& c, std::size_t s, std::size_t i) {
         0.05f + 2.0f * c.site.geometry[o].footprint_m[k]) {
       continue;
     }
-    if (truth_area(c.site, c.prepared[o], o, k) < area * (1.0 - c.tie_tolerance)) return true;
+    if (truth_area(c.site, c.prepared[o], o, k) < area / (1.0 + c.tie_tolerance)) return true;
   }
   return false;
 }

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,8 @@ inline constexpr std::uint32_t kProjectApplicationId = 0x53424E43;
 
 // PRAGMA user_version written by this build. Older projects are migrated on
 // open; newer ones are refused.
-inline constexpr int kProjectSchemaVersion = 2;  // 2: scan_geometry
+// 2: scan_geometry; 3: registration_runs, merge_masks.
+inline constexpr int kProjectSchemaVersion = 3;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
@@ -113,6 +115,35 @@ class Project {
   // not run on it. Throws acquisition::InputError naming the scan when the
   // stored data is damaged.
   std::optional<acquisition::ScanGeometry> load_geometry(std::int64_t id) const;
+
+  // Moves scan `id` to scan.T_world_scan: stores the pose, the scanner
+  // position (the pose's origin) and the world bounds of `scan`, which must
+  // be the stored scan with only its pose changed (asserted on size). Asserts
+  // a Transaction is open; throws acquisition::InputError when there is no
+  // such scan or SQLite fails.
+  void update_pose(std::int64_t id, const acquisition::Scan& scan);
+
+  // Appends a registration run: its settings and report as JSON text.
+  // Asserts a Transaction is open; throws acquisition::InputError when SQLite fails.
+  void store_registration(const std::string& settings_json, const std::string& report_json);
+
+  // The report of the latest registration run, or none.
+  std::optional<std::string> latest_registration_report() const;
+
+  // Stores (replacing any earlier) the merge keep mask of scan `id`: one
+  // byte per pixel, 1 = in the merged model. Asserts a Transaction is open
+  // and the mask matches the scan's pixel count; throws
+  // acquisition::InputError when there is no such scan or SQLite fails.
+  void store_keep_mask(std::int64_t id, std::span<const std::uint8_t> keep,
+                       const std::string& settings_json);
+
+  // The keep mask of scan `id`, or none when `scanbench merge` has not run
+  // since its pose last changed. Throws acquisition::InputError when damaged.
+  std::optional<std::vector<std::uint8_t>> load_keep_mask(std::int64_t id) const;
+
+  // Deletes every keep mask (poses changed: the masks are stale). Asserts a
+  // Transaction is open.
+  void clear_keep_masks();
 
  private:
   struct CloseConnection {

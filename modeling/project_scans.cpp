@@ -180,6 +180,31 @@ std::int64_t Project::insert_scan(const acquisition::Scan& scan) {
   return id;
 }
 
+void Project::update_pose(std::int64_t id, const acquisition::Scan& scan) {
+  assert(sqlite3_get_autocommit(db()) == 0 && "update_pose needs an open Project::Transaction");
+  const acquisition::ScanSummary summary = acquisition::summarize(scan);
+  const auto pose_bytes = encode_pose(scan.T_world_scan);
+  sqlite::Statement update(db(), R"sql(
+UPDATE scans SET T_world_scan = ?2, scanner_x = ?3, scanner_y = ?4, scanner_z = ?5,
+  bbox_min_x = ?6, bbox_min_y = ?7, bbox_min_z = ?8, bbox_max_x = ?9, bbox_max_y = ?10,
+  bbox_max_z = ?11
+WHERE id = ?1 AND rows = ?12 AND columns = ?13)sql",
+                           file_name());
+  update.bind_int(1, id).bind_blob(2, pose_bytes);
+  const Eigen::Vector3d origin = scan.T_world_scan.translation();
+  for (int axis = 0; axis < 3; ++axis) update.bind_double(3 + axis, origin[axis]);
+  const auto& box = summary.bbox_world;
+  for (int axis = 0; axis < 3; ++axis) {
+    update.bind_optional_double(6 + axis, box ? std::optional(box->min()[axis]) : std::nullopt)
+        .bind_optional_double(9 + axis, box ? std::optional(box->max()[axis]) : std::nullopt);
+  }
+  update.bind_int(12, scan.rows).bind_int(13, scan.columns).run();
+  if (sqlite3_changes(db()) != 1) {
+    throw acquisition::InputError(file_name(), {},
+                                  "no scan with id " + std::to_string(id) + " of that size");
+  }
+}
+
 std::vector<StoredScanSummary> Project::scans() const {
   const std::string sql = kSelectScans + " ORDER BY id";
   sqlite::Statement select(db(), sql.c_str(), file_name());

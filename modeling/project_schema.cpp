@@ -75,7 +75,8 @@ INSERT INTO meta (key, value) VALUES
 // Tables every version has (checked before migrating) and those of later
 // versions (checked after).
 constexpr std::array<const char*, 3> kVersion1Tables = {"meta", "scans", "scan_channels"};
-constexpr std::array<const char*, 1> kLaterTables = {"scan_geometry"};
+constexpr std::array<const char*, 3> kLaterTables = {"scan_geometry", "registration_runs",
+                                                     "merge_masks"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
   throw acquisition::InputError(file, {}, problem);
@@ -140,12 +141,33 @@ CREATE TABLE scan_geometry (
 );
 )sql";
 
+// Version 3: the reports of `scanbench register` (JSON, one row per run) and
+// the keep masks of `scanbench merge` (one zstd-compressed byte per pixel).
+constexpr const char* kMigrate2To3 = R"sql(
+CREATE TABLE registration_runs (
+  id INTEGER PRIMARY KEY,
+  settings TEXT NOT NULL,
+  report TEXT NOT NULL,
+  created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+);
+CREATE TABLE merge_masks (
+  scan_id INTEGER PRIMARY KEY REFERENCES scans (id) ON DELETE CASCADE,
+  settings TEXT NOT NULL,
+  kept_points INTEGER NOT NULL CHECK (kept_points >= 0),
+  keep BLOB NOT NULL,
+  computed_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+);
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction.
 void migrate_step(sqlite3* db, int version, const std::string& file) {
   switch (version) {
     case 1:
       sqlite::execute(db, kMigrate1To2, file);
+      return;
+    case 2:
+      sqlite::execute(db, kMigrate2To3, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

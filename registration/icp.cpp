@@ -121,7 +121,7 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
   IcpResult result;
   result.T_target_source = initial;
   IcpProblem problem(source, initial, settings);
-  double gate = settings.initial_gate_m;
+  double gate = std::max(settings.initial_gate_m, settings.min_gate_m);
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
     const std::vector<Correspondence> matches = associate_samples(
         source, target, result.T_target_source, gate_of(gate, settings), settings.threads,

@@ -30,7 +30,7 @@ struct OtherScan {
 struct Thresholds {
   float range_sigmas;
   float min_normal_cos;
-  float tie_low;   // A_o < A_s · tie_low: o is finer
+  float tie_low;   // A_o < A_s · tie_low: o is finer (1 / tie_high: symmetric)
   float tie_high;  // A_o ≤ A_s · tie_high (and not finer): a tie
   RangeNoise noise;
 };
@@ -114,7 +114,7 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
   const Thresholds thresholds{
       static_cast<float>(settings.range_sigmas),
       static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0)),
-      static_cast<float>(1.0 - settings.tie_tolerance),
+      static_cast<float>(1.0 / (1.0 + settings.tie_tolerance)),
       static_cast<float>(1.0 + settings.tie_tolerance), settings.noise};
   MergeResult result;
   for (int s = 0; s < static_cast<int>(scans.size()); ++s) {

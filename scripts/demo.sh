@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # The main job, end to end: installs what is missing, builds, then runs the
 # pipeline and prints what it made.
-#   simulate  a 4-scan campaign of the campus site with exact ground truth
+#   simulate  a 4-scan campaign of the campus site with exact ground truth,
+#             the scan files carrying pose errors of up to 3° and 0.5 m
 #   import    the simulated scans, then the bundled real-format samples
 #             (multi-scan georeferenced PTX, image triplet, organized PCD)
 #   geometry  per-point footprints, normals and mixed-pixel flags
+#   register  coarse (features) + point-to-plane ICP + global refinement
+#   merge     keep masks: each surface from the scan that sampled it most finely
 #   info      table and JSON
 #   export    PTX (lossless), PLY and CSV (world coordinates)
 #   bench     raw-scan I/O throughput against PCL's reader
-# Output goes to DEMO_OUT (default: out/demo/). Later stages (register,
-# merge, segment, render) join this script as they land.
+# Output goes to DEMO_OUT (default: out/demo/). Later stages (segment,
+# render) join this script as they land.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/build.sh"
@@ -23,7 +26,7 @@ project="$out/demo.sbproj"
 phase() { printf '\n== %s ==\n' "$1"; }
 
 phase "simulate"
-"$scanbench" simulate --site campus --seed 1 --out "$out/campus"
+"$scanbench" simulate --site campus --seed 1 --out "$out/campus" --pose-error-deg 3 --pose-error-m 0.5
 
 phase "import"
 "$scanbench" import "$project" "$out"/campus/campus_scan_*.json
@@ -34,6 +37,12 @@ samples="$out/samples.sbproj"
 phase "geometry"
 "$scanbench" geometry "$project"
 "$scanbench" geometry "$samples" --window 2 --edge-window 1
+
+phase "register"
+"$scanbench" register "$project"
+
+phase "merge"
+"$scanbench" merge "$project"
 
 phase "info"
 "$scanbench" info "$project"

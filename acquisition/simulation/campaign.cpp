@@ -9,6 +9,7 @@
 #include "acquisition/input_error.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/rigid_transform.hpp"
+#include "acquisition/simulation/pose_error.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/truth_images.hpp"
 #include "acquisition/triplet_writer.hpp"
@@ -71,8 +72,9 @@ std::string relative_name(const fs::path& path, const fs::path& dir) {
 }
 
 // Writes one simulated scan in the requested formats; returns its JSON entry.
-json write_scan(const SimulatedScan& sim, const CampaignSettings& settings, const fs::path& dir,
-                const ScanLighting& lighting, CampaignResult& result) {
+json write_scan(const SimulatedScan& sim, const Eigen::Isometry3d& true_pose,
+                const CampaignSettings& settings, const fs::path& dir, const ScanLighting& lighting,
+                CampaignResult& result) {
   const std::string& name = sim.scan.name;
   json files = json::object();
   if (settings.format != CampaignFormat::kTriplet) {
@@ -93,7 +95,8 @@ json write_scan(const SimulatedScan& sim, const CampaignSettings& settings, cons
   for (const std::uint8_t m : sim.truth.mixed) mixed += m;
   return {{"name", name},
           {"files", files},
-          {"T_world_scan", row_major(sim.scan.T_world_scan)},
+          {"T_world_scan", row_major(true_pose)},
+          {"stored_T_world_scan", row_major(sim.scan.T_world_scan)},
           {"lighting", lighting_json(lighting)},
           {"truth",
            {{"object_id", relative_name(truth.object_id, dir)},
@@ -136,7 +139,14 @@ CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::pat
                                       scan_seed, settings.simulation);
     result.simulate_seconds += seconds_since(cast_start);
     sim.scan.name = scan_name(settings.site, k);
-    scans.push_back(write_scan(sim, settings, out_dir, lighting, result));
+    const Eigen::Isometry3d true_pose = sim.scan.T_world_scan;
+    if (k > 0 && (settings.pose_error_deg > 0.0 || settings.pose_error_m > 0.0)) {
+      Random random(hash_combine(scan_seed, 0x504f5345u));  // "POSE"
+      sim.scan.T_world_scan =
+          true_pose * random_pose_error(settings.pose_error_deg, settings.pose_error_m, random);
+      sim.scan.scanner.position_world = sim.scan.T_world_scan.translation();
+    }
+    scans.push_back(write_scan(sim, true_pose, settings, out_dir, lighting, result));
     if (settings.on_scan_written)
       settings.on_scan_written(k, static_cast<int>(site.scan_poses.size()));
   }

@@ -34,6 +34,11 @@ struct CampaignSettings {
   ScannerModel scanner;
   CampaignFormat format = CampaignFormat::kTriplet;
   SimulationSettings simulation;
+  // Pose error written into the scan files of every scan but the first, as
+  // an uncalibrated instrument set-up would give (truth.json keeps the true
+  // poses): up to this rotation [deg] and translation [m], seeded. 0 = exact.
+  double pose_error_deg = 0.0;
+  double pose_error_m = 0.0;
   // Called after each scan is written (k is 0-based). Optional.
   std::function<void(int k, int count)> on_scan_written;
 };

@@ -50,7 +50,9 @@ TEST(ProjectGeometry, AVersionOneProjectIsMigratedOnOpen) {
   { Project::create(file); }
   {
     test::RawDatabase raw(file);
-    raw.execute("DROP TABLE scan_geometry; PRAGMA user_version = 1");
+    raw.execute(
+        "DROP TABLE scan_geometry; DROP TABLE registration_runs; DROP TABLE merge_masks; "
+        "PRAGMA user_version = 1");
   }
   Project project = Project::open(file);
   EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);

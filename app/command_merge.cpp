@@ -1,0 +1,64 @@
+// scanbench merge PROJECT [--threads N] [--json]
+#include <fmt/core.h>
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.hpp"
+#include "modeling/registration_stage.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct MergeOptions {
+  std::string project;
+  registration::MergeSettings settings;
+  bool json = false;
+};
+
+void run_merge(const MergeOptions& options) {
+  const modeling::MergeStageResult out = modeling::merge_project(options.project, options.settings);
+  std::size_t kept = 0;
+  nlohmann::json scans = nlohmann::json::array();
+  for (const modeling::MergeStageScan& s : out.scans) {
+    kept += s.counts.kept;
+    scans.push_back({{"id", s.id},
+                     {"name", s.name},
+                     {"in_model", s.counts.in_model},
+                     {"kept", s.counts.kept},
+                     {"redundant", s.counts.redundant}});
+  }
+  if (options.json) {
+    const nlohmann::json report = {
+        {"scans", scans}, {"points", out.points}, {"kept", kept}, {"seconds", out.seconds}};
+    fmt::print("{}\n", report.dump());
+    return;
+  }
+  fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>10}\n", "id", "name", "in model", "kept", "redundant");
+  for (const modeling::MergeStageScan& s : out.scans) {
+    fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>10}\n", s.id, s.name, s.counts.in_model,
+               s.counts.kept, s.counts.redundant);
+  }
+  fmt::print("merged model: {} of {} points kept ({:.2f} s); keep masks stored in {}\n", kept,
+             out.points, out.seconds, options.project);
+}
+
+}  // namespace
+
+void add_merge_command(CLI::App& app) {
+  auto options = std::make_shared<MergeOptions>();
+  CLI::App* command = app.add_subcommand(
+      "merge",
+      "Decide the merged model: keep each point only if no other scan sampled its surface more "
+      "finely (seed 004 §4.3), and store a keep mask per scan (one transaction). Scans are never "
+      "changed.");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--threads", options->settings.threads, "Worker threads (0 = all cores)");
+  command->add_flag("--json", options->json, "Print one JSON object");
+  command->callback([options] { run_merge(*options); });
+}
+
+}  // namespace scanbench::app

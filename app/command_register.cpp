@@ -1,0 +1,91 @@
+// scanbench register PROJECT [--coarse features|pairs|none] [--pairs FILE] [--no-global]
+//                            [--threads N] [--json]
+#include <fmt/core.h>
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/point_pairs_file.hpp"
+#include "modeling/registration_stage.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct RegisterOptions {
+  std::string project;
+  std::string coarse = "features";
+  std::string pairs_file;
+  bool no_global = false;
+  int threads = 0;
+  bool json = false;
+};
+
+void print_table(const modeling::RegisterStageResult& out) {
+  const registration::RegistrationResult& r = out.result;
+  fmt::print("{:>6} {:>6}  {:<10} {:<8} {:>9} {:>8} {:>8} {:>5}  {}\n", "source", "target",
+             "coarse", "start", "rms [mm]", "overlap", "inliers", "iter", "result");
+  for (const registration::PairReport& p : r.pairs) {
+    fmt::print("{:>6} {:>6}  {:<10} {:<8} {:>9.2f} {:>8.3f} {:>8} {:>5}  {}\n",
+               out.ids[static_cast<std::size_t>(p.source)],
+               out.ids[static_cast<std::size_t>(p.target)],
+               p.coarse.success ? p.coarse.method : "failed", p.start, 1000.0 * p.icp.rms_m,
+               p.icp.overlap, p.icp.correspondences, p.icp.iterations,
+               p.registered ? "registered" : "FAILED: " + p.failure);
+  }
+  fmt::print("global refinement: {} rounds, {}; {} overlapping pairs\n", r.global.rounds,
+             r.global.converged ? "converged" : "not converged", r.edges.size());
+  fmt::print("overall: rms {:.2f} mm, overlap {:.3f}, {} inliers, {} iterations, {} ({:.2f} s)\n",
+             1000.0 * r.rms_m, r.overlap, r.correspondences, r.iterations,
+             r.converged ? "converged" : "NOT converged", r.seconds);
+}
+
+void run_register(const RegisterOptions& options) {
+  modeling::RegisterStageSettings settings;
+  registration::RegistrationSettings& s = settings.registration;
+  s.coarse = options.coarse == "none"    ? registration::CoarseMethod::kNone
+             : options.coarse == "pairs" ? registration::CoarseMethod::kPointPairs
+                                         : registration::CoarseMethod::kFeatures;
+  if (!options.pairs_file.empty()) {
+    s.coarse = registration::CoarseMethod::kPointPairs;
+    settings.picks = read_point_pairs_file(options.pairs_file);
+  } else if (s.coarse == registration::CoarseMethod::kPointPairs) {
+    throw CLI::ValidationError("--coarse pairs", "needs --pairs FILE");
+  }
+  s.refine_globally = !options.no_global;
+  s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;
+  const modeling::RegisterStageResult out = modeling::register_project(options.project, settings);
+  if (options.json) {
+    fmt::print("{}\n", out.report_json);
+  } else {
+    print_table(out);
+  }
+}
+
+}  // namespace
+
+void add_register_command(CLI::App& app) {
+  auto options = std::make_shared<RegisterOptions>();
+  CLI::App* command = app.add_subcommand(
+      "register",
+      "Align every scan of the project to the first: coarse (features or picked point pairs), "
+      "point-to-plane ICP, then a global refinement over all overlapping pairs. Stores the poses "
+      "and the report (one transaction); merge keep masks become stale and are dropped.");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--coarse", options->coarse, "Coarse stage")
+      ->check(CLI::IsMember({"features", "pairs", "none"}))
+      ->capture_default_str();
+  command
+      ->add_option("--pairs", options->pairs_file,
+                   "Picked point pairs (JSON, see docs/registration.md); implies --coarse pairs")
+      ->check(CLI::ExistingFile);
+  command->add_flag("--no-global", options->no_global, "Skip the global refinement");
+  command->add_option("--threads", options->threads, "Worker threads (0 = all cores)");
+  command->add_flag("--json", options->json, "Print the report as one JSON object");
+  command->callback([options] { run_register(*options); });
+}
+
+}  // namespace scanbench::app

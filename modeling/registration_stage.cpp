@@ -1,0 +1,208 @@
+#include "modeling/registration_stage.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+
+#include "acquisition/input_error.hpp"
+#include "modeling/project.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+// Scans with their geometry, in id order, and the prepared views of both.
+struct LoadedScans {
+  std::vector<std::int64_t> ids;
+  std::vector<acquisition::Scan> scans;
+  std::vector<acquisition::ScanGeometry> geometry;
+  std::vector<registration::PreparedScan> prepared;
+};
+
+LoadedScans load_scans(const Project& project, int threads) {
+  LoadedScans loaded;
+  for (const StoredScanSummary& stored : project.scans()) {
+    std::optional<acquisition::ScanGeometry> geometry = project.load_geometry(stored.id);
+    if (!geometry) {
+      throw acquisition::InputError(project.path().string(), {},
+                                    "scan " + std::to_string(stored.id) + " (" +
+                                        stored.summary.name +
+                                        ") has no geometry: run scanbench geometry first");
+    }
+    loaded.ids.push_back(stored.id);
+    loaded.scans.push_back(project.load_scan(stored.id));
+    loaded.geometry.push_back(std::move(*geometry));
+  }
+  for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
+    loaded.prepared.push_back(
+        registration::prepare_scan(loaded.scans[k], loaded.geometry[k], threads));
+  }
+  return loaded;
+}
+
+int index_of(const std::vector<std::int64_t>& ids, std::int64_t id, const std::string& file) {
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (ids[k] == id) return static_cast<int>(k);
+  }
+  throw acquisition::InputError(
+      file, {}, "picked pairs name scan " + std::to_string(id) + ", which is not in the project");
+}
+
+// Turns picks by id into picks by position, and checks that every scan but
+// the first has one, with an earlier scan as target.
+std::vector<registration::PickedPairs> picks_by_index(const RegisterStageSettings& settings,
+                                                      const std::vector<std::int64_t>& ids,
+                                                      const std::string& file) {
+  std::vector<registration::PickedPairs> picks;
+  for (const ProjectPicks& p : settings.picks) {
+    const int source = index_of(ids, p.source_id, file);
+    const int target = index_of(ids, p.target_id, file);
+    if (target >= source) {
+      throw acquisition::InputError(
+          file, {},
+          "picked pairs of scan " + std::to_string(p.source_id) + " must target an earlier scan");
+    }
+    picks.push_back({source, target, p.pairs});
+  }
+  for (int k = 1; k < static_cast<int>(ids.size()); ++k) {
+    const bool found =
+        std::any_of(picks.begin(), picks.end(),
+                    [k](const registration::PickedPairs& p) { return p.source == k; });
+    if (!found) {
+      throw acquisition::InputError(
+          file, {}, "no picked pairs for scan " + std::to_string(ids[static_cast<std::size_t>(k)]));
+    }
+  }
+  return picks;
+}
+
+nlohmann::json pose_json(const Eigen::Isometry3d& T) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) {
+    rows.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
+  }
+  return rows;
+}
+
+nlohmann::json pair_json(const registration::PairReport& p, const std::vector<std::int64_t>& ids) {
+  const auto id = [&ids](int k) { return ids[static_cast<std::size_t>(k)]; };
+  return {{"source", id(p.source)},
+          {"target", id(p.target)},
+          {"registered", p.registered},
+          {"failure", p.failure},
+          {"start", p.start},
+          {"coarse",
+           {{"method", p.coarse.method},
+            {"success", p.coarse.success},
+            {"inlier_ratio", p.coarse.inlier_ratio},
+            {"overlap", p.coarse.overlap},
+            {"count", p.coarse.count},
+            {"rms_m", p.coarse.rms_m},
+            {"seconds", p.coarse.seconds},
+            {"failure", p.coarse.failure}}},
+          {"rms_m", p.icp.rms_m},
+          {"overlap", p.icp.overlap},
+          {"inliers", p.icp.correspondences},
+          {"iterations", p.icp.iterations},
+          {"converged", p.icp.converged},
+          {"seconds", p.seconds}};
+}
+
+std::string report_json(const registration::RegistrationResult& r,
+                        const std::vector<std::int64_t>& ids,
+                        const std::vector<acquisition::Scan>& scans) {
+  nlohmann::json report;
+  report["pairs"] = nlohmann::json::array();
+  for (const auto& pair : r.pairs) report["pairs"].push_back(pair_json(pair, ids));
+  report["global"] = {{"rounds", r.global.rounds},
+                      {"converged", r.global.converged},
+                      {"inliers", r.global.correspondences},
+                      {"seconds", r.global.seconds}};
+  report["edges"] = nlohmann::json::array();
+  for (const auto& e : r.edges) {
+    report["edges"].push_back({{"source", ids[static_cast<std::size_t>(e.source)]},
+                               {"target", ids[static_cast<std::size_t>(e.target)]},
+                               {"rms_m", e.quality.rms_m},
+                               {"overlap", e.quality.overlap},
+                               {"inliers", e.quality.correspondences}});
+  }
+  report["overall"] = {
+      {"rms_m", r.rms_m},           {"overlap", r.overlap},     {"inliers", r.correspondences},
+      {"iterations", r.iterations}, {"converged", r.converged}, {"seconds", r.seconds}};
+  report["poses"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    report["poses"].push_back({{"scan", ids[k]},
+                               {"name", scans[k].name},
+                               {"initial_T_world_scan", pose_json(scans[k].T_world_scan)},
+                               {"T_world_scan", pose_json(r.T_world_scan[k])}});
+  }
+  return report.dump();
+}
+
+nlohmann::json settings_json(const registration::RegistrationSettings& s) {
+  const char* coarse = s.coarse == registration::CoarseMethod::kNone         ? "none"
+                       : s.coarse == registration::CoarseMethod::kPointPairs ? "point_pairs"
+                                                                             : "features";
+  return {{"coarse", coarse},
+          {"icp_sample_voxel_m", s.icp_sample.voxel_m},
+          {"icp_max_samples", s.icp_sample.max_points},
+          {"min_gate_m", s.icp.min_gate_m},
+          {"loss_scale_m", s.icp.loss_scale_m},
+          {"min_overlap", s.min_overlap},
+          {"refine_globally", s.refine_globally}};
+}
+
+}  // namespace
+
+RegisterStageResult register_project(const std::filesystem::path& project_path,
+                                     const RegisterStageSettings& settings) {
+  Project project = Project::open(project_path);
+  LoadedScans loaded = load_scans(project, settings.registration.icp.threads);
+  registration::RegistrationSettings run = settings.registration;
+  if (run.coarse == registration::CoarseMethod::kPointPairs) {
+    run.picks = picks_by_index(settings, loaded.ids, project_path.string());
+  }
+  std::vector<Eigen::Isometry3d> initial;
+  for (const acquisition::Scan& scan : loaded.scans) initial.push_back(scan.T_world_scan);
+  RegisterStageResult out;
+  out.ids = loaded.ids;
+  out.result = registration::register_scans(loaded.prepared, initial, run);
+  out.report_json = report_json(out.result, loaded.ids, loaded.scans);
+
+  Project::Transaction transaction = project.begin();
+  for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
+    out.names.push_back(loaded.scans[k].name);
+    loaded.scans[k].T_world_scan = out.result.T_world_scan[k];
+    project.update_pose(loaded.ids[k], loaded.scans[k]);
+  }
+  project.store_registration(settings_json(run).dump(), out.report_json);
+  project.clear_keep_masks();
+  transaction.commit();
+  return out;
+}
+
+MergeStageResult merge_project(const std::filesystem::path& project_path,
+                               const registration::MergeSettings& settings) {
+  Project project = Project::open(project_path);
+  const LoadedScans loaded = load_scans(project, settings.threads);
+  std::vector<Eigen::Isometry3d> poses;
+  for (const acquisition::Scan& scan : loaded.scans) poses.push_back(scan.T_world_scan);
+  registration::MergeResult merged =
+      registration::merge_by_sampling_rate(loaded.prepared, poses, settings);
+  const nlohmann::json stored_settings = {{"range_sigmas", settings.range_sigmas},
+                                          {"max_normal_angle_deg", settings.max_normal_angle_deg},
+                                          {"tie_tolerance", settings.tie_tolerance}};
+  MergeStageResult out;
+  out.points = merged.points;
+  out.seconds = merged.seconds;
+  Project::Transaction transaction = project.begin();
+  for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
+    project.store_keep_mask(loaded.ids[k], merged.scans[k].keep, stored_settings.dump());
+    MergeStageScan scan{loaded.ids[k], loaded.scans[k].name, std::move(merged.scans[k])};
+    scan.counts.keep.clear();
+    out.scans.push_back(std::move(scan));
+  }
+  transaction.commit();
+  return out;
+}
+
+}  // namespace scanbench::modeling
