@@ -14,6 +14,12 @@ function(scanbench_target_settings target)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                              -fno-sanitize-recover=undefined -UNDEBUG)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    # Eigen switches to its own aligned allocator under AddressSanitizer; the
+    # prebuilt PCL and Ceres libraries use malloc. Objects crossing that line
+    # (PCL's feature estimators own Eigen matrices) would be freed by the
+    # other allocator. glibc's and ASan's malloc both align to 16 bytes, which
+    # is all Eigen needs here, so keep malloc everywhere.
+    target_compile_definitions(${target} PRIVATE EIGEN_MALLOC_ALREADY_ALIGNED=1)
   endif()
 endfunction()
 
