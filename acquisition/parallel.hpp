@@ -7,7 +7,17 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <thread>
+
 namespace scanbench::acquisition {
+
+// The number of workers `threads` stands for: itself when positive, else
+// every core (at least 1).
+inline int worker_count(int threads) {
+  if (threads > 0) return threads;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
 
 // Calls body(k) for k in [0, count) on `threads` workers (0 = all cores),
 // handing out `grain` consecutive indices at a time.

@@ -6,37 +6,18 @@
 
 #include <chrono>
 
+#include "registration/pcl_sample_cloud.hpp"
+
 namespace scanbench::bench {
-namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointNormal>;
-
-Cloud::Ptr to_pcl(const registration::SampleCloud& sample) {
-  auto cloud = std::make_shared<Cloud>();
-  cloud->reserve(sample.size());
-  for (std::size_t i = 0; i < sample.size(); ++i) {
-    pcl::PointNormal p;
-    // Component-wise: PCL's 4-float maps trip GCC 12's array-bounds check.
-    p.x = sample.points[i].x();
-    p.y = sample.points[i].y();
-    p.z = sample.points[i].z();
-    p.normal_x = sample.normals[i].x();
-    p.normal_y = sample.normals[i].y();
-    p.normal_z = sample.normals[i].z();
-    p.curvature = 0.0f;
-    cloud->push_back(p);
-  }
-  return cloud;
-}
-
-}  // namespace
 
 PclIcpResult pcl_point_to_plane_icp(const registration::SampleCloud& source,
                                     const registration::SampleCloud& target,
                                     const Eigen::Isometry3d& initial,
                                     const PclIcpSettings& settings) {
-  const Cloud::Ptr source_cloud = to_pcl(source);
-  const Cloud::Ptr target_cloud = to_pcl(target);
+  const Cloud::Ptr source_cloud = registration::to_pcl_cloud(source);
+  const Cloud::Ptr target_cloud = registration::to_pcl_cloud(target);
   const auto start = std::chrono::steady_clock::now();
   pcl::IterativeClosestPointWithNormals<pcl::PointNormal, pcl::PointNormal> icp;
   icp.setInputSource(source_cloud);

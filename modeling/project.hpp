@@ -154,6 +154,8 @@ class Project {
   Project(std::filesystem::path file, Connection db);
   sqlite3* db() const;
   std::string file_name() const { return file_.string(); }
+  // rows × columns of scan `id`; throws acquisition::InputError when there is none.
+  std::size_t stored_pixel_count(std::int64_t id) const;
 
   std::filesystem::path file_;
   Connection db_;

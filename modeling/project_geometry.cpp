@@ -23,22 +23,22 @@ SELECT g.footprint_m, g.normal, g.confidence, g.flags, s.rows * s.columns
 FROM scan_geometry g JOIN scans s ON s.id = g.scan_id WHERE g.scan_id = ?1
 )sql";
 
-std::size_t pixel_count(sqlite3* db, const std::string& file, std::int64_t id) {
-  sqlite::Statement statement(db, "SELECT rows * columns FROM scans WHERE id = ?1", file);
+}  // namespace
+
+std::size_t Project::stored_pixel_count(std::int64_t id) const {
+  sqlite::Statement statement(db(), "SELECT rows * columns FROM scans WHERE id = ?1", file_name());
   statement.bind_int(1, id);
   if (!statement.step()) {
-    throw acquisition::InputError(file, {}, "no scan with id " + std::to_string(id));
+    throw acquisition::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
   }
   return static_cast<std::size_t>(statement.column_int(0));
 }
-
-}  // namespace
 
 void Project::store_geometry(std::int64_t id, const acquisition::GeometryResult& result,
                              const std::string& settings_json) {
   assert(sqlite3_get_autocommit(db()) == 0 && "store_geometry needs an open Transaction");
   const acquisition::ScanGeometry& g = result.geometry;
-  [[maybe_unused]] const std::size_t n = pixel_count(db(), file_name(), id);
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id);
   assert(g.footprint_m.size() == n && g.normal.size() == n && g.confidence.size() == n &&
          g.flags.size() == n && "geometry does not match the scan");
   sqlite::Statement statement(db(), kUpsert, file_name());

@@ -11,19 +11,6 @@
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling {
-namespace {
-
-std::size_t scan_pixels(sqlite3* db, const std::string& file, std::int64_t id) {
-  sqlite::Statement statement(db, "SELECT rows * columns FROM scans WHERE id = ?1", file);
-  statement.bind_int(1, id);
-  if (!statement.step()) {
-    throw acquisition::InputError(file, {}, "no scan with id " + std::to_string(id));
-  }
-  return static_cast<std::size_t>(statement.column_int(0));
-}
-
-}  // namespace
-
 void Project::store_registration(const std::string& settings_json, const std::string& report_json) {
   assert(sqlite3_get_autocommit(db()) == 0 && "store_registration needs an open Transaction");
   sqlite::Statement insert(db(), "INSERT INTO registration_runs (settings, report) VALUES (?1, ?2)",
@@ -41,7 +28,7 @@ std::optional<std::string> Project::latest_registration_report() const {
 void Project::store_keep_mask(std::int64_t id, std::span<const std::uint8_t> keep,
                               const std::string& settings_json) {
   assert(sqlite3_get_autocommit(db()) == 0 && "store_keep_mask needs an open Transaction");
-  [[maybe_unused]] const std::size_t n = scan_pixels(db(), file_name(), id);
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id);
   assert(keep.size() == n && "keep mask does not match the scan");
   std::int64_t kept = 0;
   for (const std::uint8_t k : keep) kept += k != 0;

@@ -1,8 +1,7 @@
 #include "modeling/registration_stage.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
+#include <nlohmann/json.hpp>
 
 #include "acquisition/input_error.hpp"
 #include "modeling/project.hpp"

@@ -9,7 +9,10 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <thread>
+
+#include "acquisition/parallel.hpp"
+#include "acquisition/timing.hpp"
+#include "registration/pcl_sample_cloud.hpp"
 
 namespace scanbench::registration {
 
@@ -21,39 +24,12 @@ struct FeatureCloud::Impl {
   Features::Ptr features = std::make_shared<Features>();
 };
 
-namespace {
-
-Cloud::Ptr to_pcl(const SampleCloud& sample) {
-  auto cloud = std::make_shared<Cloud>();
-  cloud->reserve(sample.size());
-  for (std::size_t i = 0; i < sample.size(); ++i) {
-    pcl::PointNormal p;
-    // Component-wise: PCL's 4-float maps trip GCC 12's array-bounds check.
-    p.x = sample.points[i].x();
-    p.y = sample.points[i].y();
-    p.z = sample.points[i].z();
-    p.normal_x = sample.normals[i].x();
-    p.normal_y = sample.normals[i].y();
-    p.normal_z = sample.normals[i].z();
-    p.curvature = 0.0f;
-    cloud->push_back(p);
-  }
-  return cloud;
-}
-
-unsigned feature_threads(int threads) {
-  return threads > 0 ? static_cast<unsigned>(threads)
-                     : std::max(1u, std::thread::hardware_concurrency());
-}
-
-}  // namespace
-
 FeatureCloud::FeatureCloud(const SampleCloud& sample, const FeatureSettings& settings)
     : impl_(std::make_unique<Impl>()) {
-  impl_->points = to_pcl(sample);
+  impl_->points = to_pcl_cloud(sample);
   if (impl_->points->empty()) return;
   pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> estimator;
-  estimator.setNumberOfThreads(feature_threads(settings.threads));
+  estimator.setNumberOfThreads(static_cast<unsigned>(acquisition::worker_count(settings.threads)));
   estimator.setInputCloud(impl_->points);
   estimator.setInputNormals(impl_->points);
   estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointNormal>>());
@@ -117,7 +93,7 @@ FeatureAlignmentResult align_features(const FeatureCloud& source, const FeatureC
   FeatureAlignmentResult result =
       run_ransac({source.impl_->points, source.impl_->features},
                  {target.impl_->points, target.impl_->features}, settings);
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = acquisition::seconds_since(start);
   return result;
 }
 

@@ -9,8 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
-#include <thread>
 
+#include "acquisition/parallel.hpp"
+#include "acquisition/timing.hpp"
 #include "registration/association.hpp"
 #include "registration/pair_point_to_plane_residual.hpp"
 #include "registration/pose_parameters.hpp"
@@ -37,8 +38,7 @@ ceres::Solver::Options solver_options(int threads) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = 20;
-  options.num_threads =
-      threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.num_threads = acquisition::worker_count(threads);
   options.logging_type = ceres::SILENT;
   return options;
 }
@@ -113,7 +113,7 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
     }
   }
   result.T_first_scan = std::move(T_first_scan);
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = acquisition::seconds_since(start);
   return result;
 }
 

@@ -11,9 +11,10 @@
 #include <memory>
 #include <numbers>
 #include <optional>
-#include <thread>
 #include <vector>
 
+#include "acquisition/parallel.hpp"
+#include "acquisition/timing.hpp"
 #include "registration/association.hpp"
 #include "registration/point_to_plane_residual.hpp"
 #include "registration/pose_parameters.hpp"
@@ -22,15 +23,6 @@ namespace scanbench::registration {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-int solver_threads(int threads) {
-  if (threads > 0) return threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
 
 AssociationGate gate_of(double max_distance_m, const IcpSettings& settings) {
   const double angle_rad = settings.max_normal_angle_deg * std::numbers::pi / 180.0;
@@ -80,7 +72,7 @@ class IcpProblem {
     }
     solver_options_.linear_solver_type = ceres::DENSE_QR;
     solver_options_.max_num_iterations = 10;
-    solver_options_.num_threads = solver_threads(settings.threads);
+    solver_options_.num_threads = acquisition::worker_count(settings.threads);
     solver_options_.logging_type = ceres::SILENT;
   }
 
@@ -150,7 +142,7 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
   result.overlap = quality.overlap;
   result.rms_m = quality.rms_m;
   result.converged = result.converged && quality.correspondences >= settings.min_correspondences;
-  result.seconds = seconds_since(start);
+  result.seconds = acquisition::seconds_since(start);
   return result;
 }
 

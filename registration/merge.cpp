@@ -15,6 +15,7 @@
 #include <numbers>
 
 #include "acquisition/parallel.hpp"
+#include "acquisition/timing.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -129,7 +130,7 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
     result.points += out.in_model;
     result.scans.push_back(std::move(out));
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = acquisition::seconds_since(start);
   return result;
 }
 

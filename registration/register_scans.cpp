@@ -6,16 +6,13 @@
 #include <cmath>
 #include <optional>
 
+#include "acquisition/timing.hpp"
 #include "registration/sample_cloud.hpp"
 
 namespace scanbench::registration {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 struct Candidate {
   std::string start;
@@ -120,7 +117,7 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
       report.start = start.start;
     }
   }
-  report.seconds = seconds_since(start);
+  report.seconds = acquisition::seconds_since(start);
   if (!best) {
     report.failure = "coarse alignment failed: " + report.coarse.failure;
     return report;
@@ -196,7 +193,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
     }
   }
   RegistrationResult result;
-  result.coarse_seconds = seconds_since(start);
+  result.coarse_seconds = acquisition::seconds_since(start);
   std::vector<Eigen::Isometry3d> T_first_scan(n, Eigen::Isometry3d::Identity());
   std::vector<bool> registered(n, true);
   for (std::size_t k = 1; k < n; ++k) {
@@ -231,7 +228,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
   }
   result.converged = std::all_of(registered.begin(), registered.end(), [](bool r) { return r; }) &&
                      (!settings.refine_globally || n == 1 || result.global.converged);
-  result.seconds = seconds_since(start);
+  result.seconds = acquisition::seconds_since(start);
   return result;
 }
 

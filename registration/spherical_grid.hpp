@@ -43,7 +43,7 @@ class SphericalGrid {
     if (row < 0 || row >= rows_) return -1;
     Scalar u = static_cast<Scalar>((azimuth - azimuth_start_) * inverse_azimuth_step_);
     const auto period = static_cast<Scalar>(period_columns_);
-    u -= period * std::floor(u / period);       // into [0, period)
+    u -= period * std::floor(u / period);        // into [0, period)
     if (u >= period - Scalar(0.5)) u -= period;  // the seam: nearer to column 0
     const auto col = static_cast<std::int64_t>(std::floor(u + Scalar(0.5)));
     if (col < 0 || col >= columns_) return -1;

@@ -12,6 +12,7 @@
 #include "acquisition/simulation/pose_error.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/truth_images.hpp"
+#include "acquisition/timing.hpp"
 #include "acquisition/triplet_writer.hpp"
 
 namespace scanbench::acquisition::sim {
@@ -117,10 +118,6 @@ std::string scan_name(const std::string& site, int k) {
   char number[16];
   std::snprintf(number, sizeof number, "%02d", k + 1);
   return site + "_scan_" + number;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
