@@ -1,6 +1,7 @@
 #include "acquisition/grid_covariance.hpp"
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -23,6 +24,60 @@ GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
     sin_el.push_back(static_cast<float>(std::sin(el)));
   }
 }
+
+namespace {
+
+// The smallest eigenvalue of a symmetric 3 × 3 matrix with trace 1, its
+// eigenvector, and the middle eigenvalue; false when the smallest eigenvalue
+// is not separated (the eigenvector is then undefined).
+//
+// Why not a general solver: the closed form needs acos, cos and sin, and
+// dominated the fallback's time. The characteristic polynomial
+// p(λ) = λ³ − λ² + c1·λ − c0 (c1: sum of the principal 2 × 2 minors, c0: the
+// determinant) is increasing and concave left of its smallest root λ0
+// (p'' < 0 for λ < 1/3 ≥ λ0), so Newton's method started left of λ0 climbs
+// to it monotonically, quadratically fast when λ0 is a simple root — the
+// planar case; a blob or a line is rejected anyway. λ1 and λ2 then solve
+// λ1 + λ2 = 1 − λ0, λ1·λ2 = c1 − λ0·(1 − λ0), and the eigenvector is the
+// longest cross product of two rows of C − λ0·I (a rank-2 matrix).
+bool smallest_eigenpair(const Eigen::Matrix3d& a, Eigen::Vector3d& vector, double& smallest,
+                        double& middle) {
+  const double c1 = a(0, 0) * a(1, 1) - a(0, 1) * a(0, 1) + a(0, 0) * a(2, 2) - a(0, 2) * a(0, 2) +
+                    a(1, 1) * a(2, 2) - a(1, 2) * a(1, 2);
+  const double c0 = a.determinant();
+  // Start at 0 unless rounding made the matrix slightly indefinite (c0 < 0);
+  // then at the Gershgorin bound, which is left of every eigenvalue.
+  double lambda = 0.0;
+  if (c0 < 0.0) {
+    for (int i = 0; i < 3; ++i)
+      lambda =
+          std::min(lambda, a(i, i) - std::abs(a(i, (i + 1) % 3)) - std::abs(a(i, (i + 2) % 3)));
+  }
+  for (int iteration = 0; iteration < 40; ++iteration) {
+    const double p = ((lambda - 1.0) * lambda + c1) * lambda - c0;
+    const double slope = (3.0 * lambda - 2.0) * lambda + c1;
+    if (!(slope > 0.0)) break;
+    const double step = p / slope;
+    lambda -= step;
+    if (std::abs(step) <= 1e-15) break;
+  }
+  const double sum = 1.0 - lambda, product = c1 - lambda * sum;
+  const double root = std::sqrt(std::max(0.0, sum * sum - 4.0 * product));
+  smallest = lambda;
+  middle = sum + root > 0.0 ? 2.0 * product / (sum + root) : 0.0;
+  const Eigen::Matrix3d shifted = a - lambda * Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d r0 = shifted.row(0), r1 = shifted.row(1), r2 = shifted.row(2);
+  const Eigen::Vector3d candidates[3] = {r0.cross(r1), r0.cross(r2), r1.cross(r2)};
+  int best = 0;
+  for (int i = 1; i < 3; ++i)
+    if (candidates[i].squaredNorm() > candidates[best].squaredNorm()) best = i;
+  const double length = candidates[best].norm();
+  if (!(length > 0.0)) return false;
+  vector = candidates[best] / length;
+  return true;
+}
+
+}  // namespace
 
 NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
                          const std::uint8_t* mask, const float* log_range, int row, int col,
@@ -57,11 +112,14 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
   Eigen::Matrix3f covariance;
   covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
   covariance = covariance / static_cast<float>(fit.used) - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
-  solver.computeDirect(covariance);
-  const Eigen::Vector3f& values = solver.eigenvalues();
-  if (values[1] <= 4.0f * values[0]) return fit;  // a line or a blob, not a surface
-  fit.normal = solver.eigenvectors().col(0).normalized();
+  const double trace = covariance.trace();
+  if (!(trace > 0.0)) return fit;
+  Eigen::Vector3d normal;
+  double smallest = 0.0, middle = 0.0;
+  if (!smallest_eigenpair(covariance.cast<double>() / trace, normal, smallest, middle) ||
+      middle <= 4.0 * smallest)  // a line or a blob, not a surface
+    return fit;
+  fit.normal = normal.cast<float>();
   if (fit.normal.dot(origin) > 0) fit.normal = -fit.normal;
   fit.cos_incidence = std::abs(fit.normal.dot(view));
   fit.ok = true;
