@@ -21,9 +21,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "acquisition/grid_covariance.hpp"
@@ -137,26 +139,6 @@ float half_spacing_per_pixel(const Scan& scan, int row, int col) {
   return static_cast<float>(0.5 * std::sqrt(az * az + el * el));
 }
 
-// Unit normal towards the scanner from the log-range slopes of a clean
-// window. The frame (u, e_az, e_el) is orthonormal, so the unnormalised
-// normal −u + g_az·e_az + g_el·e_el has length √(1 + g_az² + g_el²), and the
-// cosine of the incidence angle is one over it.
-NormalFit window_fit(const GridDirections& d, const RowFactors& f, const WindowSlope& s, int row,
-                     int col) {
-  const float ca = d.cos_az[col], sa = d.sin_az[col], ce = d.cos_el[row], se = d.sin_el[row];
-  const float g_az = s.per_column * f.azimuth_gradient[row];
-  const float g_el = s.per_row * f.elevation_gradient;
-  const float inverse_length = 1.0f / std::sqrt(1.0f + g_az * g_az + g_el * g_el);
-  const Eigen::Vector3f u(ce * ca, ce * sa, se), e_az(-sa, ca, 0.0f), e_el(-se * ca, -se * sa, ce);
-  NormalFit fit;
-  fit.normal = (-u + g_az * e_az + g_el * e_el) * inverse_length;
-  fit.cos_incidence = inverse_length;
-  fit.used = s.used;
-  fit.window = s.used;
-  fit.ok = true;
-  return fit;
-}
-
 struct Counts {
   std::atomic<std::size_t> valid{0}, normals{0}, mixed{0}, edges{0};
 };
@@ -171,8 +153,9 @@ struct StageContext {
   Counts& counts;
 };
 
-// Normal, confidence, footprint and the no-normal flag of valid pixel i.
-void store_pixel(const StageContext& c, const NormalFit& fit, std::size_t i, float half_spacing) {
+// Normal, confidence, footprint and the no-normal flag of valid pixel i
+// from a covariance fit (or from none: fit.ok false).
+void store_fit(const StageContext& c, const NormalFit& fit, std::size_t i, float half_spacing) {
   const bool ok = fit.ok && fit.used >= c.settings.min_neighbours && fit.normal.allFinite();
   float cos_incidence = 1.0f;
   if (ok) {
@@ -182,42 +165,144 @@ void store_pixel(const StageContext& c, const NormalFit& fit, std::size_t i, flo
         std::max(1e-6f, std::min(1.0f, static_cast<float>(fit.used) / fit.window) * cos_incidence);
   } else {
     c.g.normal[i] = Eigen::Vector3f::Zero();
+    c.g.confidence[i] = 0.0f;
     c.g.flags[i] |= kFlagNoNormal;
   }
   const float stretch = static_cast<float>(1.0 / c.settings.max_footprint_stretch);
   c.g.footprint_m[i] = c.scan.range_m[i] * half_spacing / std::max(cos_incidence, stretch);
 }
 
-// Finishes pixels (row, begin … end − 1); `slopes` (spherical scans) holds
-// their window fits, else every masked pixel takes the covariance fit.
-void finish_pixels(const StageContext& c, int row, int begin, int end, const WindowSlope* slopes) {
+// Adds the counts of GeometryResult for pixels [first, first + count).
+void count_pixels(const StageContext& c, std::size_t first, int count) {
   std::size_t valid = 0, normals = 0, mixed = 0, edges = 0;
-  for (int col = begin; col < end; ++col) {
-    const std::size_t i = c.scan.index(row, col);
-    if (!c.scan.valid[i]) {
-      c.g.normal[i] = Eigen::Vector3f::Zero();
-      continue;
-    }
-    NormalFit fit;
-    if (slopes != nullptr && slopes[col - begin].used > 0) {
-      fit = window_fit(c.directions, c.factors, slopes[col - begin], row, col);
-    } else if (c.in.mask[i]) {
-      // No clean window (cut by a discontinuity, an invalid region or the
-      // grid's border), or no angle model: the log-range slope of a lopsided
-      // window is biased by the curvature of ln r, a 3D plane fit is not.
-      fit = covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(),
-                           c.in.log_range.get(), row, col, c.scan.rows, c.settings);
-    }
-    store_pixel(
-        c, fit, i,
-        slopes != nullptr ? c.factors.half_spacing[row] : half_spacing_per_pixel(c.scan, row, col));
-    ++valid;
+  for (std::size_t i = first; i < first + count; ++i) {
+    valid += c.scan.valid[i] != 0;
     normals += c.g.confidence[i] > 0.0f;
     mixed += (c.g.flags[i] & kFlagMixedPixel) != 0;
     edges += (c.g.flags[i] & kFlagEdge) != 0;
   }
   c.counts.valid += valid, c.counts.normals += normals;
   c.counts.mixed += mixed, c.counts.edges += edges;
+}
+
+// All bits of `value` where `keep` is all ones, +0 where it is zero: a select
+// that GCC's vectorizer accepts (a conditional expression it turns back into
+// a branch) and that no non-finite value can leak through.
+inline float select_bits(float value, std::uint32_t keep) {
+  return std::bit_cast<float>(std::bit_cast<std::uint32_t>(value) & keep);
+}
+
+inline std::uint32_t all_bits(bool b) {
+  return b ? ~0u : 0u;
+}
+
+// 1/√q for q ≥ 1 with a relative error below 1.5·10⁻⁷ (as good as float
+// arithmetic gets): the classic bit-level estimate (Lomont's constant, error
+// < 3.5·10⁻²) and three Newton steps, each squaring the error. Plain
+// arithmetic, so it vectorizes, where std::sqrt keeps a scalar branch for
+// errno. Two steps (error 5·10⁻⁶) would not do: the length of a unit normal
+// enters angles to other unit vectors as √(2·error), 0.2° here.
+inline float inverse_sqrt(float q) {
+  float y = std::bit_cast<float>(0x5f375a86u - (std::bit_cast<std::uint32_t>(q) >> 1));
+  y *= 1.5f - 0.5f * q * y * y;
+  y *= 1.5f - 0.5f * q * y * y;
+  y *= 1.5f - 0.5f * q * y * y;
+  return y;
+}
+
+// What the window normals of one row share.
+struct RowConstants {
+  float cos_el, sin_el;
+  float az_gradient, el_gradient;  // slope per pixel → per radian (see RowFactors)
+  float half_spacing, stretch;
+  std::uint16_t min_used;
+};
+
+// The normal towards the scanner is −u + g_az·e_az + g_el·e_el in the
+// orthonormal frame (u, e_az, e_el), with g the log-range slopes per radian
+// (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
+// of the incidence angle is one over it, so the footprint's stretch is the
+// length itself. Writes n pixels' normals (as three arrays), confidences,
+// footprints and no-normal flags. Branch-free over plain, unaliased arrays,
+// so that the loop vectorizes. Masked pixels without a clean window are left
+// for the covariance fit (no flag).
+void window_normals(int n, const RowConstants& k, const float* __restrict per_column,
+                    const float* __restrict per_row, const std::uint16_t* __restrict used,
+                    const float* __restrict cos_az, const float* __restrict sin_az,
+                    const float* __restrict range, const std::uint8_t* __restrict valid,
+                    const std::uint8_t* __restrict mask, float* __restrict nx, float* __restrict ny,
+                    float* __restrict nz, float* __restrict confidence, float* __restrict footprint,
+                    std::uint8_t* __restrict flags) {
+  for (int j = 0; j < n; ++j) {
+    const float g_az = per_column[j] * k.az_gradient, g_el = per_row[j] * k.el_gradient;
+    const float q = 1.0f + g_az * g_az + g_el * g_el;
+    const float inverse = inverse_sqrt(q), length = q * inverse;
+    const std::uint32_t ok =
+        all_bits((used[j] >= k.min_used) & (length <= std::numeric_limits<float>::max()));
+    const std::uint32_t is_valid = all_bits(valid[j] != 0);
+    const std::uint32_t pending = all_bits((used[j] == 0) & (mask[j] != 0));
+    const float ca = cos_az[j], sa = sin_az[j];
+    nx[j] = select_bits((-k.cos_el * ca - g_az * sa - g_el * k.sin_el * ca) * inverse, ok);
+    ny[j] = select_bits((-k.cos_el * sa + g_az * ca - g_el * k.sin_el * sa) * inverse, ok);
+    nz[j] = select_bits((-k.sin_el + g_el * k.cos_el) * inverse, ok);
+    confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
+    const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
+    footprint[j] = select_bits(range[j] * k.half_spacing * std::min(stretch, k.stretch), is_valid);
+    flags[j] |= static_cast<std::uint8_t>(is_valid & ~ok & ~pending & kFlagNoNormal);
+  }
+}
+
+// A spherical scan's row segment: window normals in chunks (scratch arrays
+// on the stack), then the covariance fit where no clean window exists.
+void store_window_fits(const StageContext& c, int row, int begin, int end,
+                       const WindowSlopeRow& s) {
+  constexpr int kChunk = 128;
+  const RowConstants k{c.directions.cos_el[row],
+                       c.directions.sin_el[row],
+                       c.factors.azimuth_gradient[row],
+                       c.factors.elevation_gradient,
+                       c.factors.half_spacing[row],
+                       static_cast<float>(c.settings.max_footprint_stretch),
+                       static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
+  const std::size_t first = c.scan.index(row, begin);
+  for (int j0 = 0; j0 < end - begin; j0 += kChunk) {
+    const int n = std::min(kChunk, end - begin - j0);
+    const std::size_t i0 = first + j0;
+    float nx[kChunk], ny[kChunk], nz[kChunk];
+    window_normals(n, k, s.per_column + j0, s.per_row + j0, s.used + j0,
+                   c.directions.cos_az.data() + begin + j0, c.directions.sin_az.data() + begin + j0,
+                   c.scan.range_m.data() + i0, c.scan.valid.data() + i0, c.in.mask.get() + i0, nx,
+                   ny, nz, c.g.confidence.data() + i0, c.g.footprint_m.data() + i0,
+                   c.g.flags.data() + i0);
+    for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
+  }
+  for (int j = 0; j < end - begin; ++j) {
+    if (s.used[j] != 0 || !c.in.mask[first + j]) continue;
+    // No clean window (cut by a discontinuity, an invalid region or the
+    // grid's border): the log-range slope of a lopsided window is biased by
+    // the curvature of ln r, a 3D plane fit is not.
+    const NormalFit fit =
+        covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(), c.in.log_range.get(),
+                       row, begin + j, c.scan.rows, c.settings);
+    store_fit(c, fit, first + j, k.half_spacing);
+  }
+  count_pixels(c, first, end - begin);
+}
+
+// A row of a per-pixel direction grid: covariance fits only.
+void store_covariance_fits(const StageContext& c, int row) {
+  for (int col = 0; col < c.scan.columns; ++col) {
+    const std::size_t i = c.scan.index(row, col);
+    c.g.normal[i] = Eigen::Vector3f::Zero();
+    if (!c.scan.valid[i]) continue;
+    NormalFit fit;
+    if (c.in.mask[i]) {
+      fit = covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(),
+                           c.in.log_range.get(), row, col, c.scan.rows, c.settings);
+    }
+    store_fit(c, fit, i, half_spacing_per_pixel(c.scan, row, col));
+  }
+  count_pixels(c, c.scan.index(row, 0), c.scan.columns);
 }
 
 // The window radii of the cascade, widest first: halving from window_radius
@@ -259,12 +344,12 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
     const std::vector<int> radii = cascade_radii(settings);
     visit_window_slopes(scan.rows, scan.columns, radii, {in.clean.get(), scan.pixel_count()},
                         {in.log_range.get(), scan.pixel_count()}, settings.threads,
-                        [&](int row, int begin, int end, const WindowSlope* slopes) {
-                          finish_pixels(context, row, begin, end, slopes);
+                        [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
+                          store_window_fits(context, row, begin, end, slopes);
                         });
   } else {
     parallel_rows(scan.rows, settings.threads,
-                  [&](int row) { finish_pixels(context, row, 0, scan.columns, nullptr); });
+                  [&](int row) { store_covariance_fits(context, row); });
   }
   result.valid_points = counts.valid, result.normals = counts.normals;
   result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;

@@ -141,38 +141,52 @@ double inverse_sxx(int k) {
   return 3.0 / (side * side * k * (k + 1.0));
 }
 
-// The widest clean window of one pixel at region (y, x).
-WindowSlope widest_clean_fit(const IntegralRing& ring, std::span<const int> radii,
-                             std::span<const double> inverse, int y, int x) {
-  WindowSlope s;
+// One row segment's fits as parallel arrays.
+struct SlopeBuffers {
+  std::vector<float> per_column, per_row;
+  std::vector<std::uint16_t> used;
+
+  explicit SlopeBuffers(std::size_t n) : per_column(n), per_row(n), used(n) {}
+  WindowSlopeRow row() const { return {per_column.data(), per_row.data(), used.data()}; }
+};
+
+// The widest clean window of the pixel at region (y, x), stored at `j`.
+void widest_clean_fit(const IntegralRing& ring, std::span<const int> radii,
+                      std::span<const double> inverse, int y, int x, SlopeBuffers& out,
+                      std::size_t j) {
   for (std::size_t r = 0; r < radii.size(); ++r) {
     const int k = radii[r];
     if (ring.unclean(y, x, k) != 0) continue;
     double sxv = 0.0, syv = 0.0;
     ring.centred_moments(y, x, k, sxv, syv);
-    s.per_column = static_cast<float>(sxv * inverse[r]);
-    s.per_row = static_cast<float>(syv * inverse[r]);
-    s.used = static_cast<std::uint16_t>((2 * k + 1) * (2 * k + 1));
-    break;
+    out.per_column[j] = static_cast<float>(sxv * inverse[r]);
+    out.per_row[j] = static_cast<float>(syv * inverse[r]);
+    out.used[j] = static_cast<std::uint16_t>((2 * k + 1) * (2 * k + 1));
+    return;
   }
-  return s;
+  out.per_column[j] = out.per_row[j] = 0.0f;
+  out.used[j] = 0;
 }
 
 void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
                 std::span<const double> inverse, const SlopeVisitor& visit) {
   const int halo = radii.front();
   IntegralRing ring(grid, tile, halo);
-  std::vector<WindowSlope> out(static_cast<std::size_t>(tile.col_end - tile.col_begin));
+  SlopeBuffers out(static_cast<std::size_t>(tile.col_end - tile.col_begin));
   for (int row = tile.row_begin; row < tile.row_end; ++row) {
     const int y = row - tile.row_begin + halo;
     ring.extend_to(y + halo + 1);
     const std::size_t offset = static_cast<std::size_t>(row) * grid.columns;
     for (int col = tile.col_begin; col < tile.col_end; ++col) {
-      const int x = col - tile.col_begin + halo;
-      out[col - tile.col_begin] =
-          grid.clean[offset + col] ? widest_clean_fit(ring, radii, inverse, y, x) : WindowSlope{};
+      const auto j = static_cast<std::size_t>(col - tile.col_begin);
+      if (grid.clean[offset + col]) {
+        widest_clean_fit(ring, radii, inverse, y, col - tile.col_begin + halo, out, j);
+      } else {
+        out.per_column[j] = out.per_row[j] = 0.0f;
+        out.used[j] = 0;
+      }
     }
-    visit(row, tile.col_begin, tile.col_end, out.data());
+    visit(row, tile.col_begin, tile.col_end, out.row());
   }
 }
 
@@ -197,12 +211,13 @@ std::vector<WindowSlope> window_slopes(int rows, int columns, std::span<const in
                                        std::span<const std::uint8_t> clean,
                                        std::span<const float> value, int threads) {
   std::vector<WindowSlope> result(static_cast<std::size_t>(rows) * columns);
-  visit_window_slopes(rows, columns, radii, clean, value, threads,
-                      [&](int row, int begin, int end, const WindowSlope* slopes) {
-                        std::copy(
-                            slopes, slopes + (end - begin),
-                            result.begin() + static_cast<std::ptrdiff_t>(row) * columns + begin);
-                      });
+  visit_window_slopes(
+      rows, columns, radii, clean, value, threads,
+      [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
+        WindowSlope* out = result.data() + static_cast<std::size_t>(row) * columns;
+        for (int j = 0; j < end - begin; ++j)
+          out[begin + j] = {slopes.per_column[j], slopes.per_row[j], slopes.used[j]};
+      });
   return result;
 }
 

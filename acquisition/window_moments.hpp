@@ -28,6 +28,14 @@ struct WindowSlope {
   std::uint16_t used = 0;   // pixels in the window, (2k + 1)²; 0 = no clean window
 };
 
+// The fits of one row segment as parallel arrays, one entry per pixel (the
+// loops that consume them vectorize).
+struct WindowSlopeRow {
+  const float* per_column;
+  const float* per_row;
+  const std::uint16_t* used;
+};
+
 // Hands the slopes of pixels (row, col_begin … col_end − 1) to `visit`, tile
 // by tile, tiles in parallel (so `visit` must only touch its own pixels);
 // every pixel is visited exactly once. A pixel takes the first radius of
@@ -37,7 +45,7 @@ struct WindowSlope {
 // cores). Asserts the spans hold rows × columns entries and the radii are
 // descending, ≥ 1 and ≤ 127 (so `used` fits 16 bits).
 using SlopeVisitor =
-    std::function<void(int row, int col_begin, int col_end, const WindowSlope* slopes)>;
+    std::function<void(int row, int col_begin, int col_end, const WindowSlopeRow& slopes)>;
 void visit_window_slopes(int rows, int columns, std::span<const int> radii,
                          std::span<const std::uint8_t> clean, std::span<const float> value,
                          int threads, const SlopeVisitor& visit);
