@@ -67,31 +67,69 @@ void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, Fit
   });
 }
 
-// clean and the edge flag: a masked pixel whose log-range jumps, i.e. its
-// second difference along the row or the column exceeds the threshold of
-// GeometrySettings (noise-aware, capped by depth_jump_relative).
+// The depth-jump test of GeometrySettings: a second difference `d` of
+// log-range above depth_jump_relative, or above depth_jump_sigmas · √6 ·
+// σ(range) / range — compared as d · range > √6 · depth_jump_sigmas · σ,
+// without a division.
+struct JumpTest {
+  float relative, noise0, noise1;  // threshold·range = noise0 + noise1·range
+
+  explicit JumpTest(const GeometrySettings& s)
+      : relative(static_cast<float>(s.depth_jump_relative)),
+        noise0(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_m)),
+        noise1(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_per_m)) {}
+
+  bool operator()(float before, float centre, float after, float range) const {
+    const float d = std::abs(before - 2.0f * centre + after);
+    return (d > relative) | (d * range > noise0 + noise1 * range);
+  }
+};
+
+// Interior pixels 1 … n − 2 of a row whose rows above and below exist;
+// branch-free over plain, unaliased arrays so that the loop vectorizes.
+void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
+                    const std::uint8_t* __restrict mask, const float* __restrict v,
+                    const float* __restrict range, std::uint8_t* __restrict clean,
+                    std::uint8_t* __restrict flags) {
+  for (int c = 1; c + 1 < n; ++c) {
+    const bool along_row =
+        (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range[c]);
+    const bool along_column = (mask[c - stride] != 0) & (mask[c + stride] != 0) &
+                              test(v[c - stride], v[c], v[c + stride], range[c]);
+    const bool jumps = (mask[c] != 0) & (along_row | along_column);
+    clean[c] = (mask[c] != 0) & !jumps;
+    flags[c] |= static_cast<std::uint8_t>(jumps ? kFlagEdge : 0);
+  }
+}
+
+// clean (masked and no depth jump) and the edge flag, for every pixel.
 void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& in,
                 std::vector<std::uint8_t>& flags) {
-  const int columns = scan.columns;
-  const double noise_factor = settings.depth_jump_sigmas * std::sqrt(6.0);
+  const JumpTest test(settings);
+  const int rows = scan.rows, columns = scan.columns;
   const std::uint8_t* mask = in.mask.get();
   const float* v = in.log_range.get();
-  parallel_rows(scan.rows, settings.threads, [&](int r) {
-    for (int c = 0; c < columns; ++c) {
-      const std::size_t i = scan.index(r, c);
-      in.clean[i] = 0;
-      if (!mask[i]) continue;
-      const double range = scan.range_m[i];
-      const double sigma = settings.range_noise_m + settings.range_noise_per_m * range;
-      const double jump = std::min(settings.depth_jump_relative, noise_factor * sigma / range);
-      const auto jumps_between = [&](std::size_t before, std::size_t after) {
-        return mask[before] && mask[after] && std::abs(v[before] - 2 * v[i] + v[after]) > jump;
-      };
-      const bool jumps = (c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
-                         (r > 0 && r + 1 < scan.rows && jumps_between(i - columns, i + columns));
-      in.clean[i] = !jumps;
-      flags[i] |= jumps ? kFlagEdge : 0;
+  const auto one_pixel = [&](int r, int c) {
+    const std::size_t i = scan.index(r, c);
+    const auto jumps_between = [&](std::size_t before, std::size_t after) {
+      return mask[before] && mask[after] && test(v[before], v[i], v[after], scan.range_m[i]);
+    };
+    const bool jumps =
+        mask[i] && ((c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
+                    (r > 0 && r + 1 < rows && jumps_between(i - columns, i + columns)));
+    in.clean[i] = mask[i] && !jumps;
+    flags[i] |= jumps ? kFlagEdge : 0;
+  };
+  parallel_rows(rows, settings.threads, [&](int r) {
+    const std::size_t i = scan.index(r, 0);
+    if (r == 0 || r + 1 == rows || columns < 3) {
+      for (int c = 0; c < columns; ++c) one_pixel(r, c);
+      return;
     }
+    one_pixel(r, 0);
+    interior_jumps(columns, columns, test, mask + i, v + i, scan.range_m.data() + i,
+                   in.clean.get() + i, flags.data() + i);
+    one_pixel(r, columns - 1);
   });
 }
 
