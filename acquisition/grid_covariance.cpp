@@ -3,7 +3,10 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+
+#include "acquisition/branch_free.hpp"
 
 namespace scanbench::acquisition {
 
@@ -68,59 +71,24 @@ bool plane_normal(const Eigen::Matrix3d& a, Eigen::Vector3d& normal) {
   return t < 0.5 * s && (t - s) * t + q > 0.0;
 }
 
-// Directions of a spherical scan's pixels as products of its tables; a
-// functor so that the gather below has no branch on the grid type.
-struct SphericalDirection {
-  const GridDirections& d;
-  Eigen::Vector3f operator()(int row, int col) const {
-    return {d.cos_el[row] * d.cos_az[col], d.cos_el[row] * d.sin_az[col], d.sin_el[row]};
-  }
+// Sums of the consistent neighbours' points relative to the centre's point.
+struct PointSums {
+  float x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  int used = 0;
 };
 
-struct PerPixelDirection {
-  const GridDirections& d;
-  Eigen::Vector3f operator()(int row, int col) const { return d.at(row, col); }
-};
-
-// Sums of the consistent neighbours' points relative to `origin`, then the
-// plane through them. Branch-free over the window (a rejected neighbour adds
-// zeros): which neighbours pass depends on the data, and a mispredicted
-// branch per neighbour cost more than the arithmetic it saves.
-template <typename Direction>
-NormalFit fit_window(const Direction& direction, const float* range_m, const std::uint8_t* mask,
-                     const float* log_range, int row, int col, int rows, int columns,
-                     const GeometrySettings& settings) {
-  const int k = settings.edge_window_radius;
-  const std::size_t centre_index = static_cast<std::size_t>(row) * columns + col;
-  const float centre = log_range[centre_index];
-  const Eigen::Vector3f view = direction(row, col);
-  const Eigen::Vector3f origin = range_m[centre_index] * view;  // sums relative to it stay small
-  const auto relative = static_cast<float>(settings.depth_jump_relative);
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+// The plane through the gathered points (see plane_normal), its normal
+// turned towards the scanner.
+NormalFit plane_from_sums(const PointSums& s, const Eigen::Vector3f& origin,
+                          const Eigen::Vector3f& view, int window) {
   NormalFit fit;
-  fit.window = (2 * k + 1) * (2 * k + 1);
-  const int col_begin = std::max(0, col - k), col_end = std::min(columns - 1, col + k);
-  for (int r = std::max(0, row - k); r <= std::min(rows - 1, row + k); ++r) {
-    const std::size_t offset = static_cast<std::size_t>(r) * columns;
-    for (int c = col_begin; c <= col_end; ++c) {
-      const std::size_t i = offset + c;
-      const float limit =
-          relative * static_cast<float>(std::max(std::abs(r - row), std::abs(c - col))) + 1e-7f;
-      const bool take = mask[i] && std::abs(log_range[i] - centre) <= limit;
-      const Eigen::Vector3f p =
-          take ? Eigen::Vector3f(range_m[i] * direction(r, c) - origin) : Eigen::Vector3f::Zero();
-      sum += p;
-      xx += p.x() * p.x(), xy += p.x() * p.y(), xz += p.x() * p.z();
-      yy += p.y() * p.y(), yz += p.y() * p.z(), zz += p.z() * p.z();
-      fit.used += take;
-    }
-  }
-  if (fit.used < 3) return fit;
-  const Eigen::Vector3f mean = sum / static_cast<float>(fit.used);
+  fit.window = window;
+  fit.used = s.used;
+  if (s.used < 3) return fit;
+  const Eigen::Vector3f mean = Eigen::Vector3f(s.x, s.y, s.z) / static_cast<float>(s.used);
   Eigen::Matrix3f covariance;
-  covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-  covariance = covariance / static_cast<float>(fit.used) - mean * mean.transpose();
+  covariance << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
+  covariance = covariance / static_cast<float>(s.used) - mean * mean.transpose();
   const double trace = covariance.trace();
   if (!(trace > 0.0)) return fit;
   Eigen::Vector3d normal;
@@ -132,17 +100,131 @@ NormalFit fit_window(const Direction& direction, const float* range_m, const std
   return fit;
 }
 
+// Largest log-range difference to the centre of a consistent neighbour at
+// Chebyshev distance `distance` (+ a rounding margin).
+float consistency_limit(const GeometrySettings& settings, int distance) {
+  return static_cast<float>(settings.depth_jump_relative) * static_cast<float>(distance) + 1e-7f;
+}
+
+// One pixel's window, clipped to the grid; a rejected neighbour adds zeros,
+// so the sums equal those of covariance_fits' lanes bit for bit.
+template <typename Direction>
+NormalFit fit_window(const Direction& direction, const float* range_m, const std::uint8_t* mask,
+                     const float* log_range, int row, int col, int rows, int columns,
+                     const GeometrySettings& settings) {
+  const int k = settings.edge_window_radius;
+  const std::size_t centre_index = static_cast<std::size_t>(row) * columns + col;
+  const float centre = log_range[centre_index];
+  const Eigen::Vector3f view = direction(row, col);
+  const Eigen::Vector3f origin = range_m[centre_index] * view;  // sums relative to it stay small
+  PointSums s;
+  const int col_begin = std::max(0, col - k), col_end = std::min(columns - 1, col + k);
+  for (int r = std::max(0, row - k); r <= std::min(rows - 1, row + k); ++r) {
+    const std::size_t offset = static_cast<std::size_t>(r) * columns;
+    for (int c = col_begin; c <= col_end; ++c) {
+      const std::size_t i = offset + c;
+      const float limit =
+          consistency_limit(settings, std::max(std::abs(r - row), std::abs(c - col)));
+      const bool take = mask[i] && std::abs(log_range[i] - centre) <= limit;
+      if (!take) continue;
+      const Eigen::Vector3f p = range_m[i] * direction(r, c) - origin;
+      s.x += p.x(), s.y += p.y(), s.z += p.z();
+      s.xx += p.x() * p.x(), s.xy += p.x() * p.y(), s.xz += p.x() * p.z();
+      s.yy += p.y() * p.y(), s.yz += p.y() * p.z(), s.zz += p.z() * p.z();
+      ++s.used;
+    }
+  }
+  return plane_from_sums(s, origin, view, (2 * k + 1) * (2 * k + 1));
+}
+
+// The sums of kCovarianceLanes horizontally adjacent centres, one lane each.
+struct LaneSums {
+  float x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {}, z[kCovarianceLanes] = {};
+  float xx[kCovarianceLanes] = {}, xy[kCovarianceLanes] = {}, xz[kCovarianceLanes] = {};
+  float yy[kCovarianceLanes] = {}, yz[kCovarianceLanes] = {}, zz[kCovarianceLanes] = {};
+  std::int32_t used[kCovarianceLanes] = {};
+};
+
+// What the lanes' centres contribute to every neighbour's test and point.
+struct LaneCentres {
+  float log_range[kCovarianceLanes], x[kCovarianceLanes], y[kCovarianceLanes], z[kCovarianceLanes];
+};
+
+// One window offset for all lanes: their neighbours are consecutive pixels
+// of one row. Branch-free over plain, unaliased arrays, so that it
+// vectorizes; the same operations in the same order as fit_window. The mask
+// is not read: log_range is NaN where it is 0, which fails the comparison.
+void add_offset(const float* __restrict range, const float* __restrict log_range,
+                const float* __restrict cos_az, const float* __restrict sin_az, float cos_el,
+                float sin_el, float limit, const LaneCentres& __restrict centres,
+                LaneSums& __restrict s) {
+  for (int j = 0; j < kCovarianceLanes; ++j) {
+    const bool take = std::abs(log_range[j] - centres.log_range[j]) <= limit;
+    const std::uint32_t keep = all_bits(take);
+    const float px = select_bits(range[j] * (cos_el * cos_az[j]) - centres.x[j], keep);
+    const float py = select_bits(range[j] * (cos_el * sin_az[j]) - centres.y[j], keep);
+    const float pz = select_bits(range[j] * sin_el - centres.z[j], keep);
+    s.x[j] += px, s.y[j] += py, s.z[j] += pz;
+    s.xx[j] += px * px, s.xy[j] += px * py, s.xz[j] += px * pz;
+    s.yy[j] += py * py, s.yz[j] += py * pz, s.zz[j] += pz * pz;
+    s.used[j] += take;
+  }
+}
+
 }  // namespace
 
 NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
                          const std::uint8_t* mask, const float* log_range, int row, int col,
                          int rows, const GeometrySettings& settings) {
+  const int columns = directions.columns;
   if (directions.per_pixel != nullptr) {
-    return fit_window(PerPixelDirection{directions}, range_m, mask, log_range, row, col, rows,
-                      directions.columns, settings);
+    return fit_window([&](int r, int c) { return directions.at(r, c); }, range_m, mask, log_range,
+                      row, col, rows, columns, settings);
   }
-  return fit_window(SphericalDirection{directions}, range_m, mask, log_range, row, col, rows,
-                    directions.columns, settings);
+  const auto spherical = [&](int r, int c) -> Eigen::Vector3f {
+    return {directions.cos_el[r] * directions.cos_az[c],
+            directions.cos_el[r] * directions.sin_az[c], directions.sin_el[r]};
+  };
+  return fit_window(spherical, range_m, mask, log_range, row, col, rows, columns, settings);
+}
+
+bool covariance_lanes_fit(const GridDirections& directions, int row, int col, int rows,
+                          const GeometrySettings& settings) {
+  const int k = settings.edge_window_radius;
+  return directions.per_pixel == nullptr && row - k >= 0 && row + k < rows && col - k >= 0 &&
+         col + kCovarianceLanes - 1 + k < directions.columns;
+}
+
+void covariance_fits(const GridDirections& directions, const float* range_m, const float* log_range,
+                     int row, int col, [[maybe_unused]] int rows, const GeometrySettings& settings,
+                     unsigned wanted, NormalFit* fits) {
+  assert(covariance_lanes_fit(directions, row, col, rows, settings) && "lanes inside the grid");
+  const int k = settings.edge_window_radius, columns = directions.columns;
+  const std::size_t centre_index = static_cast<std::size_t>(row) * columns + col;
+  LaneCentres centres;
+  Eigen::Vector3f views[kCovarianceLanes], origins[kCovarianceLanes];
+  for (int j = 0; j < kCovarianceLanes; ++j) {
+    views[j] = directions.at(row, col + j);
+    origins[j] = range_m[centre_index + j] * views[j];
+    centres.log_range[j] = log_range[centre_index + j];
+    centres.x[j] = origins[j].x(), centres.y[j] = origins[j].y(), centres.z[j] = origins[j].z();
+  }
+  LaneSums s;
+  for (int r = row - k; r <= row + k; ++r) {
+    for (int dc = -k; dc <= k; ++dc) {
+      const std::size_t i = static_cast<std::size_t>(r) * columns + col + dc;
+      add_offset(range_m + i, log_range + i, directions.cos_az.data() + col + dc,
+                 directions.sin_az.data() + col + dc, directions.cos_el[r], directions.sin_el[r],
+                 consistency_limit(settings, std::max(std::abs(r - row), std::abs(dc))), centres,
+                 s);
+    }
+  }
+  for (int j = 0; j < kCovarianceLanes; ++j) {
+    if ((wanted & (1u << j)) == 0) continue;
+    const PointSums lane{s.x[j],  s.y[j],  s.z[j],  s.xx[j], s.xy[j],
+                         s.xz[j], s.yy[j], s.yz[j], s.zz[j], s.used[j]};
+    fits[j] = plane_from_sums(lane, origins[j], views[j], (2 * k + 1) * (2 * k + 1));
+  }
 }
 
 }  // namespace scanbench::acquisition

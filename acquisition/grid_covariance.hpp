@@ -45,9 +45,28 @@ struct NormalFit {
 // by at most depth_jump_relative per pixel of (Chebyshev) distance; ok is
 // false with fewer than 3 such pixels or when they form a line or a blob
 // (second eigenvalue ≤ 4 × the first). `range_m`, `mask` and `log_range` are
-// rows × columns arrays of the scan; the centre must be masked.
+// rows × columns arrays of the scan, log_range NaN where mask is 0; the
+// centre must be masked.
 NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
                          const std::uint8_t* mask, const float* log_range, int row, int col,
                          int rows, const GeometrySettings& settings);
+
+// Fallback pixels come in runs along edges: covariance_fits fits this many
+// horizontally adjacent pixels at once, their windows read as consecutive
+// pixels of each row, several times faster per pixel.
+inline constexpr int kCovarianceLanes = 4;
+
+// Whether covariance_fits can take pixels (row, col … col + 3): a spherical
+// grid and all their windows inside it.
+bool covariance_lanes_fit(const GridDirections& directions, int row, int col, int rows,
+                          const GeometrySettings& settings);
+
+// covariance_fit of pixels (row, col + j) for the lanes j < kCovarianceLanes
+// whose bit is set in `wanted`, into fits[j] (other entries untouched); the
+// same results as covariance_fit, bit for bit (the mask is read through
+// log_range's NaN). Asserts covariance_lanes_fit.
+void covariance_fits(const GridDirections& directions, const float* range_m, const float* log_range,
+                     int row, int col, int rows, const GeometrySettings& settings, unsigned wanted,
+                     NormalFit* fits);
 
 }  // namespace scanbench::acquisition

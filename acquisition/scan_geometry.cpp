@@ -21,13 +21,13 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 
+#include "acquisition/branch_free.hpp"
 #include "acquisition/grid_covariance.hpp"
 #include "acquisition/mixed_pixels.hpp"
 #include "acquisition/parallel.hpp"
@@ -47,7 +47,7 @@ void parallel_rows(int rows, int threads, Body&& body) {
 struct FitInputs {
   std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive range
   std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
-  std::unique_ptr<float[]> log_range;     // ln range where masked, else 0
+  std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
 };
 
 // mask, log_range and the mixed-pixel flag of every pixel.
@@ -62,7 +62,7 @@ void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, Fit
       flags[i] = mixed[i] ? kFlagMixedPixel : 0;
       const bool mask = scan.valid[i] && !mixed[i] && scan.range_m[i] > 0.0f;
       in.mask[i] = mask;
-      in.log_range[i] = mask ? std::log(scan.range_m[i]) : 0.0f;
+      in.log_range[i] = mask ? std::log(scan.range_m[i]) : std::numeric_limits<float>::quiet_NaN();
     }
   });
 }
@@ -223,31 +223,6 @@ void count_pixels(const StageContext& c, std::size_t first, int count) {
   c.counts.mixed += mixed, c.counts.edges += edges;
 }
 
-// All bits of `value` where `keep` is all ones, +0 where it is zero: a select
-// that GCC's vectorizer accepts (a conditional expression it turns back into
-// a branch) and that no non-finite value can leak through.
-inline float select_bits(float value, std::uint32_t keep) {
-  return std::bit_cast<float>(std::bit_cast<std::uint32_t>(value) & keep);
-}
-
-inline std::uint32_t all_bits(bool b) {
-  return b ? ~0u : 0u;
-}
-
-// 1/√q for q ≥ 1 with a relative error below 1.5·10⁻⁷ (as good as float
-// arithmetic gets): the classic bit-level estimate (Lomont's constant, error
-// < 3.5·10⁻²) and three Newton steps, each squaring the error. Plain
-// arithmetic, so it vectorizes, where std::sqrt keeps a scalar branch for
-// errno. Two steps (error 5·10⁻⁶) would not do: the length of a unit normal
-// enters angles to other unit vectors as √(2·error), 0.2° here.
-inline float inverse_sqrt(float q) {
-  float y = std::bit_cast<float>(0x5f375a86u - (std::bit_cast<std::uint32_t>(q) >> 1));
-  y *= 1.5f - 0.5f * q * y * y;
-  y *= 1.5f - 0.5f * q * y * y;
-  y *= 1.5f - 0.5f * q * y * y;
-  return y;
-}
-
 // What the window normals of one row share.
 struct RowConstants {
   float cos_el, sin_el;
@@ -290,6 +265,39 @@ void window_normals(int n, const RowConstants& k, const float* __restrict per_co
   }
 }
 
+// The covariance fits of a spherical row segment's masked pixels without a
+// clean window (cut by a discontinuity, an invalid region or the grid's
+// border): the log-range slope of a lopsided window is biased by the
+// curvature of ln r, a 3D plane fit is not. Runs of them go in lanes.
+void store_fallback_fits(const StageContext& c, int row, int begin, int end,
+                         const std::uint16_t* used, float half_spacing) {
+  const std::size_t first = c.scan.index(row, begin);
+  const auto pending = [&](int j) {
+    return j < end - begin && used[j] == 0 && c.in.mask[first + j];
+  };
+  const float* range = c.scan.range_m.data();
+  for (int j = 0; j < end - begin; ++j) {
+    if (!pending(j)) continue;
+    if (!covariance_lanes_fit(c.directions, row, begin + j, c.scan.rows, c.settings)) {
+      store_fit(c,
+                covariance_fit(c.directions, range, c.in.mask.get(), c.in.log_range.get(), row,
+                               begin + j, c.scan.rows, c.settings),
+                first + j, half_spacing);
+      continue;
+    }
+    unsigned wanted = 0;
+    for (int lane = 0; lane < kCovarianceLanes; ++lane)
+      wanted |= pending(j + lane) ? 1u << lane : 0u;
+    NormalFit fits[kCovarianceLanes];
+    covariance_fits(c.directions, range, c.in.log_range.get(), row, begin + j, c.scan.rows,
+                    c.settings, wanted, fits);
+    for (int lane = 0; lane < kCovarianceLanes; ++lane) {
+      if (wanted & (1u << lane)) store_fit(c, fits[lane], first + j + lane, half_spacing);
+    }
+    j += kCovarianceLanes - 1;
+  }
+}
+
 // A spherical scan's row segment: window normals in chunks (scratch arrays
 // on the stack), then the covariance fit where no clean window exists.
 void store_window_fits(const StageContext& c, int row, int begin, int end,
@@ -314,16 +322,7 @@ void store_window_fits(const StageContext& c, int row, int begin, int end,
                    c.g.flags.data() + i0);
     for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
   }
-  for (int j = 0; j < end - begin; ++j) {
-    if (s.used[j] != 0 || !c.in.mask[first + j]) continue;
-    // No clean window (cut by a discontinuity, an invalid region or the
-    // grid's border): the log-range slope of a lopsided window is biased by
-    // the curvature of ln r, a 3D plane fit is not.
-    const NormalFit fit =
-        covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(), c.in.log_range.get(),
-                       row, begin + j, c.scan.rows, c.settings);
-    store_fit(c, fit, first + j, k.half_spacing);
-  }
+  store_fallback_fits(c, row, begin, end, s.used, k.half_spacing);
   count_pixels(c, first, end - begin);
 }
 

@@ -1,0 +1,36 @@
+// Small helpers for loops that GCC's vectorizer should accept with the
+// project's portable flags (x86-64 baseline, errno-setting math, trapping
+// math): it turns conditional expressions on floats back into branches and
+// keeps a scalar branch in std::sqrt for errno, and a branch stops it.
+#pragma once
+
+#include <bit>
+#include <cstdint>
+
+namespace scanbench::acquisition {
+
+// All bits set when b, none otherwise.
+inline std::uint32_t all_bits(bool b) {
+  return b ? ~0u : 0u;
+}
+
+// `value` where `keep` is all ones, +0 where it is zero: a select through
+// which no non-finite value can leak (unlike value · 0).
+inline float select_bits(float value, std::uint32_t keep) {
+  return std::bit_cast<float>(std::bit_cast<std::uint32_t>(value) & keep);
+}
+
+// 1/√q for q ≥ 1 with a relative error below 1.5·10⁻⁷ (as good as float
+// arithmetic gets): the classic bit-level estimate (Lomont's constant, error
+// < 3.5·10⁻²) and three Newton steps, each squaring the error. Two steps
+// (error 5·10⁻⁶) would not do: the length of a unit normal enters angles to
+// other unit vectors as √(2·error), 0.2° here.
+inline float inverse_sqrt(float q) {
+  float y = std::bit_cast<float>(0x5f375a86u - (std::bit_cast<std::uint32_t>(q) >> 1));
+  y *= 1.5f - 0.5f * q * y * y;
+  y *= 1.5f - 0.5f * q * y * y;
+  y *= 1.5f - 0.5f * q * y * y;
+  return y;
+}
+
+}  // namespace scanbench::acquisition
