@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cstddef>
 
+#include "acquisition/branch_free.hpp"
 #include "acquisition/parallel.hpp"
 
 namespace scanbench::acquisition {
@@ -55,9 +56,10 @@ class IntegralRing {
         stride_(width_ + 1),
         slots_(2 * halo + 2),
         unclean_(static_cast<std::size_t>(slots_) * stride_, 0),
-        v_(unclean_.size(), 0.0),
-        xv_(unclean_.size(), 0.0),
-        yv_(unclean_.size(), 0.0),
+        moments_(3 * unclean_.size(), 0.0),
+        v_(moments_.data()),
+        xv_(v_ + unclean_.size()),
+        yv_(xv_ + unclean_.size()),
         row_unclean_(static_cast<std::size_t>(width_)),
         row_value_(static_cast<std::size_t>(width_)) {}
 
@@ -66,28 +68,26 @@ class IntegralRing {
     while (count_ <= j) push();
   }
 
-  // Unclean pixels in the window of radius k around region pixel (y, x).
-  int unclean(int y, int x, int k) const {
-    return box(unclean_.data(), y - k, y + k + 1, x - k, x + k + 1);
-  }
-
-  // Σ dx·v and Σ dy·v over that window (moments about the window's centre).
-  void centred_moments(int y, int x, int k, double& sxv, double& syv) const {
-    const int top = y - k, bottom = y + k + 1, left = x - k, right = x + k + 1;
-    const double sv = box(v_.data(), top, bottom, left, right);
-    sxv = box(xv_.data(), top, bottom, left, right) - x * sv;
-    syv = box(yv_.data(), top, bottom, left, right) - y * sv;
+  // The integral rows that bound the windows of radius k around region row
+  // y, resolved once per row (a ring slot costs a division).
+  struct Bounds {
+    const std::int32_t *top_unclean, *bottom_unclean;
+    const double *top_v, *bottom_v, *top_xv, *bottom_xv, *top_yv, *bottom_yv;
+  };
+  Bounds bounds(int y, int k) const {
+    const std::size_t t = slot(y - k), b = slot(y + k + 1);
+    return {unclean_.data() + t,
+            unclean_.data() + b,
+            v_ + t,
+            v_ + b,
+            xv_ + t,
+            xv_ + b,
+            yv_ + t,
+            yv_ + b};
   }
 
  private:
   std::size_t slot(int j) const { return static_cast<std::size_t>(j % slots_) * stride_; }
-
-  template <typename T>
-  T box(const T* data, int top, int bottom, int left, int right) const {
-    const T* t = data + slot(top);
-    const T* b = data + slot(bottom);
-    return (b[right] - b[left]) - (t[right] - t[left]);
-  }
 
   // Region row `y` as unclean flags and values (0 where unclean).
   void load_region_row(int y) {
@@ -97,11 +97,11 @@ class IntegralRing {
     if (row < 0 || row >= grid_.rows) return;
     const std::size_t offset = static_cast<std::size_t>(row) * grid_.columns;
     const int x_begin = std::max(0, -col0_), x_end = std::min(width_, grid_.columns - col0_);
-    for (int x = x_begin; x < x_end; ++x) {
-      const std::size_t i = offset + static_cast<std::size_t>(col0_ + x);
-      const bool clean = grid_.clean[i] != 0;
-      row_unclean_[x] = clean ? 0 : 1;
-      row_value_[x] = clean ? grid_.value[i] : 0.0f;
+    const std::uint8_t* clean = grid_.clean + offset + col0_;
+    const float* value = grid_.value + offset + col0_;
+    for (int x = x_begin; x < x_end; ++x) {  // branch-free: cleanness is data, it vectorizes
+      row_unclean_[x] = clean[x] == 0;
+      row_value_[x] = select_bits(value[x], all_bits(clean[x] != 0));
     }
   }
 
@@ -130,7 +130,8 @@ class IntegralRing {
   int row0_, col0_, width_, stride_, slots_;
   int count_ = 0;
   std::vector<std::int32_t> unclean_;
-  std::vector<double> v_, xv_, yv_;
+  std::vector<double> moments_;  // the integral images of v, x·v and y·v, one after another
+  double *v_, *xv_, *yv_;
   std::vector<std::int32_t> row_unclean_;
   std::vector<float> row_value_;
 };
@@ -139,6 +140,12 @@ class IntegralRing {
 double inverse_sxx(int k) {
   const double side = 2.0 * k + 1.0;
   return 3.0 / (side * side * k * (k + 1.0));
+}
+
+// The sum over columns [left, right) between two integral rows.
+template <typename T>
+T box(const T* top, const T* bottom, int left, int right) {
+  return (bottom[right] - bottom[left]) - (top[right] - top[left]);
 }
 
 // One row segment's fits as parallel arrays.
@@ -150,15 +157,19 @@ struct SlopeBuffers {
   WindowSlopeRow row() const { return {per_column.data(), per_row.data(), used.data()}; }
 };
 
-// The widest clean window of the pixel at region (y, x), stored at `j`.
-void widest_clean_fit(const IntegralRing& ring, std::span<const int> radii,
+// The widest clean window of the pixel at region (y, x), stored at `j`;
+// bounds[r] are the integral rows of radius radii[r] around row y.
+void widest_clean_fit(std::span<const IntegralRing::Bounds> bounds, std::span<const int> radii,
                       std::span<const double> inverse, int y, int x, SlopeBuffers& out,
                       std::size_t j) {
   for (std::size_t r = 0; r < radii.size(); ++r) {
-    const int k = radii[r];
-    if (ring.unclean(y, x, k) != 0) continue;
-    double sxv = 0.0, syv = 0.0;
-    ring.centred_moments(y, x, k, sxv, syv);
+    const int k = radii[r], left = x - k, right = x + k + 1;
+    const IntegralRing::Bounds& b = bounds[r];
+    if (box(b.top_unclean, b.bottom_unclean, left, right) != 0) continue;
+    // Moments about the window's centre: Σ dx·v = Σ x·v − x·Σ v, likewise dy.
+    const double sv = box(b.top_v, b.bottom_v, left, right);
+    const double sxv = box(b.top_xv, b.bottom_xv, left, right) - x * sv;
+    const double syv = box(b.top_yv, b.bottom_yv, left, right) - y * sv;
     out.per_column[j] = static_cast<float>(sxv * inverse[r]);
     out.per_row[j] = static_cast<float>(syv * inverse[r]);
     out.used[j] = static_cast<std::uint16_t>((2 * k + 1) * (2 * k + 1));
@@ -173,14 +184,16 @@ void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
   const int halo = radii.front();
   IntegralRing ring(grid, tile, halo);
   SlopeBuffers out(static_cast<std::size_t>(tile.col_end - tile.col_begin));
+  std::vector<IntegralRing::Bounds> bounds(radii.size());
   for (int row = tile.row_begin; row < tile.row_end; ++row) {
     const int y = row - tile.row_begin + halo;
     ring.extend_to(y + halo + 1);
+    for (std::size_t r = 0; r < radii.size(); ++r) bounds[r] = ring.bounds(y, radii[r]);
     const std::size_t offset = static_cast<std::size_t>(row) * grid.columns;
     for (int col = tile.col_begin; col < tile.col_end; ++col) {
       const auto j = static_cast<std::size_t>(col - tile.col_begin);
       if (grid.clean[offset + col]) {
-        widest_clean_fit(ring, radii, inverse, y, col - tile.col_begin + halo, out, j);
+        widest_clean_fit(bounds, radii, inverse, y, col - tile.col_begin + halo, out, j);
       } else {
         out.per_column[j] = out.per_row[j] = 0.0f;
         out.used[j] = 0;
@@ -199,8 +212,8 @@ void visit_window_slopes(int rows, int columns, std::span<const int> radii,
          !radii.empty() && "spans of rows × columns, radii");
   assert(std::is_sorted(radii.rbegin(), radii.rend()) && radii.back() >= 1 &&
          radii.front() <= 127 && "radii descending in [1, 127]");
-  std::vector<double> inverse;
-  for (const int k : radii) inverse.push_back(inverse_sxx(k));
+  std::vector<double> inverse(radii.size());
+  std::transform(radii.begin(), radii.end(), inverse.begin(), inverse_sxx);
   const Grid grid{rows, columns, clean.data(), value.data()};
   const std::vector<Tile> tiles = make_tiles(rows, columns);
   parallel_for_index(static_cast<int>(tiles.size()), threads,
