@@ -65,7 +65,7 @@ bool plane_normal(const Eigen::Matrix3d& a, Eigen::Vector3d& normal) {
   Eigen::Vector3d v = adjugate * (adjugate * adjugate.col(longest));
   const double length = v.norm();
   if (!(length > 0.0)) return false;
-  normal = v / length;
+  normal = v * (1.0 / length);
   const double smallest = normal.dot(a * normal);
   const double s = 1.0 - smallest, q = c1 - smallest * s, t = 4.0 * smallest;
   return t < 0.5 * s && (t - s) * t + q > 0.0;
@@ -85,14 +85,20 @@ NormalFit plane_from_sums(const PointSums& s, const Eigen::Vector3f& origin,
   fit.window = window;
   fit.used = s.used;
   if (s.used < 3) return fit;
-  const Eigen::Vector3f mean = Eigen::Vector3f(s.x, s.y, s.z) / static_cast<float>(s.used);
-  Eigen::Matrix3f covariance;
-  covariance << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
-  covariance = covariance / static_cast<float>(s.used) - mean * mean.transpose();
-  const double trace = covariance.trace();
+  // The covariance in double from the float sums, normalised to trace 1;
+  // reciprocals, not the 18 divisions of the plain expression.
+  const double inverse_n = 1.0 / s.used;
+  const double mx = s.x * inverse_n, my = s.y * inverse_n, mz = s.z * inverse_n;
+  const double xx = s.xx * inverse_n - mx * mx, yy = s.yy * inverse_n - my * my,
+               zz = s.zz * inverse_n - mz * mz, xy = s.xy * inverse_n - mx * my,
+               xz = s.xz * inverse_n - mx * mz, yz = s.yz * inverse_n - my * mz;
+  const double trace = xx + yy + zz;
   if (!(trace > 0.0)) return fit;
+  const double t = 1.0 / trace;
+  Eigen::Matrix3d covariance;
+  covariance << xx * t, xy * t, xz * t, xy * t, yy * t, yz * t, xz * t, yz * t, zz * t;
   Eigen::Vector3d normal;
-  if (!plane_normal(covariance.cast<double>() / trace, normal)) return fit;
+  if (!plane_normal(covariance, normal)) return fit;
   fit.normal = normal.cast<float>();
   if (fit.normal.dot(origin) > 0) fit.normal = -fit.normal;
   fit.cos_incidence = std::abs(fit.normal.dot(view));
