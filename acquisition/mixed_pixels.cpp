@@ -68,9 +68,10 @@ void detect_row(const PaddedBlock& block, int row, int columns, float sigma0, fl
 
 }  // namespace
 
-std::vector<std::uint8_t> detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings) {
-  assert(check_consistency(scan).empty() && "inconsistent scan");
-  std::vector<std::uint8_t> mixed(scan.pixel_count(), 0);
+void detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings,
+                         std::span<std::uint8_t> mixed) {
+  assert(check_consistency(scan).empty() && mixed.size() == scan.pixel_count() &&
+         "a consistent scan and one output per pixel");
   const auto sigma0 = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_m);
   const auto sigma1 = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_per_m);
   const int blocks = (scan.rows + kBlockRows - 1) / kBlockRows;
@@ -80,7 +81,6 @@ std::vector<std::uint8_t> detect_mixed_pixels(const Scan& scan, const GeometrySe
     for (int row = begin; row < end; ++row)
       detect_row(block, row, scan.columns, sigma0, sigma1, mixed.data() + scan.index(row, 0));
   });
-  return mixed;
 }
 
 }  // namespace scanbench::acquisition

@@ -19,6 +19,9 @@
 // footprints, so a tile's data is still in cache when its pixels finish.
 #include "acquisition/scan_geometry.hpp"
 
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cassert>
@@ -45,21 +48,32 @@ void parallel_rows(int rows, int threads, Body&& body) {
 // (make_unique_for_overwrite) and first written by the parallel passes, so
 // their pages are faulted in by the threads that use them.
 struct FitInputs {
+  std::unique_ptr<std::uint8_t[]> mixed;  // 1 = mixed pixel
   std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive range
   std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
   std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
+
+  explicit FitInputs(std::size_t n)
+      : mixed(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        mask(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        clean(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        log_range(std::make_unique_for_overwrite<float[]>(n)) {}
+
+  // The mixed-pixel and edge flags of pixel i (an edge: masked, not clean).
+  std::uint8_t flags(std::size_t i) const {
+    return static_cast<std::uint8_t>((mixed[i] ? kFlagMixedPixel : 0) |
+                                     (mask[i] && !clean[i] ? kFlagEdge : 0));
+  }
 };
 
-// mask, log_range and the mixed-pixel flag of every pixel.
-void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, FitInputs& in,
-                         std::vector<std::uint8_t>& flags) {
-  const std::vector<std::uint8_t> mixed = settings.flag_mixed_pixels
-                                              ? detect_mixed_pixels(scan, settings)
-                                              : std::vector<std::uint8_t>(scan.pixel_count(), 0);
+// mixed, mask and log_range of every pixel.
+void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
+  const std::span<std::uint8_t> mixed(in.mixed.get(), scan.pixel_count());
+  if (settings.flag_mixed_pixels) detect_mixed_pixels(scan, settings, mixed);
   parallel_rows(scan.rows, settings.threads, [&](int row) {
     const std::size_t begin = scan.index(row, 0), end = begin + scan.columns;
+    if (!settings.flag_mixed_pixels) std::fill(&mixed[begin], &mixed[begin] + scan.columns, 0);
     for (std::size_t i = begin; i < end; ++i) {
-      flags[i] = mixed[i] ? kFlagMixedPixel : 0;
       const bool mask = scan.valid[i] && !mixed[i] && scan.range_m[i] > 0.0f;
       in.mask[i] = mask;
       in.log_range[i] = mask ? std::log(scan.range_m[i]) : std::numeric_limits<float>::quiet_NaN();
@@ -89,8 +103,7 @@ struct JumpTest {
 // branch-free over plain, unaliased arrays so that the loop vectorizes.
 void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
                     const std::uint8_t* __restrict mask, const float* __restrict v,
-                    const float* __restrict range, std::uint8_t* __restrict clean,
-                    std::uint8_t* __restrict flags) {
+                    const float* __restrict range, std::uint8_t* __restrict clean) {
   for (int c = 1; c + 1 < n; ++c) {
     const bool along_row =
         (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range[c]);
@@ -98,13 +111,11 @@ void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
                               test(v[c - stride], v[c], v[c + stride], range[c]);
     const bool jumps = (mask[c] != 0) & (along_row | along_column);
     clean[c] = (mask[c] != 0) & !jumps;
-    flags[c] |= static_cast<std::uint8_t>(jumps ? kFlagEdge : 0);
   }
 }
 
-// clean (masked and no depth jump) and the edge flag, for every pixel.
-void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& in,
-                std::vector<std::uint8_t>& flags) {
+// clean (masked and no depth jump) for every pixel.
+void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
   const JumpTest test(settings);
   const int rows = scan.rows, columns = scan.columns;
   const std::uint8_t* mask = in.mask.get();
@@ -118,7 +129,6 @@ void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& i
         mask[i] && ((c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
                     (r > 0 && r + 1 < rows && jumps_between(i - columns, i + columns)));
     in.clean[i] = mask[i] && !jumps;
-    flags[i] |= jumps ? kFlagEdge : 0;
   };
   parallel_rows(rows, settings.threads, [&](int r) {
     const std::size_t i = scan.index(r, 0);
@@ -128,20 +138,9 @@ void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& i
     }
     one_pixel(r, 0);
     interior_jumps(columns, columns, test, mask + i, v + i, scan.range_m.data() + i,
-                   in.clean.get() + i, flags.data() + i);
+                   in.clean.get() + i);
     one_pixel(r, columns - 1);
   });
-}
-
-FitInputs prepare_inputs(const Scan& scan, const GeometrySettings& settings,
-                         std::vector<std::uint8_t>& flags) {
-  const std::size_t n = scan.pixel_count();
-  FitInputs in{std::make_unique_for_overwrite<std::uint8_t[]>(n),
-               std::make_unique_for_overwrite<std::uint8_t[]>(n),
-               std::make_unique_for_overwrite<float[]>(n)};
-  mark_mixed_and_mask(scan, settings, in, flags);
-  mark_jumps(scan, settings, in, flags);
-  return in;
 }
 
 // Per-row factors of a spherical scan, so the per-pixel work is free of
@@ -236,16 +235,17 @@ struct RowConstants {
 // (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
 // of the incidence angle is one over it, so the footprint's stretch is the
 // length itself. Writes n pixels' normals (as three arrays), confidences,
-// footprints and no-normal flags. Branch-free over plain, unaliased arrays,
+// footprints and flags. Branch-free over plain, unaliased arrays,
 // so that the loop vectorizes. Masked pixels without a clean window are left
 // for the covariance fit (no flag).
 void window_normals(int n, const RowConstants& k, const float* __restrict per_column,
                     const float* __restrict per_row, const std::uint16_t* __restrict used,
                     const float* __restrict cos_az, const float* __restrict sin_az,
                     const float* __restrict range, const std::uint8_t* __restrict valid,
-                    const std::uint8_t* __restrict mask, float* __restrict nx, float* __restrict ny,
-                    float* __restrict nz, float* __restrict confidence, float* __restrict footprint,
-                    std::uint8_t* __restrict flags) {
+                    const std::uint8_t* __restrict mask, const std::uint8_t* __restrict mixed,
+                    const std::uint8_t* __restrict clean, float* __restrict nx,
+                    float* __restrict ny, float* __restrict nz, float* __restrict confidence,
+                    float* __restrict footprint, std::uint8_t* __restrict flags) {
   for (int j = 0; j < n; ++j) {
     const float g_az = per_column[j] * k.az_gradient, g_el = per_row[j] * k.el_gradient;
     const float q = 1.0f + g_az * g_az + g_el * g_el;
@@ -261,7 +261,10 @@ void window_normals(int n, const RowConstants& k, const float* __restrict per_co
     confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
     const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
     footprint[j] = select_bits(range[j] * k.half_spacing * std::min(stretch, k.stretch), is_valid);
-    flags[j] |= static_cast<std::uint8_t>(is_valid & ~ok & ~pending & kFlagNoNormal);
+    const std::uint32_t edge = all_bits((mask[j] != 0) & (clean[j] == 0));
+    flags[j] =
+        static_cast<std::uint8_t>((mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
+                                  (is_valid & ~ok & ~pending & kFlagNoNormal));
   }
 }
 
@@ -317,9 +320,9 @@ void store_window_fits(const StageContext& c, int row, int begin, int end,
     float nx[kChunk], ny[kChunk], nz[kChunk];
     window_normals(n, k, s.per_column + j0, s.per_row + j0, s.used + j0,
                    c.directions.cos_az.data() + begin + j0, c.directions.sin_az.data() + begin + j0,
-                   c.scan.range_m.data() + i0, c.scan.valid.data() + i0, c.in.mask.get() + i0, nx,
-                   ny, nz, c.g.confidence.data() + i0, c.g.footprint_m.data() + i0,
-                   c.g.flags.data() + i0);
+                   c.scan.range_m.data() + i0, c.scan.valid.data() + i0, c.in.mask.get() + i0,
+                   c.in.mixed.get() + i0, c.in.clean.get() + i0, nx, ny, nz,
+                   c.g.confidence.data() + i0, c.g.footprint_m.data() + i0, c.g.flags.data() + i0);
     for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
   }
   store_fallback_fits(c, row, begin, end, s.used, k.half_spacing);
@@ -331,6 +334,7 @@ void store_covariance_fits(const StageContext& c, int row) {
   for (int col = 0; col < c.scan.columns; ++col) {
     const std::size_t i = c.scan.index(row, col);
     c.g.normal[i] = Eigen::Vector3f::Zero();
+    c.g.flags[i] = c.in.flags(i);
     if (!c.scan.valid[i]) continue;
     NormalFit fit;
     if (c.in.mask[i]) {
@@ -355,6 +359,7 @@ std::vector<int> cascade_radii(const GeometrySettings& settings) {
   return radii;
 }
 
+// The outputs; every pixel is written by the passes below.
 void allocate(ScanGeometry& g, std::size_t n) {
   g.footprint_m.assign(n, 0.0f);
   g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
@@ -371,8 +376,17 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   const auto start = std::chrono::steady_clock::now();
   GeometryResult result;
   ScanGeometry& g = result.geometry;
-  allocate(g, scan.pixel_count());
-  const FitInputs in = prepare_inputs(scan, settings, g.flags);
+  FitInputs in(scan.pixel_count());
+  // std::vector zero-fills the outputs on one thread (every pixel is then
+  // written again); that runs beside the first passes, not before them.
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_invoke([&] { allocate(g, scan.pixel_count()); },
+                         [&] {
+                           mark_mixed_and_mask(scan, settings, in);
+                           mark_jumps(scan, settings, in);
+                         });
+  });
   const GridDirections directions(scan);
   const RowFactors factors(scan);
   Counts counts;
