@@ -1,7 +1,6 @@
 #include "acquisition/grid_covariance.hpp"
 
 #include <Eigen/Geometry>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -51,22 +50,40 @@ namespace {
 // 3. λ0 is the Rayleigh quotient; λ1, λ2 solve t² − s·t + q = 0 with
 //    s = 1 − λ0, q = c1 − λ0·s, and λ1 > 4·λ0 holds exactly when that
 //    quadratic is positive at 4·λ0 with its vertex s/2 to the right of it.
-bool plane_normal(const Eigen::Matrix3d& a, Eigen::Vector3d& normal) {
-  const double c1 = a(0, 0) * a(1, 1) - a(0, 1) * a(0, 1) + a(0, 0) * a(2, 2) - a(0, 2) * a(0, 2) +
-                    a(1, 1) * a(2, 2) - a(1, 2) * a(1, 2);
+//
+// Plain scalars on the six unique entries: Eigen's fixed 3 × 3 double
+// products compile into packet shuffles that cost more than the arithmetic.
+struct Symmetric3 {
+  double xx, xy, xz, yy, yz, zz;
+
+  Eigen::Vector3d times(const Eigen::Vector3d& v) const {
+    return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
+            xz * v.x() + yz * v.y() + zz * v.z()};
+  }
+};
+
+bool plane_normal(const Symmetric3& a, Eigen::Vector3d& normal) {
+  const double c1 =
+      a.xx * a.yy - a.xy * a.xy + a.xx * a.zz - a.xz * a.xz + a.yy * a.zz - a.yz * a.yz;
   if (!(c1 > 0.0)) return false;  // rank ≤ 1: a line or a point
-  const double sigma = a.determinant() / c1;
-  const Eigen::Matrix3d shifted = a - sigma * Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d r0 = shifted.row(0), r1 = shifted.row(1), r2 = shifted.row(2);
-  Eigen::Matrix3d adjugate;  // symmetric: its columns are these cross products
-  adjugate << r1.cross(r2), r2.cross(r0), r0.cross(r1);
-  Eigen::Index longest = 0;
-  adjugate.colwise().squaredNorm().maxCoeff(&longest);
-  Eigen::Vector3d v = adjugate * (adjugate * adjugate.col(longest));
+  const double c0 = a.xx * (a.yy * a.zz - a.yz * a.yz) - a.xy * (a.xy * a.zz - a.yz * a.xz) +
+                    a.xz * (a.xy * a.yz - a.yy * a.xz);
+  const double sigma = c0 / c1;
+  const double bx = a.xx - sigma, by = a.yy - sigma, bz = a.zz - sigma;
+  // The adjugate of a − σ·I (symmetric, so its columns are also its rows).
+  const Symmetric3 adjugate{by * bz - a.yz * a.yz, a.xz * a.yz - a.xy * bz, a.xy * a.yz - a.xz * by,
+                            bx * bz - a.xz * a.xz, a.xy * a.xz - bx * a.yz, bx * by - a.xy * a.xy};
+  const Eigen::Vector3d columns[3] = {{adjugate.xx, adjugate.xy, adjugate.xz},
+                                      {adjugate.xy, adjugate.yy, adjugate.yz},
+                                      {adjugate.xz, adjugate.yz, adjugate.zz}};
+  int longest = 0;
+  for (int i = 1; i < 3; ++i)
+    if (columns[i].squaredNorm() > columns[longest].squaredNorm()) longest = i;
+  const Eigen::Vector3d v = adjugate.times(adjugate.times(columns[longest]));
   const double length = v.norm();
   if (!(length > 0.0)) return false;
   normal = v * (1.0 / length);
-  const double smallest = normal.dot(a * normal);
+  const double smallest = normal.dot(a.times(normal));
   const double s = 1.0 - smallest, q = c1 - smallest * s, t = 4.0 * smallest;
   return t < 0.5 * s && (t - s) * t + q > 0.0;
 }
@@ -95,10 +112,8 @@ NormalFit plane_from_sums(const PointSums& s, const Eigen::Vector3f& origin,
   const double trace = xx + yy + zz;
   if (!(trace > 0.0)) return fit;
   const double t = 1.0 / trace;
-  Eigen::Matrix3d covariance;
-  covariance << xx * t, xy * t, xz * t, xy * t, yy * t, yz * t, xz * t, yz * t, zz * t;
   Eigen::Vector3d normal;
-  if (!plane_normal(covariance, normal)) return fit;
+  if (!plane_normal({xx * t, xy * t, xz * t, yy * t, yz * t, zz * t}, normal)) return fit;
   fit.normal = normal.cast<float>();
   if (fit.normal.dot(origin) > 0) fit.normal = -fit.normal;
   fit.cos_incidence = std::abs(fit.normal.dot(view));
