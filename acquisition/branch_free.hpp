@@ -7,6 +7,20 @@
 #include <bit>
 #include <cstdint>
 
+// Function multiversioning for the stage's widest vector loops: an AVX2
+// clone next to the baseline x86-64 one, chosen once at load time, so the
+// binary still runs on any x86-64. Only AVX2, not FMA: without fused
+// multiply-adds and with no reductions in these loops, both clones give
+// identical results.
+// A build may define it empty to compare the two.
+#ifndef SCANBENCH_VECTOR_CLONES
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SCANBENCH_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SCANBENCH_VECTOR_CLONES
+#endif
+#endif
+
 namespace scanbench::acquisition {
 
 // All bits set when b, none otherwise.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "acquisition/branch_free.hpp"
 #include "acquisition/parallel.hpp"
 
 namespace scanbench::acquisition {
@@ -49,8 +50,8 @@ inline bool mixed_along(float centre, float a2, float a1, float b1, float b2, fl
          (miss_a * miss_b < 0.0f);
 }
 
-void detect_row(const PaddedBlock& block, int row, int columns, float sigma0, float sigma1,
-                std::uint8_t* out) {
+SCANBENCH_VECTOR_CLONES void detect_row(const PaddedBlock& block, int row, int columns,
+                                        float sigma0, float sigma1, std::uint8_t* out) {
   const std::ptrdiff_t s = block.stride;
   const float* p = block.values.data() + block.at(row, 0);
   for (int col = 0; col < columns; ++col) {

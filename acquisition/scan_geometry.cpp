@@ -101,9 +101,11 @@ struct JumpTest {
 
 // Interior pixels 1 … n − 2 of a row whose rows above and below exist;
 // branch-free over plain, unaliased arrays so that the loop vectorizes.
-void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
-                    const std::uint8_t* __restrict mask, const float* __restrict v,
-                    const float* __restrict range, std::uint8_t* __restrict clean) {
+SCANBENCH_VECTOR_CLONES void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
+                                            const std::uint8_t* __restrict mask,
+                                            const float* __restrict v,
+                                            const float* __restrict range,
+                                            std::uint8_t* __restrict clean) {
   for (int c = 1; c + 1 < n; ++c) {
     const bool along_row =
         (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range[c]);
@@ -238,14 +240,14 @@ struct RowConstants {
 // footprints and flags. Branch-free over plain, unaliased arrays,
 // so that the loop vectorizes. Masked pixels without a clean window are left
 // for the covariance fit (no flag).
-void window_normals(int n, const RowConstants& k, const float* __restrict per_column,
-                    const float* __restrict per_row, const std::uint16_t* __restrict used,
-                    const float* __restrict cos_az, const float* __restrict sin_az,
-                    const float* __restrict range, const std::uint8_t* __restrict valid,
-                    const std::uint8_t* __restrict mask, const std::uint8_t* __restrict mixed,
-                    const std::uint8_t* __restrict clean, float* __restrict nx,
-                    float* __restrict ny, float* __restrict nz, float* __restrict confidence,
-                    float* __restrict footprint, std::uint8_t* __restrict flags) {
+SCANBENCH_VECTOR_CLONES void window_normals(
+    int n, const RowConstants& k, const float* __restrict per_column,
+    const float* __restrict per_row, const std::uint16_t* __restrict used,
+    const float* __restrict cos_az, const float* __restrict sin_az, const float* __restrict range,
+    const std::uint8_t* __restrict valid, const std::uint8_t* __restrict mask,
+    const std::uint8_t* __restrict mixed, const std::uint8_t* __restrict clean,
+    float* __restrict nx, float* __restrict ny, float* __restrict nz, float* __restrict confidence,
+    float* __restrict footprint, std::uint8_t* __restrict flags) {
   for (int j = 0; j < n; ++j) {
     const float g_az = per_column[j] * k.az_gradient, g_el = per_row[j] * k.el_gradient;
     const float q = 1.0f + g_az * g_az + g_el * g_el;
