@@ -157,26 +157,57 @@ struct SlopeBuffers {
   WindowSlopeRow row() const { return {per_column.data(), per_row.data(), used.data()}; }
 };
 
-// The widest clean window of the pixel at region (y, x), stored at `j`;
-// bounds[r] are the integral rows of radius radii[r] around row y.
-void widest_clean_fit(std::span<const IntegralRing::Bounds> bounds, std::span<const int> radii,
-                      std::span<const double> inverse, int y, int x, SlopeBuffers& out,
-                      std::size_t j) {
-  for (std::size_t r = 0; r < radii.size(); ++r) {
-    const int k = radii[r], left = x - k, right = x + k + 1;
-    const IntegralRing::Bounds& b = bounds[r];
-    if (box(b.top_unclean, b.bottom_unclean, left, right) != 0) continue;
-    // Moments about the window's centre: Σ dx·v = Σ x·v − x·Σ v, likewise dy.
-    const double sv = box(b.top_v, b.bottom_v, left, right);
-    const double sxv = box(b.top_xv, b.bottom_xv, left, right) - x * sv;
-    const double syv = box(b.top_yv, b.bottom_yv, left, right) - y * sv;
-    out.per_column[j] = static_cast<float>(sxv * inverse[r]);
-    out.per_row[j] = static_cast<float>(syv * inverse[r]);
-    out.used[j] = static_cast<std::uint16_t>((2 * k + 1) * (2 * k + 1));
+// The count of unclean pixels and the centred moments Σ dx·v, Σ dy·v of the
+// window of radius k around region pixel (y, x); `b` bounds its rows.
+struct Window {
+  std::int32_t unclean;
+  double sxv, syv;
+};
+
+inline Window window_at(const IntegralRing::Bounds& b, int y, int x, int k) {
+  const int left = x - k, right = x + k + 1;
+  // Moments about the window's centre: Σ dx·v = Σ x·v − x·Σ v, likewise dy.
+  const double sv = box(b.top_v, b.bottom_v, left, right);
+  return {box(b.top_unclean, b.bottom_unclean, left, right),
+          box(b.top_xv, b.bottom_xv, left, right) - x * sv,
+          box(b.top_yv, b.bottom_yv, left, right) - y * sv};
+}
+
+std::uint16_t window_pixels(int k) {
+  return static_cast<std::uint16_t>((2 * k + 1) * (2 * k + 1));
+}
+
+// The fit at radius k of every pixel of a row segment, x = x0 … x0 + n − 1
+// in region coordinates (y its row): used = (2k + 1)² where the pixel and its
+// window are clean, else 0. Branch-free, so that it vectorizes: most pixels
+// stop at the widest radius.
+SCANBENCH_VECTOR_CLONES void fit_radius(int n, int x0, int y, int k, double inverse,
+                                        const IntegralRing::Bounds& b,
+                                        const std::uint8_t* __restrict clean,
+                                        float* __restrict per_column, float* __restrict per_row,
+                                        std::uint16_t* __restrict used) {
+  const std::uint16_t full = window_pixels(k);
+  for (int j = 0; j < n; ++j) {
+    const Window w = window_at(b, y, x0 + j, k);
+    const std::uint32_t ok = all_bits((clean[j] != 0) & (w.unclean == 0));
+    per_column[j] = select_bits(static_cast<float>(w.sxv * inverse), ok);
+    per_row[j] = select_bits(static_cast<float>(w.syv * inverse), ok);
+    used[j] = static_cast<std::uint16_t>(full & ok);
+  }
+}
+
+// The narrower radii, widest first, for one clean pixel the widest left
+// without a window.
+void fit_narrower(std::span<const IntegralRing::Bounds> bounds, std::span<const int> radii,
+                  std::span<const double> inverse, int y, int x, SlopeBuffers& out, std::size_t j) {
+  for (std::size_t r = 1; r < radii.size(); ++r) {
+    const Window w = window_at(bounds[r], y, x, radii[r]);
+    if (w.unclean != 0) continue;
+    out.per_column[j] = static_cast<float>(w.sxv * inverse[r]);
+    out.per_row[j] = static_cast<float>(w.syv * inverse[r]);
+    out.used[j] = window_pixels(radii[r]);
     return;
   }
-  out.per_column[j] = out.per_row[j] = 0.0f;
-  out.used[j] = 0;
 }
 
 void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
@@ -190,14 +221,14 @@ void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
     ring.extend_to(y + halo + 1);
     for (std::size_t r = 0; r < radii.size(); ++r) bounds[r] = ring.bounds(y, radii[r]);
     const std::size_t offset = static_cast<std::size_t>(row) * grid.columns;
-    for (int col = tile.col_begin; col < tile.col_end; ++col) {
-      const auto j = static_cast<std::size_t>(col - tile.col_begin);
-      if (grid.clean[offset + col]) {
-        widest_clean_fit(bounds, radii, inverse, y, col - tile.col_begin + halo, out, j);
-      } else {
-        out.per_column[j] = out.per_row[j] = 0.0f;
-        out.used[j] = 0;
-      }
+    const int n = tile.col_end - tile.col_begin;
+    // Widest radius for the whole segment, then the narrower ones for the
+    // clean pixels it left without a window.
+    fit_radius(n, halo, y, radii[0], inverse[0], bounds[0], grid.clean + offset + tile.col_begin,
+               out.per_column.data(), out.per_row.data(), out.used.data());
+    for (int j = 0; j < n; ++j) {
+      if (out.used[j] == 0 && grid.clean[offset + tile.col_begin + j])
+        fit_narrower(bounds, radii, inverse, y, halo + j, out, static_cast<std::size_t>(j));
     }
     visit(row, tile.col_begin, tile.col_end, out.row());
   }
