@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -50,7 +51,7 @@ void parallel_rows(int rows, int threads, Body&& body) {
 // their (huge) pages are faulted in by the threads that use them.
 struct FitInputs {
   std::unique_ptr<std::uint8_t[]> mixed;  // 1 = mixed pixel
-  std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive range
+  std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive finite range
   std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
   std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
 
@@ -74,18 +75,34 @@ struct FitInputs {
   }
 };
 
+// mask and log_range of n pixels of a row. Branch-free over plain,
+// unaliased arrays, so that it vectorizes. A range that is not a positive
+// normal float (or is infinite) is no return here.
+SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict valid,
+                                      const std::uint8_t* __restrict mixed,
+                                      const float* __restrict range, std::uint8_t* __restrict mask,
+                                      float* __restrict log_range) {
+  constexpr std::uint32_t kNaN = 0x7fc00000u;
+  for (int i = 0; i < n; ++i) {
+    const bool masked = (valid[i] != 0) & (mixed[i] == 0) &
+                        (range[i] >= std::numeric_limits<float>::min()) &
+                        (range[i] <= std::numeric_limits<float>::max());
+    const std::uint32_t keep = all_bits(masked);
+    mask[i] = masked;
+    log_range[i] = std::bit_cast<float>(
+        (std::bit_cast<std::uint32_t>(log_positive(range[i])) & keep) | (kNaN & ~keep));
+  }
+}
+
 // mixed, mask and log_range of every pixel.
 void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
   const std::span<std::uint8_t> mixed(in.mixed.get(), scan.pixel_count());
   if (settings.flag_mixed_pixels) detect_mixed_pixels(scan, settings, mixed);
   parallel_rows(scan.rows, settings.threads, [&](int row) {
-    const std::size_t begin = scan.index(row, 0), end = begin + scan.columns;
-    if (!settings.flag_mixed_pixels) std::fill(&mixed[begin], &mixed[begin] + scan.columns, 0);
-    for (std::size_t i = begin; i < end; ++i) {
-      const bool mask = scan.valid[i] && !mixed[i] && scan.range_m[i] > 0.0f;
-      in.mask[i] = mask;
-      in.log_range[i] = mask ? std::log(scan.range_m[i]) : std::numeric_limits<float>::quiet_NaN();
-    }
+    const std::size_t i = scan.index(row, 0);
+    if (!settings.flag_mixed_pixels) std::fill(&mixed[i], &mixed[i] + scan.columns, 0);
+    mask_row(scan.columns, scan.valid.data() + i, &mixed[i], scan.range_m.data() + i,
+             in.mask.get() + i, in.log_range.get() + i);
   });
 }
 
