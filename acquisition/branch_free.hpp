@@ -34,6 +34,16 @@ inline float select_bits(float value, std::uint32_t keep) {
   return std::bit_cast<float>(std::bit_cast<std::uint32_t>(value) & keep);
 }
 
+// The same for doubles (a separate name, so that a 32-bit mask cannot be
+// widened into a wrong one by overload resolution).
+inline std::uint64_t all_bits64(bool b) {
+  return b ? ~std::uint64_t{0} : 0;
+}
+
+inline double select_bits64(double value, std::uint64_t keep) {
+  return std::bit_cast<double>(std::bit_cast<std::uint64_t>(value) & keep);
+}
+
 // 1/√q for q ≥ 1 with a relative error below 1.5·10⁻⁷ (as good as float
 // arithmetic gets): the classic bit-level estimate (Lomont's constant, error
 // < 3.5·10⁻²) and three Newton steps, each squaring the error. Two steps

@@ -29,9 +29,39 @@ GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
 
 namespace {
 
-// Whether the symmetric positive semidefinite 3 × 3 matrix `a` with trace 1
-// is a plane's covariance — middle eigenvalue λ1 more than 4 × the smallest
-// λ0 — and then the eigenvector of λ0.
+// The sums of the consistent neighbours' points relative to the centre's
+// point, for kCovarianceLanes centres at once (one lane each).
+struct LaneSums {
+  float x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {}, z[kCovarianceLanes] = {};
+  float xx[kCovarianceLanes] = {}, xy[kCovarianceLanes] = {}, xz[kCovarianceLanes] = {};
+  float yy[kCovarianceLanes] = {}, yz[kCovarianceLanes] = {}, zz[kCovarianceLanes] = {};
+  std::int32_t used[kCovarianceLanes] = {};
+};
+
+// The lanes' centres: log-range, point (the origin of the sums) and viewing
+// direction.
+struct LaneCentres {
+  float log_range[kCovarianceLanes] = {}, x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {},
+        z[kCovarianceLanes] = {};
+  float view_x[kCovarianceLanes] = {}, view_y[kCovarianceLanes] = {}, view_z[kCovarianceLanes] = {};
+};
+
+// The planes through each lane's points: unit normals towards the scanner.
+struct LanePlanes {
+  float x[kCovarianceLanes], y[kCovarianceLanes], z[kCovarianceLanes];
+  float cos_incidence[kCovarianceLanes];
+  std::int32_t ok[kCovarianceLanes];
+};
+
+// `value` where `keep`, else 1: a divisor that is never 0 (branch-free).
+inline double or_one(double value, bool keep) {
+  return select_bits64(value, all_bits64(keep)) + select_bits64(1.0, all_bits64(!keep));
+}
+
+// For each lane: the covariance of its points normalised to trace 1, a
+// symmetric positive semidefinite 3 × 3 matrix a; whether it is a plane's —
+// middle eigenvalue λ1 more than 4 × the smallest λ0 — and then the
+// eigenvector of λ0, turned towards the scanner.
 //
 // Why not a general solver: the closed form needs acos, cos and sin, and a
 // Newton loop for λ0 is a chain of dependent divisions; both dominated the
@@ -50,73 +80,79 @@ namespace {
 // 3. λ0 is the Rayleigh quotient; λ1, λ2 solve t² − s·t + q = 0 with
 //    s = 1 − λ0, q = c1 − λ0·s, and λ1 > 4·λ0 holds exactly when that
 //    quadratic is positive at 4·λ0 with its vertex s/2 to the right of it.
-//
-// Plain scalars on the six unique entries: Eigen's fixed 3 × 3 double
-// products compile into packet shuffles that cost more than the arithmetic.
-struct Symmetric3 {
-  double xx, xy, xz, yy, yz, zz;
-
-  Eigen::Vector3d times(const Eigen::Vector3d& v) const {
-    return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
-            xz * v.x() + yz * v.y() + zz * v.z()};
+// In double precision, branch-free over the lanes so that it vectorizes
+// (every lane is computed; unused ones cost nothing extra).
+SCANBENCH_VECTOR_CLONES void lane_planes(const LaneSums& __restrict s,
+                                         const LaneCentres& __restrict c,
+                                         LanePlanes& __restrict out) {
+  for (int j = 0; j < kCovarianceLanes; ++j) {
+    bool ok = s.used[j] >= 3;
+    const double inverse_n = 1.0 / std::max(s.used[j], 1);
+    const double mx = s.x[j] * inverse_n, my = s.y[j] * inverse_n, mz = s.z[j] * inverse_n;
+    const double cxx = s.xx[j] * inverse_n - mx * mx, cyy = s.yy[j] * inverse_n - my * my,
+                 czz = s.zz[j] * inverse_n - mz * mz, cxy = s.xy[j] * inverse_n - mx * my,
+                 cxz = s.xz[j] * inverse_n - mx * mz, cyz = s.yz[j] * inverse_n - my * mz;
+    const double trace = cxx + cyy + czz;
+    ok &= trace > 0.0;
+    const double t = 1.0 / or_one(trace, trace > 0.0);
+    const double xx = cxx * t, yy = cyy * t, zz = czz * t, xy = cxy * t, xz = cxz * t, yz = cyz * t;
+    const double c1 = xx * yy - xy * xy + xx * zz - xz * xz + yy * zz - yz * yz;
+    ok &= c1 > 0.0;  // else rank ≤ 1: a line or a point
+    const double c0 =
+        xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+    const double sigma = c0 / or_one(c1, c1 > 0.0);
+    const double bx = xx - sigma, by = yy - sigma, bz = zz - sigma;
+    // The adjugate of a − σ·I (symmetric: its columns are also its rows).
+    const double axx = by * bz - yz * yz, axy = xz * yz - xy * bz, axz = xy * yz - xz * by,
+                 ayy = bx * bz - xz * xz, ayz = xy * xz - bx * yz, azz = bx * by - xy * xy;
+    const double n0 = axx * axx + axy * axy + axz * axz, n1 = axy * axy + ayy * ayy + ayz * ayz,
+                 n2 = axz * axz + ayz * ayz + azz * azz;
+    const std::uint64_t take1 = all_bits64(n1 > n0);
+    const std::uint64_t take2 = all_bits64(n2 > std::max(n0, n1));
+    const std::uint64_t take0 = ~(take1 | take2), only1 = take1 & ~take2;
+    const double ux =
+        select_bits64(axx, take0) + select_bits64(axy, only1) + select_bits64(axz, take2);
+    const double uy =
+        select_bits64(axy, take0) + select_bits64(ayy, only1) + select_bits64(ayz, take2);
+    const double uz =
+        select_bits64(axz, take0) + select_bits64(ayz, only1) + select_bits64(azz, take2);
+    const double wx = axx * ux + axy * uy + axz * uz, wy = axy * ux + ayy * uy + ayz * uz,
+                 wz = axz * ux + ayz * uy + azz * uz;
+    double vx = axx * wx + axy * wy + axz * wz, vy = axy * wx + ayy * wy + ayz * wz,
+           vz = axz * wx + ayz * wy + azz * wz;
+    // Normalise: scaled to its largest entry first, so the float estimate of
+    // 1/√q is in range, then one Newton step in double.
+    const double largest = std::max(std::max(std::abs(vx), std::abs(vy)), std::abs(vz));
+    ok &= largest > 0.0;
+    const double scale = 1.0 / or_one(largest, largest > 0.0);
+    vx *= scale, vy *= scale, vz *= scale;
+    const double q = vx * vx + vy * vy + vz * vz;
+    double inverse = inverse_sqrt(static_cast<float>(q));
+    inverse *= 1.5 - 0.5 * q * inverse * inverse;
+    vx *= inverse, vy *= inverse, vz *= inverse;
+    const double smallest = vx * (xx * vx + xy * vy + xz * vz) +
+                            vy * (xy * vx + yy * vy + yz * vz) + vz * (xz * vx + yz * vy + zz * vz);
+    const double sum = 1.0 - smallest, product = c1 - smallest * sum, t4 = 4.0 * smallest;
+    ok &= (t4 < 0.5 * sum) & ((t4 - sum) * t4 + product > 0.0);
+    const float nx = static_cast<float>(vx), ny = static_cast<float>(vy),
+                nz = static_cast<float>(vz);
+    const float away = nx * c.x[j] + ny * c.y[j] + nz * c.z[j];  // > 0: faces away
+    const float sign =
+        select_bits(-1.0f, all_bits(away > 0.0f)) + select_bits(1.0f, all_bits(!(away > 0.0f)));
+    out.x[j] = sign * nx, out.y[j] = sign * ny, out.z[j] = sign * nz;
+    out.cos_incidence[j] = std::abs(nx * c.view_x[j] + ny * c.view_y[j] + nz * c.view_z[j]);
+    out.ok[j] = ok;
   }
-};
-
-bool plane_normal(const Symmetric3& a, Eigen::Vector3d& normal) {
-  const double c1 =
-      a.xx * a.yy - a.xy * a.xy + a.xx * a.zz - a.xz * a.xz + a.yy * a.zz - a.yz * a.yz;
-  if (!(c1 > 0.0)) return false;  // rank ≤ 1: a line or a point
-  const double c0 = a.xx * (a.yy * a.zz - a.yz * a.yz) - a.xy * (a.xy * a.zz - a.yz * a.xz) +
-                    a.xz * (a.xy * a.yz - a.yy * a.xz);
-  const double sigma = c0 / c1;
-  const double bx = a.xx - sigma, by = a.yy - sigma, bz = a.zz - sigma;
-  // The adjugate of a − σ·I (symmetric, so its columns are also its rows).
-  const Symmetric3 adjugate{by * bz - a.yz * a.yz, a.xz * a.yz - a.xy * bz, a.xy * a.yz - a.xz * by,
-                            bx * bz - a.xz * a.xz, a.xy * a.xz - bx * a.yz, bx * by - a.xy * a.xy};
-  const Eigen::Vector3d columns[3] = {{adjugate.xx, adjugate.xy, adjugate.xz},
-                                      {adjugate.xy, adjugate.yy, adjugate.yz},
-                                      {adjugate.xz, adjugate.yz, adjugate.zz}};
-  int longest = 0;
-  for (int i = 1; i < 3; ++i)
-    if (columns[i].squaredNorm() > columns[longest].squaredNorm()) longest = i;
-  const Eigen::Vector3d v = adjugate.times(adjugate.times(columns[longest]));
-  const double length = v.norm();
-  if (!(length > 0.0)) return false;
-  normal = v * (1.0 / length);
-  const double smallest = normal.dot(a.times(normal));
-  const double s = 1.0 - smallest, q = c1 - smallest * s, t = 4.0 * smallest;
-  return t < 0.5 * s && (t - s) * t + q > 0.0;
 }
 
-// Sums of the consistent neighbours' points relative to the centre's point.
-struct PointSums {
-  float x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  int used = 0;
-};
-
-// The plane through the gathered points (see plane_normal), its normal
-// turned towards the scanner.
-NormalFit plane_from_sums(const PointSums& s, const Eigen::Vector3f& origin,
-                          const Eigen::Vector3f& view, int window) {
+// Lane j's result as a NormalFit.
+NormalFit lane_fit(const LaneSums& s, const LanePlanes& planes, int j, int window) {
   NormalFit fit;
   fit.window = window;
-  fit.used = s.used;
-  if (s.used < 3) return fit;
-  // The covariance in double from the float sums, normalised to trace 1;
-  // reciprocals, not the 18 divisions of the plain expression.
-  const double inverse_n = 1.0 / s.used;
-  const double mx = s.x * inverse_n, my = s.y * inverse_n, mz = s.z * inverse_n;
-  const double xx = s.xx * inverse_n - mx * mx, yy = s.yy * inverse_n - my * my,
-               zz = s.zz * inverse_n - mz * mz, xy = s.xy * inverse_n - mx * my,
-               xz = s.xz * inverse_n - mx * mz, yz = s.yz * inverse_n - my * mz;
-  const double trace = xx + yy + zz;
-  if (!(trace > 0.0)) return fit;
-  const double t = 1.0 / trace;
-  Eigen::Vector3d normal;
-  if (!plane_normal({xx * t, xy * t, xz * t, yy * t, yz * t, zz * t}, normal)) return fit;
-  fit.normal = normal.cast<float>();
-  if (fit.normal.dot(origin) > 0) fit.normal = -fit.normal;
-  fit.cos_incidence = std::abs(fit.normal.dot(view));
+  fit.used = s.used[j];
+  if (!planes.ok[j]) return fit;
+  fit.normal = Eigen::Vector3f(planes.x[j], planes.y[j], planes.z[j]);
+  fit.cos_incidence = planes.cos_incidence[j];
   fit.ok = true;
   return fit;
 }
@@ -138,7 +174,7 @@ NormalFit fit_window(const Direction& direction, const float* range_m, const std
   const float centre = log_range[centre_index];
   const Eigen::Vector3f view = direction(row, col);
   const Eigen::Vector3f origin = range_m[centre_index] * view;  // sums relative to it stay small
-  PointSums s;
+  LaneSums s;                                                   // lane 0 only
   const int col_begin = std::max(0, col - k), col_end = std::min(columns - 1, col + k);
   for (int r = std::max(0, row - k); r <= std::min(rows - 1, row + k); ++r) {
     const std::size_t offset = static_cast<std::size_t>(r) * columns;
@@ -149,27 +185,19 @@ NormalFit fit_window(const Direction& direction, const float* range_m, const std
       const bool take = mask[i] && std::abs(log_range[i] - centre) <= limit;
       if (!take) continue;
       const Eigen::Vector3f p = range_m[i] * direction(r, c) - origin;
-      s.x += p.x(), s.y += p.y(), s.z += p.z();
-      s.xx += p.x() * p.x(), s.xy += p.x() * p.y(), s.xz += p.x() * p.z();
-      s.yy += p.y() * p.y(), s.yz += p.y() * p.z(), s.zz += p.z() * p.z();
-      ++s.used;
+      s.x[0] += p.x(), s.y[0] += p.y(), s.z[0] += p.z();
+      s.xx[0] += p.x() * p.x(), s.xy[0] += p.x() * p.y(), s.xz[0] += p.x() * p.z();
+      s.yy[0] += p.y() * p.y(), s.yz[0] += p.y() * p.z(), s.zz[0] += p.z() * p.z();
+      ++s.used[0];
     }
   }
-  return plane_from_sums(s, origin, view, (2 * k + 1) * (2 * k + 1));
+  LaneCentres centres;
+  centres.x[0] = origin.x(), centres.y[0] = origin.y(), centres.z[0] = origin.z();
+  centres.view_x[0] = view.x(), centres.view_y[0] = view.y(), centres.view_z[0] = view.z();
+  LanePlanes planes;
+  lane_planes(s, centres, planes);
+  return lane_fit(s, planes, 0, (2 * k + 1) * (2 * k + 1));
 }
-
-// The sums of kCovarianceLanes horizontally adjacent centres, one lane each.
-struct LaneSums {
-  float x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {}, z[kCovarianceLanes] = {};
-  float xx[kCovarianceLanes] = {}, xy[kCovarianceLanes] = {}, xz[kCovarianceLanes] = {};
-  float yy[kCovarianceLanes] = {}, yz[kCovarianceLanes] = {}, zz[kCovarianceLanes] = {};
-  std::int32_t used[kCovarianceLanes] = {};
-};
-
-// What the lanes' centres contribute to every neighbour's test and point.
-struct LaneCentres {
-  float log_range[kCovarianceLanes], x[kCovarianceLanes], y[kCovarianceLanes], z[kCovarianceLanes];
-};
 
 // One window offset for all lanes: their neighbours are consecutive pixels
 // of one row. Branch-free over plain, unaliased arrays, so that it
@@ -177,14 +205,15 @@ struct LaneCentres {
 // is not read: log_range is NaN where it is 0, which fails the comparison.
 void add_offset(const float* __restrict range, const float* __restrict log_range,
                 const float* __restrict cos_az, const float* __restrict sin_az, float cos_el,
-                float sin_el, float limit, const LaneCentres& __restrict centres,
-                LaneSums& __restrict s) {
+                float sin_el, float limit, const float* __restrict centre_log_range,
+                const float* __restrict centre_x, const float* __restrict centre_y,
+                const float* __restrict centre_z, LaneSums& __restrict s) {
   for (int j = 0; j < kCovarianceLanes; ++j) {
-    const bool take = std::abs(log_range[j] - centres.log_range[j]) <= limit;
+    const bool take = std::abs(log_range[j] - centre_log_range[j]) <= limit;
     const std::uint32_t keep = all_bits(take);
-    const float px = select_bits(range[j] * (cos_el * cos_az[j]) - centres.x[j], keep);
-    const float py = select_bits(range[j] * (cos_el * sin_az[j]) - centres.y[j], keep);
-    const float pz = select_bits(range[j] * sin_el - centres.z[j], keep);
+    const float px = select_bits(range[j] * (cos_el * cos_az[j]) - centre_x[j], keep);
+    const float py = select_bits(range[j] * (cos_el * sin_az[j]) - centre_y[j], keep);
+    const float pz = select_bits(range[j] * sin_el - centre_z[j], keep);
     s.x[j] += px, s.y[j] += py, s.z[j] += pz;
     s.xx[j] += px * px, s.xy[j] += px * py, s.xz[j] += px * pz;
     s.yy[j] += py * py, s.yz[j] += py * pz, s.zz[j] += pz * pz;
@@ -223,12 +252,12 @@ void covariance_fits(const GridDirections& directions, const float* range_m, con
   const int k = settings.edge_window_radius, columns = directions.columns;
   const std::size_t centre_index = static_cast<std::size_t>(row) * columns + col;
   LaneCentres centres;
-  Eigen::Vector3f views[kCovarianceLanes], origins[kCovarianceLanes];
   for (int j = 0; j < kCovarianceLanes; ++j) {
-    views[j] = directions.at(row, col + j);
-    origins[j] = range_m[centre_index + j] * views[j];
+    const Eigen::Vector3f view = directions.at(row, col + j);
+    const Eigen::Vector3f origin = range_m[centre_index + j] * view;
     centres.log_range[j] = log_range[centre_index + j];
-    centres.x[j] = origins[j].x(), centres.y[j] = origins[j].y(), centres.z[j] = origins[j].z();
+    centres.x[j] = origin.x(), centres.y[j] = origin.y(), centres.z[j] = origin.z();
+    centres.view_x[j] = view.x(), centres.view_y[j] = view.y(), centres.view_z[j] = view.z();
   }
   LaneSums s;
   for (int r = row - k; r <= row + k; ++r) {
@@ -236,15 +265,17 @@ void covariance_fits(const GridDirections& directions, const float* range_m, con
       const std::size_t i = static_cast<std::size_t>(r) * columns + col + dc;
       add_offset(range_m + i, log_range + i, directions.cos_az.data() + col + dc,
                  directions.sin_az.data() + col + dc, directions.cos_el[r], directions.sin_el[r],
-                 consistency_limit(settings, std::max(std::abs(r - row), std::abs(dc))), centres,
-                 s);
+                 consistency_limit(settings, std::max(std::abs(r - row), std::abs(dc))),
+                 centres.log_range, centres.x, centres.y, centres.z, s);
     }
   }
+  // A copy goes to the solver, so that `s` itself never escapes this
+  // function (otherwise GCC no longer vectorizes add_offset's lanes).
+  const LaneSums sums = s;
+  LanePlanes planes;
+  lane_planes(sums, centres, planes);
   for (int j = 0; j < kCovarianceLanes; ++j) {
-    if ((wanted & (1u << j)) == 0) continue;
-    const PointSums lane{s.x[j],  s.y[j],  s.z[j],  s.xx[j], s.xy[j],
-                         s.xz[j], s.yy[j], s.yz[j], s.zz[j], s.used[j]};
-    fits[j] = plane_from_sums(lane, origins[j], views[j], (2 * k + 1) * (2 * k + 1));
+    if ((wanted & (1u << j)) != 0) fits[j] = lane_fit(s, planes, j, (2 * k + 1) * (2 * k + 1));
   }
 }
 
