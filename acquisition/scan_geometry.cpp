@@ -33,7 +33,6 @@
 
 #include "acquisition/branch_free.hpp"
 #include "acquisition/grid_covariance.hpp"
-#include "acquisition/huge_pages.hpp"
 #include "acquisition/mixed_pixels.hpp"
 #include "acquisition/parallel.hpp"
 #include "acquisition/window_moments.hpp"
@@ -48,7 +47,7 @@ void parallel_rows(int rows, int threads, Body&& body) {
 
 // What every fit reads per pixel. Scratch arrays are left uninitialised
 // (make_unique_for_overwrite) and first written by the parallel passes, so
-// their (huge) pages are faulted in by the threads that use them.
+// their pages are faulted in by the threads that use them.
 struct FitInputs {
   std::unique_ptr<std::uint8_t[]> mixed;  // 1 = mixed pixel
   std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive finite range
@@ -56,17 +55,10 @@ struct FitInputs {
   std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
 
   explicit FitInputs(std::size_t n)
-      : mixed(scratch<std::uint8_t>(n)),
-        mask(scratch<std::uint8_t>(n)),
-        clean(scratch<std::uint8_t>(n)),
-        log_range(scratch<float>(n)) {}
-
-  template <typename T>
-  static std::unique_ptr<T[]> scratch(std::size_t n) {
-    std::unique_ptr<T[]> array = std::make_unique_for_overwrite<T[]>(n);
-    advise_huge_pages(array.get(), n * sizeof(T));
-    return array;
-  }
+      : mixed(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        mask(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        clean(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        log_range(std::make_unique_for_overwrite<float[]>(n)) {}
 
   // The mixed-pixel and edge flags of pixel i (an edge: masked, not clean).
   std::uint8_t flags(std::size_t i) const {
@@ -386,23 +378,12 @@ std::vector<int> cascade_radii(const GeometrySettings& settings) {
   return radii;
 }
 
-// Reserves, advises huge pages (huge_pages.hpp), then fills: the vector's
-// memory is untouched until the fill.
-template <typename T>
-void allocate_filled(std::vector<T>& v, std::size_t n, T value) {
-  v.reserve(n);
-  advise_huge_pages(v.data(), n * sizeof(T));
-  v.assign(n, value);
-}
-
 // The outputs; every pixel is written by the passes below.
 void allocate(ScanGeometry& g, std::size_t n) {
-  allocate_filled(g.footprint_m, n, 0.0f);
-  g.normal.reserve(n);
-  advise_huge_pages(g.normal.data(), n * sizeof(Eigen::Vector3f));
-  g.normal.resize(n);  // Eigen leaves it uninitialised; the last pass writes every pixel
-  allocate_filled(g.confidence, n, 0.0f);
-  allocate_filled(g.flags, n, std::uint8_t{0});
+  g.footprint_m.assign(n, 0.0f);
+  g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
+  g.confidence.assign(n, 0.0f);
+  g.flags.assign(n, 0);
 }
 
 }  // namespace
