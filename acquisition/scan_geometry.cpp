@@ -31,6 +31,11 @@
 #include <limits>
 #include <memory>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
 #include "acquisition/branch_free.hpp"
 #include "acquisition/grid_covariance.hpp"
 #include "acquisition/mixed_pixels.hpp"
@@ -378,12 +383,35 @@ std::vector<int> cascade_radii(const GeometrySettings& settings) {
   return radii;
 }
 
+// Maps the pages of [data, data + bytes) in one system call (Linux ≥ 5.14),
+// instead of one page fault per 4 KB at the first write; it runs beside the
+// first passes (see compute_geometry). A no-op elsewhere or on failure.
+void prefault(const void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+  const auto begin = reinterpret_cast<std::uintptr_t>(data) & ~(page - 1);
+  const auto end = reinterpret_cast<std::uintptr_t>(data) + bytes;
+  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+#else
+  (void)data, (void)bytes;
+#endif
+}
+
+// Reserves, maps in bulk, then fills.
+template <typename T>
+void allocate_filled(std::vector<T>& v, std::size_t n, T value) {
+  v.reserve(n);
+  prefault(v.data(), n * sizeof(T));
+  v.assign(n, value);
+}
+
 // The outputs; every pixel is written by the passes below.
 void allocate(ScanGeometry& g, std::size_t n) {
-  g.footprint_m.assign(n, 0.0f);
+  allocate_filled(g.footprint_m, n, 0.0f);
   g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
-  g.confidence.assign(n, 0.0f);
-  g.flags.assign(n, 0);
+  prefault(g.normal.data(), n * sizeof(Eigen::Vector3f));
+  allocate_filled(g.confidence, n, 0.0f);
+  allocate_filled(g.flags, n, std::uint8_t{0});
 }
 
 }  // namespace
