@@ -1,68 +1,87 @@
 #include "acquisition/mixed_pixels.hpp"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstddef>
 
+#include "acquisition/branch_free.hpp"
 #include "acquisition/parallel.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
-// Ranges with a border of two pixels, −1 where there is no valid return, so
-// the line tests below need no bounds checks.
-struct PaddedRanges {
+// Rows per task: the block's padded copy (block + 4 rows) stays in cache.
+constexpr int kBlockRows = 16;
+
+// Ranges of rows [row_begin − 2, row_end + 2) with a border of two pixels,
+// −1 where there is no valid return, so the line tests below need no bounds
+// checks and no branches.
+struct PaddedBlock {
   static constexpr int kPad = 2;
-  int stride;
+  int row_begin, stride;
   std::vector<float> values;
 
-  explicit PaddedRanges(const Scan& scan)
-      : stride(scan.columns + 2 * kPad),
-        values(static_cast<std::size_t>(scan.rows + 2 * kPad) * stride, -1.0f) {
-    for (int row = 0; row < scan.rows; ++row) {
-      for (int col = 0; col < scan.columns; ++col) {
-        const std::size_t i = scan.index(row, col);
-        if (scan.valid[i]) values[at(row, col)] = scan.range_m[i];
-      }
+  PaddedBlock(const Scan& scan, int begin, int end)
+      : row_begin(begin),
+        stride(scan.columns + 2 * kPad),
+        values(static_cast<std::size_t>(end - begin + 2 * kPad) * stride, -1.0f) {
+    for (int row = std::max(0, begin - kPad); row < std::min(scan.rows, end + kPad); ++row) {
+      float* out = values.data() + at(row, 0);
+      const std::size_t i = scan.index(row, 0);
+      for (int col = 0; col < scan.columns; ++col)
+        out[col] = scan.valid[i + col] ? scan.range_m[i + col] : -1.0f;
     }
   }
   std::size_t at(int row, int col) const {
-    return static_cast<std::size_t>(row + kPad) * stride + (col + kPad);
+    return static_cast<std::size_t>(row - row_begin + kPad) * stride + (col + kPad);
   }
 };
 
-// The test of detect_mixed_pixels along one grid line with step `step` in
-// the padded array.
-bool mixed_along(const float* c, std::ptrdiff_t step, float threshold) {
-  const float a1 = c[-step], a2 = c[-2 * step], b1 = c[step], b2 = c[2 * step];
-  if (a1 < 0 || a2 < 0 || b1 < 0 || b2 < 0) return false;
-  const float centre = *c;
-  if (!((a1 < centre && centre < b1) || (b1 < centre && centre < a1))) return false;
+// The test of detect_mixed_pixels along one grid line, on the centre and its
+// neighbours at −2, −1 (side a) and +1, +2 (side b). Bitwise operators, no
+// early exits: the column loop below vectorizes.
+inline bool mixed_along(float centre, float a2, float a1, float b1, float b2, float threshold) {
+  const bool present = (a1 >= 0.0f) & (a2 >= 0.0f) & (b1 >= 0.0f) & (b2 >= 0.0f);
+  const bool between = ((a1 < centre) & (centre < b1)) | ((b1 < centre) & (centre < a1));
   const float miss_a = centre - (2.0f * a1 - a2);  // off the continuation of side a
   const float miss_b = centre - (2.0f * b1 - b2);
-  return std::abs(miss_a) > threshold && std::abs(miss_b) > threshold && miss_a * miss_b < 0.0f;
+  return present & between & (std::abs(miss_a) > threshold) & (std::abs(miss_b) > threshold) &
+         (miss_a * miss_b < 0.0f);
+}
+
+SCANBENCH_VECTOR_CLONES void detect_row(const PaddedBlock& block, int row, int columns,
+                                        float sigma0, float sigma1, std::uint8_t* out) {
+  const std::ptrdiff_t s = block.stride;
+  const float* p = block.values.data() + block.at(row, 0);
+  for (int col = 0; col < columns; ++col) {
+    const float* c = p + col;
+    const float centre = *c;
+    const float threshold = sigma0 + sigma1 * centre;
+    const bool mixed =
+        mixed_along(centre, c[-2], c[-1], c[1], c[2], threshold) |
+        mixed_along(centre, c[-2 * s], c[-s], c[s], c[2 * s], threshold) |
+        mixed_along(centre, c[-2 * s - 2], c[-s - 1], c[s + 1], c[2 * s + 2], threshold) |
+        mixed_along(centre, c[-2 * s + 2], c[-s + 1], c[s - 1], c[2 * s - 2], threshold);
+    out[col] = (centre >= 0.0f) & mixed;
+  }
 }
 
 }  // namespace
 
-std::vector<std::uint8_t> detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings) {
-  std::vector<std::uint8_t> mixed(scan.pixel_count(), 0);
-  const PaddedRanges padded(scan);
-  const std::ptrdiff_t s = padded.stride;
-  const std::ptrdiff_t steps[4] = {1, s, s + 1, s - 1};  // row, column, both diagonals
-  parallel_for_index(scan.rows, settings.threads, [&](int row) {
-    for (int col = 0; col < scan.columns; ++col) {
-      const float* centre = padded.values.data() + padded.at(row, col);
-      if (*centre < 0) continue;
-      const auto threshold =
-          static_cast<float>(settings.mixed_pixel_sigmas *
-                             (settings.range_noise_m + settings.range_noise_per_m * *centre));
-      bool is_mixed = false;
-      for (const std::ptrdiff_t step : steps)
-        is_mixed = is_mixed || mixed_along(centre, step, threshold);
-      mixed[scan.index(row, col)] = is_mixed;
-    }
+void detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings,
+                         std::span<std::uint8_t> mixed) {
+  assert(check_consistency(scan).empty() && mixed.size() == scan.pixel_count() &&
+         "a consistent scan and one output per pixel");
+  const auto sigma0 = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_m);
+  const auto sigma1 = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_per_m);
+  const int blocks = (scan.rows + kBlockRows - 1) / kBlockRows;
+  parallel_for_index(blocks, settings.threads, [&](int b) {
+    const int begin = b * kBlockRows, end = std::min(scan.rows, begin + kBlockRows);
+    const PaddedBlock block(scan, begin, end);
+    for (int row = begin; row < end; ++row)
+      detect_row(block, row, scan.columns, sigma0, sigma1, mixed.data() + scan.index(row, 0));
   });
-  return mixed;
 }
 
 }  // namespace scanbench::acquisition

@@ -4,14 +4,15 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
+#include <span>
 
 #include "acquisition/scan.hpp"
 #include "acquisition/scan_geometry.hpp"
 
 namespace scanbench::acquisition {
 
-// 1 where a valid pixel is a mixed pixel, else 0 (rows × columns).
+// Writes 1 where a valid pixel is a mixed pixel, else 0, to every entry of
+// `mixed` (rows × columns; asserted).
 //
 // Along each of four grid lines through the pixel (row, column, both
 // diagonals) with valid neighbours at distance 1 and 2 on both sides, the
@@ -20,6 +21,7 @@ namespace scanbench::acquisition {
 // 2·r(+1) − r(+2) — by more than mixed_pixel_sigmas · σ(range), in opposite
 // directions (beyond one side's surface, short of the other's). A point on a
 // smooth surface, however steep or grazing, continues both sides linearly.
-std::vector<std::uint8_t> detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings);
+void detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings,
+                         std::span<std::uint8_t> mixed);
 
 }  // namespace scanbench::acquisition

@@ -5,22 +5,39 @@
 //   ∂p/∂θ = r_θ u + r cos φ e_θ,   ∂p/∂φ = r_φ u + r e_φ,
 //   ∂p/∂θ × ∂p/∂φ ∝ u − (∂ln r/∂θ) / cos φ · e_θ − (∂ln r/∂φ) · e_φ,
 // so a normal needs only the two slopes of ln r, which a least-squares plane
-// fit of ln r over the pixel window gives from ten running window moments
+// fit of ln r over the pixel window gives from integral images of its moments
 // (window_moments.hpp): constant time per pixel for any window size. That fit
 // is exact to second order only in a full, symmetric window; windows cut by a
 // depth discontinuity, by invalid pixels or by the grid's border get a
-// covariance fit of their 3D points instead, leaving out the neighbours across
-// the discontinuity. Scans with per-pixel directions have no angle model and
-// always take the covariance fit.
+// covariance fit of their 3D points instead (grid_covariance.hpp), leaving
+// out the neighbours across the discontinuity. Scans with per-pixel
+// directions have no angle model and always take the covariance fit.
+//
+// The stage runs as three passes over the grid, each parallel and each
+// touching a pixel's data once: mixed pixels; mask, log-range and depth
+// jumps; then tile by tile the window slopes, normals, confidences and
+// footprints, so a tile's data is still in cache when its pixels finish.
 #include "acquisition/scan_geometry.hpp"
 
-#include <Eigen/Eigenvalues>
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <optional>
+#include <limits>
+#include <memory>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
+#include "acquisition/branch_free.hpp"
+#include "acquisition/grid_covariance.hpp"
 #include "acquisition/mixed_pixels.hpp"
 #include "acquisition/parallel.hpp"
 #include "acquisition/window_moments.hpp"
@@ -33,275 +50,368 @@ void parallel_rows(int rows, int threads, Body&& body) {
   parallel_for_index(rows, threads, body, 8);
 }
 
-// Least-squares slopes (per column, per row) of v over a window, from its
-// moments; false when the window does not span two independent directions.
-bool plane_slopes(double n, double sx, double sy, double sxx, double sxy, double syy, double sv,
-                  double sxv, double syv, double& b, double& c) {
-  if (n < 3) return false;
-  const double cxx = sxx - sx * sx / n, cxy = sxy - sx * sy / n, cyy = syy - sy * sy / n;
-  const double cxv = sxv - sx * sv / n, cyv = syv - sy * sv / n;
-  const double det = cxx * cyy - cxy * cxy;
-  if (cxx < 0.5 || cyy < 0.5 || det < 0.25 * cxx * cyy) return false;
-  b = (cyy * cxv - cxy * cyv) / det;
-  c = (cxx * cyv - cxy * cxv) / det;
-  return true;
+// What every fit reads per pixel. Scratch arrays are left uninitialised
+// (make_unique_for_overwrite) and first written by the parallel passes, so
+// their pages are faulted in by the threads that use them.
+struct FitInputs {
+  std::unique_ptr<std::uint8_t[]> mixed;  // 1 = mixed pixel
+  std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive finite range
+  std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
+  std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
+
+  explicit FitInputs(std::size_t n)
+      : mixed(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        mask(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        clean(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        log_range(std::make_unique_for_overwrite<float[]>(n)) {}
+
+  // The mixed-pixel and edge flags of pixel i (an edge: masked, not clean).
+  std::uint8_t flags(std::size_t i) const {
+    return static_cast<std::uint8_t>((mixed[i] ? kFlagMixedPixel : 0) |
+                                     (mask[i] && !clean[i] ? kFlagEdge : 0));
+  }
+};
+
+// mask and log_range of n pixels of a row. Branch-free over plain,
+// unaliased arrays, so that it vectorizes. A range that is not a positive
+// normal float (or is infinite) is no return here.
+SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict valid,
+                                      const std::uint8_t* __restrict mixed,
+                                      const float* __restrict range, std::uint8_t* __restrict mask,
+                                      float* __restrict log_range) {
+  constexpr std::uint32_t kNaN = 0x7fc00000u;
+  for (int i = 0; i < n; ++i) {
+    const bool masked = (valid[i] != 0) & (mixed[i] == 0) &
+                        (range[i] >= std::numeric_limits<float>::min()) &
+                        (range[i] <= std::numeric_limits<float>::max());
+    const std::uint32_t keep = all_bits(masked);
+    mask[i] = masked;
+    log_range[i] = std::bit_cast<float>(
+        (std::bit_cast<std::uint32_t>(log_positive(range[i])) & keep) | (kNaN & ~keep));
+  }
 }
 
-// 1 where a masked pixel's log-range jumps: its second difference along the
-// row or the column exceeds the threshold of GeometrySettings (noise-aware,
-// capped by depth_jump_relative).
-std::vector<std::uint8_t> jump_map(const Scan& scan, const std::vector<std::uint8_t>& mask,
-                                   const std::vector<float>& v, const GeometrySettings& settings) {
-  std::vector<std::uint8_t> jumps(mask.size(), 0);
-  const int columns = scan.columns;
-  const double noise_factor = settings.depth_jump_sigmas * std::sqrt(6.0);
-  parallel_rows(scan.rows, settings.threads, [&](int r) {
-    for (int c = 0; c < columns; ++c) {
-      const std::size_t i = scan.index(r, c);
-      if (!mask[i]) continue;
-      const double range = scan.range_m[i];
-      const double sigma = settings.range_noise_m + settings.range_noise_per_m * range;
-      const double jump = std::min(settings.depth_jump_relative, noise_factor * sigma / range);
-      const auto jumps_between = [&](std::size_t before, std::size_t after) {
-        return mask[before] && mask[after] && std::abs(v[before] - 2 * v[i] + v[after]) > jump;
-      };
-      jumps[i] = (c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
-                 (r > 0 && r + 1 < scan.rows && jumps_between(i - columns, i + columns));
-    }
+// mixed, mask and log_range of every pixel.
+void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
+  const std::span<std::uint8_t> mixed(in.mixed.get(), scan.pixel_count());
+  if (settings.flag_mixed_pixels) detect_mixed_pixels(scan, settings, mixed);
+  parallel_rows(scan.rows, settings.threads, [&](int row) {
+    const std::size_t i = scan.index(row, 0);
+    if (!settings.flag_mixed_pixels) std::fill(&mixed[i], &mixed[i] + scan.columns, 0);
+    mask_row(scan.columns, scan.valid.data() + i, &mixed[i], scan.range_m.data() + i,
+             in.mask.get() + i, in.log_range.get() + i);
   });
-  return jumps;
 }
 
-// Sines and cosines of every column's azimuth and every row's elevation, so
-// the per-pixel work is free of trigonometry.
-struct AngleTables {
-  std::vector<double> cos_az, sin_az, cos_el, sin_el;
+// The depth-jump test of GeometrySettings: a second difference `d` of
+// log-range above depth_jump_relative, or above depth_jump_sigmas · √6 ·
+// σ(range) / range — compared as d · range > √6 · depth_jump_sigmas · σ,
+// without a division.
+struct JumpTest {
+  float relative, noise0, noise1;  // threshold·range = noise0 + noise1·range
 
-  explicit AngleTables(const Scan& scan) {
+  explicit JumpTest(const GeometrySettings& s)
+      : relative(static_cast<float>(s.depth_jump_relative)),
+        noise0(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_m)),
+        noise1(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_per_m)) {}
+
+  bool operator()(float before, float centre, float after, float range) const {
+    const float d = std::abs(before - 2.0f * centre + after);
+    return (d > relative) | (d * range > noise0 + noise1 * range);
+  }
+};
+
+// Interior pixels 1 … n − 2 of a row whose rows above and below exist;
+// branch-free over plain, unaliased arrays so that the loop vectorizes.
+SCANBENCH_VECTOR_CLONES void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
+                                            const std::uint8_t* __restrict mask,
+                                            const float* __restrict v,
+                                            const float* __restrict range,
+                                            std::uint8_t* __restrict clean) {
+  for (int c = 1; c + 1 < n; ++c) {
+    const bool along_row =
+        (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range[c]);
+    const bool along_column = (mask[c - stride] != 0) & (mask[c + stride] != 0) &
+                              test(v[c - stride], v[c], v[c + stride], range[c]);
+    const bool jumps = (mask[c] != 0) & (along_row | along_column);
+    clean[c] = (mask[c] != 0) & !jumps;
+  }
+}
+
+// clean (masked and no depth jump) for every pixel.
+void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
+  const JumpTest test(settings);
+  const int rows = scan.rows, columns = scan.columns;
+  const std::uint8_t* mask = in.mask.get();
+  const float* v = in.log_range.get();
+  const auto one_pixel = [&](int r, int c) {
+    const std::size_t i = scan.index(r, c);
+    const auto jumps_between = [&](std::size_t before, std::size_t after) {
+      return mask[before] && mask[after] && test(v[before], v[i], v[after], scan.range_m[i]);
+    };
+    const bool jumps =
+        mask[i] && ((c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
+                    (r > 0 && r + 1 < rows && jumps_between(i - columns, i + columns)));
+    in.clean[i] = mask[i] && !jumps;
+  };
+  parallel_rows(rows, settings.threads, [&](int r) {
+    const std::size_t i = scan.index(r, 0);
+    if (r == 0 || r + 1 == rows || columns < 3) {
+      for (int c = 0; c < columns; ++c) one_pixel(r, c);
+      return;
+    }
+    one_pixel(r, 0);
+    interior_jumps(columns, columns, test, mask + i, v + i, scan.range_m.data() + i,
+                   in.clean.get() + i);
+    one_pixel(r, columns - 1);
+  });
+}
+
+// Per-row factors of a spherical scan, so the per-pixel work is free of
+// trigonometry and division.
+struct RowFactors {
+  std::vector<float> azimuth_gradient;  // 1 / (Δaz · cos el): d ln r / d col → ∂ ln r/∂az / cos el
+  std::vector<float> half_spacing;  // half the pixel cell's diagonal per metre of range
+  float elevation_gradient = 0.0f;  // 1 / Δel
+
+  explicit RowFactors(const Scan& scan) {
     const auto* a = std::get_if<SphericalAngles>(&scan.angles);
     if (a == nullptr) return;
-    for (int col = 0; col < scan.columns; ++col) {
-      const double az = a->azimuth_start_rad + col * a->azimuth_step_rad;
-      cos_az.push_back(std::cos(az));
-      sin_az.push_back(std::sin(az));
-    }
     for (int row = 0; row < scan.rows; ++row) {
-      const double el = a->elevation_start_rad + row * a->elevation_step_rad;
-      cos_el.push_back(std::cos(el));
-      sin_el.push_back(std::sin(el));
+      const double cos_el = std::cos(a->elevation_start_rad + row * a->elevation_step_rad);
+      azimuth_gradient.push_back(
+          static_cast<float>(1.0 / a->azimuth_step_rad / std::max(cos_el, 1e-3)));
+      const double az = std::abs(a->azimuth_step_rad) * cos_el, el = a->elevation_step_rad;
+      half_spacing.push_back(static_cast<float>(0.5 * std::sqrt(az * az + el * el)));
     }
-  }
-
-  // The pixel's unit viewing direction, from the tables when the scan is spherical.
-  Eigen::Vector3f direction(const Scan& scan, int row, int col) const {
-    if (cos_az.empty()) return acquisition::direction(scan, row, col);
-    return Eigen::Vector3d(cos_el[row] * cos_az[col], cos_el[row] * sin_az[col], sin_el[row])
-        .cast<float>();
+    elevation_gradient = static_cast<float>(1.0 / a->elevation_step_rad);
   }
 };
 
-// The log-range slopes of the widest clean window of every pixel: widest
-// first, a pixel takes the first window size at which its whole window is
-// valid and free of depth discontinuities.
-struct WindowSlopes {
-  std::vector<float> per_column, per_row;  // d ln r / d col, d ln r / d row
-  std::vector<std::uint16_t> used;         // window pixels; 0 = no clean window
+// Half the pixel cell's diagonal per metre of range on a per-pixel direction
+// grid: the angles to the next column and row.
+float half_spacing_per_pixel(const Scan& scan, int row, int col) {
+  const Eigen::Vector3f d = direction(scan, row, col);
+  const int c2 = col + 1 < scan.columns ? col + 1 : col - 1,
+            r2 = row + 1 < scan.rows ? row + 1 : row - 1;
+  double az = 0, el = 0;
+  if (c2 >= 0) az = std::acos(std::clamp(d.dot(direction(scan, row, c2)), -1.0f, 1.0f));
+  if (r2 >= 0) el = std::acos(std::clamp(d.dot(direction(scan, r2, col)), -1.0f, 1.0f));
+  return static_cast<float>(0.5 * std::sqrt(az * az + el * el));
+}
 
-  WindowSlopes(const Scan& scan, const std::vector<std::uint8_t>& mask,
-               const std::vector<float>& log_range, const std::vector<std::uint8_t>& jump_map,
-               const GeometrySettings& settings)
-      : per_column(scan.pixel_count(), 0.0f),
-        per_row(scan.pixel_count(), 0.0f),
-        used(scan.pixel_count(), 0) {
-    for (int radius = settings.window_radius;;) {
-      add_scale(scan, radius, mask, log_range, jump_map, settings.threads);
-      if (radius <= settings.edge_window_radius) break;
-      radius =
-          radius / 2 >= 2 * settings.edge_window_radius ? radius / 2 : settings.edge_window_radius;
-    }
-  }
-
- private:
-  void add_scale(const Scan& scan, int radius, const std::vector<std::uint8_t>& mask,
-                 const std::vector<float>& log_range, const std::vector<std::uint8_t>& jump_map,
-                 int threads) {
-    const std::vector<std::uint16_t> jumps =
-        window_counts(scan.rows, scan.columns, radius, jump_map, threads);
-    const float full = static_cast<float>((2 * radius + 1) * (2 * radius + 1));
-    visit_window_moments(
-        scan.rows, scan.columns, radius, mask, log_range, threads,
-        [&](int row, int begin, int end, const WindowMoments* moments) {
-          for (int col = begin; col < end; ++col) {
-            const std::size_t i = scan.index(row, col);
-            const WindowMoments& m = moments[col - begin];
-            if (used[i] || !mask[i] || jumps[i] != 0 || m.n != full) continue;
-            double b = 0, c = 0;
-            if (!plane_slopes(m.n, m.sx, m.sy, m.sxx, m.sxy, m.syy, m.sv, m.sxv, m.syv, b, c))
-              continue;
-            per_column[i] = static_cast<float>(b);
-            per_row[i] = static_cast<float>(c);
-            used[i] = static_cast<std::uint16_t>(m.n);
-          }
-        });
-  }
+struct Counts {
+  std::atomic<std::size_t> valid{0}, normals{0}, mixed{0}, edges{0};
 };
 
-struct GridContext {
+struct StageContext {
   const Scan& scan;
   const GeometrySettings& settings;
-  const std::vector<std::uint8_t>& mask;  // valid and not mixed
-  const std::vector<float>& log_range;
-  const std::vector<Eigen::Vector3f>& points;  // scan frame, where masked
+  const FitInputs& in;
+  const GridDirections& directions;
+  const RowFactors& factors;
+  ScanGeometry& g;
+  Counts& counts;
 };
 
-// Unit normal towards the scanner from the log-range slopes per column (b)
-// and per row (c) at a pixel of a spherical scan.
-Eigen::Vector3f spherical_normal(const SphericalAngles& a, const AngleTables& t, int row, int col,
-                                 double b, double c) {
-  const double ca = t.cos_az[col], sa = t.sin_az[col], ce = t.cos_el[row], se = t.sin_el[row];
-  const Eigen::Vector3d u(ce * ca, ce * sa, se), e_az(-sa, ca, 0.0), e_el(-se * ca, -se * sa, ce);
-  const double g_az = b / a.azimuth_step_rad / std::max(ce, 1e-3);
-  const double g_el = c / a.elevation_step_rad;
-  return (-u + g_az * e_az + g_el * e_el).normalized().cast<float>();
-}
-
-// Covariance fit of the 3D points over the window (per-pixel grids).
-bool covariance_normal(const GridContext& g, int row, int col, Eigen::Vector3f& normal, int& used) {
-  const int k = g.settings.edge_window_radius;
-  const std::size_t centre_index = g.scan.index(row, col);
-  const float centre = g.log_range[centre_index];
-  const Eigen::Vector3f origin = g.points[centre_index];  // sums relative to it stay small
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  used = 0;
-  for (int r = std::max(0, row - k); r <= std::min(g.scan.rows - 1, row + k); ++r) {
-    for (int cc = std::max(0, col - k); cc <= std::min(g.scan.columns - 1, col + k); ++cc) {
-      const std::size_t i = g.scan.index(r, cc);
-      const float limit = static_cast<float>(g.settings.depth_jump_relative) *
-                          static_cast<float>(std::max(std::abs(r - row), std::abs(cc - col)));
-      if (!g.mask[i] || std::abs(g.log_range[i] - centre) > limit + 1e-7f) continue;
-      const Eigen::Vector3f p = g.points[i] - origin;
-      sum += p;
-      xx += p.x() * p.x(), xy += p.x() * p.y(), xz += p.x() * p.z();
-      yy += p.y() * p.y(), yz += p.y() * p.z(), zz += p.z() * p.z();
-      ++used;
-    }
-  }
-  if (used < 3) return false;
-  const Eigen::Vector3f mean = sum / static_cast<float>(used);
-  Eigen::Matrix3f covariance;
-  covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-  covariance = covariance / static_cast<float>(used) - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
-  solver.computeDirect(covariance);
-  const Eigen::Vector3f& values = solver.eigenvalues();
-  if (values[1] <= 4.0f * values[0]) return false;  // a line or a blob, not a surface
-  normal = solver.eigenvectors().col(0).normalized();
-  if (normal.dot(origin) > 0) normal = -normal;
-  return true;
-}
-
-float footprint(const Scan& scan, const AngleTables& tables, int row, int col,
-                const Eigen::Vector3f& normal, const GeometrySettings& settings) {
-  const std::size_t i = scan.index(row, col);
-  double spacing_az = 0, spacing_el = 0;
-  if (const auto* a = std::get_if<SphericalAngles>(&scan.angles)) {
-    spacing_az = std::abs(a->azimuth_step_rad) * tables.cos_el[row];
-    spacing_el = std::abs(a->elevation_step_rad);
-  } else {  // angle to the next column and row of the direction grid
-    const Eigen::Vector3f d = direction(scan, row, col);
-    const int c2 = col + 1 < scan.columns ? col + 1 : col - 1,
-              r2 = row + 1 < scan.rows ? row + 1 : row - 1;
-    if (c2 >= 0) spacing_az = std::acos(std::clamp(d.dot(direction(scan, row, c2)), -1.0f, 1.0f));
-    if (r2 >= 0) spacing_el = std::acos(std::clamp(d.dot(direction(scan, r2, col)), -1.0f, 1.0f));
-  }
-  const double gap = scan.range_m[i] * std::sqrt(spacing_az * spacing_az + spacing_el * spacing_el);
-  double cos_incidence = 1.0;
-  if (normal != Eigen::Vector3f::Zero())
-    cos_incidence = std::abs(normal.dot(tables.direction(scan, row, col)));
-  return static_cast<float>(0.5 * gap /
-                            std::max(cos_incidence, 1.0 / settings.max_footprint_stretch));
-}
-
-}  // namespace
-
-namespace {
-
-// The per-pixel inputs every fit reads: which pixels take part (valid, not
-// mixed), their log-range and their scan-frame points.
-struct FitInputs {
-  std::vector<std::uint8_t> mixed, mask, jumps;
-  std::vector<float> log_range;
-  std::vector<Eigen::Vector3f> points;
-};
-
-FitInputs prepare_inputs(const Scan& scan, const AngleTables& tables,
-                         const GeometrySettings& settings) {
-  const std::size_t n = scan.pixel_count();
-  FitInputs in;
-  in.mixed = settings.flag_mixed_pixels ? detect_mixed_pixels(scan, settings)
-                                        : std::vector<std::uint8_t>(n, 0);
-  in.mask.assign(n, 0);
-  in.log_range.assign(n, 0.0f);
-  in.points.assign(n, Eigen::Vector3f::Zero());
-  parallel_rows(scan.rows, settings.threads, [&](int row) {
-    for (int col = 0; col < scan.columns; ++col) {
-      const std::size_t i = scan.index(row, col);
-      in.mask[i] = scan.valid[i] && !in.mixed[i] && scan.range_m[i] > 0.0f;
-      if (!in.mask[i]) continue;
-      in.log_range[i] = std::log(scan.range_m[i]);
-      in.points[i] = scan.range_m[i] * tables.direction(scan, row, col);
-    }
-  });
-  in.jumps = jump_map(scan, in.mask, in.log_range, settings);
-  return in;
-}
-
-// Normal, confidence, flags and footprint of one valid pixel.
-void fit_pixel(const GridContext& context, const AngleTables& tables, const FitInputs& in,
-               const WindowSlopes* slopes, int row, int col, ScanGeometry& g) {
-  const Scan& scan = context.scan;
-  const GeometrySettings& settings = context.settings;
-  const std::size_t i = scan.index(row, col);
-  std::uint8_t flags = (in.mixed[i] ? kFlagMixedPixel : 0) | (in.jumps[i] ? kFlagEdge : 0);
-  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
-  int used = 0;
-  bool ok = false;
-  double area = (2.0 * settings.edge_window_radius + 1) * (2.0 * settings.edge_window_radius + 1);
-  if (in.mask[i] && slopes != nullptr && slopes->used[i] > 0) {
-    used = slopes->used[i];
-    area = used;
-    normal = spherical_normal(std::get<SphericalAngles>(scan.angles), tables, row, col,
-                              slopes->per_column[i], slopes->per_row[i]);
-    ok = true;
-  } else if (in.mask[i]) {
-    // No clean window (cut by a discontinuity, an invalid region or the
-    // grid's border), or no angle model: the log-range slope of a lopsided
-    // window is biased by the curvature of ln r, a 3D plane fit is not.
-    ok = covariance_normal(context, row, col, normal, used);
-  }
-  ok = ok && used >= settings.min_neighbours && normal.allFinite();
+// Normal, confidence, footprint and the no-normal flag of valid pixel i
+// from a covariance fit (or from none: fit.ok false).
+void store_fit(const StageContext& c, const NormalFit& fit, std::size_t i, float half_spacing) {
+  const bool ok = fit.ok && fit.used >= c.settings.min_neighbours && fit.normal.allFinite();
+  float cos_incidence = 1.0f;
   if (ok) {
-    const float cos_incidence = std::abs(normal.dot(tables.direction(scan, row, col)));
-    g.normal[i] = normal;
-    g.confidence[i] =
-        std::max(1e-6f, static_cast<float>(std::min(1.0, used / area)) * cos_incidence);
+    cos_incidence = fit.cos_incidence;
+    c.g.normal[i] = fit.normal;
+    c.g.confidence[i] =
+        std::max(1e-6f, std::min(1.0f, static_cast<float>(fit.used) / fit.window) * cos_incidence);
   } else {
-    flags |= kFlagNoNormal;
+    c.g.normal[i] = Eigen::Vector3f::Zero();
+    c.g.confidence[i] = 0.0f;
+    c.g.flags[i] |= kFlagNoNormal;
   }
-  g.flags[i] = flags;
-  g.footprint_m[i] = footprint(scan, tables, row, col, g.normal[i], settings);
+  const float stretch = static_cast<float>(1.0 / c.settings.max_footprint_stretch);
+  c.g.footprint_m[i] = c.scan.range_m[i] * half_spacing / std::max(cos_incidence, stretch);
 }
 
-void count_results(const Scan& scan, GeometryResult& result) {
-  const ScanGeometry& g = result.geometry;
-  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
-    if (!scan.valid[i]) continue;
-    ++result.valid_points;
-    result.normals += g.has_normal(i);
-    result.mixed_pixels += (g.flags[i] & kFlagMixedPixel) != 0;
-    result.edge_pixels += (g.flags[i] & kFlagEdge) != 0;
+// Adds the counts of GeometryResult for pixels [first, first + count).
+void count_pixels(const StageContext& c, std::size_t first, int count) {
+  std::size_t valid = 0, normals = 0, mixed = 0, edges = 0;
+  for (std::size_t i = first; i < first + count; ++i) {
+    valid += c.scan.valid[i] != 0;
+    normals += c.g.confidence[i] > 0.0f;
+    mixed += (c.g.flags[i] & kFlagMixedPixel) != 0;
+    edges += (c.g.flags[i] & kFlagEdge) != 0;
   }
+  c.counts.valid += valid, c.counts.normals += normals;
+  c.counts.mixed += mixed, c.counts.edges += edges;
+}
+
+// What the window normals of one row share.
+struct RowConstants {
+  float cos_el, sin_el;
+  float az_gradient, el_gradient;  // slope per pixel → per radian (see RowFactors)
+  float half_spacing, stretch;
+  std::uint16_t min_used;
+};
+
+// The normal towards the scanner is −u + g_az·e_az + g_el·e_el in the
+// orthonormal frame (u, e_az, e_el), with g the log-range slopes per radian
+// (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
+// of the incidence angle is one over it, so the footprint's stretch is the
+// length itself. Writes n pixels' normals (as three arrays), confidences,
+// footprints and flags. Branch-free over plain, unaliased arrays,
+// so that the loop vectorizes. Masked pixels without a clean window are left
+// for the covariance fit (no flag).
+SCANBENCH_VECTOR_CLONES void window_normals(
+    int n, const RowConstants& k, const float* __restrict per_column,
+    const float* __restrict per_row, const std::uint16_t* __restrict used,
+    const float* __restrict cos_az, const float* __restrict sin_az, const float* __restrict range,
+    const std::uint8_t* __restrict valid, const std::uint8_t* __restrict mask,
+    const std::uint8_t* __restrict mixed, const std::uint8_t* __restrict clean,
+    float* __restrict nx, float* __restrict ny, float* __restrict nz, float* __restrict confidence,
+    float* __restrict footprint, std::uint8_t* __restrict flags) {
+  for (int j = 0; j < n; ++j) {
+    const float g_az = per_column[j] * k.az_gradient, g_el = per_row[j] * k.el_gradient;
+    const float q = 1.0f + g_az * g_az + g_el * g_el;
+    const float inverse = inverse_sqrt(q), length = q * inverse;
+    const std::uint32_t ok =
+        all_bits((used[j] >= k.min_used) & (length <= std::numeric_limits<float>::max()));
+    const std::uint32_t is_valid = all_bits(valid[j] != 0);
+    const std::uint32_t pending = all_bits((used[j] == 0) & (mask[j] != 0));
+    const float ca = cos_az[j], sa = sin_az[j];
+    nx[j] = select_bits((-k.cos_el * ca - g_az * sa - g_el * k.sin_el * ca) * inverse, ok);
+    ny[j] = select_bits((-k.cos_el * sa + g_az * ca - g_el * k.sin_el * sa) * inverse, ok);
+    nz[j] = select_bits((-k.sin_el + g_el * k.cos_el) * inverse, ok);
+    confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
+    const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
+    footprint[j] = select_bits(range[j] * k.half_spacing * std::min(stretch, k.stretch), is_valid);
+    const std::uint32_t edge = all_bits((mask[j] != 0) & (clean[j] == 0));
+    flags[j] =
+        static_cast<std::uint8_t>((mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
+                                  (is_valid & ~ok & ~pending & kFlagNoNormal));
+  }
+}
+
+// The covariance fits of a spherical row segment's masked pixels without a
+// clean window (cut by a discontinuity, an invalid region or the grid's
+// border): the log-range slope of a lopsided window is biased by the
+// curvature of ln r, a 3D plane fit is not. Runs of them go in lanes.
+void store_fallback_fits(const StageContext& c, int row, int begin, int end,
+                         const std::uint16_t* used, float half_spacing) {
+  const std::size_t first = c.scan.index(row, begin);
+  const auto pending = [&](int j) {
+    return j < end - begin && used[j] == 0 && c.in.mask[first + j];
+  };
+  const float* range = c.scan.range_m.data();
+  for (int j = 0; j < end - begin; ++j) {
+    if (!pending(j)) continue;
+    if (!covariance_lanes_fit(c.directions, row, begin + j, c.scan.rows, c.settings)) {
+      store_fit(c,
+                covariance_fit(c.directions, range, c.in.mask.get(), c.in.log_range.get(), row,
+                               begin + j, c.scan.rows, c.settings),
+                first + j, half_spacing);
+      continue;
+    }
+    unsigned wanted = 0;
+    for (int lane = 0; lane < kCovarianceLanes; ++lane)
+      wanted |= pending(j + lane) ? 1u << lane : 0u;
+    NormalFit fits[kCovarianceLanes];
+    covariance_fits(c.directions, range, c.in.log_range.get(), row, begin + j, c.scan.rows,
+                    c.settings, wanted, fits);
+    for (int lane = 0; lane < kCovarianceLanes; ++lane) {
+      if (wanted & (1u << lane)) store_fit(c, fits[lane], first + j + lane, half_spacing);
+    }
+    j += kCovarianceLanes - 1;
+  }
+}
+
+// A spherical scan's row segment: window normals in chunks (scratch arrays
+// on the stack), then the covariance fit where no clean window exists.
+void store_window_fits(const StageContext& c, int row, int begin, int end,
+                       const WindowSlopeRow& s) {
+  constexpr int kChunk = 128;
+  const RowConstants k{c.directions.cos_el[row],
+                       c.directions.sin_el[row],
+                       c.factors.azimuth_gradient[row],
+                       c.factors.elevation_gradient,
+                       c.factors.half_spacing[row],
+                       static_cast<float>(c.settings.max_footprint_stretch),
+                       static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
+  const std::size_t first = c.scan.index(row, begin);
+  for (int j0 = 0; j0 < end - begin; j0 += kChunk) {
+    const int n = std::min(kChunk, end - begin - j0);
+    const std::size_t i0 = first + j0;
+    float nx[kChunk], ny[kChunk], nz[kChunk];
+    window_normals(n, k, s.per_column + j0, s.per_row + j0, s.used + j0,
+                   c.directions.cos_az.data() + begin + j0, c.directions.sin_az.data() + begin + j0,
+                   c.scan.range_m.data() + i0, c.scan.valid.data() + i0, c.in.mask.get() + i0,
+                   c.in.mixed.get() + i0, c.in.clean.get() + i0, nx, ny, nz,
+                   c.g.confidence.data() + i0, c.g.footprint_m.data() + i0, c.g.flags.data() + i0);
+    for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
+  }
+  store_fallback_fits(c, row, begin, end, s.used, k.half_spacing);
+  count_pixels(c, first, end - begin);
+}
+
+// A row of a per-pixel direction grid: covariance fits only.
+void store_covariance_fits(const StageContext& c, int row) {
+  for (int col = 0; col < c.scan.columns; ++col) {
+    const std::size_t i = c.scan.index(row, col);
+    c.g.normal[i] = Eigen::Vector3f::Zero();
+    c.g.flags[i] = c.in.flags(i);
+    if (!c.scan.valid[i]) continue;
+    NormalFit fit;
+    if (c.in.mask[i]) {
+      fit = covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(),
+                           c.in.log_range.get(), row, col, c.scan.rows, c.settings);
+    }
+    store_fit(c, fit, i, half_spacing_per_pixel(c.scan, row, col));
+  }
+  count_pixels(c, c.scan.index(row, 0), c.scan.columns);
+}
+
+// The window radii of the cascade, widest first: halving from window_radius
+// down to edge_window_radius.
+std::vector<int> cascade_radii(const GeometrySettings& settings) {
+  std::vector<int> radii;
+  for (int radius = settings.window_radius;;) {
+    radii.push_back(radius);
+    if (radius <= settings.edge_window_radius) break;
+    radius =
+        radius / 2 >= 2 * settings.edge_window_radius ? radius / 2 : settings.edge_window_radius;
+  }
+  return radii;
+}
+
+// Maps the pages of [data, data + bytes) in one system call (Linux ≥ 5.14),
+// instead of one page fault per 4 KB at the first write; it runs beside the
+// first passes (see compute_geometry). A no-op elsewhere or on failure.
+void prefault(const void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+  const auto begin = reinterpret_cast<std::uintptr_t>(data) & ~(page - 1);
+  const auto end = reinterpret_cast<std::uintptr_t>(data) + bytes;
+  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+#else
+  (void)data, (void)bytes;
+#endif
+}
+
+// Reserves, maps in bulk, then fills.
+template <typename T>
+void allocate_filled(std::vector<T>& v, std::size_t n, T value) {
+  v.reserve(n);
+  prefault(v.data(), n * sizeof(T));
+  v.assign(n, value);
+}
+
+// The outputs; every pixel is written by the passes below.
+void allocate(ScanGeometry& g, std::size_t n) {
+  allocate_filled(g.footprint_m, n, 0.0f);
+  g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
+  prefault(g.normal.data(), n * sizeof(Eigen::Vector3f));
+  allocate_filled(g.confidence, n, 0.0f);
+  allocate_filled(g.flags, n, std::uint8_t{0});
 }
 
 }  // namespace
@@ -311,27 +421,36 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
          settings.window_radius >= settings.edge_window_radius &&
          settings.window_radius <= kMaxWindowRadius);
   const auto start = std::chrono::steady_clock::now();
-  const AngleTables tables(scan);
-  const FitInputs in = prepare_inputs(scan, tables, settings);
-  std::optional<WindowSlopes> slopes;
-  if (scan.is_spherical()) slopes.emplace(scan, in.mask, in.log_range, in.jumps, settings);
-  const GridContext context{scan, settings, in.mask, in.log_range, in.points};
-
   GeometryResult result;
   ScanGeometry& g = result.geometry;
-  const std::size_t n = scan.pixel_count();
-  g.footprint_m.assign(n, 0.0f);
-  g.normal.assign(n, Eigen::Vector3f::Zero());
-  g.confidence.assign(n, 0.0f);
-  g.flags.assign(n, 0);
-  parallel_rows(scan.rows, settings.threads, [&](int row) {
-    for (int col = 0; col < scan.columns; ++col) {
-      if (scan.valid[scan.index(row, col)]) {
-        fit_pixel(context, tables, in, slopes ? &*slopes : nullptr, row, col, g);
-      }
-    }
+  FitInputs in(scan.pixel_count());
+  // std::vector zero-fills the outputs on one thread (every pixel is then
+  // written again); that runs beside the first passes, not before them.
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_invoke([&] { allocate(g, scan.pixel_count()); },
+                         [&] {
+                           mark_mixed_and_mask(scan, settings, in);
+                           mark_jumps(scan, settings, in);
+                         });
   });
-  count_results(scan, result);
+  const GridDirections directions(scan);
+  const RowFactors factors(scan);
+  Counts counts;
+  const StageContext context{scan, settings, in, directions, factors, g, counts};
+  if (scan.is_spherical()) {
+    const std::vector<int> radii = cascade_radii(settings);
+    visit_window_slopes(scan.rows, scan.columns, radii, {in.clean.get(), scan.pixel_count()},
+                        {in.log_range.get(), scan.pixel_count()}, settings.threads,
+                        [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
+                          store_window_fits(context, row, begin, end, slopes);
+                        });
+  } else {
+    parallel_rows(scan.rows, settings.threads,
+                  [&](int row) { store_covariance_fits(context, row); });
+  }
+  result.valid_points = counts.valid, result.normals = counts.normals;
+  result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -1,216 +1,268 @@
 #include "acquisition/window_moments.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cassert>
+#include <cstddef>
 
+#include "acquisition/branch_free.hpp"
 #include "acquisition/parallel.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
-// Running window sums of a, d·a and d²·a for d in [−k, k], advanced by one
-// sample: `out` leaves the window, `in` enters it. Derivation: re-index the
-// shifted window (e = d + 1) and expand (e − 1) and (e − 1)².
-struct Running {
-  double s0 = 0, s1 = 0, s2 = 0;
+// Tile size targets: a tile's ring of integral rows (2k + 2 rows of
+// 28 bytes per column) stays in a core's L2 cache, the halo of k pixels on
+// every side costs little next to the tile, and a 3600 × 900 scan gives
+// 32 tiles for the threads to share.
+constexpr int kTileColumns = 512;
+constexpr int kTileRows = 256;
 
-  void advance(double out, double in, int k) {
-    const double kk = k, k1 = k + 1.0;
-    const double s0_old = s0, s1_old = s1;
-    s0 = s0_old - out + in;
-    s1 = s1_old - s0_old + k1 * out + kk * in;
-    s2 = s2 - 2.0 * s1_old + s0_old - k1 * k1 * out + kk * kk * in;
-  }
+struct Tile {
+  int row_begin, row_end, col_begin, col_end;
 };
 
-// The five per-row inputs of the vertical pass.
-enum Horizontal { kM, kMx, kMxx, kV, kVx, kHorizontalCount };
-using RowSums = std::array<float, kHorizontalCount>;
-
-// Column blocks: wide enough that a block's running state stays in cache,
-// many enough for the threads to share the work.
-constexpr int kBlockColumns = 256;
-
-template <typename Body>
-void parallel_blocks(int columns, int threads, Body&& body) {
-  const int blocks = (columns + kBlockColumns - 1) / kBlockColumns;
-  parallel_for_index(blocks, threads, [&](int b) {
-    body(b * kBlockColumns, std::min(columns, (b + 1) * kBlockColumns));
-  });
-}
-
-// Sums along one row for columns [begin, end): m, m·dx, m·dx², m·v, m·dx·v.
-void horizontal_row(int columns, int begin, int end, int k, const std::uint8_t* mask,
-                    const float* value, RowSums* out) {
-  Running m, v;
-  const auto sample = [&](int c, double& mi, double& vi) {
-    mi = vi = 0;
-    if (c < 0 || c >= columns || !mask[c]) return;
-    mi = 1;
-    vi = value[c];
-  };
-  double mi, vi;
-  for (int d = -k; d <= k; ++d) {  // the window of the first column, built explicitly
-    sample(begin + d, mi, vi);
-    m.s0 += mi, m.s1 += d * mi, m.s2 += d * d * mi;
-    v.s0 += vi, v.s1 += d * vi;
-  }
-  for (int c = begin; c < end; ++c) {
-    out[c - begin] = {static_cast<float>(m.s0), static_cast<float>(m.s1), static_cast<float>(m.s2),
-                      static_cast<float>(v.s0), static_cast<float>(v.s1)};
-    double mo, vo;
-    sample(c - k, mo, vo);
-    sample(c + k + 1, mi, vi);
-    m.advance(mo, mi, k);
-    v.advance(vo, vi, k);
-  }
-}
-
-// Running vertical sums for one column: each horizontal input gets the dy
-// weights it needs (m: 1, dy, dy²; m·dx: 1, dy; m·v: 1, dy; others: 1).
-struct ColumnState {
-  Running m, mx, v;
-  double mxx = 0, vx = 0;
-
-  void add(const RowSums& h, int dy) {
-    m.s0 += h[kM], m.s1 += dy * h[kM], m.s2 += dy * dy * h[kM];
-    mx.s0 += h[kMx], mx.s1 += dy * h[kMx];
-    v.s0 += h[kV], v.s1 += dy * h[kV];
-    mxx += h[kMxx], vx += h[kVx];
-  }
-  void advance(const RowSums& out, const RowSums& in, int k) {
-    m.advance(out[kM], in[kM], k);
-    mx.advance(out[kMx], in[kMx], k);
-    v.advance(out[kV], in[kV], k);
-    mxx += in[kMxx] - out[kMxx], vx += in[kVx] - out[kVx];
-  }
-  WindowMoments moments() const {
-    const auto f = [](double x) { return static_cast<float>(x); };
-    return {f(m.s0), f(mx.s0), f(m.s1), f(mxx), f(mx.s1), f(m.s2), f(v.s0), f(vx), f(v.s1)};
-  }
-};
-
-// The horizontal sums of rows [row − k, row + k + 1] for one column block,
-// kept in a ring of 2k + 2 rows: the vertical pass needs the row leaving and
-// the row entering the window.
-class RowRing {
- public:
-  RowRing(int rows, int columns, int begin, int end, int k, std::span<const std::uint8_t> mask,
-          std::span<const float> value)
-      : rows_(rows),
-        columns_(columns),
-        begin_(begin),
-        width_(end - begin),
-        k_(k),
-        mask_(mask),
-        value_(value),
-        slots_(2 * k + 2),
-        data_(static_cast<std::size_t>(slots_) * width_) {}
-
-  // Horizontal sums of `row` (zeros outside the grid), computed once per row.
-  const RowSums* row(int r) {
-    RowSums* slot =
-        data_.data() + static_cast<std::size_t>(((r % slots_) + slots_) % slots_) * width_;
-    if (r < 0 || r >= rows_) {
-      std::fill(slot, slot + width_, RowSums{});
-    } else if (r != filled_[((r % slots_) + slots_) % slots_]) {
-      const std::size_t o = static_cast<std::size_t>(r) * columns_;
-      horizontal_row(columns_, begin_, begin_ + width_, k_, mask_.data() + o, value_.data() + o,
-                     slot);
+// The grid split evenly into tiles of at most the target size; the split
+// depends on the grid size alone, so results do not depend on the threads.
+std::vector<Tile> make_tiles(int rows, int columns) {
+  const int row_tiles = (rows + kTileRows - 1) / kTileRows;
+  const int col_tiles = (columns + kTileColumns - 1) / kTileColumns;
+  std::vector<Tile> tiles;
+  for (int i = 0; i < row_tiles; ++i) {
+    for (int j = 0; j < col_tiles; ++j) {
+      tiles.push_back({rows * i / row_tiles, rows * (i + 1) / row_tiles, columns * j / col_tiles,
+                       columns * (j + 1) / col_tiles});
     }
-    filled_[((r % slots_) + slots_) % slots_] = r;
-    return slot;
+  }
+  return tiles;
+}
+
+struct Grid {
+  int rows, columns;
+  const std::uint8_t* clean;
+  const float* value;
+};
+
+// Integral images over one tile grown by `halo` pixels on every side (the
+// "region"; pixels outside the grid are unclean), in region coordinates
+// (y, x). Integral row j, entry x, sums region rows [0, j) and columns
+// [0, x). Only the 2·halo + 2 rows the current output row needs are kept.
+class IntegralRing {
+ public:
+  IntegralRing(const Grid& grid, const Tile& tile, int halo)
+      : grid_(grid),
+        row0_(tile.row_begin - halo),
+        col0_(tile.col_begin - halo),
+        width_(tile.col_end - tile.col_begin + 2 * halo),
+        stride_(width_ + 1),
+        slots_(2 * halo + 2),
+        unclean_(static_cast<std::size_t>(slots_) * stride_, 0),
+        moments_(3 * unclean_.size(), 0.0),
+        v_(moments_.data()),
+        xv_(v_ + unclean_.size()),
+        yv_(xv_ + unclean_.size()),
+        row_unclean_(static_cast<std::size_t>(width_)),
+        row_value_(static_cast<std::size_t>(width_)) {}
+
+  // Makes integral rows up to `j` available (slot 0 is row 0: all zeros).
+  void extend_to(int j) {
+    while (count_ <= j) push();
+  }
+
+  // The integral rows that bound the windows of radius k around region row
+  // y, resolved once per row (a ring slot costs a division).
+  struct Bounds {
+    const std::int32_t *top_unclean, *bottom_unclean;
+    const double *top_v, *bottom_v, *top_xv, *bottom_xv, *top_yv, *bottom_yv;
+  };
+  Bounds bounds(int y, int k) const {
+    const std::size_t t = slot(y - k), b = slot(y + k + 1);
+    return {unclean_.data() + t,
+            unclean_.data() + b,
+            v_ + t,
+            v_ + b,
+            xv_ + t,
+            xv_ + b,
+            yv_ + t,
+            yv_ + b};
   }
 
  private:
-  int rows_, columns_, begin_, width_, k_;
-  std::span<const std::uint8_t> mask_;
-  std::span<const float> value_;
-  int slots_;
-  std::vector<RowSums> data_;
-  std::vector<int> filled_ = std::vector<int>(static_cast<std::size_t>(slots_), -1 << 30);
+  std::size_t slot(int j) const { return static_cast<std::size_t>(j % slots_) * stride_; }
+
+  // Region row `y` as unclean flags and values (0 where unclean).
+  void load_region_row(int y) {
+    const int row = row0_ + y;
+    std::fill(row_unclean_.begin(), row_unclean_.end(), 1);
+    std::fill(row_value_.begin(), row_value_.end(), 0.0f);
+    if (row < 0 || row >= grid_.rows) return;
+    const std::size_t offset = static_cast<std::size_t>(row) * grid_.columns;
+    const int x_begin = std::max(0, -col0_), x_end = std::min(width_, grid_.columns - col0_);
+    const std::uint8_t* clean = grid_.clean + offset + col0_;
+    const float* value = grid_.value + offset + col0_;
+    for (int x = x_begin; x < x_end; ++x) {  // branch-free: cleanness is data, it vectorizes
+      row_unclean_[x] = clean[x] == 0;
+      row_value_[x] = select_bits(value[x], all_bits(clean[x] != 0));
+    }
+  }
+
+  // Integral row count_ = integral row count_ − 1 + the prefix sums of
+  // region row count_ − 1.
+  void push() {
+    if (count_ > 0) {
+      const int y = count_ - 1;
+      load_region_row(y);
+      const std::size_t dst = slot(count_) + 1, src = slot(count_ - 1) + 1;
+      std::int32_t pu = 0;
+      double pv = 0.0, pxv = 0.0;
+      for (int x = 0; x < width_; ++x) {
+        const double v = row_value_[x];
+        pu += row_unclean_[x], pv += v, pxv += x * v;
+        unclean_[dst + x] = unclean_[src + x] + pu;
+        v_[dst + x] = v_[src + x] + pv;
+        xv_[dst + x] = xv_[src + x] + pxv;
+        yv_[dst + x] = yv_[src + x] + y * pv;
+      }
+    }
+    ++count_;
+  }
+
+  Grid grid_;
+  int row0_, col0_, width_, stride_, slots_;
+  int count_ = 0;
+  std::vector<std::int32_t> unclean_;
+  std::vector<double> moments_;  // the integral images of v, x·v and y·v, one after another
+  double *v_, *xv_, *yv_;
+  std::vector<std::int32_t> row_unclean_;
+  std::vector<float> row_value_;
 };
+
+// 1 / Σ dx² of a full window of radius k.
+double inverse_sxx(int k) {
+  const double side = 2.0 * k + 1.0;
+  return 3.0 / (side * side * k * (k + 1.0));
+}
+
+// The sum over columns [left, right) between two integral rows.
+template <typename T>
+T box(const T* top, const T* bottom, int left, int right) {
+  return (bottom[right] - bottom[left]) - (top[right] - top[left]);
+}
+
+// One row segment's fits as parallel arrays.
+struct SlopeBuffers {
+  std::vector<float> per_column, per_row;
+  std::vector<std::uint16_t> used;
+
+  explicit SlopeBuffers(std::size_t n) : per_column(n), per_row(n), used(n) {}
+  WindowSlopeRow row() const { return {per_column.data(), per_row.data(), used.data()}; }
+};
+
+// The count of unclean pixels and the centred moments Σ dx·v, Σ dy·v of the
+// window of radius k around region pixel (y, x); `b` bounds its rows.
+struct Window {
+  std::int32_t unclean;
+  double sxv, syv;
+};
+
+inline Window window_at(const IntegralRing::Bounds& b, int y, int x, int k) {
+  const int left = x - k, right = x + k + 1;
+  // Moments about the window's centre: Σ dx·v = Σ x·v − x·Σ v, likewise dy.
+  const double sv = box(b.top_v, b.bottom_v, left, right);
+  return {box(b.top_unclean, b.bottom_unclean, left, right),
+          box(b.top_xv, b.bottom_xv, left, right) - x * sv,
+          box(b.top_yv, b.bottom_yv, left, right) - y * sv};
+}
+
+std::uint16_t window_pixels(int k) {
+  return static_cast<std::uint16_t>((2 * k + 1) * (2 * k + 1));
+}
+
+// The fit at radius k of every pixel of a row segment, x = x0 … x0 + n − 1
+// in region coordinates (y its row): used = (2k + 1)² where the pixel and its
+// window are clean, else 0. Branch-free, so that it vectorizes: most pixels
+// stop at the widest radius.
+SCANBENCH_VECTOR_CLONES void fit_radius(int n, int x0, int y, int k, double inverse,
+                                        const IntegralRing::Bounds& b,
+                                        const std::uint8_t* __restrict clean,
+                                        float* __restrict per_column, float* __restrict per_row,
+                                        std::uint16_t* __restrict used) {
+  const std::uint16_t full = window_pixels(k);
+  for (int j = 0; j < n; ++j) {
+    const Window w = window_at(b, y, x0 + j, k);
+    const std::uint32_t ok = all_bits((clean[j] != 0) & (w.unclean == 0));
+    per_column[j] = select_bits(static_cast<float>(w.sxv * inverse), ok);
+    per_row[j] = select_bits(static_cast<float>(w.syv * inverse), ok);
+    used[j] = static_cast<std::uint16_t>(full & ok);
+  }
+}
+
+// The narrower radii, widest first, for one clean pixel the widest left
+// without a window.
+void fit_narrower(std::span<const IntegralRing::Bounds> bounds, std::span<const int> radii,
+                  std::span<const double> inverse, int y, int x, SlopeBuffers& out, std::size_t j) {
+  for (std::size_t r = 1; r < radii.size(); ++r) {
+    const Window w = window_at(bounds[r], y, x, radii[r]);
+    if (w.unclean != 0) continue;
+    out.per_column[j] = static_cast<float>(w.sxv * inverse[r]);
+    out.per_row[j] = static_cast<float>(w.syv * inverse[r]);
+    out.used[j] = window_pixels(radii[r]);
+    return;
+  }
+}
+
+void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
+                std::span<const double> inverse, const SlopeVisitor& visit) {
+  const int halo = radii.front();
+  IntegralRing ring(grid, tile, halo);
+  SlopeBuffers out(static_cast<std::size_t>(tile.col_end - tile.col_begin));
+  std::vector<IntegralRing::Bounds> bounds(radii.size());
+  for (int row = tile.row_begin; row < tile.row_end; ++row) {
+    const int y = row - tile.row_begin + halo;
+    ring.extend_to(y + halo + 1);
+    for (std::size_t r = 0; r < radii.size(); ++r) bounds[r] = ring.bounds(y, radii[r]);
+    const std::size_t offset = static_cast<std::size_t>(row) * grid.columns;
+    const int n = tile.col_end - tile.col_begin;
+    // Widest radius for the whole segment, then the narrower ones for the
+    // clean pixels it left without a window.
+    fit_radius(n, halo, y, radii[0], inverse[0], bounds[0], grid.clean + offset + tile.col_begin,
+               out.per_column.data(), out.per_row.data(), out.used.data());
+    for (int j = 0; j < n; ++j) {
+      if (out.used[j] == 0 && grid.clean[offset + tile.col_begin + j])
+        fit_narrower(bounds, radii, inverse, y, halo + j, out, static_cast<std::size_t>(j));
+    }
+    visit(row, tile.col_begin, tile.col_end, out.row());
+  }
+}
 
 }  // namespace
 
-void visit_window_moments(int rows, int columns, int radius, std::span<const std::uint8_t> mask,
-                          std::span<const float> value, int threads, const MomentsVisitor& visit) {
-  assert(mask.size() == static_cast<std::size_t>(rows) * columns && value.size() == mask.size() &&
-         radius >= 1);
-  parallel_blocks(columns, threads, [&](int begin, int end) {
-    const int width = end - begin;
-    RowRing ring(rows, columns, begin, end, radius, mask, value);
-    std::vector<ColumnState> state(static_cast<std::size_t>(width));
-    for (int dy = -radius; dy <= radius; ++dy) {
-      const RowSums* h = ring.row(dy);
-      for (int c = 0; c < width; ++c) state[c].add(h[c], dy);
-    }
-    std::vector<WindowMoments> out(static_cast<std::size_t>(width));
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < width; ++c) out[c] = state[c].moments();
-      visit(r, begin, end, out.data());
-      const RowSums* leaving = ring.row(r - radius);
-      const RowSums* entering = ring.row(r + radius + 1);
-      for (int c = 0; c < width; ++c) state[c].advance(leaving[c], entering[c], radius);
-    }
-  });
+void visit_window_slopes(int rows, int columns, std::span<const int> radii,
+                         std::span<const std::uint8_t> clean, std::span<const float> value,
+                         int threads, const SlopeVisitor& visit) {
+  assert(clean.size() == static_cast<std::size_t>(rows) * columns && value.size() == clean.size() &&
+         !radii.empty() && "spans of rows × columns, radii");
+  assert(std::is_sorted(radii.rbegin(), radii.rend()) && radii.back() >= 1 &&
+         radii.front() <= 127 && "radii descending in [1, 127]");
+  std::vector<double> inverse(radii.size());
+  std::transform(radii.begin(), radii.end(), inverse.begin(), inverse_sxx);
+  const Grid grid{rows, columns, clean.data(), value.data()};
+  const std::vector<Tile> tiles = make_tiles(rows, columns);
+  parallel_for_index(static_cast<int>(tiles.size()), threads,
+                     [&](int t) { visit_tile(grid, tiles[t], radii, inverse, visit); });
 }
 
-std::vector<WindowMoments> window_moments(int rows, int columns, int radius,
-                                          std::span<const std::uint8_t> mask,
-                                          std::span<const float> value, int threads) {
-  std::vector<WindowMoments> result(static_cast<std::size_t>(rows) * columns);
-  visit_window_moments(rows, columns, radius, mask, value, threads,
-                       [&](int row, int begin, int end, const WindowMoments* moments) {
-                         std::copy(
-                             moments, moments + (end - begin),
-                             result.begin() + static_cast<std::ptrdiff_t>(row) * columns + begin);
-                       });
+std::vector<WindowSlope> window_slopes(int rows, int columns, std::span<const int> radii,
+                                       std::span<const std::uint8_t> clean,
+                                       std::span<const float> value, int threads) {
+  std::vector<WindowSlope> result(static_cast<std::size_t>(rows) * columns);
+  visit_window_slopes(
+      rows, columns, radii, clean, value, threads,
+      [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
+        WindowSlope* out = result.data() + static_cast<std::size_t>(row) * columns;
+        for (int j = 0; j < end - begin; ++j)
+          out[begin + j] = {slopes.per_column[j], slopes.per_row[j], slopes.used[j]};
+      });
   return result;
-}
-
-std::vector<std::uint16_t> window_counts(int rows, int columns, int radius,
-                                         std::span<const std::uint8_t> mask, int threads) {
-  const std::size_t n = static_cast<std::size_t>(rows) * columns;
-  assert(mask.size() == n && radius >= 1 && (2 * radius + 1) * (2 * radius + 1) < 65536);
-  std::vector<std::uint16_t> horizontal(n), counts(n);
-  parallel_for_index(
-      rows, threads,
-      [&](int r) {
-        const std::uint8_t* m = mask.data() + static_cast<std::size_t>(r) * columns;
-        const auto at = [&](int c) { return c < 0 || c >= columns ? 0 : (m[c] ? 1 : 0); };
-        int sum = 0;
-        for (int c = -radius; c <= radius; ++c) sum += at(c);
-        for (int c = 0; c < columns; ++c) {
-          horizontal[static_cast<std::size_t>(r) * columns + c] = static_cast<std::uint16_t>(sum);
-          sum += at(c + radius + 1) - at(c - radius);
-        }
-      },
-      16);
-  parallel_blocks(columns, threads, [&](int begin, int end) {
-    std::vector<int> sum(static_cast<std::size_t>(end - begin), 0);
-    const auto row = [&](int r) -> const std::uint16_t* {
-      return r < 0 || r >= rows ? nullptr
-                                : horizontal.data() + static_cast<std::size_t>(r) * columns;
-    };
-    for (int r = -radius; r <= radius; ++r) {
-      if (const std::uint16_t* h = row(r)) {
-        for (int c = begin; c < end; ++c) sum[c - begin] += h[c];
-      }
-    }
-    for (int r = 0; r < rows; ++r) {
-      std::uint16_t* out = counts.data() + static_cast<std::size_t>(r) * columns;
-      for (int c = begin; c < end; ++c) out[c] = static_cast<std::uint16_t>(sum[c - begin]);
-      if (const std::uint16_t* leaving = row(r - radius)) {
-        for (int c = begin; c < end; ++c) sum[c - begin] -= leaving[c];
-      }
-      if (const std::uint16_t* entering = row(r + radius + 1)) {
-        for (int c = begin; c < end; ++c) sum[c - begin] += entering[c];
-      }
-    }
-  });
-  return counts;
 }
 
 }  // namespace scanbench::acquisition

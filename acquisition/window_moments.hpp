@@ -1,15 +1,17 @@
-// Moments of a masked value over a square window around every pixel, in
-// constant time per pixel whatever the window size: running sums along rows,
-// then along columns (the separable form of an integral image, which keeps
-// every sum local and so free of the cancellation a global integral image
-// suffers in float or double).
+// Least-squares slopes of a value over square pixel windows, in constant time
+// per pixel whatever the window size: the window moments come from integral
+// images (summed-area tables; Crow, SIGGRAPH 1984), four look-ups per moment.
 //
-// For pixel (row, col) and window offsets dx = c − col, dy = r − row in
-// [−k, k], with mask m and value v:
-//   n   = Σ m          sx  = Σ m dx      sy  = Σ m dy
-//   sxx = Σ m dx²      sxy = Σ m dx dy   syy = Σ m dy²
-//   sv  = Σ m v        sxv = Σ m dx v    syv = Σ m dy v
-// Pixels outside the grid count as m = 0.
+// Only *clean* windows are fitted — every pixel inside the grid and marked
+// clean — and a clean window is full and symmetric, so for window offsets
+// dx = c − col, dy = r − row in [−k, k] the plane fit v ≈ a + b·dx + c·dy
+// decouples (Σdx = Σdy = Σdx·dy = 0):
+//   b = Σ dx·v / Σ dx²,   c = Σ dy·v / Σ dy²,   Σ dx² = Σ dy² = (2k+1)² k(k+1) / 3,
+// and needs three moments of v (Σv, Σx·v, Σy·v) and the count of unclean
+// pixels. Each tile of the grid builds its own integral images, in double
+// precision and tile-local coordinates, so every sum stays small (no
+// cancellation of a global integral image) and the result depends on the grid
+// size only, never on the thread count.
 #pragma once
 
 #include <cstdint>
@@ -19,30 +21,38 @@
 
 namespace scanbench::acquisition {
 
-struct WindowMoments {
-  float n, sx, sy, sxx, sxy, syy, sv, sxv, syv;
+// The fit of the widest clean window around one pixel.
+struct WindowSlope {
+  float per_column = 0.0f;  // d value / d col
+  float per_row = 0.0f;     // d value / d row
+  std::uint16_t used = 0;   // pixels in the window, (2k + 1)²; 0 = no clean window
 };
 
-// Hands the moments of pixels (row, col_begin … col_end − 1) to `visit`, every
-// row once per column block, blocks in parallel (so `visit` must only touch
-// its own pixels). Nothing of grid size is kept beyond one row of running
-// sums per block. `mask` is 0 or 1 per pixel, `value` is read only where the
-// mask is 1. `threads` as in the Settings structs (0 = all cores); the
-// moments do not depend on it. Asserts the spans hold rows × columns entries
-// and radius ≥ 1.
-using MomentsVisitor =
-    std::function<void(int row, int col_begin, int col_end, const WindowMoments* moments)>;
-void visit_window_moments(int rows, int columns, int radius, std::span<const std::uint8_t> mask,
-                          std::span<const float> value, int threads, const MomentsVisitor& visit);
+// The fits of one row segment as parallel arrays, one entry per pixel (the
+// loops that consume them vectorize).
+struct WindowSlopeRow {
+  const float* per_column;
+  const float* per_row;
+  const std::uint16_t* used;
+};
 
-// All moments at once (rows × columns, row-major), for tests and small grids.
-std::vector<WindowMoments> window_moments(int rows, int columns, int radius,
-                                          std::span<const std::uint8_t> mask,
-                                          std::span<const float> value, int threads);
+// Hands the slopes of pixels (row, col_begin … col_end − 1) to `visit`, tile
+// by tile, tiles in parallel (so `visit` must only touch its own pixels);
+// every pixel is visited exactly once. A pixel takes the first radius of
+// `radii` (widest first) at which its window is clean; pixels that are not
+// clean themselves get used = 0. `clean` is 0 or 1 per pixel, `value` is read
+// only where clean is 1. `threads` as in the Settings structs (0 = all
+// cores). Asserts the spans hold rows × columns entries and the radii are
+// descending, ≥ 1 and ≤ 127 (so `used` fits 16 bits).
+using SlopeVisitor =
+    std::function<void(int row, int col_begin, int col_end, const WindowSlopeRow& slopes)>;
+void visit_window_slopes(int rows, int columns, std::span<const int> radii,
+                         std::span<const std::uint8_t> clean, std::span<const float> value,
+                         int threads, const SlopeVisitor& visit);
 
-// Number of set pixels of `mask` in the window around every pixel (the n of
-// window_moments alone, for flag maps). Same contract as window_moments.
-std::vector<std::uint16_t> window_counts(int rows, int columns, int radius,
-                                         std::span<const std::uint8_t> mask, int threads);
+// All slopes at once (rows × columns, row-major), for tests and small grids.
+std::vector<WindowSlope> window_slopes(int rows, int columns, std::span<const int> radii,
+                                       std::span<const std::uint8_t> clean,
+                                       std::span<const float> value, int threads);
 
 }  // namespace scanbench::acquisition
