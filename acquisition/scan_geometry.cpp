@@ -40,6 +40,7 @@
 #include "acquisition/grid_covariance.hpp"
 #include "acquisition/mixed_pixels.hpp"
 #include "acquisition/parallel.hpp"
+#include "acquisition/timing.hpp"
 #include "acquisition/window_moments.hpp"
 
 namespace scanbench::acquisition {
@@ -451,7 +452,7 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   }
   result.valid_points = counts.valid, result.normals = counts.normals;
   result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = seconds_since(start);
   return result;
 }
 

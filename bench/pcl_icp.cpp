@@ -6,6 +6,7 @@
 
 #include <chrono>
 
+#include "acquisition/timing.hpp"
 #include "registration/pcl_sample_cloud.hpp"
 
 namespace scanbench::bench {
@@ -28,7 +29,7 @@ PclIcpResult pcl_point_to_plane_icp(const registration::SampleCloud& source,
   Cloud aligned;
   icp.align(aligned, initial.matrix().cast<float>());
   PclIcpResult result;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = acquisition::seconds_since(start);
   result.converged = icp.hasConverged();
   result.T_target_source.matrix() = icp.getFinalTransformation().cast<double>();
   return result;

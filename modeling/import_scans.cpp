@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "acquisition/timing.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::modeling {
@@ -43,7 +44,7 @@ ImportResult import_scan_files(const std::filesystem::path& project_path,
     throw;
   }
   result.created_project = created;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = acquisition::seconds_since(start);
   return result;
 }
 
