@@ -12,13 +12,18 @@
 // binary still runs on any x86-64. Only AVX2, not FMA: without fused
 // multiply-adds and with no reductions in these loops, both clones give
 // identical results.
-// A build may define it empty to compare the two.
+// A build may define it empty: the sanitizer build does (clones are chosen by
+// an ifunc resolver, which runs before the sanitizer runtime is set up), and
+// a build may do so to compare the two.
 #ifndef SCANBENCH_VECTOR_CLONES
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#if defined(__x86_64__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
 #define SCANBENCH_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define SCANBENCH_VECTOR_CLONES
 #endif
+#endif
+#endif
+#ifndef SCANBENCH_VECTOR_CLONES
+#define SCANBENCH_VECTOR_CLONES
 #endif
 
 namespace scanbench::acquisition {
