@@ -95,13 +95,14 @@ class IntegralRing {
     std::fill(row_unclean_.begin(), row_unclean_.end(), 1);
     std::fill(row_value_.begin(), row_value_.end(), 0.0f);
     if (row < 0 || row >= grid_.rows) return;
-    const std::size_t offset = static_cast<std::size_t>(row) * grid_.columns;
+    // Grid index of region column x: first + x, ≥ 0 for x ≥ x_begin (col0_
+    // is negative on the tiles at the grid's left border).
+    const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(row) * grid_.columns + col0_;
     const int x_begin = std::max(0, -col0_), x_end = std::min(width_, grid_.columns - col0_);
-    const std::uint8_t* clean = grid_.clean + offset + col0_;
-    const float* value = grid_.value + offset + col0_;
     for (int x = x_begin; x < x_end; ++x) {  // branch-free: cleanness is data, it vectorizes
-      row_unclean_[x] = clean[x] == 0;
-      row_value_[x] = select_bits(value[x], all_bits(clean[x] != 0));
+      const std::uint8_t clean = grid_.clean[first + x];
+      row_unclean_[x] = clean == 0;
+      row_value_[x] = select_bits(grid_.value[first + x], all_bits(clean != 0));
     }
   }
 
