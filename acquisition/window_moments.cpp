@@ -46,6 +46,7 @@ struct Grid {
 // "region"; pixels outside the grid are unclean), in region coordinates
 // (y, x). Integral row j, entry x, sums region rows [0, j) and columns
 // [0, x). Only the 2·halo + 2 rows the current output row needs are kept.
+// Not copyable or movable: v_, xv_ and yv_ point into its own moments_.
 class IntegralRing {
  public:
   IntegralRing(const Grid& grid, const Tile& tile, int halo)
@@ -62,6 +63,10 @@ class IntegralRing {
         yv_(xv_ + unclean_.size()),
         row_unclean_(static_cast<std::size_t>(width_)),
         row_value_(static_cast<std::size_t>(width_)) {}
+  IntegralRing(const IntegralRing&) = delete;
+  IntegralRing& operator=(const IntegralRing&) = delete;
+  IntegralRing(IntegralRing&&) = delete;
+  IntegralRing& operator=(IntegralRing&&) = delete;
 
   // Makes integral rows up to `j` available (slot 0 is row 0: all zeros).
   void extend_to(int j) {
