@@ -11,7 +11,7 @@ namespace scanbench::acquisition {
 
 GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
   if (const auto* p = std::get_if<PerPixelDirections>(&scan.angles)) {
-    per_pixel = p->directions.data();
+    per_pixel = p->directions;
     return;
   }
   const auto& a = std::get<SphericalAngles>(scan.angles);
@@ -227,7 +227,7 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
                          const std::uint8_t* mask, const float* log_range, int row, int col,
                          int rows, const GeometrySettings& settings) {
   const int columns = directions.columns;
-  if (directions.per_pixel != nullptr) {
+  if (directions.is_per_pixel()) {
     return fit_window([&](int r, int c) { return directions.at(r, c); }, range_m, mask, log_range,
                       row, col, rows, columns, settings);
   }
@@ -241,7 +241,7 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
 bool covariance_lanes_fit(const GridDirections& directions, int row, int col, int rows,
                           const GeometrySettings& settings) {
   const int k = settings.edge_window_radius;
-  return directions.per_pixel == nullptr && row - k >= 0 && row + k < rows && col - k >= 0 &&
+  return !directions.is_per_pixel() && row - k >= 0 && row + k < rows && col - k >= 0 &&
          col + kCovarianceLanes - 1 + k < directions.columns;
 }
 
