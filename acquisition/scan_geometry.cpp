@@ -251,8 +251,36 @@ void count_pixels(const StageContext& c, std::size_t first, int count) {
 struct RowConstants {
   float cos_el, sin_el;
   float az_gradient, el_gradient;  // slope per pixel → per radian (see RowFactors)
-  float half_spacing, stretch;
-  std::uint16_t min_used;
+  float half_spacing, max_stretch;
+  std::uint16_t min_used;  // pixels a window fit needs
+};
+
+// The per-pixel arrays of a row segment that window_normals reads, n entries
+// each, and those it writes. No output overlaps another array: the
+// __restrict members say so, which GCC uses for a struct passed by value.
+struct WindowNormalInputs {
+  // The window fits (WindowSlopeRow).
+  const float* __restrict per_column;
+  const float* __restrict per_row;
+  const std::uint16_t* __restrict used;
+  // The pixels' azimuths (GridDirections).
+  const float* __restrict cos_az;
+  const float* __restrict sin_az;
+  // The scan's, then FitInputs'.
+  const float* __restrict range;
+  const std::uint8_t* __restrict valid;
+  const std::uint8_t* __restrict mask;
+  const std::uint8_t* __restrict mixed;
+  const std::uint8_t* __restrict clean;
+};
+
+struct WindowNormalOutputs {
+  float* __restrict nx;  // the unit normal's components
+  float* __restrict ny;
+  float* __restrict nz;
+  float* __restrict confidence;
+  float* __restrict footprint;
+  std::uint8_t* __restrict flags;
 };
 
 // The normal towards the scanner is −u + g_az·e_az + g_el·e_el in the
@@ -260,37 +288,45 @@ struct RowConstants {
 // (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
 // of the incidence angle is one over it, so the footprint's stretch is the
 // length itself. Writes n pixels' normals (as three arrays), confidences,
-// footprints and flags. Branch-free over plain, unaliased arrays,
-// so that the loop vectorizes. Masked pixels without a clean window are left
-// for the covariance fit (no flag).
-SCANBENCH_VECTOR_CLONES void window_normals(
-    int n, const RowConstants& k, const float* __restrict per_column,
-    const float* __restrict per_row, const std::uint16_t* __restrict used,
-    const float* __restrict cos_az, const float* __restrict sin_az, const float* __restrict range,
-    const std::uint8_t* __restrict valid, const std::uint8_t* __restrict mask,
-    const std::uint8_t* __restrict mixed, const std::uint8_t* __restrict clean,
-    float* __restrict nx, float* __restrict ny, float* __restrict nz, float* __restrict confidence,
-    float* __restrict footprint, std::uint8_t* __restrict flags) {
+// footprints and flags. Branch-free over plain, unaliased arrays, so that
+// the loop vectorizes. Masked pixels without a clean window are left for the
+// covariance fit (no flag).
+SCANBENCH_VECTOR_CLONES void window_normals(int n, const RowConstants& constants,
+                                            WindowNormalInputs in, WindowNormalOutputs out) {
   for (int j = 0; j < n; ++j) {
-    const float g_az = per_column[j] * k.az_gradient, g_el = per_row[j] * k.el_gradient;
+    const float g_az = in.per_column[j] * constants.az_gradient,
+                g_el = in.per_row[j] * constants.el_gradient;
     const float q = 1.0f + g_az * g_az + g_el * g_el;
     const float inverse = inverse_sqrt(q), length = q * inverse;
-    const std::uint32_t ok =
-        all_bits((used[j] >= k.min_used) & (length <= std::numeric_limits<float>::max()));
-    const std::uint32_t is_valid = all_bits(valid[j] != 0);
-    const std::uint32_t pending = all_bits((used[j] == 0) & (mask[j] != 0));
-    const float ca = cos_az[j], sa = sin_az[j];
-    nx[j] = select_bits((-k.cos_el * ca - g_az * sa - g_el * k.sin_el * ca) * inverse, ok);
-    ny[j] = select_bits((-k.cos_el * sa + g_az * ca - g_el * k.sin_el * sa) * inverse, ok);
-    nz[j] = select_bits((-k.sin_el + g_el * k.cos_el) * inverse, ok);
-    confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
+    const std::uint32_t ok = all_bits((in.used[j] >= constants.min_used) &
+                                      (length <= std::numeric_limits<float>::max()));
+    const std::uint32_t is_valid = all_bits(in.valid[j] != 0);
+    const std::uint32_t pending = all_bits((in.used[j] == 0) & (in.mask[j] != 0));
+    const float ca = in.cos_az[j], sa = in.sin_az[j];
+    out.nx[j] = select_bits(
+        (-constants.cos_el * ca - g_az * sa - g_el * constants.sin_el * ca) * inverse, ok);
+    out.ny[j] = select_bits(
+        (-constants.cos_el * sa + g_az * ca - g_el * constants.sin_el * sa) * inverse, ok);
+    out.nz[j] = select_bits((-constants.sin_el + g_el * constants.cos_el) * inverse, ok);
+    out.confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
     const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
-    footprint[j] = select_bits(range[j] * k.half_spacing * std::min(stretch, k.stretch), is_valid);
-    const std::uint32_t edge = all_bits((mask[j] != 0) & (clean[j] == 0));
-    flags[j] =
-        static_cast<std::uint8_t>((mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
+    out.footprint[j] = select_bits(
+        in.range[j] * constants.half_spacing * std::min(stretch, constants.max_stretch), is_valid);
+    const std::uint32_t edge = all_bits((in.mask[j] != 0) & (in.clean[j] == 0));
+    out.flags[j] =
+        static_cast<std::uint8_t>((in.mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
                                   (is_valid & ~ok & ~pending & kFlagNoNormal));
   }
+}
+
+RowConstants row_constants(const StageContext& c, int row) {
+  return {c.directions.cos_el[row],
+          c.directions.sin_el[row],
+          c.factors.azimuth_gradient[row],
+          c.factors.elevation_gradient,
+          c.factors.half_spacing[row],
+          static_cast<float>(c.settings.max_footprint_stretch),
+          static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
 }
 
 // The covariance fits of a spherical row segment's masked pixels without a
@@ -331,26 +367,28 @@ void store_fallback_fits(const StageContext& c, int row, int begin, int end,
 void store_window_fits(const StageContext& c, int row, int begin, int end,
                        const WindowSlopeRow& s) {
   constexpr int kChunk = 128;
-  const RowConstants k{c.directions.cos_el[row],
-                       c.directions.sin_el[row],
-                       c.factors.azimuth_gradient[row],
-                       c.factors.elevation_gradient,
-                       c.factors.half_spacing[row],
-                       static_cast<float>(c.settings.max_footprint_stretch),
-                       static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
+  const RowConstants constants = row_constants(c, row);
   const std::size_t first = c.scan.index(row, begin);
   for (int j0 = 0; j0 < end - begin; j0 += kChunk) {
     const int n = std::min(kChunk, end - begin - j0);
     const std::size_t i0 = first + j0;
     float nx[kChunk], ny[kChunk], nz[kChunk];
-    window_normals(n, k, s.per_column + j0, s.per_row + j0, s.used + j0,
-                   c.directions.cos_az.data() + begin + j0, c.directions.sin_az.data() + begin + j0,
-                   c.scan.range_m.data() + i0, c.scan.valid.data() + i0, c.in.mask.get() + i0,
-                   c.in.mixed.get() + i0, c.in.clean.get() + i0, nx, ny, nz,
-                   c.g.confidence.data() + i0, c.g.footprint_m.data() + i0, c.g.flags.data() + i0);
+    const WindowNormalInputs inputs{s.per_column + j0,
+                                    s.per_row + j0,
+                                    s.used + j0,
+                                    c.directions.cos_az.data() + begin + j0,
+                                    c.directions.sin_az.data() + begin + j0,
+                                    c.scan.range_m.data() + i0,
+                                    c.scan.valid.data() + i0,
+                                    c.in.mask.get() + i0,
+                                    c.in.mixed.get() + i0,
+                                    c.in.clean.get() + i0};
+    window_normals(n, constants, inputs,
+                   {nx, ny, nz, c.g.confidence.data() + i0, c.g.footprint_m.data() + i0,
+                    c.g.flags.data() + i0});
     for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
   }
-  store_fallback_fits(c, row, begin, end, s.used, k.half_spacing);
+  store_fallback_fits(c, row, begin, end, s.used, constants.half_spacing);
   count_pixels(c, first, end - begin);
 }
 
