@@ -329,37 +329,52 @@ RowConstants row_constants(const StageContext& c, int row) {
           static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
 }
 
+// A spherical row segment, pixels (row, begin … begin + n − 1), with its
+// window fits' pixel counts (0: no clean window).
+struct RowSegment {
+  int row, begin, n;
+  std::size_t first;  // the scan index of its first pixel
+  const std::uint16_t* used;
+  float half_spacing;
+
+  // Segment pixel j is masked and has no window fit.
+  bool pending(const StageContext& c, int j) const {
+    return j < n && used[j] == 0 && c.in.mask[first + j];
+  }
+};
+
+// Stores the covariance fit of pending segment pixel j, together with those
+// of the pending pixels among the next kCovarianceLanes − 1 where their
+// windows allow it; returns how many pixels it has done.
+int store_fallback_from(const StageContext& c, const RowSegment& s, int j) {
+  const float* range = c.scan.range_m.data();
+  const int col = s.begin + j;
+  if (!covariance_lanes_fit(c.directions, s.row, col, c.scan.rows, c.settings)) {
+    store_fit(c,
+              covariance_fit(c.directions, range, c.in.mask.get(), c.in.log_range.get(), s.row, col,
+                             c.scan.rows, c.settings),
+              s.first + j, s.half_spacing);
+    return 1;
+  }
+  unsigned wanted = 0;
+  for (int lane = 0; lane < kCovarianceLanes; ++lane)
+    wanted |= s.pending(c, j + lane) ? 1u << lane : 0u;
+  NormalFit fits[kCovarianceLanes];
+  covariance_fits(c.directions, range, c.in.log_range.get(), s.row, col, c.scan.rows, c.settings,
+                  wanted, fits);
+  for (int lane = 0; lane < kCovarianceLanes; ++lane) {
+    if (wanted & (1u << lane)) store_fit(c, fits[lane], s.first + j + lane, s.half_spacing);
+  }
+  return kCovarianceLanes;
+}
+
 // The covariance fits of a spherical row segment's masked pixels without a
 // clean window (cut by a discontinuity, an invalid region or the grid's
 // border): the log-range slope of a lopsided window is biased by the
 // curvature of ln r, a 3D plane fit is not. Runs of them go in lanes.
-void store_fallback_fits(const StageContext& c, int row, int begin, int end,
-                         const std::uint16_t* used, float half_spacing) {
-  const std::size_t first = c.scan.index(row, begin);
-  const auto pending = [&](int j) {
-    return j < end - begin && used[j] == 0 && c.in.mask[first + j];
-  };
-  const float* range = c.scan.range_m.data();
-  for (int j = 0; j < end - begin; ++j) {
-    if (!pending(j)) continue;
-    if (!covariance_lanes_fit(c.directions, row, begin + j, c.scan.rows, c.settings)) {
-      store_fit(c,
-                covariance_fit(c.directions, range, c.in.mask.get(), c.in.log_range.get(), row,
-                               begin + j, c.scan.rows, c.settings),
-                first + j, half_spacing);
-      continue;
-    }
-    unsigned wanted = 0;
-    for (int lane = 0; lane < kCovarianceLanes; ++lane)
-      wanted |= pending(j + lane) ? 1u << lane : 0u;
-    NormalFit fits[kCovarianceLanes];
-    covariance_fits(c.directions, range, c.in.log_range.get(), row, begin + j, c.scan.rows,
-                    c.settings, wanted, fits);
-    for (int lane = 0; lane < kCovarianceLanes; ++lane) {
-      if (wanted & (1u << lane)) store_fit(c, fits[lane], first + j + lane, half_spacing);
-    }
-    j += kCovarianceLanes - 1;
-  }
+void store_fallback_fits(const StageContext& c, const RowSegment& s) {
+  int j = 0;
+  while (j < s.n) j += s.pending(c, j) ? store_fallback_from(c, s, j) : 1;
 }
 
 // A spherical scan's row segment: window normals in chunks (scratch arrays
@@ -388,7 +403,7 @@ void store_window_fits(const StageContext& c, int row, int begin, int end,
                     c.g.flags.data() + i0});
     for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
   }
-  store_fallback_fits(c, row, begin, end, s.used, constants.half_spacing);
+  store_fallback_fits(c, {row, begin, end - begin, first, s.used, constants.half_spacing});
   count_pixels(c, first, end - begin);
 }
 
