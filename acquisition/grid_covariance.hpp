@@ -68,8 +68,8 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
 // pixels of each row, several times faster per pixel.
 inline constexpr int kCovarianceLanes = 4;
 
-// Whether covariance_fits can take pixels (row, col … col + 3): a spherical
-// grid and all their windows inside it.
+// Whether covariance_fits can take pixels (row, col … col + kCovarianceLanes
+// − 1): a spherical grid and all their windows inside it.
 bool covariance_lanes_fit(const GridDirections& directions, int row, int col, int rows,
                           const GeometrySettings& settings);
 
