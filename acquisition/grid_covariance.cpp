@@ -30,7 +30,8 @@ GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
 namespace {
 
 // The sums of the consistent neighbours' points relative to the centre's
-// point, for kCovarianceLanes centres at once (one lane each).
+// point, for kCovarianceLanes centres at once (one lane each): coordinates
+// [m], their products [m²], and the count.
 struct LaneSums {
   float x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {}, z[kCovarianceLanes] = {};
   float xx[kCovarianceLanes] = {}, xy[kCovarianceLanes] = {}, xz[kCovarianceLanes] = {};
@@ -38,8 +39,8 @@ struct LaneSums {
   std::int32_t used[kCovarianceLanes] = {};
 };
 
-// The lanes' centres: log-range, point (the origin of the sums) and viewing
-// direction.
+// The lanes' centres: log-range, point [m] (the origin of the sums) and unit
+// viewing direction.
 struct LaneCentres {
   float log_range[kCovarianceLanes] = {}, x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {},
         z[kCovarianceLanes] = {};
@@ -261,7 +262,7 @@ NormalFit fit_window(const Direction& direction, const float* range_m, const std
 // of one row. Branch-free over plain, unaliased arrays, so that it
 // vectorizes; the same operations in the same order as fit_window. The mask
 // is not read: log_range is NaN where it is 0, which fails the comparison.
-void add_offset(const float* __restrict range, const float* __restrict log_range,
+void add_offset(const float* __restrict range_m, const float* __restrict log_range,
                 const float* __restrict cos_az, const float* __restrict sin_az, float cos_el,
                 float sin_el, float limit, const float* __restrict centre_log_range,
                 const float* __restrict centre_x, const float* __restrict centre_y,
@@ -269,9 +270,9 @@ void add_offset(const float* __restrict range, const float* __restrict log_range
   for (int j = 0; j < kCovarianceLanes; ++j) {
     const bool take = std::abs(log_range[j] - centre_log_range[j]) <= limit;
     const std::uint32_t keep = all_bits(take);
-    const float px = select_bits(range[j] * (cos_el * cos_az[j]) - centre_x[j], keep);
-    const float py = select_bits(range[j] * (cos_el * sin_az[j]) - centre_y[j], keep);
-    const float pz = select_bits(range[j] * sin_el - centre_z[j], keep);
+    const float px = select_bits(range_m[j] * (cos_el * cos_az[j]) - centre_x[j], keep);
+    const float py = select_bits(range_m[j] * (cos_el * sin_az[j]) - centre_y[j], keep);
+    const float pz = select_bits(range_m[j] * sin_el - centre_z[j], keep);
     s.x[j] += px, s.y[j] += py, s.z[j] += pz;
     s.xx[j] += px * px, s.xy[j] += px * py, s.xz[j] += px * pz;
     s.yy[j] += py * py, s.yz[j] += py * pz, s.zz[j] += pz * pz;
