@@ -11,7 +11,7 @@ namespace scanbench::acquisition {
 
 GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
   if (const auto* p = std::get_if<PerPixelDirections>(&scan.angles)) {
-    per_pixel = p->directions.data();
+    per_pixel = p->directions;
     return;
   }
   const auto& a = std::get<SphericalAngles>(scan.angles);
@@ -30,7 +30,8 @@ GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
 namespace {
 
 // The sums of the consistent neighbours' points relative to the centre's
-// point, for kCovarianceLanes centres at once (one lane each).
+// point, for kCovarianceLanes centres at once (one lane each): coordinates
+// [m], their products [m²], and the count.
 struct LaneSums {
   float x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {}, z[kCovarianceLanes] = {};
   float xx[kCovarianceLanes] = {}, xy[kCovarianceLanes] = {}, xz[kCovarianceLanes] = {};
@@ -38,8 +39,8 @@ struct LaneSums {
   std::int32_t used[kCovarianceLanes] = {};
 };
 
-// The lanes' centres: log-range, point (the origin of the sums) and viewing
-// direction.
+// The lanes' centres: log-range, point [m] (the origin of the sums) and unit
+// viewing direction.
 struct LaneCentres {
   float log_range[kCovarianceLanes] = {}, x[kCovarianceLanes] = {}, y[kCovarianceLanes] = {},
         z[kCovarianceLanes] = {};
@@ -56,6 +57,113 @@ struct LanePlanes {
 // `value` where `keep`, else 1: a divisor that is never 0 (branch-free).
 inline double or_one(double value, bool keep) {
   return select_bits64(value, all_bits64(keep)) + select_bits64(1.0, all_bits64(!keep));
+}
+
+// A symmetric 3 × 3 matrix, in double precision.
+struct Symmetric3 {
+  double xx, xy, xz, yy, yz, zz;
+};
+
+struct Vector3 {
+  double x, y, z;
+};
+
+inline Vector3 times(const Symmetric3& m, const Vector3& v) {
+  return {m.xx * v.x + m.xy * v.y + m.xz * v.z, m.xy * v.x + m.yy * v.y + m.yz * v.z,
+          m.xz * v.x + m.yz * v.y + m.zz * v.z};
+}
+
+// Lane j's covariance normalised to trace 1; `ok` is false with fewer than 3
+// points or a zero trace.
+struct NormalisedCovariance {
+  Symmetric3 a;
+  bool ok;
+};
+
+inline NormalisedCovariance normalised_covariance(const LaneSums& s, int j) {
+  const double inverse_n = 1.0 / std::max(s.used[j], 1);
+  const double mx = s.x[j] * inverse_n, my = s.y[j] * inverse_n, mz = s.z[j] * inverse_n;
+  const double cxx = s.xx[j] * inverse_n - mx * mx, cyy = s.yy[j] * inverse_n - my * my,
+               czz = s.zz[j] * inverse_n - mz * mz, cxy = s.xy[j] * inverse_n - mx * my,
+               cxz = s.xz[j] * inverse_n - mx * mz, cyz = s.yz[j] * inverse_n - my * mz;
+  const double trace = cxx + cyy + czz;
+  const double t = 1.0 / or_one(trace, trace > 0.0);
+  const bool ok = (s.used[j] >= 3) & (trace > 0.0);
+  return {{cxx * t, cxy * t, cxz * t, cyy * t, cyz * t, czz * t}, ok};
+}
+
+// c1 of the characteristic polynomial: the sum of the principal 2 × 2 minors.
+inline double minor_sum(const Symmetric3& a) {
+  return a.xx * a.yy - a.xy * a.xy + a.xx * a.zz - a.xz * a.xz + a.yy * a.zz - a.yz * a.yz;
+}
+
+// c0 of the characteristic polynomial: the determinant.
+inline double determinant(const Symmetric3& a) {
+  return a.xx * (a.yy * a.zz - a.yz * a.yz) - a.xy * (a.xy * a.zz - a.yz * a.xz) +
+         a.xz * (a.xy * a.yz - a.yy * a.xz);
+}
+
+// The adjugate of a − σ·I (symmetric: its columns are also its rows).
+inline Symmetric3 shifted_adjugate(const Symmetric3& a, double sigma) {
+  const double bx = a.xx - sigma, by = a.yy - sigma, bz = a.zz - sigma;
+  return {by * bz - a.yz * a.yz, a.xz * a.yz - a.xy * bz, a.xy * a.yz - a.xz * by,
+          bx * bz - a.xz * a.xz, a.xy * a.xz - bx * a.yz, bx * by - a.xy * a.xy};
+}
+
+// Step 2 below: the longest column of m, then two power steps with m.
+inline Vector3 dominant_direction(const Symmetric3& m) {
+  const double n0 = m.xx * m.xx + m.xy * m.xy + m.xz * m.xz,
+               n1 = m.xy * m.xy + m.yy * m.yy + m.yz * m.yz,
+               n2 = m.xz * m.xz + m.yz * m.yz + m.zz * m.zz;
+  const std::uint64_t take1 = all_bits64(n1 > n0);
+  const std::uint64_t take2 = all_bits64(n2 > std::max(n0, n1));
+  const std::uint64_t take0 = ~(take1 | take2), only1 = take1 & ~take2;
+  const Vector3 column = {
+      select_bits64(m.xx, take0) + select_bits64(m.xy, only1) + select_bits64(m.xz, take2),
+      select_bits64(m.xy, take0) + select_bits64(m.yy, only1) + select_bits64(m.yz, take2),
+      select_bits64(m.xz, take0) + select_bits64(m.yz, only1) + select_bits64(m.zz, take2)};
+  return times(m, times(m, column));
+}
+
+// v scaled to unit length; `ok` is false for the zero vector. Scaled to its
+// largest entry first, so the float estimate of 1/√q is in range, then one
+// Newton step in double.
+struct UnitVector {
+  Vector3 v;
+  bool ok;
+};
+
+inline UnitVector normalised(Vector3 v) {
+  const double largest = std::max(std::max(std::abs(v.x), std::abs(v.y)), std::abs(v.z));
+  const double scale = 1.0 / or_one(largest, largest > 0.0);
+  v.x *= scale, v.y *= scale, v.z *= scale;
+  const double q = v.x * v.x + v.y * v.y + v.z * v.z;
+  double inverse = inverse_sqrt(static_cast<float>(q));
+  inverse *= 1.5 - 0.5 * q * inverse * inverse;
+  v.x *= inverse, v.y *= inverse, v.z *= inverse;
+  return {v, largest > 0.0};
+}
+
+// Step 3 below: whether λ1 > 4·λ0, with λ0 the Rayleigh quotient of unit v.
+inline bool is_planar(const Symmetric3& a, double c1, const Vector3& v) {
+  const Vector3 av = times(a, v);
+  const double smallest = v.x * av.x + v.y * av.y + v.z * av.z;
+  const double sum = 1.0 - smallest, product = c1 - smallest * sum, t4 = 4.0 * smallest;
+  return (t4 < 0.5 * sum) & ((t4 - sum) * t4 + product > 0.0);
+}
+
+// Lane j's unit normal n into `out`, turned towards the scanner, with the
+// cosine of its incidence angle.
+inline void store_towards_scanner(const Vector3& n, const LaneCentres& c, int j, bool ok,
+                                  LanePlanes& out) {
+  const float nx = static_cast<float>(n.x), ny = static_cast<float>(n.y),
+              nz = static_cast<float>(n.z);
+  const float away = nx * c.x[j] + ny * c.y[j] + nz * c.z[j];  // > 0: faces away
+  const float sign =
+      select_bits(-1.0f, all_bits(away > 0.0f)) + select_bits(1.0f, all_bits(!(away > 0.0f)));
+  out.x[j] = sign * nx, out.y[j] = sign * ny, out.z[j] = sign * nz;
+  out.cos_incidence[j] = std::abs(nx * c.view_x[j] + ny * c.view_y[j] + nz * c.view_z[j]);
+  out.ok[j] = ok;
 }
 
 // For each lane: the covariance of its points normalised to trace 1, a
@@ -86,62 +194,13 @@ SCANBENCH_VECTOR_CLONES void lane_planes(const LaneSums& __restrict s,
                                          const LaneCentres& __restrict c,
                                          LanePlanes& __restrict out) {
   for (int j = 0; j < kCovarianceLanes; ++j) {
-    bool ok = s.used[j] >= 3;
-    const double inverse_n = 1.0 / std::max(s.used[j], 1);
-    const double mx = s.x[j] * inverse_n, my = s.y[j] * inverse_n, mz = s.z[j] * inverse_n;
-    const double cxx = s.xx[j] * inverse_n - mx * mx, cyy = s.yy[j] * inverse_n - my * my,
-                 czz = s.zz[j] * inverse_n - mz * mz, cxy = s.xy[j] * inverse_n - mx * my,
-                 cxz = s.xz[j] * inverse_n - mx * mz, cyz = s.yz[j] * inverse_n - my * mz;
-    const double trace = cxx + cyy + czz;
-    ok &= trace > 0.0;
-    const double t = 1.0 / or_one(trace, trace > 0.0);
-    const double xx = cxx * t, yy = cyy * t, zz = czz * t, xy = cxy * t, xz = cxz * t, yz = cyz * t;
-    const double c1 = xx * yy - xy * xy + xx * zz - xz * xz + yy * zz - yz * yz;
-    ok &= c1 > 0.0;  // else rank ≤ 1: a line or a point
-    const double c0 =
-        xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
-    const double sigma = c0 / or_one(c1, c1 > 0.0);
-    const double bx = xx - sigma, by = yy - sigma, bz = zz - sigma;
-    // The adjugate of a − σ·I (symmetric: its columns are also its rows).
-    const double axx = by * bz - yz * yz, axy = xz * yz - xy * bz, axz = xy * yz - xz * by,
-                 ayy = bx * bz - xz * xz, ayz = xy * xz - bx * yz, azz = bx * by - xy * xy;
-    const double n0 = axx * axx + axy * axy + axz * axz, n1 = axy * axy + ayy * ayy + ayz * ayz,
-                 n2 = axz * axz + ayz * ayz + azz * azz;
-    const std::uint64_t take1 = all_bits64(n1 > n0);
-    const std::uint64_t take2 = all_bits64(n2 > std::max(n0, n1));
-    const std::uint64_t take0 = ~(take1 | take2), only1 = take1 & ~take2;
-    const double ux =
-        select_bits64(axx, take0) + select_bits64(axy, only1) + select_bits64(axz, take2);
-    const double uy =
-        select_bits64(axy, take0) + select_bits64(ayy, only1) + select_bits64(ayz, take2);
-    const double uz =
-        select_bits64(axz, take0) + select_bits64(ayz, only1) + select_bits64(azz, take2);
-    const double wx = axx * ux + axy * uy + axz * uz, wy = axy * ux + ayy * uy + ayz * uz,
-                 wz = axz * ux + ayz * uy + azz * uz;
-    double vx = axx * wx + axy * wy + axz * wz, vy = axy * wx + ayy * wy + ayz * wz,
-           vz = axz * wx + ayz * wy + azz * wz;
-    // Normalise: scaled to its largest entry first, so the float estimate of
-    // 1/√q is in range, then one Newton step in double.
-    const double largest = std::max(std::max(std::abs(vx), std::abs(vy)), std::abs(vz));
-    ok &= largest > 0.0;
-    const double scale = 1.0 / or_one(largest, largest > 0.0);
-    vx *= scale, vy *= scale, vz *= scale;
-    const double q = vx * vx + vy * vy + vz * vz;
-    double inverse = inverse_sqrt(static_cast<float>(q));
-    inverse *= 1.5 - 0.5 * q * inverse * inverse;
-    vx *= inverse, vy *= inverse, vz *= inverse;
-    const double smallest = vx * (xx * vx + xy * vy + xz * vz) +
-                            vy * (xy * vx + yy * vy + yz * vz) + vz * (xz * vx + yz * vy + zz * vz);
-    const double sum = 1.0 - smallest, product = c1 - smallest * sum, t4 = 4.0 * smallest;
-    ok &= (t4 < 0.5 * sum) & ((t4 - sum) * t4 + product > 0.0);
-    const float nx = static_cast<float>(vx), ny = static_cast<float>(vy),
-                nz = static_cast<float>(vz);
-    const float away = nx * c.x[j] + ny * c.y[j] + nz * c.z[j];  // > 0: faces away
-    const float sign =
-        select_bits(-1.0f, all_bits(away > 0.0f)) + select_bits(1.0f, all_bits(!(away > 0.0f)));
-    out.x[j] = sign * nx, out.y[j] = sign * ny, out.z[j] = sign * nz;
-    out.cos_incidence[j] = std::abs(nx * c.view_x[j] + ny * c.view_y[j] + nz * c.view_z[j]);
-    out.ok[j] = ok;
+    const NormalisedCovariance covariance = normalised_covariance(s, j);
+    const Symmetric3& a = covariance.a;
+    const double c1 = minor_sum(a);  // ≤ 0: rank ≤ 1, a line or a point
+    const double sigma = determinant(a) / or_one(c1, c1 > 0.0);
+    const UnitVector n = normalised(dominant_direction(shifted_adjugate(a, sigma)));
+    const bool ok = covariance.ok & (c1 > 0.0) & n.ok & is_planar(a, c1, n.v);
+    store_towards_scanner(n.v, c, j, ok, out);
   }
 }
 
@@ -203,7 +262,7 @@ NormalFit fit_window(const Direction& direction, const float* range_m, const std
 // of one row. Branch-free over plain, unaliased arrays, so that it
 // vectorizes; the same operations in the same order as fit_window. The mask
 // is not read: log_range is NaN where it is 0, which fails the comparison.
-void add_offset(const float* __restrict range, const float* __restrict log_range,
+void add_offset(const float* __restrict range_m, const float* __restrict log_range,
                 const float* __restrict cos_az, const float* __restrict sin_az, float cos_el,
                 float sin_el, float limit, const float* __restrict centre_log_range,
                 const float* __restrict centre_x, const float* __restrict centre_y,
@@ -211,9 +270,9 @@ void add_offset(const float* __restrict range, const float* __restrict log_range
   for (int j = 0; j < kCovarianceLanes; ++j) {
     const bool take = std::abs(log_range[j] - centre_log_range[j]) <= limit;
     const std::uint32_t keep = all_bits(take);
-    const float px = select_bits(range[j] * (cos_el * cos_az[j]) - centre_x[j], keep);
-    const float py = select_bits(range[j] * (cos_el * sin_az[j]) - centre_y[j], keep);
-    const float pz = select_bits(range[j] * sin_el - centre_z[j], keep);
+    const float px = select_bits(range_m[j] * (cos_el * cos_az[j]) - centre_x[j], keep);
+    const float py = select_bits(range_m[j] * (cos_el * sin_az[j]) - centre_y[j], keep);
+    const float pz = select_bits(range_m[j] * sin_el - centre_z[j], keep);
     s.x[j] += px, s.y[j] += py, s.z[j] += pz;
     s.xx[j] += px * px, s.xy[j] += px * py, s.xz[j] += px * pz;
     s.yy[j] += py * py, s.yz[j] += py * pz, s.zz[j] += pz * pz;
@@ -227,7 +286,7 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
                          const std::uint8_t* mask, const float* log_range, int row, int col,
                          int rows, const GeometrySettings& settings) {
   const int columns = directions.columns;
-  if (directions.per_pixel != nullptr) {
+  if (directions.is_per_pixel()) {
     return fit_window([&](int r, int c) { return directions.at(r, c); }, range_m, mask, log_range,
                       row, col, rows, columns, settings);
   }
@@ -241,7 +300,7 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
 bool covariance_lanes_fit(const GridDirections& directions, int row, int col, int rows,
                           const GeometrySettings& settings) {
   const int k = settings.edge_window_radius;
-  return directions.per_pixel == nullptr && row - k >= 0 && row + k < rows && col - k >= 0 &&
+  return !directions.is_per_pixel() && row - k >= 0 && row + k < rows && col - k >= 0 &&
          col + kCovarianceLanes - 1 + k < directions.columns;
 }
 

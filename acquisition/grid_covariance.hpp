@@ -6,7 +6,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cassert>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "acquisition/scan.hpp"
@@ -15,18 +17,28 @@
 namespace scanbench::acquisition {
 
 // Unit viewing directions without trigonometry per pixel: a spherical scan's
-// from per-column and per-row tables, a per-pixel grid's from the scan.
+// from per-column and per-row tables, a per-pixel grid's from the scan (a view:
+// the scan must outlive it).
 struct GridDirections {
   std::vector<float> cos_az, sin_az, cos_el, sin_el;  // spherical scans only
-  const Eigen::Vector3f* per_pixel = nullptr;         // per-pixel grids only
+  std::span<const Eigen::Vector3f> per_pixel;         // per-pixel grids only, rows × columns
   int columns = 0;
 
   explicit GridDirections(const Scan& scan);
 
+  // (An empty per-pixel grid counts as spherical: it has no pixel to ask about.)
+  bool is_per_pixel() const { return !per_pixel.empty(); }
+
   // Direction of pixel (row, col); the zero vector where a per-pixel grid
-  // has none. Row and column must lie in the grid.
+  // has none. Asserts that row and column lie in the grid.
   Eigen::Vector3f at(int row, int col) const {
-    if (per_pixel != nullptr) return per_pixel[static_cast<std::size_t>(row) * columns + col];
+    assert(row >= 0 && col >= 0 && col < columns && "pixel inside the grid");
+    if (is_per_pixel()) {
+      const std::size_t i = static_cast<std::size_t>(row) * columns + col;
+      assert(i < per_pixel.size() && "pixel inside the grid");
+      return per_pixel[i];
+    }
+    assert(static_cast<std::size_t>(row) < cos_el.size() && "pixel inside the grid");
     return {cos_el[row] * cos_az[col], cos_el[row] * sin_az[col], sin_el[row]};
   }
 };
@@ -56,8 +68,8 @@ NormalFit covariance_fit(const GridDirections& directions, const float* range_m,
 // pixels of each row, several times faster per pixel.
 inline constexpr int kCovarianceLanes = 4;
 
-// Whether covariance_fits can take pixels (row, col … col + 3): a spherical
-// grid and all their windows inside it.
+// Whether covariance_fits can take pixels (row, col … col + kCovarianceLanes
+// − 1): a spherical grid and all their windows inside it.
 bool covariance_lanes_fit(const GridDirections& directions, int row, int col, int rows,
                           const GeometrySettings& settings);
 

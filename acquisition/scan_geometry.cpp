@@ -78,17 +78,17 @@ struct FitInputs {
 // normal float (or is infinite) is no return here.
 SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict valid,
                                       const std::uint8_t* __restrict mixed,
-                                      const float* __restrict range, std::uint8_t* __restrict mask,
-                                      float* __restrict log_range) {
+                                      const float* __restrict range_m,
+                                      std::uint8_t* __restrict mask, float* __restrict log_range) {
   constexpr std::uint32_t kNaN = 0x7fc00000u;
   for (int i = 0; i < n; ++i) {
     const bool masked = (valid[i] != 0) & (mixed[i] == 0) &
-                        (range[i] >= std::numeric_limits<float>::min()) &
-                        (range[i] <= std::numeric_limits<float>::max());
+                        (range_m[i] >= std::numeric_limits<float>::min()) &
+                        (range_m[i] <= std::numeric_limits<float>::max());
     const std::uint32_t keep = all_bits(masked);
     mask[i] = masked;
     log_range[i] = std::bit_cast<float>(
-        (std::bit_cast<std::uint32_t>(log_positive(range[i])) & keep) | (kNaN & ~keep));
+        (std::bit_cast<std::uint32_t>(log_positive(range_m[i])) & keep) | (kNaN & ~keep));
   }
 }
 
@@ -109,16 +109,17 @@ void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, Fit
 // σ(range) / range — compared as d · range > √6 · depth_jump_sigmas · σ,
 // without a division.
 struct JumpTest {
-  float relative, noise0, noise1;  // threshold·range = noise0 + noise1·range
+  float relative;          // threshold on d (ln range: no unit)
+  float noise0_m, noise1;  // threshold · range [m] = noise0_m + noise1 · range [m]
 
   explicit JumpTest(const GeometrySettings& s)
       : relative(static_cast<float>(s.depth_jump_relative)),
-        noise0(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_m)),
+        noise0_m(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_m)),
         noise1(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_per_m)) {}
 
-  bool operator()(float before, float centre, float after, float range) const {
+  bool operator()(float before, float centre, float after, float range_m) const {
     const float d = std::abs(before - 2.0f * centre + after);
-    return (d > relative) | (d * range > noise0 + noise1 * range);
+    return (d > relative) | (d * range_m > noise0_m + noise1 * range_m);
   }
 };
 
@@ -127,13 +128,13 @@ struct JumpTest {
 SCANBENCH_VECTOR_CLONES void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
                                             const std::uint8_t* __restrict mask,
                                             const float* __restrict v,
-                                            const float* __restrict range,
+                                            const float* __restrict range_m,
                                             std::uint8_t* __restrict clean) {
   for (int c = 1; c + 1 < n; ++c) {
     const bool along_row =
-        (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range[c]);
+        (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range_m[c]);
     const bool along_column = (mask[c - stride] != 0) & (mask[c + stride] != 0) &
-                              test(v[c - stride], v[c], v[c + stride], range[c]);
+                              test(v[c - stride], v[c], v[c + stride], range_m[c]);
     const bool jumps = (mask[c] != 0) & (along_row | along_column);
     clean[c] = (mask[c] != 0) & !jumps;
   }
@@ -172,7 +173,8 @@ void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& i
 // trigonometry and division.
 struct RowFactors {
   std::vector<float> azimuth_gradient;  // 1 / (Δaz · cos el): d ln r / d col → ∂ ln r/∂az / cos el
-  std::vector<float> half_spacing;  // half the pixel cell's diagonal per metre of range
+  // Half the pixel cell's diagonal [rad]: the footprint [m] per metre of range.
+  std::vector<float> half_spacing_rad;
   float elevation_gradient = 0.0f;  // 1 / Δel
 
   explicit RowFactors(const Scan& scan) {
@@ -183,15 +185,15 @@ struct RowFactors {
       azimuth_gradient.push_back(
           static_cast<float>(1.0 / a->azimuth_step_rad / std::max(cos_el, 1e-3)));
       const double az = std::abs(a->azimuth_step_rad) * cos_el, el = a->elevation_step_rad;
-      half_spacing.push_back(static_cast<float>(0.5 * std::sqrt(az * az + el * el)));
+      half_spacing_rad.push_back(static_cast<float>(0.5 * std::sqrt(az * az + el * el)));
     }
     elevation_gradient = static_cast<float>(1.0 / a->elevation_step_rad);
   }
 };
 
-// Half the pixel cell's diagonal per metre of range on a per-pixel direction
-// grid: the angles to the next column and row.
-float half_spacing_per_pixel(const Scan& scan, int row, int col) {
+// Half the pixel cell's diagonal [rad] on a per-pixel direction grid, from
+// the angles to the next column and row.
+float per_pixel_half_spacing_rad(const Scan& scan, int row, int col) {
   const Eigen::Vector3f d = direction(scan, row, col);
   const int c2 = col + 1 < scan.columns ? col + 1 : col - 1,
             r2 = row + 1 < scan.rows ? row + 1 : row - 1;
@@ -217,7 +219,7 @@ struct StageContext {
 
 // Normal, confidence, footprint and the no-normal flag of valid pixel i
 // from a covariance fit (or from none: fit.ok false).
-void store_fit(const StageContext& c, const NormalFit& fit, std::size_t i, float half_spacing) {
+void store_fit(const StageContext& c, const NormalFit& fit, std::size_t i, float half_spacing_rad) {
   const bool ok = fit.ok && fit.used >= c.settings.min_neighbours && fit.normal.allFinite();
   float cos_incidence = 1.0f;
   if (ok) {
@@ -231,7 +233,7 @@ void store_fit(const StageContext& c, const NormalFit& fit, std::size_t i, float
     c.g.flags[i] |= kFlagNoNormal;
   }
   const float stretch = static_cast<float>(1.0 / c.settings.max_footprint_stretch);
-  c.g.footprint_m[i] = c.scan.range_m[i] * half_spacing / std::max(cos_incidence, stretch);
+  c.g.footprint_m[i] = c.scan.range_m[i] * half_spacing_rad / std::max(cos_incidence, stretch);
 }
 
 // Adds the counts of GeometryResult for pixels [first, first + count).
@@ -251,8 +253,37 @@ void count_pixels(const StageContext& c, std::size_t first, int count) {
 struct RowConstants {
   float cos_el, sin_el;
   float az_gradient, el_gradient;  // slope per pixel → per radian (see RowFactors)
-  float half_spacing, stretch;
-  std::uint16_t min_used;
+  float half_spacing_rad;          // see RowFactors
+  float max_stretch;
+  std::uint16_t min_used;  // pixels a window fit needs
+};
+
+// The per-pixel arrays of a row segment that window_normals reads, n entries
+// each, and those it writes. No output overlaps another array: the
+// __restrict members say so, which GCC uses for a struct passed by value.
+struct WindowNormalInputs {
+  // The window fits (WindowSlopeRow).
+  const float* __restrict per_column;
+  const float* __restrict per_row;
+  const std::uint16_t* __restrict used;
+  // The pixels' azimuths (GridDirections).
+  const float* __restrict cos_az;
+  const float* __restrict sin_az;
+  // The scan's, then FitInputs'.
+  const float* __restrict range_m;
+  const std::uint8_t* __restrict valid;
+  const std::uint8_t* __restrict mask;
+  const std::uint8_t* __restrict mixed;
+  const std::uint8_t* __restrict clean;
+};
+
+struct WindowNormalOutputs {
+  float* __restrict nx;  // the unit normal's components
+  float* __restrict ny;
+  float* __restrict nz;
+  float* __restrict confidence;
+  float* __restrict footprint_m;
+  std::uint8_t* __restrict flags;
 };
 
 // The normal towards the scanner is −u + g_az·e_az + g_el·e_el in the
@@ -260,70 +291,94 @@ struct RowConstants {
 // (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
 // of the incidence angle is one over it, so the footprint's stretch is the
 // length itself. Writes n pixels' normals (as three arrays), confidences,
-// footprints and flags. Branch-free over plain, unaliased arrays,
-// so that the loop vectorizes. Masked pixels without a clean window are left
-// for the covariance fit (no flag).
-SCANBENCH_VECTOR_CLONES void window_normals(
-    int n, const RowConstants& k, const float* __restrict per_column,
-    const float* __restrict per_row, const std::uint16_t* __restrict used,
-    const float* __restrict cos_az, const float* __restrict sin_az, const float* __restrict range,
-    const std::uint8_t* __restrict valid, const std::uint8_t* __restrict mask,
-    const std::uint8_t* __restrict mixed, const std::uint8_t* __restrict clean,
-    float* __restrict nx, float* __restrict ny, float* __restrict nz, float* __restrict confidence,
-    float* __restrict footprint, std::uint8_t* __restrict flags) {
+// footprints and flags. Branch-free over plain, unaliased arrays, so that
+// the loop vectorizes. Masked pixels without a clean window are left for the
+// covariance fit (no flag).
+SCANBENCH_VECTOR_CLONES void window_normals(int n, const RowConstants& constants,
+                                            WindowNormalInputs in, WindowNormalOutputs out) {
   for (int j = 0; j < n; ++j) {
-    const float g_az = per_column[j] * k.az_gradient, g_el = per_row[j] * k.el_gradient;
+    const float g_az = in.per_column[j] * constants.az_gradient,
+                g_el = in.per_row[j] * constants.el_gradient;
     const float q = 1.0f + g_az * g_az + g_el * g_el;
     const float inverse = inverse_sqrt(q), length = q * inverse;
-    const std::uint32_t ok =
-        all_bits((used[j] >= k.min_used) & (length <= std::numeric_limits<float>::max()));
-    const std::uint32_t is_valid = all_bits(valid[j] != 0);
-    const std::uint32_t pending = all_bits((used[j] == 0) & (mask[j] != 0));
-    const float ca = cos_az[j], sa = sin_az[j];
-    nx[j] = select_bits((-k.cos_el * ca - g_az * sa - g_el * k.sin_el * ca) * inverse, ok);
-    ny[j] = select_bits((-k.cos_el * sa + g_az * ca - g_el * k.sin_el * sa) * inverse, ok);
-    nz[j] = select_bits((-k.sin_el + g_el * k.cos_el) * inverse, ok);
-    confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
+    const std::uint32_t ok = all_bits((in.used[j] >= constants.min_used) &
+                                      (length <= std::numeric_limits<float>::max()));
+    const std::uint32_t is_valid = all_bits(in.valid[j] != 0);
+    const std::uint32_t pending = all_bits((in.used[j] == 0) & (in.mask[j] != 0));
+    const float ca = in.cos_az[j], sa = in.sin_az[j];
+    out.nx[j] = select_bits(
+        (-constants.cos_el * ca - g_az * sa - g_el * constants.sin_el * ca) * inverse, ok);
+    out.ny[j] = select_bits(
+        (-constants.cos_el * sa + g_az * ca - g_el * constants.sin_el * sa) * inverse, ok);
+    out.nz[j] = select_bits((-constants.sin_el + g_el * constants.cos_el) * inverse, ok);
+    out.confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
     const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
-    footprint[j] = select_bits(range[j] * k.half_spacing * std::min(stretch, k.stretch), is_valid);
-    const std::uint32_t edge = all_bits((mask[j] != 0) & (clean[j] == 0));
-    flags[j] =
-        static_cast<std::uint8_t>((mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
+    out.footprint_m[j] = select_bits(
+        in.range_m[j] * constants.half_spacing_rad * std::min(stretch, constants.max_stretch),
+        is_valid);
+    const std::uint32_t edge = all_bits((in.mask[j] != 0) & (in.clean[j] == 0));
+    out.flags[j] =
+        static_cast<std::uint8_t>((in.mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
                                   (is_valid & ~ok & ~pending & kFlagNoNormal));
   }
+}
+
+RowConstants row_constants(const StageContext& c, int row) {
+  return {c.directions.cos_el[row],
+          c.directions.sin_el[row],
+          c.factors.azimuth_gradient[row],
+          c.factors.elevation_gradient,
+          c.factors.half_spacing_rad[row],
+          static_cast<float>(c.settings.max_footprint_stretch),
+          static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
+}
+
+// A spherical row segment, pixels (row, begin … begin + n − 1), with its
+// window fits' pixel counts (0: no clean window).
+struct RowSegment {
+  int row, begin, n;
+  std::size_t first;  // the scan index of its first pixel
+  const std::uint16_t* used;
+  float half_spacing_rad;  // see RowFactors
+
+  // Segment pixel j is masked and has no window fit.
+  bool pending(const StageContext& c, int j) const {
+    return j < n && used[j] == 0 && c.in.mask[first + j];
+  }
+};
+
+// Stores the covariance fit of pending segment pixel j, together with those
+// of the pending pixels among the next kCovarianceLanes − 1 where their
+// windows allow it; returns how many pixels it has done.
+int store_fallback_from(const StageContext& c, const RowSegment& s, int j) {
+  const float* range_m = c.scan.range_m.data();
+  const int col = s.begin + j;
+  if (!covariance_lanes_fit(c.directions, s.row, col, c.scan.rows, c.settings)) {
+    store_fit(c,
+              covariance_fit(c.directions, range_m, c.in.mask.get(), c.in.log_range.get(), s.row,
+                             col, c.scan.rows, c.settings),
+              s.first + j, s.half_spacing_rad);
+    return 1;
+  }
+  unsigned wanted = 0;
+  for (int lane = 0; lane < kCovarianceLanes; ++lane)
+    wanted |= s.pending(c, j + lane) ? 1u << lane : 0u;
+  NormalFit fits[kCovarianceLanes];
+  covariance_fits(c.directions, range_m, c.in.log_range.get(), s.row, col, c.scan.rows, c.settings,
+                  wanted, fits);
+  for (int lane = 0; lane < kCovarianceLanes; ++lane) {
+    if (wanted & (1u << lane)) store_fit(c, fits[lane], s.first + j + lane, s.half_spacing_rad);
+  }
+  return kCovarianceLanes;
 }
 
 // The covariance fits of a spherical row segment's masked pixels without a
 // clean window (cut by a discontinuity, an invalid region or the grid's
 // border): the log-range slope of a lopsided window is biased by the
 // curvature of ln r, a 3D plane fit is not. Runs of them go in lanes.
-void store_fallback_fits(const StageContext& c, int row, int begin, int end,
-                         const std::uint16_t* used, float half_spacing) {
-  const std::size_t first = c.scan.index(row, begin);
-  const auto pending = [&](int j) {
-    return j < end - begin && used[j] == 0 && c.in.mask[first + j];
-  };
-  const float* range = c.scan.range_m.data();
-  for (int j = 0; j < end - begin; ++j) {
-    if (!pending(j)) continue;
-    if (!covariance_lanes_fit(c.directions, row, begin + j, c.scan.rows, c.settings)) {
-      store_fit(c,
-                covariance_fit(c.directions, range, c.in.mask.get(), c.in.log_range.get(), row,
-                               begin + j, c.scan.rows, c.settings),
-                first + j, half_spacing);
-      continue;
-    }
-    unsigned wanted = 0;
-    for (int lane = 0; lane < kCovarianceLanes; ++lane)
-      wanted |= pending(j + lane) ? 1u << lane : 0u;
-    NormalFit fits[kCovarianceLanes];
-    covariance_fits(c.directions, range, c.in.log_range.get(), row, begin + j, c.scan.rows,
-                    c.settings, wanted, fits);
-    for (int lane = 0; lane < kCovarianceLanes; ++lane) {
-      if (wanted & (1u << lane)) store_fit(c, fits[lane], first + j + lane, half_spacing);
-    }
-    j += kCovarianceLanes - 1;
-  }
+void store_fallback_fits(const StageContext& c, const RowSegment& s) {
+  int j = 0;
+  while (j < s.n) j += s.pending(c, j) ? store_fallback_from(c, s, j) : 1;
 }
 
 // A spherical scan's row segment: window normals in chunks (scratch arrays
@@ -331,26 +386,28 @@ void store_fallback_fits(const StageContext& c, int row, int begin, int end,
 void store_window_fits(const StageContext& c, int row, int begin, int end,
                        const WindowSlopeRow& s) {
   constexpr int kChunk = 128;
-  const RowConstants k{c.directions.cos_el[row],
-                       c.directions.sin_el[row],
-                       c.factors.azimuth_gradient[row],
-                       c.factors.elevation_gradient,
-                       c.factors.half_spacing[row],
-                       static_cast<float>(c.settings.max_footprint_stretch),
-                       static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
+  const RowConstants constants = row_constants(c, row);
   const std::size_t first = c.scan.index(row, begin);
   for (int j0 = 0; j0 < end - begin; j0 += kChunk) {
     const int n = std::min(kChunk, end - begin - j0);
     const std::size_t i0 = first + j0;
     float nx[kChunk], ny[kChunk], nz[kChunk];
-    window_normals(n, k, s.per_column + j0, s.per_row + j0, s.used + j0,
-                   c.directions.cos_az.data() + begin + j0, c.directions.sin_az.data() + begin + j0,
-                   c.scan.range_m.data() + i0, c.scan.valid.data() + i0, c.in.mask.get() + i0,
-                   c.in.mixed.get() + i0, c.in.clean.get() + i0, nx, ny, nz,
-                   c.g.confidence.data() + i0, c.g.footprint_m.data() + i0, c.g.flags.data() + i0);
+    const WindowNormalInputs inputs{s.per_column + j0,
+                                    s.per_row + j0,
+                                    s.used + j0,
+                                    c.directions.cos_az.data() + begin + j0,
+                                    c.directions.sin_az.data() + begin + j0,
+                                    c.scan.range_m.data() + i0,
+                                    c.scan.valid.data() + i0,
+                                    c.in.mask.get() + i0,
+                                    c.in.mixed.get() + i0,
+                                    c.in.clean.get() + i0};
+    window_normals(n, constants, inputs,
+                   {nx, ny, nz, c.g.confidence.data() + i0, c.g.footprint_m.data() + i0,
+                    c.g.flags.data() + i0});
     for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
   }
-  store_fallback_fits(c, row, begin, end, s.used, k.half_spacing);
+  store_fallback_fits(c, {row, begin, end - begin, first, s.used, constants.half_spacing_rad});
   count_pixels(c, first, end - begin);
 }
 
@@ -366,7 +423,7 @@ void store_covariance_fits(const StageContext& c, int row) {
       fit = covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(),
                            c.in.log_range.get(), row, col, c.scan.rows, c.settings);
     }
-    store_fit(c, fit, i, half_spacing_per_pixel(c.scan, row, col));
+    store_fit(c, fit, i, per_pixel_half_spacing_rad(c.scan, row, col));
   }
   count_pixels(c, c.scan.index(row, 0), c.scan.columns);
 }

@@ -46,6 +46,7 @@ struct Grid {
 // "region"; pixels outside the grid are unclean), in region coordinates
 // (y, x). Integral row j, entry x, sums region rows [0, j) and columns
 // [0, x). Only the 2·halo + 2 rows the current output row needs are kept.
+// Not copyable or movable: v_, xv_ and yv_ point into its own moments_.
 class IntegralRing {
  public:
   IntegralRing(const Grid& grid, const Tile& tile, int halo)
@@ -62,6 +63,10 @@ class IntegralRing {
         yv_(xv_ + unclean_.size()),
         row_unclean_(static_cast<std::size_t>(width_)),
         row_value_(static_cast<std::size_t>(width_)) {}
+  IntegralRing(const IntegralRing&) = delete;
+  IntegralRing& operator=(const IntegralRing&) = delete;
+  IntegralRing(IntegralRing&&) = delete;
+  IntegralRing& operator=(IntegralRing&&) = delete;
 
   // Makes integral rows up to `j` available (slot 0 is row 0: all zeros).
   void extend_to(int j) {
@@ -95,13 +100,14 @@ class IntegralRing {
     std::fill(row_unclean_.begin(), row_unclean_.end(), 1);
     std::fill(row_value_.begin(), row_value_.end(), 0.0f);
     if (row < 0 || row >= grid_.rows) return;
-    const std::size_t offset = static_cast<std::size_t>(row) * grid_.columns;
+    // Grid index of region column x: first + x, ≥ 0 for x ≥ x_begin (col0_
+    // is negative on the tiles at the grid's left border).
+    const std::ptrdiff_t first = static_cast<std::ptrdiff_t>(row) * grid_.columns + col0_;
     const int x_begin = std::max(0, -col0_), x_end = std::min(width_, grid_.columns - col0_);
-    const std::uint8_t* clean = grid_.clean + offset + col0_;
-    const float* value = grid_.value + offset + col0_;
     for (int x = x_begin; x < x_end; ++x) {  // branch-free: cleanness is data, it vectorizes
-      row_unclean_[x] = clean[x] == 0;
-      row_value_[x] = select_bits(value[x], all_bits(clean[x] != 0));
+      const std::uint8_t clean = grid_.clean[first + x];
+      row_unclean_[x] = clean == 0;
+      row_value_[x] = select_bits(grid_.value[first + x], all_bits(clean != 0));
     }
   }
 

@@ -20,6 +20,9 @@ function(scanbench_target_settings target)
     # other allocator. glibc's and ASan's malloc both align to 16 bytes, which
     # is all Eigen needs here, so keep malloc everywhere.
     target_compile_definitions(${target} PRIVATE EIGEN_MALLOC_ALREADY_ALIGNED=1)
+    # No AVX2 clones (acquisition/branch_free.hpp): their ifunc resolvers run
+    # during relocation, before the sanitizer runtime is initialised.
+    target_compile_definitions(${target} PRIVATE SCANBENCH_VECTOR_CLONES=)
   endif()
 endfunction()
 
