@@ -13,32 +13,24 @@
 #include "acquisition/parallel.hpp"
 #include "acquisition/timing.hpp"
 #include "registration/association.hpp"
-#include "registration/pair_point_to_plane_residual.hpp"
+#include "registration/point_to_plane_costs.hpp"
 #include "registration/pose_parameters.hpp"
 
 namespace scanbench::registration {
 namespace {
 
-std::size_t add_edge_residuals(ceres::Problem& problem, ceres::LossFunction* loss,
-                               const SampleCloud& source, const PreparedScan& target,
-                               const std::vector<Correspondence>& matches, PoseParameters& a,
-                               PoseParameters& b) {
-  for (const Correspondence& c : matches) {
-    const auto k = static_cast<std::size_t>(c.pixel);
-    auto* cost = new ceres::AutoDiffCostFunction<PairPointToPlaneResidual, 1, 4, 3, 4, 3>(
-        new PairPointToPlaneResidual(source.points[c.sample].cast<double>(),
-                                     target.points[k].cast<double>(),
-                                     target.geometry->normal[k].cast<double>()));
-    problem.AddResidualBlock(cost, loss, a.rotation, a.translation, b.rotation, b.translation);
-  }
-  return matches.size();
-}
+// The correspondences of one edge, and the poses they tie together.
+struct EdgeMatches {
+  std::vector<PlaneCorrespondence> matches;
+  PoseParameters* source = nullptr;
+  PoseParameters* target = nullptr;
+};
 
-ceres::Solver::Options solver_options(int threads) {
+ceres::Solver::Options solver_options(const GlobalSettings& settings) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = 20;
-  options.num_threads = acquisition::worker_count(threads);
+  options.max_num_iterations = settings.solver_iterations;
+  options.num_threads = acquisition::worker_count(settings.icp.threads);
   options.logging_type = ceres::SILENT;
   return options;
 }
@@ -48,23 +40,28 @@ ceres::Solver::Options solver_options(int threads) {
 std::size_t solve_round(std::span<const SampleCloud> samples, std::span<const PreparedScan> scans,
                         std::span<const ScanEdge> edges, std::vector<PoseParameters>& poses,
                         double gate_m, const GlobalSettings& settings) {
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  ceres::CauchyLoss loss(settings.icp.loss_scale_m);
   const double min_cos = std::cos(settings.icp.max_normal_angle_deg * std::numbers::pi / 180.0);
-  std::size_t total = 0;
+  std::vector<EdgeMatches> associated;
   for (const ScanEdge& edge : edges) {
-    PoseParameters& a = poses[static_cast<std::size_t>(edge.source)];
-    PoseParameters& b = poses[static_cast<std::size_t>(edge.target)];
-    const Eigen::Isometry3d T_target_source = b.isometry().inverse() * a.isometry();
-    const std::vector<Correspondence> matches =
-        associate_samples(samples[static_cast<std::size_t>(edge.source)],
-                          scans[static_cast<std::size_t>(edge.target)], T_target_source,
-                          {gate_m, min_cos}, settings.icp.threads);
+    const auto a = static_cast<std::size_t>(edge.source);
+    const auto b = static_cast<std::size_t>(edge.target);
+    const Eigen::Isometry3d T_target_source = poses[b].isometry().inverse() * poses[a].isometry();
+    std::vector<PlaneCorrespondence> matches =
+        plane_correspondences(samples[a], scans[b],
+                              associate_samples(samples[a], scans[b], T_target_source,
+                                                {gate_m, min_cos}, settings.icp.threads));
     if (matches.size() < settings.icp.min_correspondences) continue;
-    total += add_edge_residuals(problem, &loss, samples[static_cast<std::size_t>(edge.source)],
-                                scans[static_cast<std::size_t>(edge.target)], matches, a, b);
+    associated.push_back({std::move(matches), &poses[a], &poses[b]});
+  }
+  ceres::Problem problem;
+  std::size_t total = 0;
+  for (const EdgeMatches& edge : associated) {
+    for (std::span<const PlaneCorrespondence> block : correspondence_blocks(edge.matches)) {
+      problem.AddResidualBlock(new PairPointToPlaneCost(block, settings.icp.loss_scale_m), nullptr,
+                               edge.source->rotation, edge.source->translation,
+                               edge.target->rotation, edge.target->translation);
+    }
+    total += edge.matches.size();
   }
   for (PoseParameters& pose : poses) {
     if (!problem.HasParameterBlock(pose.rotation)) continue;
@@ -76,7 +73,7 @@ std::size_t solve_round(std::span<const SampleCloud> samples, std::span<const Pr
   }
   if (total == 0) return 0;
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options(settings.icp.threads), &problem, &summary);
+  ceres::Solve(solver_options(settings), &problem, &summary);
   return total;
 }
 

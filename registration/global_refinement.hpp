@@ -21,6 +21,8 @@ struct GlobalSettings {
   // Association is redone this many times at most; each round solves the
   // joint problem for fixed correspondences.
   int max_rounds = 8;
+  // Levenberg-Marquardt steps of Ceres per round.
+  int solver_iterations = 5;
   // Gate of the first round [m] (the pairwise results are already close).
   double initial_gate_m = 0.1;
   // Gates, normal test, loss, stop thresholds and threads as in ICP.
