@@ -33,7 +33,8 @@ struct Thresholds {
   float min_normal_cos;
   float tie_low;   // A_o < A_s · tie_low: o is finer (1 / tie_high: symmetric)
   float tie_high;  // A_o ≤ A_s · tie_high (and not finer): a tie
-  RangeNoise noise;
+  float noise_m;   // RangeNoise in float
+  float noise_per_m;
 };
 
 // True when o sampled the surface of point i of s more finely (or equally
@@ -47,8 +48,9 @@ bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Ot
   if (!o.scan->in_model[k]) return false;
   const float range_p = p.norm();
   const float range_o = o.scan->scan->range_m[k];
-  const float sigma =
-      static_cast<float>(std::hypot(t.noise.sigma(range_p), t.noise.sigma(s.scan->range_m[i])));
+  const float sigma_p = t.noise_m + t.noise_per_m * range_p;
+  const float sigma_s = t.noise_m + t.noise_per_m * s.scan->range_m[i];
+  const float sigma = std::sqrt(sigma_p * sigma_p + sigma_s * sigma_s);
   const float tolerance = t.range_sigmas * sigma + o.scan->geometry->footprint_m[k];
   if (std::abs(range_o - range_p) > tolerance) return false;
   if (s.usable[i] && o.scan->usable[k]) {
@@ -116,7 +118,9 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
       static_cast<float>(settings.range_sigmas),
       static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0)),
       static_cast<float>(1.0 / (1.0 + settings.tie_tolerance)),
-      static_cast<float>(1.0 + settings.tie_tolerance), settings.noise};
+      static_cast<float>(1.0 + settings.tie_tolerance),
+      static_cast<float>(settings.noise.noise_m),
+      static_cast<float>(settings.noise.noise_per_m)};
   MergeResult result;
   for (int s = 0; s < static_cast<int>(scans.size()); ++s) {
     const PreparedScan& scan = scans[static_cast<std::size_t>(s)];

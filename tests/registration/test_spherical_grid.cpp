@@ -1,6 +1,7 @@
 // Projective association on hand-built spherical grids with exact answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -137,6 +138,31 @@ TEST(SphericalGrid, PartialPanoramaDoesNotWrap) {
   EXPECT_EQ(grid.pixel_of(along(0.0, -5.4 * kDeg)), scan.index(0, 10));
   EXPECT_EQ(grid.pixel_of(along(0.0, -5.6 * kDeg)), -1);
   EXPECT_EQ(grid.pixel_of(along(0.0, 4.6 * kDeg)), -1);
+}
+
+}  // namespace
+}  // namespace scanbench::registration
+
+namespace scanbench::registration {
+namespace {
+
+TEST(FastAtan2, FollowsTheLibraryWithinItsBoundEverywhere) {
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double angle = -std::numbers::pi + 2.0 * std::numbers::pi * (i + 0.5) / 200000.0;
+    for (const double length : {1e-3, 1.0, 37.0, 1e4}) {
+      const auto x = static_cast<float>(length * std::cos(angle));
+      const auto y = static_cast<float>(length * std::sin(angle));
+      const double exact = std::atan2(static_cast<double>(y), static_cast<double>(x));
+      worst = std::max(worst, std::abs(fast_atan2(y, x) - exact));
+    }
+  }
+  EXPECT_LT(worst, 6e-7);
+  EXPECT_FLOAT_EQ(fast_atan2(0.0f, -1.0f), std::numbers::pi_v<float>);
+  EXPECT_FLOAT_EQ(fast_atan2(-0.0f, -1.0f), -std::numbers::pi_v<float>);
+  EXPECT_EQ(fast_atan2(0.0f, 0.0f), 0.0f);
+  EXPECT_FLOAT_EQ(fast_atan2(-2.0f, 0.0f), -std::numbers::pi_v<float> / 2);
+  EXPECT_FLOAT_EQ(fast_atan2(3.0f, 3.0f), std::numbers::pi_v<float> / 4);
 }
 
 }  // namespace
