@@ -100,9 +100,10 @@ std::vector<Eigen::Isometry3d> pcl_chain(const SiteScans& site,
   for (const registration::PairReport& pair : ours.pairs) {
     const auto s = static_cast<std::size_t>(pair.source);
     const auto t = static_cast<std::size_t>(pair.target);
+    // As ours: the source's initial pose against where PCL put the target.
     const Eigen::Isometry3d start = pair.coarse.success && pair.coarse.method == "features"
                                         ? pair.coarse.T_target_source
-                                        : initial[t].inverse() * initial[s];
+                                        : poses[t].inverse() * initial[s];
     const PclIcpResult icp = pcl_point_to_plane_icp(site.samples[s], site.samples[t], start, {});
     seconds += icp.seconds;
     poses.push_back(poses[t] * icp.T_target_source);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "registration/prepared_scan.hpp"
@@ -19,7 +20,10 @@ struct Correspondence {
 };
 
 struct AssociationGate {
-  double max_distance_m = 0.5;  // |T · sample − target point| at most this
+  // Distance of T · sample from the target point's tangent plane at most
+  // this; from the target point itself, at most this plus twice the point's
+  // footprint radius.
+  double max_distance_m = 0.5;
   double min_normal_cos = 0.9;  // cos of the largest angle between the two normals
 };
 
@@ -41,5 +45,39 @@ std::vector<Correspondence> associate_samples(const SampleCloud& source, const P
                                               const Eigen::Isometry3d& T_target_source,
                                               const AssociationGate& gate, int threads,
                                               const SampleIndex* nearest = nullptr);
+
+// The share of the samples seen by the target scan that the pose puts in
+// the target's free space: in front of the surface that the target measured
+// on that beam, by more than tolerance_m, plus twice the pixel's footprint,
+// plus the range change across half a pixel on an oblique surface. Only
+// pixels with a normal and an incidence below 80° count (at grazing
+// incidence the range of a neighbouring beam is too uncertain).
+// The target's beam passed through where such a sample would sit, so a pose
+// that puts many samples there is wrong however well the rest fits; a
+// dominant plane (the ground) fits under many wrong poses, free space does
+// not. 0 for targets
+// without a spherical grid. (Huber and Hebert 2003 use the same test to
+// verify pairwise matches.)
+double free_space_violation(const SampleCloud& source, const PreparedScan& target,
+                            const Eigen::Isometry3d& T_target_source, double tolerance_m,
+                            int threads);
+
+// A correspondence as the point-to-plane costs read it: the source sample
+// and the target point and normal, in double.
+struct PlaneCorrespondence {
+  Eigen::Vector3d sample;  // source scan frame [m]
+  Eigen::Vector3d point;   // target scan frame [m]
+  Eigen::Vector3d normal;  // target scan frame, unit
+};
+std::vector<PlaneCorrespondence> plane_correspondences(const SampleCloud& source,
+                                                       const PreparedScan& target,
+                                                       std::span<const Correspondence> matches);
+
+// Signed distance [m] of the sample, moved by T_target_source, from the
+// target's tangent plane.
+inline double plane_distance(const PlaneCorrespondence& c,
+                             const Eigen::Isometry3d& T_target_source) {
+  return c.normal.dot(T_target_source * c.sample - c.point);
+}
 
 }  // namespace scanbench::registration

@@ -16,7 +16,7 @@
 #include "acquisition/parallel.hpp"
 #include "acquisition/timing.hpp"
 #include "registration/association.hpp"
-#include "registration/point_to_plane_residual.hpp"
+#include "registration/point_to_plane_costs.hpp"
 #include "registration/pose_parameters.hpp"
 
 namespace scanbench::registration {
@@ -29,78 +29,46 @@ AssociationGate gate_of(double max_distance_m, const IcpSettings& settings) {
   return {max_distance_m, std::cos(angle_rad)};
 }
 
-double plane_distance(const SampleCloud& source, const PreparedScan& target,
-                      const Eigen::Isometry3d& T, const Correspondence& c) {
-  const auto k = static_cast<std::size_t>(c.pixel);
-  const Eigen::Vector3d p = T * source.points[c.sample].cast<double>();
-  return target.geometry->normal[k].cast<double>().dot(p - target.points[k].cast<double>());
-}
-
 // 1.4826 · median |distance|: a standard deviation that outliers do not inflate.
-double robust_sigma(const SampleCloud& source, const PreparedScan& target,
-                    const Eigen::Isometry3d& T, const std::vector<Correspondence>& matches) {
+double robust_sigma(const std::vector<PlaneCorrespondence>& matches, const Eigen::Isometry3d& T) {
   if (matches.empty()) return 0.0;
   std::vector<double> distances(matches.size());
   for (std::size_t i = 0; i < matches.size(); ++i) {
-    distances[i] = std::abs(plane_distance(source, target, T, matches[i]));
+    distances[i] = std::abs(plane_distance(matches[i], T));
   }
   auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
   std::nth_element(distances.begin(), middle, distances.end());
   return 1.4826 * *middle;
 }
 
-// One Ceres problem for the whole run: a residual per sample, switched on
-// and off through its PlaneMatch.
-class IcpProblem {
- public:
-  IcpProblem(const SampleCloud& source, const Eigen::Isometry3d& initial,
-             const IcpSettings& settings)
-      : pose_(PoseParameters::from(initial)),
-        loss_(new ceres::CauchyLoss(settings.loss_scale_m), ceres::TAKE_OWNERSHIP) {
-    sources_.reserve(source.size());
-    for (const Eigen::Vector3f& p : source.points) sources_.push_back(p.cast<double>());
-    matches_.resize(source.size());
-    ceres::Problem::Options options;
-    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    problem_ = std::make_unique<ceres::Problem>(options);
-    problem_->AddParameterBlock(pose_.rotation, 4, new ceres::EigenQuaternionManifold);
-    problem_->AddParameterBlock(pose_.translation, 3);
-    for (std::size_t s = 0; s < sources_.size(); ++s) {
-      auto* cost = new ceres::AutoDiffCostFunction<PointToPlaneResidual, 1, 4, 3>(
-          new PointToPlaneResidual(sources_[s], matches_[s]));
-      problem_->AddResidualBlock(cost, &loss_, pose_.rotation, pose_.translation);
-    }
-    solver_options_.linear_solver_type = ceres::DENSE_QR;
-    solver_options_.max_num_iterations = 10;
-    solver_options_.num_threads = acquisition::worker_count(settings.threads);
-    solver_options_.logging_type = ceres::SILENT;
+ceres::Solver::Options solver_options(const IcpSettings& settings) {
+  ceres::Solver::Options options;
+  // Six unknowns: the normal equations are a 6 × 6 dense system.
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = settings.solver_iterations;
+  options.num_threads = acquisition::worker_count(settings.threads);
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+// T_target_source minimising the robust point-to-plane cost of fixed
+// correspondences, from `T`. The correspondences are redone after every
+// solve, so a few Levenberg-Marquardt steps suffice.
+Eigen::Isometry3d solve_pose(const std::vector<PlaneCorrespondence>& matches,
+                             const Eigen::Isometry3d& T, double loss_scale_m,
+                             const ceres::Solver::Options& options) {
+  PoseParameters pose = PoseParameters::from(T);
+  ceres::Problem problem;
+  problem.AddParameterBlock(pose.rotation, 4, new ceres::EigenQuaternionManifold);
+  problem.AddParameterBlock(pose.translation, 3);
+  for (std::span<const PlaneCorrespondence> block : correspondence_blocks(matches)) {
+    problem.AddResidualBlock(new PointToPlaneCost(block, loss_scale_m), nullptr, pose.rotation,
+                             pose.translation);
   }
-
-  Eigen::Isometry3d pose() const { return pose_.isometry(); }
-
-  // Activates exactly the given correspondences, then solves with a Cauchy
-  // loss of scale `loss_scale_m`.
-  void solve(const PreparedScan& target, const std::vector<Correspondence>& matches,
-             double loss_scale_m) {
-    loss_.Reset(new ceres::CauchyLoss(loss_scale_m), ceres::TAKE_OWNERSHIP);
-    for (PlaneMatch& m : matches_) m.weight = 0.0;
-    for (const Correspondence& c : matches) {
-      const auto k = static_cast<std::size_t>(c.pixel);
-      matches_[c.sample] = {target.points[k].cast<double>(),
-                            target.geometry->normal[k].cast<double>(), 1.0};
-    }
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options_, problem_.get(), &summary);
-  }
-
- private:
-  PoseParameters pose_;
-  ceres::LossFunctionWrapper loss_;
-  std::vector<Eigen::Vector3d> sources_;
-  std::vector<PlaneMatch> matches_;
-  std::unique_ptr<ceres::Problem> problem_;
-  ceres::Solver::Options solver_options_;
-};
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  return pose.isometry();
+}
 
 }  // namespace
 
@@ -112,35 +80,41 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
   if (target_sample != nullptr) nearest.emplace(*target_sample);
   IcpResult result;
   result.T_target_source = initial;
-  IcpProblem problem(source, initial, settings);
+  const ceres::Solver::Options options = solver_options(settings);
   double gate = std::max(settings.initial_gate_m, settings.min_gate_m);
+  const SampleCloud rough = nearest ? thin(source, settings.closest_point_samples) : SampleCloud{};
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
-    const std::vector<Correspondence> matches = associate_samples(
-        source, target, result.T_target_source, gate_of(gate, settings), settings.threads,
-        nearest && gate > settings.projective_gate_m ? &*nearest : nullptr);
+    const bool closest_point = nearest && gate > settings.projective_gate_m;
+    const SampleCloud& samples = closest_point ? rough : source;
+    const std::vector<PlaneCorrespondence> matches = plane_correspondences(
+        samples, target,
+        associate_samples(samples, target, result.T_target_source, gate_of(gate, settings),
+                          settings.threads, closest_point ? &*nearest : nullptr));
     result.iterations = iteration + 1;
     if (matches.size() < settings.min_correspondences) break;
     // The loss follows the gate: wide while the pose is far off, so that the
     // few matches of a rough start all pull; tight at the end.
-    problem.solve(target, matches, std::max(settings.loss_scale_m, gate / 4.0));
-    const Eigen::Isometry3d next = problem.pose();
+    const Eigen::Isometry3d next = solve_pose(matches, result.T_target_source,
+                                              std::max(settings.loss_scale_m, gate / 4.0), options);
     const auto [rotation, translation] = pose_change(result.T_target_source, next);
     result.T_target_source = next;
-    const double previous_gate = gate;
-    const double sigma = robust_sigma(source, target, next, matches);
+    const double sigma = robust_sigma(matches, next);
     gate = std::clamp(settings.distance_sigmas * sigma, settings.min_gate_m, gate);
-    const bool projective = !nearest || previous_gate <= settings.projective_gate_m;
-    if (projective && rotation < settings.stop_rotation_rad &&
-        translation < settings.stop_translation_m) {
+    const bool still =
+        rotation < settings.stop_rotation_rad && translation < settings.stop_translation_m;
+    if (still && !closest_point) {
       result.converged = true;
       break;
     }
+    // Closest points that no longer move the pose have done their part.
+    if (still) gate = std::min(gate, settings.projective_gate_m);
   }
   const AlignmentQuality quality =
       measure_alignment(source, target, result.T_target_source, settings);
   result.correspondences = quality.correspondences;
   result.overlap = quality.overlap;
   result.rms_m = quality.rms_m;
+  result.free_space_violation = quality.free_space_violation;
   result.converged = result.converged && quality.correspondences >= settings.min_correspondences;
   result.seconds = acquisition::seconds_since(start);
   return result;
@@ -155,11 +129,13 @@ AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan
   quality.correspondences = matches.size();
   quality.overlap = source.size() > 0 ? static_cast<double>(matches.size()) / source.size() : 0.0;
   double sum_squared = 0.0;
-  for (const Correspondence& c : matches) {
-    const double d = plane_distance(source, target, T_target_source, c);
+  for (const PlaneCorrespondence& c : plane_correspondences(source, target, matches)) {
+    const double d = plane_distance(c, T_target_source);
     sum_squared += d * d;
   }
   quality.rms_m = matches.empty() ? 0.0 : std::sqrt(sum_squared / matches.size());
+  quality.free_space_violation = registration::free_space_violation(
+      source, target, T_target_source, settings.min_gate_m, settings.threads);
   return quality;
 }
 

@@ -20,6 +20,10 @@ struct IcpSettings {
   // closest point of a target sample (when one is given); below it, by
   // projection into the target's grid.
   double projective_gate_m = 0.3;
+  // The closest-point iterations use at most this many source samples: they
+  // only have to bring the pose within the projective gate, and a kd-tree
+  // query costs far more than a projection.
+  std::size_t closest_point_samples = 8000;
   double distance_sigmas = 3.0;
   // Normals of matched points differ by at most this [deg].
   double max_normal_angle_deg = 25.0;
@@ -28,6 +32,8 @@ struct IcpSettings {
   // surfaces weigh little. Early iterations use a quarter of the gate.
   double loss_scale_m = 0.02;
   int max_iterations = 50;
+  // Levenberg-Marquardt steps of Ceres per set of correspondences.
+  int solver_iterations = 5;
   // Stop when one iteration moves the pose less than both of these.
   double stop_rotation_rad = 1e-5;  // 0.0006°
   double stop_translation_m = 1e-4;
@@ -42,9 +48,10 @@ struct IcpResult {
   // when iterations ran out or the correspondences were too few.
   bool converged = false;
   int iterations = 0;
-  std::size_t correspondences = 0;  // of the final pose
-  double overlap = 0.0;             // correspondences / samples
-  double rms_m = 0.0;               // point-to-plane RMS of those [m]
+  std::size_t correspondences = 0;    // of the final pose
+  double overlap = 0.0;               // correspondences / samples
+  double rms_m = 0.0;                 // point-to-plane RMS of those [m]
+  double free_space_violation = 0.0;  // of the final pose (measure_alignment)
   double seconds = 0.0;
 };
 
@@ -56,13 +63,15 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
                              const Eigen::Isometry3d& initial, const IcpSettings& settings,
                              const SampleCloud* target_sample = nullptr);
 
-// Point-to-plane RMS [m] and the correspondences of a given pose, at the
-// final gate of ICP (min_gate_m): the overlap and residual report of a pose
-// without moving it.
+// Point-to-plane RMS [m], the correspondences and the free-space violations
+// of a given pose, at the final gate of ICP (min_gate_m): the overlap and
+// residual report of a pose without moving it.
 struct AlignmentQuality {
   std::size_t correspondences = 0;
   double overlap = 0.0;  // correspondences / samples
   double rms_m = 0.0;
+  // free_space_violation (association.hpp) at the same gate.
+  double free_space_violation = 0.0;
 };
 AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan& target,
                                    const Eigen::Isometry3d& T_target_source,

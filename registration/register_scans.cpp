@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "acquisition/timing.hpp"
+#include "registration/pose_parameters.hpp"
 #include "registration/sample_cloud.hpp"
 
 namespace scanbench::registration {
@@ -19,8 +20,12 @@ struct Candidate {
   Eigen::Isometry3d T_target_source;
 };
 
-// Converged beats not converged; then more overlap; then a smaller RMS.
-bool better(const IcpResult& a, const IcpResult& b) {
+// Consistent with the target's free space beats not; then converged beats
+// not converged; then more overlap; then a smaller RMS.
+bool better(const IcpResult& a, const IcpResult& b, double max_violation) {
+  const bool a_free = a.free_space_violation <= max_violation;
+  const bool b_free = b.free_space_violation <= max_violation;
+  if (a_free != b_free) return a_free;
   if (a.converged != b.converged) return a.converged;
   if (a.overlap != b.overlap) return a.overlap > b.overlap;
   return a.rms_m < b.rms_m;
@@ -83,12 +88,35 @@ void check_coarse_overlap(const SampleCloud& source, const PreparedScan& target,
                           const RegistrationSettings& settings, CoarseReport& report) {
   IcpSettings gate = settings.icp;
   gate.min_gate_m = 0.5 * settings.features.inlier_distance_m;
-  report.overlap = measure_alignment(source, target, report.T_target_source, gate).overlap;
+  const AlignmentQuality quality = measure_alignment(source, target, report.T_target_source, gate);
+  report.overlap = quality.overlap;
+  report.free_space_violation = quality.free_space_violation;
   if (report.overlap < settings.min_overlap) {
     report.success = false;
     report.failure = "features matched, but only " + std::to_string(report.overlap) +
                      " of the scan overlaps the target at that pose";
+  } else if (report.free_space_violation > settings.max_free_space_violation) {
+    report.success = false;
+    report.failure = "features matched, but that pose puts " +
+                     std::to_string(report.free_space_violation) +
+                     " of the scan in space the target saw through";
   }
+}
+
+// A feature pose counts only when ICP from it ends where the best start
+// ended: a wrong match that passed its tests (a façade matched to the wrong
+// one, upside-down scenes whose points all hide behind the target's
+// surfaces) loses to the start that aligns more of the scan.
+void confirm_coarse(const IcpResult& from_coarse, const IcpResult& best, CoarseReport& report) {
+  constexpr double kSameRotationRad = 0.01;  // 0.6°
+  constexpr double kSameTranslationM = 0.1;
+  const auto [rotation, translation] =
+      pose_change(from_coarse.T_target_source, best.T_target_source);
+  if (rotation <= kSameRotationRad && translation <= kSameTranslationM) return;
+  report.success = false;
+  report.failure = "features matched, but ICP from the initial pose aligned more of the scan (" +
+                   std::to_string(best.overlap) + " against " +
+                   std::to_string(from_coarse.overlap) + ")";
 }
 
 PairReport register_pair(int source, int target, const Eigen::Isometry3d& initial,
@@ -108,27 +136,37 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
     if (!report.coarse.success) starts.pop_back();
   }
   std::optional<IcpResult> best;
+  std::optional<IcpResult> from_coarse;
   for (const Candidate& start : starts) {
     IcpResult icp = point_to_plane_icp(
         samples[static_cast<std::size_t>(source)], scans[static_cast<std::size_t>(target)],
         start.T_target_source, settings.icp, &samples[static_cast<std::size_t>(target)]);
-    if (!best || better(icp, *best)) {
+    if (start.start == "coarse") from_coarse = icp;
+    if (!best || better(icp, *best, settings.max_free_space_violation)) {
       best = icp;
       report.start = start.start;
     }
   }
   report.seconds = acquisition::seconds_since(start);
+  if (report.coarse.method == "features" && from_coarse) {
+    confirm_coarse(*from_coarse, *best, report.coarse);
+  }
   if (!best) {
     report.failure = "coarse alignment failed: " + report.coarse.failure;
     return report;
   }
   report.icp = *best;
-  report.registered = best->converged && best->overlap >= settings.min_overlap;
+  report.registered = best->converged && best->overlap >= settings.min_overlap &&
+                      best->free_space_violation <= settings.max_free_space_violation;
   if (!best->converged) {
     report.failure = "ICP did not converge";
-  } else if (!report.registered) {
+  } else if (best->overlap < settings.min_overlap) {
     report.failure = "overlap " + std::to_string(best->overlap) + " is below the minimum " +
                      std::to_string(settings.min_overlap);
+  } else if (!report.registered) {
+    report.failure = "the pose puts " + std::to_string(best->free_space_violation) +
+                     " of the scan in space the target saw through (at most " +
+                     std::to_string(settings.max_free_space_violation) + ")";
   }
   return report;
 }
@@ -203,9 +241,15 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
         settings.coarse == CoarseMethod::kPointPairs ? picks_for(settings, source) : nullptr;
     if (picks != nullptr) target = picks->target;
     const auto t = static_cast<std::size_t>(target);
-    const Eigen::Isometry3d initial = initial_T_world_scan[t].inverse() * initial_T_world_scan[k];
+    // The start: the source's initial pose against the target where the
+    // target registered, so that one scan's initial error does not add to
+    // the next one's (with a lever arm as long as the distance between them).
+    const Eigen::Isometry3d initial_T_first_source =
+        initial_T_world_scan[0].inverse() * initial_T_world_scan[k];
+    const Eigen::Isometry3d initial = T_first_scan[t].inverse() * initial_T_first_source;
     PairReport pair = register_pair(source, target, initial, scans, samples, features, settings);
-    T_first_scan[k] = T_first_scan[t] * (pair.registered ? pair.icp.T_target_source : initial);
+    T_first_scan[k] =
+        pair.registered ? T_first_scan[t] * pair.icp.T_target_source : initial_T_first_source;
     registered[k] = pair.registered && registered[t];
     result.iterations += pair.icp.iterations;
     result.coarse_seconds += pair.coarse.seconds;

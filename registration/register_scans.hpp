@@ -42,21 +42,28 @@ struct RegistrationSettings {
   GlobalSettings global;
   bool refine_globally = true;
   // A pair is registered only when ICP converges with at least this share
-  // of the source samples matched; otherwise it is reported as failed and
-  // the source scan keeps its initial pose relative to its target.
+  // of the source samples matched and at most max_free_space_violation of
+  // them in the target's free space (association.hpp); otherwise it is
+  // reported as failed and the source scan keeps its initial pose. The same
+  // two tests refuse coarse poses.
   double min_overlap = 0.1;
+  double max_free_space_violation = 0.03;
   // Pairs matched at least this share at the registered poses join the
   // global refinement (loop closures included).
   double min_global_overlap = 0.05;
 };
 
 struct CoarseReport {
-  std::string method;         // "none", "point_pairs" or "features"
-  bool success = false;       // the coarse pose was produced and passed its test
+  std::string method;  // "none", "point_pairs" or "features"
+  // The coarse pose was produced and passed its tests; for features also:
+  // ICP from it ended at the chosen pose (not beaten by the initial pose).
+  bool success = false;
   double inlier_ratio = 0.0;  // features: RANSAC inliers / samples
   // Features: share of the ICP samples matched at the coarse pose, within
   // half the RANSAC inlier distance; below min_overlap the pose is refused.
   double overlap = 0.0;
+  // Features: free_space_violation at the coarse pose, with the same tolerance.
+  double free_space_violation = 0.0;
   double rms_m = 0.0;     // point pairs: residual RMS of the fit
   std::size_t count = 0;  // features: inliers; point pairs: pairs
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();  // when success

@@ -1,5 +1,6 @@
 #include "registration/sample_cloud.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <unordered_set>
@@ -20,6 +21,17 @@ std::uint64_t voxel_key(const Eigen::Vector3f& p, float inverse_voxel) {
   return key;
 }
 
+// Indices 0, s, 2s, … below `count` with the stride s ≥ 1 that leaves at
+// most `max_points` of them.
+std::vector<std::size_t> evenly_spaced(std::size_t count, std::size_t max_points) {
+  const double stride = std::max(1.0, static_cast<double>(count) / static_cast<double>(max_points));
+  std::vector<std::size_t> indices;
+  for (double k = 0.0; k < static_cast<double>(count); k += stride) {
+    indices.push_back(static_cast<std::size_t>(k));
+  }
+  return indices;
+}
+
 }  // namespace
 
 SampleCloud sample_scan(const PreparedScan& scan, const SampleSettings& settings) {
@@ -33,16 +45,25 @@ SampleCloud sample_scan(const PreparedScan& scan, const SampleSettings& settings
       firsts.push_back(static_cast<std::int64_t>(i));
     }
   }
-  const double stride =
-      std::max(1.0, static_cast<double>(firsts.size()) / static_cast<double>(settings.max_points));
   SampleCloud cloud;
-  for (double k = 0.0; k < static_cast<double>(firsts.size()); k += stride) {
-    const std::int64_t pixel = firsts[static_cast<std::size_t>(k)];
+  for (std::size_t k : evenly_spaced(firsts.size(), settings.max_points)) {
+    const std::int64_t pixel = firsts[k];
     cloud.pixels.push_back(pixel);
     cloud.points.push_back(scan.points[static_cast<std::size_t>(pixel)]);
     cloud.normals.push_back(scan.geometry->normal[static_cast<std::size_t>(pixel)]);
   }
   return cloud;
+}
+
+SampleCloud thin(const SampleCloud& cloud, std::size_t max_points) {
+  assert(max_points > 0);
+  SampleCloud thinned;
+  for (std::size_t k : evenly_spaced(cloud.size(), max_points)) {
+    thinned.points.push_back(cloud.points[k]);
+    thinned.normals.push_back(cloud.normals[k]);
+    thinned.pixels.push_back(cloud.pixels[k]);
+  }
+  return thinned;
 }
 
 }  // namespace scanbench::registration

@@ -31,4 +31,8 @@ struct SampleSettings {
 // Asserts voxel_m > 0 and max_points > 0.
 SampleCloud sample_scan(const PreparedScan& scan, const SampleSettings& settings);
 
+// Every k-th sample of `cloud`, with the smallest k that leaves at most
+// max_points (asserted > 0). Deterministic.
+SampleCloud thin(const SampleCloud& cloud, std::size_t max_points);
+
 }  // namespace scanbench::registration

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <numbers>
 
 #include "acquisition/simulation/pose_error.hpp"
+#include "registration/association.hpp"
 #include "registration/icp.hpp"
 #include "registration/sample_cloud.hpp"
 #include "registration/simulated_campus.hpp"
@@ -68,6 +70,20 @@ TEST_F(IcpOnCampus, SamplesAreAlignedAtTheTruePoseWhichIcpKeeps) {
   const PoseError error = pose_error(truth, result.T_target_source);
   EXPECT_LT(error.rotation_deg, kMaxRotationErrorDeg);
   EXPECT_LT(error.translation_m, kMaxTranslationErrorM);
+}
+
+// At the true pose almost no sample sits in space the target scanner saw
+// through; turned about the scanner's vertical axis, the scan puts its
+// buildings across the target's open ground.
+TEST_F(IcpOnCampus, FreeSpaceViolationsSeparateTheTruePoseFromATurnedOne) {
+  const Eigen::Isometry3d truth = campus(2).true_relative(0, 1);
+  const PreparedScan& target = campus(2).prepared[0];
+  EXPECT_LT(free_space_violation(*source_, target, truth, 0.05, 0), 0.01);
+  for (const double turn_deg : {20.0, 90.0, 180.0}) {
+    const Eigen::Isometry3d turned =
+        truth * Eigen::AngleAxisd(turn_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ());
+    EXPECT_GT(free_space_violation(*source_, target, turned, 0.05, 0), 0.05) << turn_deg;
+  }
 }
 
 TEST_F(IcpOnCampus, RecoversTheTruePoseFromSeededErrors) {
