@@ -33,17 +33,22 @@ Channels common_channels(std::span<const Scan> scans,
 }
 
 // Calls visit(scan index, pixel index, world point) for every exported pixel
-// (valid, and not a mixed pixel when geometry is exported), scan after scan,
-// row-major.
+// (valid, not a mixed pixel when geometry is exported, and kept when a keep
+// mask is given), scan after scan, row-major.
 template <typename Visit>
 void for_each_point(std::span<const Scan> scans, std::span<const ScanGeometry* const> geometry,
-                    Channels channels, Visit&& visit) {
+                    std::span<const std::vector<std::uint8_t>* const> keep, Channels channels,
+                    Visit&& visit) {
+  assert((keep.empty() || keep.size() == scans.size()) && "one keep entry per scan");
   for (std::size_t s = 0; s < scans.size(); ++s) {
     const Scan& scan = scans[s];
+    const std::vector<std::uint8_t>* mask = keep.empty() ? nullptr : keep[s];
+    assert((mask == nullptr || mask->size() == scan.pixel_count()) && "a byte per pixel");
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.columns; ++col) {
         const std::size_t i = scan.index(row, col);
         if (!scan.valid[i] || (channels.geometry && geometry[s]->is_mixed(i))) continue;
+        if (mask != nullptr && (*mask)[i] == 0) continue;
         visit(s, i, point_in_world(scan, row, col));
       }
     }
@@ -72,14 +77,15 @@ std::string ply_header(std::size_t vertices, Channels channels) {
 }  // namespace
 
 void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
-               std::span<const ScanGeometry* const> geometry) {
+               std::span<const ScanGeometry* const> geometry,
+               std::span<const std::vector<std::uint8_t>* const> keep) {
   const Channels channels = common_channels(scans, geometry);
   std::size_t vertices = 0;
-  for_each_point(scans, geometry, channels,
+  for_each_point(scans, geometry, keep, channels,
                  [&](std::size_t, std::size_t, const Eigen::Vector3d&) { ++vertices; });
   OutputFile file(path);
   file.write(ply_header(vertices, channels));
-  for_each_point(scans, geometry, channels,
+  for_each_point(scans, geometry, keep, channels,
                  [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
                    const Scan& scan = scans[s];
                    std::string& out = file.buffer();
@@ -99,12 +105,13 @@ void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
 }
 
 void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
-               std::span<const ScanGeometry* const> geometry) {
+               std::span<const ScanGeometry* const> geometry,
+               std::span<const std::vector<std::uint8_t>* const> keep) {
   const Channels channels = common_channels(scans, geometry);
   OutputFile file(path);
   file.write(std::string("x,y,z") + (channels.intensity ? ",intensity" : "") +
              (channels.color ? ",r,g,b" : "") + "\n");
-  for_each_point(scans, geometry, channels,
+  for_each_point(scans, geometry, keep, channels,
                  [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
                    const Scan& scan = scans[s];
                    std::string& out = file.buffer();

@@ -3,8 +3,10 @@
 // double precision: georeferenced sites sit at 10^5–10^6 m.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <span>
+#include <vector>
 
 #include "acquisition/scan.hpp"
 #include "acquisition/scan_geometry.hpp"
@@ -15,6 +17,10 @@ namespace scanbench::acquisition {
 // has none). When every scan has geometry, its mixed pixels are left out —
 // they float between surfaces and belong to no model — and the PLY gains the
 // normals and footprints.
+//
+// `keep`, when not empty, holds one entry per scan: a mask of one byte per
+// pixel (1 = write the point; the merged model of `scanbench merge`), or
+// nullptr to write every point of that scan.
 
 // Binary little-endian PLY: double x y z, then float intensity when every scan
 // has intensity, then uchar red green blue when every scan has colour, then
@@ -22,12 +28,14 @@ namespace scanbench::acquisition {
 // (the footprint [m]) when every scan has geometry. All-or-nothing output;
 // throws std::runtime_error naming `path` on write errors.
 void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
-               std::span<const ScanGeometry* const> geometry = {});
+               std::span<const ScanGeometry* const> geometry = {},
+               std::span<const std::vector<std::uint8_t>* const> keep = {});
 
 // CSV with a header line "x,y,z[,intensity][,r,g,b]" (channel columns as for
 // PLY), one valid point per line, shortest exact decimals. All-or-nothing
 // output; throws std::runtime_error naming `path` on write errors.
 void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
-               std::span<const ScanGeometry* const> geometry = {});
+               std::span<const ScanGeometry* const> geometry = {},
+               std::span<const std::vector<std::uint8_t>* const> keep = {});
 
 }  // namespace scanbench::acquisition

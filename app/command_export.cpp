@@ -1,4 +1,4 @@
-// scanbench export PROJECT --format ptx|ply|csv|triplet [--scan ID] -o OUT
+// scanbench export PROJECT --format ptx|ply|csv|triplet [--scan ID] [--merged] -o OUT
 #include <fmt/core.h>
 
 #include <filesystem>
@@ -24,6 +24,7 @@ struct ExportOptions {
   std::string project;
   ExportFormat format = ExportFormat::kPtx;
   std::optional<std::int64_t> scan_id;
+  bool merged = false;
   std::string output;
 };
 
@@ -51,17 +52,44 @@ std::vector<std::optional<acquisition::ScanGeometry>> load_geometry(
   return geometry;
 }
 
+// With --merged, the keep mask of every exported scan (`scanbench merge`);
+// none otherwise. Throws InputError naming the project when a scan has none
+// or the format is a scan-grid format.
+std::vector<std::vector<std::uint8_t>> load_keep_masks(const ExportOptions& options,
+                                                       const modeling::Project& project) {
+  if (!options.merged) return {};
+  if (options.format != ExportFormat::kPly && options.format != ExportFormat::kCsv) {
+    throw acquisition::InputError(options.project, {},
+                                  "--merged writes a point list: use --format ply or csv");
+  }
+  std::vector<std::vector<std::uint8_t>> masks;
+  for (const auto& stored : project.scans()) {
+    if (options.scan_id && stored.id != *options.scan_id) continue;
+    std::optional<std::vector<std::uint8_t>> mask = project.load_keep_mask(stored.id);
+    if (!mask) {
+      throw acquisition::InputError(
+          options.project, {0, 0, "scan " + std::to_string(stored.id)},
+          "no merged model for this scan: run `scanbench merge` after the last registration");
+    }
+    masks.push_back(std::move(*mask));
+  }
+  return masks;
+}
+
 void write_scans(const ExportOptions& options, const std::vector<acquisition::Scan>& scans,
-                 const std::vector<std::optional<acquisition::ScanGeometry>>& geometry) {
+                 const std::vector<std::optional<acquisition::ScanGeometry>>& geometry,
+                 const std::vector<std::vector<std::uint8_t>>& keep) {
   std::vector<const acquisition::ScanGeometry*> pointers;
   for (const auto& g : geometry) pointers.push_back(g ? &*g : nullptr);
+  std::vector<const std::vector<std::uint8_t>*> masks;
+  for (const auto& mask : keep) masks.push_back(&mask);
   switch (options.format) {
     case ExportFormat::kPtx:
       return acquisition::write_ptx(options.output, scans);
     case ExportFormat::kPly:
-      return acquisition::write_ply(options.output, scans, pointers);
+      return acquisition::write_ply(options.output, scans, pointers, masks);
     case ExportFormat::kCsv:
-      return acquisition::write_csv(options.output, scans, pointers);
+      return acquisition::write_csv(options.output, scans, pointers, masks);
     case ExportFormat::kTriplet:
       if (scans.size() != 1) {
         throw acquisition::InputError(options.project, {},
@@ -79,11 +107,19 @@ void write_scans(const ExportOptions& options, const std::vector<acquisition::Sc
 
 void run_export(const ExportOptions& options) {
   const modeling::Project project = modeling::Project::open(options.project);
+  const std::vector<std::vector<std::uint8_t>> keep = load_keep_masks(options, project);
   const std::vector<acquisition::Scan> scans = load_scans(project, options.scan_id);
-  write_scans(options, scans, load_geometry(project, options.scan_id));
+  write_scans(options, scans, load_geometry(project, options.scan_id), keep);
   std::size_t points = 0;
-  for (const auto& scan : scans) points += acquisition::count_valid(scan);
-  fmt::print("exported {} scan(s), {} valid points, to {}\n", scans.size(), points, options.output);
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    if (keep.empty()) {
+      points += acquisition::count_valid(scans[s]);
+      continue;
+    }
+    for (std::size_t i = 0; i < keep[s].size(); ++i) points += keep[s][i] != 0 ? 1 : 0;
+  }
+  fmt::print("exported {} scan(s), {} {} points, to {}\n", scans.size(), points,
+             keep.empty() ? "valid" : "merged-model", options.output);
 }
 
 }  // namespace
@@ -106,6 +142,8 @@ void add_export_command(CLI::App& app) {
       ->required()
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   command->add_option("--scan", options->scan_id, "Export only the scan with this id");
+  command->add_flag("--merged", options->merged,
+                    "PLY or CSV of the merged model only: the points `scanbench merge` kept");
   command->add_option("-o,--output", options->output, "Output file (triplet: the .json sidecar)")
       ->required();
   command->callback([options] { run_export(*options); });
