@@ -215,6 +215,46 @@ TEST(Cli, GeometryThenPlyExportCarriesNormalsAndLeavesMixedPixelsOut) {
       2);
 }
 
+// Two overlapping scans: the merged model leaves out what the finer scan
+// also sampled, and before a merge the option is refused without output.
+TEST(Cli, MergedExportWritesTheKeptPointsOnly) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
+                          "--scans", "2", "--columns", "720", "--rows", "180"})
+                .exit_code,
+            0);
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), (dir / "sim/campus_scan_01.json").string(),
+                          (dir / "sim/campus_scan_02.json").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
+  const auto export_csv = [&](const std::string& name, bool merged) {
+    std::vector<std::string> args{"export", project.string(),     "--format", "csv",
+                                  "-o",     (dir / name).string()};
+    if (merged) args.push_back("--merged");
+    return run_cli(dir, args);
+  };
+  const CliResult early = export_csv("early.csv", true);
+  EXPECT_EQ(early.exit_code, 2);
+  EXPECT_NE(early.err.find("scanbench merge"), std::string::npos) << early.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "early.csv"));
+
+  const CliResult merge = run_cli(dir, {"merge", project.string(), "--json"});
+  ASSERT_EQ(merge.exit_code, 0) << merge.err;
+  ASSERT_EQ(export_csv("all.csv", false).exit_code, 0);
+  ASSERT_EQ(export_csv("merged.csv", true).exit_code, 0);
+  const auto lines = [&](const std::string& name) {
+    const std::string text = test::read_file_bytes(dir / name);
+    return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) - 1;
+  };
+  const nlohmann::json report = nlohmann::json::parse(merge.out);
+  std::size_t kept = 0;
+  for (const auto& scan : report["scans"]) kept += scan["kept"].get<std::size_t>();
+  EXPECT_EQ(lines("merged.csv"), kept);
+  EXPECT_LT(lines("merged.csv"), lines("all.csv"));
+}
+
 TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {
   ScratchDir dir;
   const std::filesystem::path view = dir / "view.json", png = dir / "truth.png";
