@@ -9,7 +9,7 @@
 #   register  coarse (features) + point-to-plane ICP + global refinement
 #   merge     keep masks: each surface from the scan that sampled it most finely
 #   info      table and JSON
-#   export    PTX (lossless), PLY and CSV (world coordinates)
+#   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as PLY
 #   bench     raw-scan I/O throughput against PCL's reader
 # Output goes to DEMO_OUT (default: out/demo/). Later stages (segment,
 # render) join this script as they land.
@@ -52,6 +52,7 @@ echo "JSON description: $out/info.json"
 
 phase "export"
 "$scanbench" export "$project" --format ply --scan 1 -o "$out/campus_scan_1.ply"
+"$scanbench" export "$project" --format ply --merged -o "$out/campus_merged.ply"
 "$scanbench" export "$samples" --format ptx -o "$out/samples.ptx"
 "$scanbench" export "$samples" --format csv -o "$out/samples.csv"
 
