@@ -15,6 +15,7 @@
 #include "registration/association.hpp"
 #include "registration/point_to_plane_costs.hpp"
 #include "registration/pose_parameters.hpp"
+#include "registration/sample_cloud.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -90,10 +91,12 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
   GlobalResult result;
   std::vector<PoseParameters> poses;
   for (const Eigen::Isometry3d& T : T_first_scan) poses.push_back(PoseParameters::from(T));
+  std::vector<SampleCloud> thinned;
+  for (const SampleCloud& cloud : samples) thinned.push_back(thin(cloud, settings.max_samples));
   double gate = settings.initial_gate_m;
   for (int round = 0; round < settings.max_rounds; ++round) {
     result.rounds = round + 1;
-    result.correspondences = solve_round(samples, scans, edges, poses, gate, settings);
+    result.correspondences = solve_round(thinned, scans, edges, poses, gate, settings);
     double largest_rotation = 0.0;
     double largest_translation = 0.0;
     for (std::size_t i = 0; i < poses.size(); ++i) {

@@ -23,6 +23,9 @@ struct GlobalSettings {
   int max_rounds = 8;
   // Levenberg-Marquardt steps of Ceres per round.
   int solver_iterations = 5;
+  // Source samples per scan (thinned evenly): the pairwise poses are already
+  // close, and every edge of a scan reuses its samples.
+  std::size_t max_samples = 10000;
   // Gate of the first round [m] (the pairwise results are already close).
   double initial_gate_m = 0.1;
   // Gates, normal test, loss, stop thresholds and threads as in ICP.

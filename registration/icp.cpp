@@ -99,7 +99,12 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
     const auto [rotation, translation] = pose_change(result.T_target_source, next);
     result.T_target_source = next;
     const double sigma = robust_sigma(matches, next);
-    gate = std::clamp(settings.distance_sigmas * sigma, settings.min_gate_m, gate);
+    // The gate follows the residuals, but halves at most per iteration: a
+    // robust sigma reflects the surfaces that already fit (the ground, long
+    // walls), and a sudden collapse would drop the few that still hold the
+    // pose along the directions those leave free.
+    gate = std::clamp(settings.distance_sigmas * sigma,
+                      std::max(settings.min_gate_m, gate * settings.min_gate_ratio), gate);
     const bool still =
         rotation < settings.stop_rotation_rad && translation < settings.stop_translation_m;
     if (still && !closest_point) {

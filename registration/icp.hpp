@@ -25,6 +25,7 @@ struct IcpSettings {
   // query costs far more than a projection.
   std::size_t closest_point_samples = 8000;
   double distance_sigmas = 3.0;
+  double min_gate_ratio = 0.5;  // the gate shrinks at most by this factor per iteration
   // Normals of matched points differ by at most this [deg].
   double max_normal_angle_deg = 25.0;
   // Scale of the Cauchy loss on the point-to-plane distance [m] at the end:
