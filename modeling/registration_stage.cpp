@@ -94,12 +94,14 @@ nlohmann::json pair_json(const registration::PairReport& p, const std::vector<st
             {"success", p.coarse.success},
             {"inlier_ratio", p.coarse.inlier_ratio},
             {"overlap", p.coarse.overlap},
+            {"free_space_violation", p.coarse.free_space_violation},
             {"count", p.coarse.count},
             {"rms_m", p.coarse.rms_m},
             {"seconds", p.coarse.seconds},
             {"failure", p.coarse.failure}}},
           {"rms_m", p.icp.rms_m},
           {"overlap", p.icp.overlap},
+          {"free_space_violation", p.icp.free_space_violation},
           {"inliers", p.icp.correspondences},
           {"iterations", p.icp.iterations},
           {"converged", p.icp.converged},
@@ -122,6 +124,7 @@ std::string report_json(const registration::RegistrationResult& r,
                                {"target", ids[static_cast<std::size_t>(e.target)]},
                                {"rms_m", e.quality.rms_m},
                                {"overlap", e.quality.overlap},
+                               {"free_space_violation", e.quality.free_space_violation},
                                {"inliers", e.quality.correspondences}});
   }
   report["overall"] = {
@@ -147,6 +150,7 @@ nlohmann::json settings_json(const registration::RegistrationSettings& s) {
           {"min_gate_m", s.icp.min_gate_m},
           {"loss_scale_m", s.icp.loss_scale_m},
           {"min_overlap", s.min_overlap},
+          {"max_free_space_violation", s.max_free_space_violation},
           {"refine_globally", s.refine_globally}};
 }
 

@@ -93,10 +93,15 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
   for (const Eigen::Isometry3d& T : T_first_scan) poses.push_back(PoseParameters::from(T));
   std::vector<SampleCloud> thinned;
   for (const SampleCloud& cloud : samples) thinned.push_back(thin(cloud, settings.max_samples));
+  // Rounds run on the thinned samples until the poses stop moving, then on
+  // all of them until they stop again: the cheap rounds do the moving, the
+  // full ones the last tenths of a millimetre.
+  bool full = false;
   double gate = settings.initial_gate_m;
   for (int round = 0; round < settings.max_rounds; ++round) {
     result.rounds = round + 1;
-    result.correspondences = solve_round(thinned, scans, edges, poses, gate, settings);
+    result.correspondences = solve_round(full ? samples : std::span<const SampleCloud>(thinned),
+                                         scans, edges, poses, gate, settings);
     double largest_rotation = 0.0;
     double largest_translation = 0.0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -108,8 +113,11 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
     gate = std::max(settings.icp.min_gate_m, 0.5 * gate);
     if (largest_rotation < settings.icp.stop_rotation_rad &&
         largest_translation < settings.icp.stop_translation_m) {
-      result.converged = true;
-      break;
+      if (full) {
+        result.converged = true;
+        break;
+      }
+      full = true;
     }
   }
   result.T_first_scan = std::move(T_first_scan);

@@ -20,11 +20,11 @@ struct ScanEdge {
 struct GlobalSettings {
   // Association is redone this many times at most; each round solves the
   // joint problem for fixed correspondences.
-  int max_rounds = 8;
+  int max_rounds = 10;
   // Levenberg-Marquardt steps of Ceres per round.
   int solver_iterations = 5;
-  // Source samples per scan (thinned evenly): the pairwise poses are already
-  // close, and every edge of a scan reuses its samples.
+  // Source samples per scan (thinned evenly) of the rounds before the poses
+  // first stop moving; the rounds after use every sample.
   std::size_t max_samples = 10000;
   // Gate of the first round [m] (the pairwise results are already close).
   double initial_gate_m = 0.1;
