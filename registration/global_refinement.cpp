@@ -93,9 +93,10 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
   for (const Eigen::Isometry3d& T : T_first_scan) poses.push_back(PoseParameters::from(T));
   std::vector<SampleCloud> thinned;
   for (const SampleCloud& cloud : samples) thinned.push_back(thin(cloud, settings.max_samples));
-  // Rounds run on the thinned samples until the poses stop moving, then on
-  // all of them until they stop again: the cheap rounds do the moving, the
-  // full ones the last tenths of a millimetre.
+  // Rounds run on the thinned samples until the poses stop moving (then the
+  // refinement has converged); one more round on all samples polishes them:
+  // the cheap rounds do the moving, the last one the last tenths of a
+  // millimetre.
   bool full = false;
   double gate = settings.initial_gate_m;
   for (int round = 0; round < settings.max_rounds; ++round) {
@@ -110,13 +111,11 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
       largest_translation = std::max(largest_translation, translation);
       T_first_scan[i] = poses[i].isometry();
     }
+    if (full) break;
     gate = std::max(settings.icp.min_gate_m, 0.5 * gate);
     if (largest_rotation < settings.icp.stop_rotation_rad &&
         largest_translation < settings.icp.stop_translation_m) {
-      if (full) {
-        result.converged = true;
-        break;
-      }
+      result.converged = true;
       full = true;
     }
   }

@@ -23,8 +23,8 @@ struct GlobalSettings {
   int max_rounds = 10;
   // Levenberg-Marquardt steps of Ceres per round.
   int solver_iterations = 5;
-  // Source samples per scan (thinned evenly) of the rounds before the poses
-  // first stop moving; the rounds after use every sample.
+  // Source samples per scan (thinned evenly) of the rounds until the poses
+  // stop moving; the one polishing round after them uses every sample.
   std::size_t max_samples = 10000;
   // Gate of the first round [m] (the pairwise results are already close).
   double initial_gate_m = 0.1;
@@ -35,7 +35,9 @@ struct GlobalSettings {
 struct GlobalResult {
   // Pose of every scan in the first scan's frame; [0] is the identity.
   std::vector<Eigen::Isometry3d> T_first_scan;
-  bool converged = false;  // the last round moved no pose beyond the ICP stop thresholds
+  // A round on the thinned samples moved no pose beyond the ICP stop
+  // thresholds (the polishing round on all samples follows it).
+  bool converged = false;
   int rounds = 0;
   std::size_t correspondences = 0;  // over all edges, last round
   double seconds = 0.0;

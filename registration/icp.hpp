@@ -23,7 +23,7 @@ struct IcpSettings {
   // The closest-point iterations use at most this many source samples: they
   // only have to bring the pose within the projective gate, and a kd-tree
   // query costs far more than a projection.
-  std::size_t closest_point_samples = 8000;
+  std::size_t closest_point_samples = 4000;
   double distance_sigmas = 3.0;
   double min_gate_ratio = 0.5;  // the gate shrinks at most by this factor per iteration
   // Normals of matched points differ by at most this [deg].

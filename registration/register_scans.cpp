@@ -119,6 +119,33 @@ void confirm_coarse(const IcpResult& from_coarse, const IcpResult& best, CoarseR
                    std::to_string(from_coarse.overlap) + ")";
 }
 
+// Whether ICP from the feature pose can be skipped because the run from the
+// initial pose (`best`, registered) already decides it: the feature pose lies
+// within a degree and 20 cm of that result (confirmed), or the result aligns
+// at least as much of the scan at the coarse stage's tolerance (refused).
+bool decided_without_coarse_icp(const IcpResult& best, const SampleCloud& source,
+                                const PreparedScan& target, const RegistrationSettings& settings,
+                                CoarseReport& report) {
+  if (!best.converged || best.overlap < settings.min_overlap ||
+      best.free_space_violation > settings.max_free_space_violation) {
+    return false;
+  }
+  constexpr double kSameRotationRad = 0.0175;  // 1°
+  constexpr double kSameTranslationM = 0.2;
+  const auto [rotation, translation] = pose_change(report.T_target_source, best.T_target_source);
+  if (rotation <= kSameRotationRad && translation <= kSameTranslationM) return true;
+  IcpSettings gate = settings.icp;
+  gate.min_gate_m = 0.5 * settings.features.inlier_distance_m;
+  const double overlap = measure_alignment(source, target, best.T_target_source, gate).overlap;
+  if (overlap < report.overlap) return false;
+  report.success = false;
+  report.failure =
+      "features matched, but the pose ICP found from the initial pose aligns more "
+      "of the scan (" +
+      std::to_string(overlap) + " against " + std::to_string(report.overlap) + ")";
+  return true;
+}
+
 PairReport register_pair(int source, int target, const Eigen::Isometry3d& initial,
                          std::span<const PreparedScan> scans,
                          const std::vector<SampleCloud>& samples,
@@ -138,6 +165,12 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
   std::optional<IcpResult> best;
   std::optional<IcpResult> from_coarse;
   for (const Candidate& start : starts) {
+    if (start.start == "coarse" && best &&
+        decided_without_coarse_icp(*best, samples[static_cast<std::size_t>(source)],
+                                   scans[static_cast<std::size_t>(target)], settings,
+                                   report.coarse)) {
+      continue;
+    }
     IcpResult icp = point_to_plane_icp(
         samples[static_cast<std::size_t>(source)], scans[static_cast<std::size_t>(target)],
         start.T_target_source, settings.icp, &samples[static_cast<std::size_t>(target)]);
@@ -185,8 +218,9 @@ std::vector<ScanEdge> overlapping_edges(std::span<const PreparedScan> scans,
       }
       const Eigen::Isometry3d T_b_a = T_first_scan[static_cast<std::size_t>(b)].inverse() *
                                       T_first_scan[static_cast<std::size_t>(a)];
+      // An estimate decides whether the pair overlaps; a thinned sample will do.
       const AlignmentQuality quality =
-          measure_alignment(samples[static_cast<std::size_t>(a)],
+          measure_alignment(thin(samples[static_cast<std::size_t>(a)], settings.global.max_samples),
                             scans[static_cast<std::size_t>(b)], T_b_a, settings.icp);
       if (quality.overlap >= settings.min_global_overlap) edges.push_back({a, b});
     }
