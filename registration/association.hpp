@@ -62,6 +62,18 @@ double free_space_violation(const SampleCloud& source, const PreparedScan& targe
                             const Eigen::Isometry3d& T_target_source, double tolerance_m,
                             int threads);
 
+// associate_samples by projection, and in the same pass the free-space test
+// with the gate's distance as its tolerance (0 for targets without a
+// spherical grid).
+struct ProjectiveAssociation {
+  std::vector<Correspondence> matches;
+  double free_space_violation = 0.0;
+};
+ProjectiveAssociation associate_with_free_space(const SampleCloud& source,
+                                                const PreparedScan& target,
+                                                const Eigen::Isometry3d& T_target_source,
+                                                const AssociationGate& gate, int threads);
+
 // A correspondence as the point-to-plane costs read it: the source sample
 // and the target point and normal, in double.
 struct PlaneCorrespondence {

@@ -128,8 +128,9 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
 AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan& target,
                                    const Eigen::Isometry3d& T_target_source,
                                    const IcpSettings& settings) {
-  const std::vector<Correspondence> matches = associate_samples(
+  const ProjectiveAssociation associated = associate_with_free_space(
       source, target, T_target_source, gate_of(settings.min_gate_m, settings), settings.threads);
+  const std::vector<Correspondence>& matches = associated.matches;
   AlignmentQuality quality;
   quality.correspondences = matches.size();
   quality.overlap = source.size() > 0 ? static_cast<double>(matches.size()) / source.size() : 0.0;
@@ -139,8 +140,7 @@ AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan
     sum_squared += d * d;
   }
   quality.rms_m = matches.empty() ? 0.0 : std::sqrt(sum_squared / matches.size());
-  quality.free_space_violation = registration::free_space_violation(
-      source, target, T_target_source, settings.min_gate_m, settings.threads);
+  quality.free_space_violation = associated.free_space_violation;
   return quality;
 }
 

@@ -157,18 +157,22 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
   report.target = target;
   std::vector<Candidate> starts =
       coarse_stage(source, initial, features, settings, target, report.coarse);
+  // The coarse pose's tests are decisions on shares: a thinned sample will do.
+  const SampleCloud estimate =
+      report.coarse.method == "features"
+          ? thin(samples[static_cast<std::size_t>(source)], settings.estimate_samples)
+          : SampleCloud{};
   if (report.coarse.method == "features" && report.coarse.success) {
-    check_coarse_overlap(samples[static_cast<std::size_t>(source)],
-                         scans[static_cast<std::size_t>(target)], settings, report.coarse);
+    check_coarse_overlap(estimate, scans[static_cast<std::size_t>(target)], settings,
+                         report.coarse);
     if (!report.coarse.success) starts.pop_back();
   }
   std::optional<IcpResult> best;
   std::optional<IcpResult> from_coarse;
   for (const Candidate& start : starts) {
     if (start.start == "coarse" && best &&
-        decided_without_coarse_icp(*best, samples[static_cast<std::size_t>(source)],
-                                   scans[static_cast<std::size_t>(target)], settings,
-                                   report.coarse)) {
+        decided_without_coarse_icp(*best, estimate, scans[static_cast<std::size_t>(target)],
+                                   settings, report.coarse)) {
       continue;
     }
     IcpResult icp = point_to_plane_icp(
@@ -218,9 +222,9 @@ std::vector<ScanEdge> overlapping_edges(std::span<const PreparedScan> scans,
       }
       const Eigen::Isometry3d T_b_a = T_first_scan[static_cast<std::size_t>(b)].inverse() *
                                       T_first_scan[static_cast<std::size_t>(a)];
-      // An estimate decides whether the pair overlaps; a thinned sample will do.
+      // A decision on a share: a thinned sample will do.
       const AlignmentQuality quality =
-          measure_alignment(thin(samples[static_cast<std::size_t>(a)], settings.global.max_samples),
+          measure_alignment(thin(samples[static_cast<std::size_t>(a)], settings.estimate_samples),
                             scans[static_cast<std::size_t>(b)], T_b_a, settings.icp);
       if (quality.overlap >= settings.min_global_overlap) edges.push_back({a, b});
     }

@@ -51,6 +51,10 @@ struct RegistrationSettings {
   // Pairs matched at least this share at the registered poses join the
   // global refinement (loop closures included).
   double min_global_overlap = 0.05;
+  // Samples per scan (thinned evenly) for the overlap and free-space shares
+  // that only decide: a coarse pose's tests, and which pairs join the
+  // global refinement. Reported figures use every sample.
+  std::size_t estimate_samples = 10000;
 };
 
 struct CoarseReport {
