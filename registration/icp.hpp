@@ -36,8 +36,8 @@ struct IcpSettings {
   // Levenberg-Marquardt steps of Ceres per set of correspondences.
   int solver_iterations = 5;
   // Stop when one iteration moves the pose less than both of these.
-  double stop_rotation_rad = 1e-5;  // 0.0006°
-  double stop_translation_m = 1e-4;
+  double stop_rotation_rad = 3e-5;  // 0.0017°
+  double stop_translation_m = 3e-4;
   // Fewer correspondences than this: not converged.
   std::size_t min_correspondences = 50;
   int threads = 0;  // 0 = all cores; results do not depend on it
