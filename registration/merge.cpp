@@ -42,7 +42,8 @@ struct Thresholds {
 bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const OtherScan& o,
                      const Thresholds& t) {
   const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
-  const std::int64_t pixel = associate(*o.scan, p);
+  // The grid's projection inlined: the merge runs it for every point and scan.
+  const std::int64_t pixel = o.scan->grid ? o.scan->grid->pixel_of(p) : associate(*o.scan, p);
   if (pixel < 0) return false;
   const auto k = static_cast<std::size_t>(pixel);
   if (!o.scan->in_model[k]) return false;

@@ -24,14 +24,19 @@ class SphericalGrid {
     rows_ = scan.rows;
     columns_ = scan.columns;
     const double inverse_azimuth_step = 1.0 / model.azimuth_step_rad;
-    double_ = {model.azimuth_start_rad, model.elevation_start_rad, inverse_azimuth_step,
+    const double period = 2.0 * std::numbers::pi * std::abs(inverse_azimuth_step);
+    double_ = {model.azimuth_start_rad,
+               model.elevation_start_rad,
+               inverse_azimuth_step,
                1.0 / model.elevation_step_rad,
-               2.0 * std::numbers::pi * std::abs(inverse_azimuth_step)};
+               period,
+               1.0 / period};
     float_ = {static_cast<float>(double_.azimuth_start),
               static_cast<float>(double_.elevation_start),
               static_cast<float>(double_.inverse_azimuth_step),
               static_cast<float>(double_.inverse_elevation_step),
-              static_cast<float>(double_.period_columns)};
+              static_cast<float>(double_.period_columns),
+              static_cast<float>(double_.inverse_period_columns)};
     half_diagonal_rad_ = 0.5 * std::hypot(model.azimuth_step_rad, model.elevation_step_rad);
   }
 
@@ -51,14 +56,16 @@ class SphericalGrid {
     const Scalar elevation = atan2_of(p_scan.z(), horizontal);
     const Angles<Scalar>& a = angles<Scalar>();
     const Scalar v = (elevation - a.elevation_start) * a.inverse_elevation_step;
-    const auto row = static_cast<std::int64_t>(std::floor(v + Scalar(0.5)));
-    if (row < 0 || row >= rows_) return -1;
+    if (!(v >= Scalar(-0.5))) return -1;  // above the first row (or not a number)
+    const auto row =
+        static_cast<std::int64_t>(v + Scalar(0.5));  // v + ½ ≥ 0: truncation rounds down
+    if (row >= rows_) return -1;
     Scalar u = (azimuth - a.azimuth_start) * a.inverse_azimuth_step;
     const Scalar period = a.period_columns;
-    u -= period * std::floor(u / period);        // into [0, period)
-    if (u >= period - Scalar(0.5)) u -= period;  // the seam: nearer to column 0
-    const auto col = static_cast<std::int64_t>(std::floor(u + Scalar(0.5)));
-    if (col < 0 || col >= columns_) return -1;
+    u -= period * std::floor(u * a.inverse_period_columns);       // into [0, period)
+    if (u >= period - Scalar(0.5)) u -= period;                   // the seam: nearer to column 0
+    const auto col = static_cast<std::int64_t>(u + Scalar(0.5));  // u ≥ −½
+    if (col >= columns_) return -1;
     return row * columns_ + col;
   }
 
@@ -82,6 +89,7 @@ class SphericalGrid {
     Scalar inverse_azimuth_step = 0;  // [1/rad]
     Scalar inverse_elevation_step = 0;
     Scalar period_columns = 0;  // columns in a full turn
+    Scalar inverse_period_columns = 0;
   };
 
   template <typename Scalar>
