@@ -1,5 +1,5 @@
-// scanbench register PROJECT [--coarse features|pairs|none] [--pairs FILE] [--no-global]
-//                            [--threads N] [--json]
+// scanbench register PROJECT [--coarse features|pairs|none] [--pairs FILE] [--unlevelled]
+//                            [--no-global] [--threads N] [--json]
 #include <fmt/core.h>
 
 #include <memory>
@@ -17,6 +17,7 @@ struct RegisterOptions {
   std::string project;
   std::string coarse = "features";
   std::string pairs_file;
+  bool unlevelled = false;
   bool no_global = false;
   int threads = 0;
   bool json = false;
@@ -53,6 +54,7 @@ void run_register(const RegisterOptions& options) {
   } else if (s.coarse == registration::CoarseMethod::kPointPairs) {
     throw CLI::ValidationError("--coarse pairs", "needs --pairs FILE");
   }
+  s.features.levelled = !options.unlevelled;
   s.refine_globally = !options.no_global;
   s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;
   const modeling::RegisterStageResult out = modeling::register_project(options.project, settings);
@@ -82,6 +84,9 @@ void add_register_command(CLI::App& app) {
       ->add_option("--pairs", options->pairs_file,
                    "Picked point pairs (JSON, see docs/registration.md); implies --coarse pairs")
       ->check(CLI::ExistingFile);
+  command->add_flag("--unlevelled", options->unlevelled,
+                    "The scanner was not levelled on site: feature poses from three matches each "
+                    "(PCL's RANSAC) instead of one");
   command->add_flag("--no-global", options->no_global, "Skip the global refinement");
   command->add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   command->add_flag("--json", options->json, "Print the report as one JSON object");

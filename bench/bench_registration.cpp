@@ -5,11 +5,12 @@
 // the fixed reference, kept at its true pose).
 //
 // The peer, PCL's IterativeClosestPointWithNormals, aligns each scan to the
-// one before it from the same start as ours (the coarse pose when our coarse
-// stage accepted one, else the perturbed pose against where PCL put the
-// target), on the same samples; "seconds" compare the fine stages (ours: ICP
-// of every pair, the tests of coarse poses and the global refinement; PCL: its
-// ICP of every pair), per campaign. PCL's ICP runs on one thread, ours on all
+// one before it from the same start as our chosen ICP run (the coarse pose
+// when the run from it won, else the perturbed pose against where PCL put
+// the target), on the same samples; "seconds" compare the fine stages (ours:
+// ICP of every pair and the global refinement; PCL: its ICP of every pair),
+// per campaign. Our feature stage, with the ICP runs that verify its
+// hypotheses, is "coarse_seconds". PCL's ICP runs on one thread, ours on all
 // cores; "ours_one_thread" is the same pipeline on one.
 #include "bench/bench_registration.hpp"
 
@@ -93,7 +94,7 @@ nlohmann::json errors_json(const MethodErrors& e) {
           {"seconds", e.runs > 0 ? e.seconds / e.runs : 0.0}};
 }
 
-// PCL's ICP along the same chain, from the starts our coarse stage chose.
+// PCL's ICP along the same chain, from the starts of our chosen ICP runs.
 std::vector<Eigen::Isometry3d> pcl_chain(const SiteScans& site,
                                          const std::vector<Eigen::Isometry3d>& initial,
                                          const registration::RegistrationResult& ours,
@@ -102,10 +103,10 @@ std::vector<Eigen::Isometry3d> pcl_chain(const SiteScans& site,
   for (const registration::PairReport& pair : ours.pairs) {
     const auto s = static_cast<std::size_t>(pair.source);
     const auto t = static_cast<std::size_t>(pair.target);
-    // As ours: the source's initial pose against where PCL put the target.
-    const Eigen::Isometry3d start = pair.coarse.success && pair.coarse.method == "features"
-                                        ? pair.coarse.T_target_source
-                                        : poses[t].inverse() * initial[s];
+    // Where our chosen ICP run started: the coarse pose, or the source's
+    // initial pose against where PCL put the target.
+    const Eigen::Isometry3d start =
+        pair.start == "coarse" ? pair.coarse.T_target_source : poses[t].inverse() * initial[s];
     const PclIcpResult icp = pcl_point_to_plane_icp(site.samples[s], site.samples[t], start, {});
     seconds += icp.seconds;
     poses.push_back(poses[t] * icp.T_target_source);
@@ -165,8 +166,8 @@ nlohmann::json run_registration_bench(const BenchOptions& options) {
         initial[k] = initial[k] *
                      sim::random_pose_error(kMaxRotationErrorDeg, kMaxTranslationErrorM, random);
       }
-      settings.features.seed = static_cast<std::uint64_t>(trial) + 1;
-      one_thread.features.seed = settings.features.seed;
+      settings.features.hypotheses.seed = static_cast<std::uint64_t>(trial) + 1;
+      one_thread.features.hypotheses.seed = settings.features.hypotheses.seed;
       const registration::RegistrationResult result =
           registration::register_scans(site.prepared, initial, settings);
       const registration::RegistrationResult single =

@@ -1,14 +1,20 @@
-// PCL adapter: FPFH + SampleConsensusPrerejective. PCL headers stay in this file.
+// PCL adapter: FPFH features, their matching, and SampleConsensusPrerejective.
+// PCL headers stay in this file.
 #include "registration/feature_alignment.hpp"
 
 #include <pcl/features/fpfh_omp.h>
+#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/registration/sample_consensus_prerejective.h>
 #include <pcl/search/kdtree.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
+#include <iterator>
+#include <optional>
 
 #include "acquisition/parallel.hpp"
 #include "acquisition/timing.hpp"
@@ -52,13 +58,55 @@ struct Described {
   const Features::Ptr& features;
 };
 
-FeatureAlignmentResult run_ransac(Described source, Described target,
-                                  const FeatureSettings& settings) {
-  FeatureAlignmentResult result;
-  if (source.points->size() < 3 || target.points->size() < 3) {
-    result.failure = "too few points with normals for features";
-    return result;
+bool finite(const pcl::FPFHSignature33& feature) {
+  return std::all_of(std::begin(feature.histogram), std::end(feature.histogram),
+                     [](float bin) { return std::isfinite(bin); });
+}
+
+Eigen::Vector3f position(const pcl::PointNormal& p) {
+  return {p.x, p.y, p.z};
+}
+Eigen::Vector3f normal(const pcl::PointNormal& p) {
+  return {p.normal_x, p.normal_y, p.normal_z};
+}
+
+// Every source sample with each of the `neighbours` target samples whose
+// features are nearest to its own, in source order.
+std::vector<FeatureMatch> match_features(Described source, Described target,
+                                         const FeatureSettings& settings) {
+  pcl::KdTreeFLANN<pcl::FPFHSignature33> index;
+  index.setInputCloud(target.features);
+  const auto k = static_cast<std::size_t>(std::max(1, settings.neighbours));
+  const double max_dz = settings.levelled ? settings.max_normal_z_difference : 2.0;
+  // Slot i·k + j holds the source sample i's j-th match, when it has one.
+  std::vector<std::optional<FeatureMatch>> slots(source.points->size() * k);
+  acquisition::parallel_for_index(
+      static_cast<int>(source.points->size()), settings.threads,
+      [&](int i) {
+        const pcl::FPFHSignature33& feature = (*source.features)[static_cast<std::size_t>(i)];
+        if (!finite(feature)) return;
+        std::vector<int> nearest(k);
+        std::vector<float> distances(k);
+        const int found = index.nearestKSearch(feature, static_cast<int>(k), nearest, distances);
+        const pcl::PointNormal& s = (*source.points)[static_cast<std::size_t>(i)];
+        for (int j = 0; j < found; ++j) {
+          const pcl::PointNormal& t = (*target.points)[static_cast<std::size_t>(nearest[j])];
+          if (std::abs(s.normal_z - t.normal_z) > max_dz) continue;
+          slots[static_cast<std::size_t>(i) * k + static_cast<std::size_t>(j)] =
+              FeatureMatch{position(s), normal(s), position(t), normal(t)};
+        }
+      },
+      64);
+  std::vector<FeatureMatch> matches;
+  for (const std::optional<FeatureMatch>& slot : slots) {
+    if (slot) matches.push_back(*slot);
   }
+  return matches;
+}
+
+// PCL's prerejective RANSAC: one hypothesis, three matches per draw.
+std::optional<Eigen::Isometry3d> prerejective_pose(Described source, Described target,
+                                                   const FeatureSettings& settings) {
   pcl::SampleConsensusPrerejective<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> ransac;
   ransac.setInputSource(source.points);
   ransac.setSourceFeatures(source.features);
@@ -68,21 +116,26 @@ FeatureAlignmentResult run_ransac(Described source, Described target,
   ransac.setNumberOfSamples(3);
   ransac.setCorrespondenceRandomness(settings.correspondence_randomness);
   ransac.setSimilarityThreshold(static_cast<float>(settings.similarity));
-  ransac.setMaxCorrespondenceDistance(settings.inlier_distance_m);
-  ransac.setInlierFraction(static_cast<float>(settings.min_inlier_ratio));
+  ransac.setMaxCorrespondenceDistance(settings.hypotheses.inlier_distance_m);
+  ransac.setInlierFraction(static_cast<float>(settings.min_inliers) /
+                           static_cast<float>(source.points->size()));
   // PCL draws its samples with std::rand; seeding it makes runs repeatable.
-  std::srand(static_cast<unsigned>(settings.seed));
+  std::srand(static_cast<unsigned>(settings.hypotheses.seed));
   Cloud aligned;
   ransac.align(aligned);
-  result.inliers = ransac.getInliers().size();
-  result.inlier_ratio = static_cast<double>(result.inliers) / source.points->size();
-  result.T_target_source.matrix() = ransac.getFinalTransformation().cast<double>();
-  result.success = ransac.hasConverged() && result.inlier_ratio >= settings.min_inlier_ratio;
-  if (!result.success) {
-    result.failure =
-        "no consistent feature matches (inlier ratio " + std::to_string(result.inlier_ratio) + ")";
-  }
-  return result;
+  if (!ransac.hasConverged()) return std::nullopt;
+  Eigen::Isometry3d T;
+  T.matrix() = ransac.getFinalTransformation().cast<double>();
+  return T;
+}
+
+std::vector<PoseHypothesis> hypotheses_from(Described source, Described target,
+                                            std::span<const FeatureMatch> matches,
+                                            const FeatureSettings& settings) {
+  if (settings.levelled) return levelled_hypotheses(matches, settings.hypotheses);
+  const std::optional<Eigen::Isometry3d> pose = prerejective_pose(source, target, settings);
+  if (!pose) return {};
+  return {refine_hypothesis(matches, *pose, settings.hypotheses.inlier_distance_m)};
 }
 
 }  // namespace
@@ -90,9 +143,24 @@ FeatureAlignmentResult run_ransac(Described source, Described target,
 FeatureAlignmentResult align_features(const FeatureCloud& source, const FeatureCloud& target,
                                       const FeatureSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
-  FeatureAlignmentResult result =
-      run_ransac({source.impl_->points, source.impl_->features},
-                 {target.impl_->points, target.impl_->features}, settings);
+  FeatureAlignmentResult result;
+  const Described from{source.impl_->points, source.impl_->features};
+  const Described to{target.impl_->points, target.impl_->features};
+  if (from.points->size() < 3 || to.points->size() < 3) {
+    result.failure = "too few points with normals for features";
+  } else {
+    const std::vector<FeatureMatch> matches = match_features(from, to, settings);
+    result.matches = matches.size();
+    for (PoseHypothesis& hypothesis : hypotheses_from(from, to, matches, settings)) {
+      if (hypothesis.inliers >= settings.min_inliers) {
+        result.hypotheses.push_back(std::move(hypothesis));
+      }
+    }
+    if (result.hypotheses.empty()) {
+      result.failure = "no pose agrees with " + std::to_string(settings.min_inliers) + " of the " +
+                       std::to_string(matches.size()) + " feature matches";
+    }
+  }
   result.seconds = acquisition::seconds_since(start);
   return result;
 }

@@ -1,42 +1,59 @@
-// Automatic coarse registration: FPFH features (Rusu et al. 2009) matched
-// with prerejective RANSAC (Buch et al. 2013), through PCL. No pose guess is
-// needed; the result counts only when enough matched points agree.
+// Automatic coarse registration: FPFH features (Rusu et al. 2009) through
+// PCL, matched between two scans, and pose hypotheses drawn from the matches
+// by RANSAC. No pose guess is needed. A hypothesis is only a candidate: the
+// pipeline (register_scans.cpp) keeps one only after ICP from it lands most
+// of the scan on the target's surfaces and none in its free space.
 #pragma once
 
-#include <Eigen/Geometry>
 #include <cstddef>
-#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "registration/coarse_hypotheses.hpp"
 #include "registration/sample_cloud.hpp"
 
 namespace scanbench::registration {
 
 struct FeatureSettings {
   // The clouds features are computed on: one sample per voxel of this edge.
-  SampleSettings sample{0.5, 6000};
+  SampleSettings sample{0.5, 30000};
   double feature_radius_m = 1.5;  // FPFH support radius
-  // RANSAC: a hypothesis from 3 feature matches, each drawn among the
-  // `correspondence_randomness` nearest features; pre-rejected when the
-  // edge lengths of the two triangles differ by more than 1 − similarity.
+  int neighbours = 3;             // target features matched to each source feature
+  // Scans from a levelled scanner (scan z axis up, within a few degrees):
+  // hypotheses from one match each (coarse_hypotheses.hpp), and matches
+  // whose normals differ by more than max_normal_z_difference in their
+  // vertical component are dropped (a heading turn leaves it unchanged).
+  // Otherwise PCL's prerejective RANSAC (Buch et al. 2013) draws three
+  // matches per hypothesis and returns its best one.
+  bool levelled = true;
+  double max_normal_z_difference = 0.15;
+  HypothesisSettings hypotheses;  // levelled; inlier_distance_m and seed serve both
+  // Not levelled: every hypothesis of PCL's RANSAC is pre-rejected when the
+  // edge lengths of its two triangles differ by more than 1 − similarity;
+  // each draws among the `correspondence_randomness` nearest features.
   int max_iterations = 20000;
   int correspondence_randomness = 3;
   double similarity = 0.9;
-  double inlier_distance_m = 1.0;  // a moved source point this near a target point is an inlier
-  // Accepted only when at least this share of the source points are inliers.
-  double min_inlier_ratio = 0.2;
-  std::uint64_t seed = 1;  // RANSAC draws; same seed, same result
-  int threads = 0;         // feature computation; 0 = all cores
+  // A hypothesis needs at least this many matches within the inlier distance.
+  std::size_t min_inliers = 10;
+  // Verification (register_scans.cpp): ICP runs from the hypotheses with
+  // the most inliers and from those that put the largest share of a thinned
+  // sample (screening_samples) on the target's surfaces, less the share in
+  // its free space.
+  std::size_t verify_by_inliers = 6;
+  std::size_t verify_by_overlap = 6;
+  std::size_t screening_samples = 3000;
+  int threads = 0;  // feature computation and matching; 0 = all cores
 };
 
 struct FeatureAlignmentResult {
-  bool success = false;  // enough inliers; else T_target_source is meaningless
-  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
-  std::size_t inliers = 0;
-  double inlier_ratio = 0.0;  // inliers / source points
+  // Distinct poses with at least min_inliers, most inliers first; empty on
+  // failure.
+  std::vector<PoseHypothesis> hypotheses;
+  std::size_t matches = 0;  // feature matches the hypotheses were drawn from
   double seconds = 0.0;
-  std::string failure;  // why success is false; empty on success
+  std::string failure;  // why hypotheses is empty
 };
 
 // The features of one scan's sample, computed once and reused for every pair.
@@ -55,7 +72,7 @@ class FeatureCloud {
   std::unique_ptr<Impl> impl_;
 };
 
-// Aligns the source features to the target features.
+// Pose hypotheses taking the source scan's frame to the target's.
 FeatureAlignmentResult align_features(const FeatureCloud& source, const FeatureCloud& target,
                                       const FeatureSettings& settings);
 

@@ -38,11 +38,10 @@ const PickedPairs* picks_for(const RegistrationSettings& settings, int source) {
   return nullptr;
 }
 
-// The coarse stage of one pair: its report, and the starts ICP tries.
+// The coarse stage of one pair: its report, and the starts ICP tries (for
+// features only the initial pose; feature_start adds its own).
 std::vector<Candidate> coarse_stage(int source, const Eigen::Isometry3d& initial,
-                                    const std::vector<FeatureCloud>& features,
-                                    const RegistrationSettings& settings, int target,
-                                    CoarseReport& report) {
+                                    const RegistrationSettings& settings, CoarseReport& report) {
   switch (settings.coarse) {
     case CoarseMethod::kNone:
       report.method = "none";
@@ -63,44 +62,104 @@ std::vector<Candidate> coarse_stage(int source, const Eigen::Isometry3d& initial
       }
       return {{"coarse", fit.T_target_source}};
     }
-    case CoarseMethod::kFeatures: {
+    case CoarseMethod::kFeatures:
+      // The feature pose is added by feature_start, after verification.
       report.method = "features";
-      const FeatureAlignmentResult aligned =
-          align_features(features[static_cast<std::size_t>(source)],
-                         features[static_cast<std::size_t>(target)], settings.features);
-      report.success = aligned.success;
-      report.inlier_ratio = aligned.inlier_ratio;
-      report.count = aligned.inliers;
-      report.seconds = aligned.seconds;
-      report.failure = aligned.failure;
-      report.T_target_source = aligned.T_target_source;
-      std::vector<Candidate> starts{{"initial", initial}};
-      if (aligned.success) starts.push_back({"coarse", aligned.T_target_source});
-      return starts;
-    }
+      return {{"initial", initial}};
   }
   return {};
 }
 
-// A feature match can agree on a dominant plane (the ground) and nothing
-// else; it counts only when enough of the scan lands on the target's surfaces.
-void check_coarse_overlap(const SampleCloud& source, const PreparedScan& target,
-                          const RegistrationSettings& settings, CoarseReport& report) {
-  IcpSettings gate = settings.icp;
-  gate.min_gate_m = 0.5 * settings.features.inlier_distance_m;
-  const AlignmentQuality quality = measure_alignment(source, target, report.T_target_source, gate);
-  report.overlap = quality.overlap;
-  report.free_space_violation = quality.free_space_violation;
-  if (report.overlap < settings.min_overlap) {
-    report.success = false;
-    report.failure = "features matched, but only " + std::to_string(report.overlap) +
-                     " of the scan overlaps the target at that pose";
-  } else if (report.free_space_violation > settings.max_free_space_violation) {
-    report.success = false;
-    report.failure = "features matched, but that pose puts " +
-                     std::to_string(report.free_space_violation) +
-                     " of the scan in space the target saw through";
+// The hypotheses ICP verifies: the first verify_by_inliers (most inliers),
+// and the verify_by_overlap that put the largest share of a thinned sample
+// on the target's surfaces less the share in its free space. The two lists
+// fail differently: many inliers can be a façade matched to its neighbour,
+// a high overlap a pose that slid along the ground.
+std::vector<std::size_t> verification_candidates(std::span<const PoseHypothesis> hypotheses,
+                                                 const SampleCloud& estimate,
+                                                 const PreparedScan& target,
+                                                 const RegistrationSettings& settings) {
+  const FeatureSettings& features = settings.features;
+  std::vector<std::size_t> chosen;
+  for (std::size_t i = 0; i < std::min(hypotheses.size(), features.verify_by_inliers); ++i) {
+    chosen.push_back(i);
   }
+  const SampleCloud few = thin(estimate, features.screening_samples);
+  IcpSettings gate = settings.icp;
+  gate.min_gate_m = features.hypotheses.inlier_distance_m;
+  std::vector<std::pair<double, std::size_t>> by_overlap;
+  for (std::size_t i = 0; i < hypotheses.size(); ++i) {
+    const AlignmentQuality quality =
+        measure_alignment(few, target, hypotheses[i].T_target_source, gate);
+    by_overlap.emplace_back(quality.overlap - quality.free_space_violation, i);
+  }
+  std::stable_sort(by_overlap.begin(), by_overlap.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (std::size_t rank = 0; rank < std::min(by_overlap.size(), features.verify_by_overlap);
+       ++rank) {
+    const std::size_t i = by_overlap[rank].second;
+    if (std::find(chosen.begin(), chosen.end(), i) == chosen.end()) chosen.push_back(i);
+  }
+  return chosen;
+}
+
+// The feature stage of one pair: pose hypotheses from matched features, the
+// most promising refined by ICP on a thinned sample. The coarse pose is the
+// refined hypothesis that lands the largest share of the scan on the
+// target's surfaces while passing the pair's tests (converged, min_overlap,
+// max_free_space_violation); none passing is a failure, never a guess.
+std::optional<Eigen::Isometry3d> feature_start(
+    const FeatureCloud& source_features, const FeatureCloud& target_features,
+    const SampleCloud& estimate, const PreparedScan& target, const SampleCloud& target_sample,
+    const RegistrationSettings& settings, CoarseReport& report) {
+  const Clock::time_point start = Clock::now();
+  const FeatureAlignmentResult aligned =
+      align_features(source_features, target_features, settings.features);
+  report.failure = aligned.failure;
+  std::optional<IcpResult> best;
+  std::size_t best_index = 0;
+  double closest_overlap = 0.0;  // of the hypotheses that failed, for the message
+  for (const std::size_t i :
+       verification_candidates(aligned.hypotheses, estimate, target, settings)) {
+    const IcpResult icp = point_to_plane_icp(
+        estimate, target, aligned.hypotheses[i].T_target_source, settings.icp, &target_sample);
+    const bool passes = icp.converged && icp.overlap >= settings.min_overlap &&
+                        icp.free_space_violation <= settings.max_free_space_violation;
+    if (!passes) {
+      closest_overlap = std::max(closest_overlap, icp.overlap);
+    } else if (!best || icp.overlap > best->overlap) {
+      best = icp;
+      best_index = i;
+    }
+  }
+  report.seconds = acquisition::seconds_since(start);
+  if (!best) {
+    if (!aligned.hypotheses.empty()) {
+      report.failure = "none of " + std::to_string(aligned.hypotheses.size()) +
+                       " feature poses holds after ICP (largest overlap " +
+                       std::to_string(closest_overlap) +
+                       ", each non-converged, below the minimum overlap or in the target's "
+                       "free space)";
+    }
+    return std::nullopt;
+  }
+  const PoseHypothesis& chosen = aligned.hypotheses[best_index];
+  report.success = true;
+  report.failure.clear();
+  report.count = chosen.inliers;
+  report.inlier_ratio = static_cast<double>(chosen.inliers) / static_cast<double>(aligned.matches);
+  report.overlap = best->overlap;
+  report.free_space_violation = best->free_space_violation;
+  report.T_target_source = best->T_target_source;
+  return best->T_target_source;
+}
+
+// Two ICP results this close are the same minimum reached twice.
+bool same_result(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  constexpr double kSameRotationRad = 0.01;  // 0.6°
+  constexpr double kSameTranslationM = 0.1;
+  const auto [rotation, translation] = pose_change(a, b);
+  return rotation <= kSameRotationRad && translation <= kSameTranslationM;
 }
 
 // A feature pose counts only when ICP from it ends where the best start
@@ -108,11 +167,7 @@ void check_coarse_overlap(const SampleCloud& source, const PreparedScan& target,
 // one, upside-down scenes whose points all hide behind the target's
 // surfaces) loses to the start that aligns more of the scan.
 void confirm_coarse(const IcpResult& from_coarse, const IcpResult& best, CoarseReport& report) {
-  constexpr double kSameRotationRad = 0.01;  // 0.6°
-  constexpr double kSameTranslationM = 0.1;
-  const auto [rotation, translation] =
-      pose_change(from_coarse.T_target_source, best.T_target_source);
-  if (rotation <= kSameRotationRad && translation <= kSameTranslationM) return;
+  if (same_result(from_coarse.T_target_source, best.T_target_source)) return;
   report.success = false;
   report.failure = "features matched, but ICP from the initial pose aligned more of the scan (" +
                    std::to_string(best.overlap) + " against " +
@@ -120,9 +175,9 @@ void confirm_coarse(const IcpResult& from_coarse, const IcpResult& best, CoarseR
 }
 
 // Whether ICP from the feature pose can be skipped because the run from the
-// initial pose (`best`, registered) already decides it: the feature pose lies
-// within a degree and 20 cm of that result (confirmed), or the result aligns
-// at least as much of the scan at the coarse stage's tolerance (refused).
+// initial pose (`best`, registered) already decides it: the feature pose
+// (itself an ICP result on the thinned sample) is that result (confirmed),
+// or the result aligns at least as much of the thinned sample (refused).
 bool decided_without_coarse_icp(const IcpResult& best, const SampleCloud& source,
                                 const PreparedScan& target, const RegistrationSettings& settings,
                                 CoarseReport& report) {
@@ -130,13 +185,9 @@ bool decided_without_coarse_icp(const IcpResult& best, const SampleCloud& source
       best.free_space_violation > settings.max_free_space_violation) {
     return false;
   }
-  constexpr double kSameRotationRad = 0.0175;  // 1°
-  constexpr double kSameTranslationM = 0.2;
-  const auto [rotation, translation] = pose_change(report.T_target_source, best.T_target_source);
-  if (rotation <= kSameRotationRad && translation <= kSameTranslationM) return true;
-  IcpSettings gate = settings.icp;
-  gate.min_gate_m = 0.5 * settings.features.inlier_distance_m;
-  const double overlap = measure_alignment(source, target, best.T_target_source, gate).overlap;
+  if (same_result(report.T_target_source, best.T_target_source)) return true;
+  const double overlap =
+      measure_alignment(source, target, best.T_target_source, settings.icp).overlap;
   if (overlap < report.overlap) return false;
   report.success = false;
   report.failure =
@@ -155,29 +206,28 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
   PairReport report;
   report.source = source;
   report.target = target;
-  std::vector<Candidate> starts =
-      coarse_stage(source, initial, features, settings, target, report.coarse);
-  // The coarse pose's tests are decisions on shares: a thinned sample will do.
-  const SampleCloud estimate =
-      report.coarse.method == "features"
-          ? thin(samples[static_cast<std::size_t>(source)], settings.estimate_samples)
-          : SampleCloud{};
-  if (report.coarse.method == "features" && report.coarse.success) {
-    check_coarse_overlap(estimate, scans[static_cast<std::size_t>(target)], settings,
-                         report.coarse);
-    if (!report.coarse.success) starts.pop_back();
+  const auto s = static_cast<std::size_t>(source);
+  const auto t = static_cast<std::size_t>(target);
+  std::vector<Candidate> starts = coarse_stage(source, initial, settings, report.coarse);
+  // The feature poses' tests are decisions on shares: a thinned sample will do.
+  const SampleCloud estimate = settings.coarse == CoarseMethod::kFeatures
+                                   ? thin(samples[s], settings.estimate_samples)
+                                   : SampleCloud{};
+  if (settings.coarse == CoarseMethod::kFeatures) {
+    if (const std::optional<Eigen::Isometry3d> pose = feature_start(
+            features[s], features[t], estimate, scans[t], samples[t], settings, report.coarse)) {
+      starts.push_back({"coarse", *pose});
+    }
   }
   std::optional<IcpResult> best;
   std::optional<IcpResult> from_coarse;
   for (const Candidate& start : starts) {
-    if (start.start == "coarse" && best &&
-        decided_without_coarse_icp(*best, estimate, scans[static_cast<std::size_t>(target)],
-                                   settings, report.coarse)) {
+    if (start.start == "coarse" && report.coarse.method == "features" && best &&
+        decided_without_coarse_icp(*best, estimate, scans[t], settings, report.coarse)) {
       continue;
     }
-    IcpResult icp = point_to_plane_icp(
-        samples[static_cast<std::size_t>(source)], scans[static_cast<std::size_t>(target)],
-        start.T_target_source, settings.icp, &samples[static_cast<std::size_t>(target)]);
+    IcpResult icp =
+        point_to_plane_icp(samples[s], scans[t], start.T_target_source, settings.icp, &samples[t]);
     if (start.start == "coarse") from_coarse = icp;
     if (!best || better(icp, *best, settings.max_free_space_violation)) {
       best = icp;

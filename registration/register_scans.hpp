@@ -20,7 +20,7 @@ namespace scanbench::registration {
 enum class CoarseMethod {
   kNone,        // start ICP from the initial poses
   kPointPairs,  // closed-form fit of user-picked point pairs
-  kFeatures,    // FPFH + RANSAC; ICP also tries the initial pose and keeps the better
+  kFeatures,    // FPFH + RANSAC, verified by ICP; ICP also tries the initial pose, the better wins
 };
 
 // Points picked in scan `source` and scan `target` (indices into the scan
@@ -62,15 +62,17 @@ struct CoarseReport {
   // The coarse pose was produced and passed its tests; for features also:
   // ICP from it ended at the chosen pose (not beaten by the initial pose).
   bool success = false;
-  double inlier_ratio = 0.0;  // features: RANSAC inliers / samples
-  // Features: share of the ICP samples matched at the coarse pose, within
-  // half the RANSAC inlier distance; below min_overlap the pose is refused.
+  double inlier_ratio = 0.0;  // features: the chosen hypothesis's inliers / feature matches
+  // Features: the share of the thinned ICP samples (estimate_samples)
+  // matched, and in the target's free space, after the verifying ICP from
+  // the chosen hypothesis.
   double overlap = 0.0;
-  // Features: free_space_violation at the coarse pose, with the same tolerance.
   double free_space_violation = 0.0;
   double rms_m = 0.0;     // point pairs: residual RMS of the fit
   std::size_t count = 0;  // features: inliers; point pairs: pairs
-  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();  // when success
+  // When success: the fit of the picked pairs, or the chosen feature
+  // hypothesis after its verifying ICP on the thinned sample.
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
   double seconds = 0.0;
   std::string failure;
 };
