@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <variant>
 
 #include "acquisition/parallel.hpp"
 #include "acquisition/timing.hpp"
@@ -26,7 +27,15 @@ struct OtherScan {
   int index = 0;          // position in the scan list (tie-break)
   Eigen::Matrix3f R_o_s;  // rotation s → o
   Eigen::Vector3f t_o_s;  // translation s → o [m]
+  // Spherical o: |Δazimuth · Δelevation| [sr] and |Δelevation| [rad]; 0 for
+  // per-pixel grids.
+  float step_solid_angle = 0.0f;
+  float elevation_step = 0.0f;
 };
+
+// Pixel solid angles come from chords between neighbouring directions,
+// shorter than the arcs by far less than this factor.
+constexpr float kChordSlack = 0.99f;
 
 struct Thresholds {
   float range_sigmas;
@@ -42,6 +51,19 @@ struct Thresholds {
 bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const OtherScan& o,
                      const Thresholds& t) {
   const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
+  const float area_s = s.sample_area_m2[i];
+  // A sample of spherical o at p covers at least r² Ω, its area at normal
+  // incidence. Ω = |Δaz Δel| cos(el) at the elevation of o's pixel row,
+  // within one step δ of p's own elevation, and r² cos(el ± δ) ≥ r (ρ − |z| δ)
+  // (ρ: horizontal distance). When even that bound is coarser than s's
+  // sample, o is coarser whatever its normal, and p need not be projected.
+  if (o.step_solid_angle > 0.0f) {
+    const float r = p.norm();
+    const float rho = std::sqrt(p.x() * p.x() + p.y() * p.y());
+    const float min_area_o =
+        kChordSlack * r * (rho - std::abs(p.z()) * o.elevation_step) * o.step_solid_angle;
+    if (min_area_o > area_s * t.tie_high) return false;
+  }
   // The grid's projection inlined: the merge runs it for every point and scan.
   const std::int64_t pixel = o.scan->grid ? o.scan->grid->pixel_of(p) : associate(*o.scan, p);
   if (pixel < 0) return false;
@@ -58,7 +80,6 @@ bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Ot
     const Eigen::Vector3f n = o.R_o_s * s.geometry->normal[i];
     if (n.dot(o.scan->geometry->normal[k]) < t.min_normal_cos) return false;
   }
-  const float area_s = s.sample_area_m2[i];
   const float area_o = o.scan->sample_area_m2[k];
   if (area_o < area_s * t.tie_low) return true;
   return area_o <= area_s * t.tie_high && o.index < s_index;
@@ -84,14 +105,22 @@ void merge_row(std::span<const PreparedScan> scans, int s_index,
 }
 
 std::vector<OtherScan> others_of(std::span<const PreparedScan> scans,
-                                 std::span<const Eigen::Isometry3d> T_world_scan, int s_index) {
+                                 std::span<const Eigen::Isometry3d> T_world_scan, int s_index,
+                                 bool bound) {
   std::vector<OtherScan> others;
   for (int o = 0; o < static_cast<int>(scans.size()); ++o) {
     if (o == s_index) continue;
     const Eigen::Isometry3d T_o_s = T_world_scan[static_cast<std::size_t>(o)].inverse() *
                                     T_world_scan[static_cast<std::size_t>(s_index)];
-    others.push_back({&scans[static_cast<std::size_t>(o)], o, T_o_s.linear().cast<float>(),
-                      T_o_s.translation().cast<float>()});
+    const PreparedScan& other = scans[static_cast<std::size_t>(o)];
+    OtherScan entry{&other, o, T_o_s.linear().cast<float>(), T_o_s.translation().cast<float>()};
+    const auto* angles = std::get_if<acquisition::SphericalAngles>(&other.scan->angles);
+    if (angles != nullptr && bound) {
+      entry.step_solid_angle =
+          static_cast<float>(std::abs(angles->azimuth_step_rad * angles->elevation_step_rad));
+      entry.elevation_step = static_cast<float>(std::abs(angles->elevation_step_rad));
+    }
+    others.push_back(entry);
   }
   return others;
 }
@@ -125,7 +154,8 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
   MergeResult result;
   for (int s = 0; s < static_cast<int>(scans.size()); ++s) {
     const PreparedScan& scan = scans[static_cast<std::size_t>(s)];
-    const std::vector<OtherScan> others = others_of(scans, T_world_scan, s);
+    const std::vector<OtherScan> others =
+        others_of(scans, T_world_scan, s, settings.bound_coarser_scans);
     MergeScanResult out;
     out.keep.assign(scan.in_model.size(), 0);
     acquisition::parallel_for_index(

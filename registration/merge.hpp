@@ -26,6 +26,11 @@ struct MergeSettings {
   // listed first then keeps its points. Keeps the decision consistent from
   // both sides where two scans sample a surface equally finely.
   double tie_tolerance = 0.05;
+  // Skip the projection into a spherical scan whose samples at the point's
+  // position are coarser than the point's own whatever the surface's normal
+  // (a lower bound of their area). The decisions are the same without it;
+  // only the time differs (about half on the campus).
+  bool bound_coarser_scans = true;
   int threads = 0;  // 0 = all cores; results do not depend on it
 };
 

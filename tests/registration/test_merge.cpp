@@ -1,6 +1,7 @@
 // Merging by sampling rate on hand-built scans of one wall with known
 // sampling rates: the finer scan keeps the shared surface, ties go to the
-// scan listed first, mixed pixels never make it into the model.
+// scan listed first, mixed pixels never make it into the model; and, on the
+// simulated campus, the shortcut that skips coarser scans decides the same.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include "registration/merge.hpp"
 #include "registration/prepared_scan.hpp"
+#include "registration/simulated_campus.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -265,6 +267,22 @@ TEST(MergeBySamplingRate, ResultsDoNotDependOnTheThreadCount) {
   for (std::size_t s = 0; s < 3; ++s) {
     EXPECT_EQ(one.scans[s].keep, all.scans[s].keep) << s;
     EXPECT_EQ(one.scans[s].kept, all.scans[s].kept) << s;
+  }
+}
+
+// The bound on the other scan's sample area only skips projections whose
+// outcome it knows: the simulated campus gives the same keep masks with it.
+TEST(MergeBySamplingRate, TheCoarserScanBoundChangesNoDecision) {
+  const test::SimulatedCampus& site = test::campus(3);
+  MergeSettings with_bound;
+  MergeSettings without_bound;
+  without_bound.bound_coarser_scans = false;
+  const MergeResult fast = merge_by_sampling_rate(site.prepared, site.true_poses, with_bound);
+  const MergeResult full = merge_by_sampling_rate(site.prepared, site.true_poses, without_bound);
+  ASSERT_EQ(fast.scans.size(), 3u);
+  for (std::size_t s = 0; s < 3; ++s) {
+    EXPECT_EQ(fast.scans[s].keep, full.scans[s].keep) << s;
+    EXPECT_GT(full.scans[s].redundant, 0u) << s;  // the scans do share surfaces
   }
 }
 
