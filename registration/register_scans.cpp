@@ -266,16 +266,17 @@ std::vector<ScanEdge> overlapping_edges(std::span<const PreparedScan> scans,
                                         const RegistrationSettings& settings) {
   std::vector<ScanEdge> edges;
   for (int a = 1; a < static_cast<int>(scans.size()); ++a) {
+    // A decision on a share: a thinned sample will do.
+    const SampleCloud estimate =
+        thin(samples[static_cast<std::size_t>(a)], settings.estimate_samples);
     for (int b = 0; b < a; ++b) {
       if (!registered[static_cast<std::size_t>(a)] || !registered[static_cast<std::size_t>(b)]) {
         continue;
       }
       const Eigen::Isometry3d T_b_a = T_first_scan[static_cast<std::size_t>(b)].inverse() *
                                       T_first_scan[static_cast<std::size_t>(a)];
-      // A decision on a share: a thinned sample will do.
       const AlignmentQuality quality =
-          measure_alignment(thin(samples[static_cast<std::size_t>(a)], settings.estimate_samples),
-                            scans[static_cast<std::size_t>(b)], T_b_a, settings.icp);
+          measure_alignment(estimate, scans[static_cast<std::size_t>(b)], T_b_a, settings.icp);
       if (quality.overlap >= settings.min_global_overlap) edges.push_back({a, b});
     }
   }
