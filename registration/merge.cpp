@@ -9,6 +9,7 @@
 #include "registration/merge.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -31,11 +32,15 @@ struct OtherScan {
   // per-pixel grids.
   float step_solid_angle = 0.0f;
   float elevation_step = 0.0f;
+  // 1 / (1 + F), F the largest footprint / range of o's model points.
+  float inverse_footprint_growth = 1.0f;
 };
 
-// Pixel solid angles come from chords between neighbouring directions,
-// shorter than the arcs by far less than this factor.
-constexpr float kChordSlack = 0.99f;
+// Covers the second-order terms the area bound below leaves out: the chords
+// between neighbouring directions that give pixel solid angles are shorter
+// than the arcs, and cos(el + Δ) ≥ cos el − |sin el| Δ holds only to first
+// order (the rest is below cos el · Δ²/2).
+constexpr float kBoundSlack = 0.99f;
 
 struct Thresholds {
   float range_sigmas;
@@ -46,33 +51,40 @@ struct Thresholds {
   float noise_per_m;
 };
 
+// True when spherical o samples the surface at point p (s's point, in o's
+// frame at range r; sigma_s its range noise σ) more coarsely than s samples
+// it (area_s), whatever o measured there: p then need not be projected.
+// o's sample area is range_o² Ω / cos θ ≥ range_o² Ω (its value at normal
+// incidence). The range test accepts only range_o ≥ r − tolerance −
+// footprint_o, with tolerance ≤ range_sigmas (σ_p + σ_s) and footprint_o ≤
+// F · range_o (F = max_footprint_per_m), so range_o ≥ r_lo = (r − range_sigmas
+// (σ_p + σ_s)) / (1 + F). Ω = |Δaz Δel| cos(el') at the elevation el' of o's
+// pixel row, within half a step of p's elevation el, and r² cos(el') ≥
+// r² cos el − r² |sin el| δ = r (ρ − |z| δ) with δ a full step (ρ: horizontal
+// distance; kBoundSlack covers the second-order rest).
+bool coarser_by_bound(const Eigen::Vector3f& p, float r, float sigma_s, float area_s,
+                      const OtherScan& o, const Thresholds& t) {
+  if (o.step_solid_angle <= 0.0f) return false;
+  const float sigma_p = t.noise_m + t.noise_per_m * r;
+  const float r_lo = (r - t.range_sigmas * (sigma_p + sigma_s)) * o.inverse_footprint_growth;
+  if (r_lo <= 0.0f) return false;
+  const float rho = std::sqrt(p.x() * p.x() + p.y() * p.y());
+  const float min_area_o = kBoundSlack * (r_lo * r_lo / r) *
+                           (rho - std::abs(p.z()) * o.elevation_step) * o.step_solid_angle;
+  return min_area_o > area_s * t.tie_high;
+}
+
 // True when o sampled the surface of point i of s more finely (or equally
 // finely and o comes first).
-bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const OtherScan& o,
-                     const Thresholds& t) {
-  const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
-  const float area_s = s.sample_area_m2[i];
-  // A sample of spherical o at p covers at least r² Ω, its area at normal
-  // incidence. Ω = |Δaz Δel| cos(el) at the elevation of o's pixel row,
-  // within one step δ of p's own elevation, and r² cos(el ± δ) ≥ r (ρ − |z| δ)
-  // (ρ: horizontal distance). When even that bound is coarser than s's
-  // sample, o is coarser whatever its normal, and p need not be projected.
-  if (o.step_solid_angle > 0.0f) {
-    const float r = p.norm();
-    const float rho = std::sqrt(p.x() * p.x() + p.y() * p.y());
-    const float min_area_o =
-        kChordSlack * r * (rho - std::abs(p.z()) * o.elevation_step) * o.step_solid_angle;
-    if (min_area_o > area_s * t.tie_high) return false;
-  }
+bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Eigen::Vector3f& p,
+                     float range_p, float sigma_s, const OtherScan& o, const Thresholds& t) {
   // The grid's projection inlined: the merge runs it for every point and scan.
   const std::int64_t pixel = o.scan->grid ? o.scan->grid->pixel_of(p) : associate(*o.scan, p);
   if (pixel < 0) return false;
   const auto k = static_cast<std::size_t>(pixel);
   if (!o.scan->in_model[k]) return false;
-  const float range_p = p.norm();
   const float range_o = o.scan->scan->range_m[k];
   const float sigma_p = t.noise_m + t.noise_per_m * range_p;
-  const float sigma_s = t.noise_m + t.noise_per_m * s.scan->range_m[i];
   const float sigma = std::sqrt(sigma_p * sigma_p + sigma_s * sigma_s);
   const float tolerance = t.range_sigmas * sigma + o.scan->geometry->footprint_m[k];
   if (std::abs(range_o - range_p) > tolerance) return false;
@@ -80,33 +92,54 @@ bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Ot
     const Eigen::Vector3f n = o.R_o_s * s.geometry->normal[i];
     if (n.dot(o.scan->geometry->normal[k]) < t.min_normal_cos) return false;
   }
+  const float area_s = s.sample_area_m2[i];
   const float area_o = o.scan->sample_area_m2[k];
   if (area_o < area_s * t.tie_low) return true;
   return area_o <= area_s * t.tie_high && o.index < s_index;
 }
 
-void merge_row(std::span<const PreparedScan> scans, int s_index,
-               const std::vector<OtherScan>& others, const Thresholds& t, int row,
-               MergeScanResult& out) {
+// Decides row `row` of scan s; returns how many (point, other scan) tests
+// the area bound decided.
+std::size_t merge_row(std::span<const PreparedScan> scans, int s_index,
+                      const std::vector<OtherScan>& others, const Thresholds& t, int row,
+                      MergeScanResult& out) {
   const PreparedScan& s = scans[static_cast<std::size_t>(s_index)];
   const int columns = s.scan->columns;
+  std::size_t bounded = 0;
   for (int col = 0; col < columns; ++col) {
     const std::size_t i = s.scan->index(row, col);
     if (!s.in_model[i]) continue;
+    const float sigma_s = t.noise_m + t.noise_per_m * s.scan->range_m[i];
     bool keep = true;
     for (const OtherScan& o : others) {
-      if (finer_elsewhere(s, s_index, i, o, t)) {
+      const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
+      const float range = p.norm();
+      if (coarser_by_bound(p, range, sigma_s, s.sample_area_m2[i], o, t)) {
+        ++bounded;
+      } else if (finer_elsewhere(s, s_index, i, p, range, sigma_s, o, t)) {
         keep = false;
         break;
       }
     }
     out.keep[i] = keep ? 1 : 0;
   }
+  return bounded;
+}
+
+// The largest footprint per metre of range among the model points of `scan`.
+float max_footprint_per_m(const PreparedScan& scan) {
+  float largest = 0.0f;
+  for (std::size_t k = 0; k < scan.in_model.size(); ++k) {
+    if (scan.in_model[k]) {
+      largest = std::max(largest, scan.geometry->footprint_m[k] / scan.scan->range_m[k]);
+    }
+  }
+  return largest;
 }
 
 std::vector<OtherScan> others_of(std::span<const PreparedScan> scans,
                                  std::span<const Eigen::Isometry3d> T_world_scan, int s_index,
-                                 bool bound) {
+                                 std::span<const float> footprint_per_m, bool bound) {
   std::vector<OtherScan> others;
   for (int o = 0; o < static_cast<int>(scans.size()); ++o) {
     if (o == s_index) continue;
@@ -119,6 +152,7 @@ std::vector<OtherScan> others_of(std::span<const PreparedScan> scans,
       entry.step_solid_angle =
           static_cast<float>(std::abs(angles->azimuth_step_rad * angles->elevation_step_rad));
       entry.elevation_step = static_cast<float>(std::abs(angles->elevation_step_rad));
+      entry.inverse_footprint_growth = 1.0f / (1.0f + footprint_per_m[static_cast<std::size_t>(o)]);
     }
     others.push_back(entry);
   }
@@ -151,16 +185,25 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
       static_cast<float>(1.0 + settings.tie_tolerance),
       static_cast<float>(settings.noise.noise_m),
       static_cast<float>(settings.noise.noise_per_m)};
+  std::vector<float> footprint_per_m(scans.size(), 0.0f);
+  if (settings.bound_coarser_scans) {
+    acquisition::parallel_for_index(static_cast<int>(scans.size()), settings.threads, [&](int s) {
+      footprint_per_m[static_cast<std::size_t>(s)] =
+          max_footprint_per_m(scans[static_cast<std::size_t>(s)]);
+    });
+  }
   MergeResult result;
   for (int s = 0; s < static_cast<int>(scans.size()); ++s) {
     const PreparedScan& scan = scans[static_cast<std::size_t>(s)];
     const std::vector<OtherScan> others =
-        others_of(scans, T_world_scan, s, settings.bound_coarser_scans);
+        others_of(scans, T_world_scan, s, footprint_per_m, settings.bound_coarser_scans);
     MergeScanResult out;
     out.keep.assign(scan.in_model.size(), 0);
+    std::atomic<std::size_t> bounded{0};
     acquisition::parallel_for_index(
         scan.scan->rows, settings.threads,
-        [&](int row) { merge_row(scans, s, others, thresholds, row, out); }, 4);
+        [&](int row) { bounded += merge_row(scans, s, others, thresholds, row, out); }, 4);
+    out.decided_by_bound = bounded;
     count(scan, out);
     result.points += out.in_model;
     result.scans.push_back(std::move(out));

@@ -270,6 +270,39 @@ TEST(MergeBySamplingRate, ResultsDoNotDependOnTheThreadCount) {
   }
 }
 
+std::vector<std::uint8_t> merged_keep(const std::vector<HandScan>& hand, std::size_t scan,
+                                      bool bound) {
+  std::vector<PreparedScan> prepared;
+  std::vector<Eigen::Isometry3d> poses;
+  for (const HandScan& h : hand) {
+    prepared.push_back(prepare_scan(h.scan, h.geometry, 1));
+    poses.push_back(h.scan.T_world_scan);
+  }
+  MergeSettings settings;
+  settings.bound_coarser_scans = bound;
+  return merge_by_sampling_rate(prepared, poses, settings).scans[scan].keep;
+}
+
+// The first scan's ranges read 2 cm short, within the range tolerance: its
+// samples are smaller than the second scan's points, at their true distance
+// from it, suggest. Its sample areas then lie within 5 % (a tie, which the
+// first scan wins) of the second's, where a bound taken at the true distance
+// would already call the first scan coarser.
+TEST(MergeBySamplingRate, TheCoarserScanBoundAllowsForRangesReadShort) {
+  std::vector<HandScan> hand{wall_scan(pose_at(8.0)), wall_scan(pose_at(8.063))};
+  for (float& range : hand[0].scan.range_m) {
+    if (range > 0.0f) range -= 0.02f;
+  }
+  const std::vector<std::uint8_t> with_bound = merged_keep(hand, 1, true);
+  const std::vector<std::uint8_t> without_bound = merged_keep(hand, 1, false);
+  EXPECT_EQ(with_bound, without_bound);
+  std::size_t dropped = 0;
+  for (std::size_t i = 0; i < without_bound.size(); ++i) {
+    dropped += hand[1].scan.valid[i] && without_bound[i] == 0;
+  }
+  EXPECT_GT(dropped, 0u);  // the ties exist
+}
+
 // The bound on the other scan's sample area only skips projections whose
 // outcome it knows: the simulated campus gives the same keep masks with it.
 TEST(MergeBySamplingRate, TheCoarserScanBoundChangesNoDecision) {
@@ -283,6 +316,8 @@ TEST(MergeBySamplingRate, TheCoarserScanBoundChangesNoDecision) {
   for (std::size_t s = 0; s < 3; ++s) {
     EXPECT_EQ(fast.scans[s].keep, full.scans[s].keep) << s;
     EXPECT_GT(full.scans[s].redundant, 0u) << s;  // the scans do share surfaces
+    EXPECT_GT(fast.scans[s].decided_by_bound, 0u) << s;
+    EXPECT_EQ(full.scans[s].decided_by_bound, 0u) << s;
   }
 }
 
