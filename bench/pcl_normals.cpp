@@ -74,6 +74,15 @@ pcl::search::OrganizedNeighbor<pcl::PointXYZ>::Ptr prepared_organized_search(
   return search;
 }
 
+// Computes into a new cloud, then swaps it into `normals`; the previous
+// run's cloud is freed here too, as a previous run's result is in ours.
+template <typename Estimator>
+void compute_fresh(Estimator& estimator, Normals& normals) {
+  Normals fresh;
+  estimator.compute(fresh);
+  normals.swap(fresh);
+}
+
 // PCL marks a missing normal with NaN; we use the zero vector (ScanGeometry's
 // sentinel) so both are compared the same way.
 void store_normal(const pcl::Normal& n, std::size_t pixel, PclNormalResult& result) {
@@ -89,8 +98,9 @@ PclNormalResult integral_image_normals(const acquisition::Scan& scan,
   const auto unused_search = prepared_organized_search(cloud);
   Normals normals;
   PclNormalResult result;
-  // A fresh estimator per run: its integral images are allocated and filled
-  // inside the timed region, as in a one-shot use.
+  // A fresh estimator and a fresh output per run: its integral images and
+  // its normals are allocated and filled inside the timed region, as in a
+  // one-shot use (and as compute_geometry allocates its own outputs).
   result.seconds = best_seconds(settings.repeats, [&] {
     pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
     estimator.setNormalEstimationMethod(settings.method == PclNormalMethod::kIntegralCovariance
@@ -102,7 +112,7 @@ PclNormalResult integral_image_normals(const acquisition::Scan& scan,
     estimator.setViewPoint(0.0f, 0.0f, 0.0f);
     estimator.setSearchMethod(unused_search);
     estimator.setInputCloud(cloud);
-    estimator.compute(normals);
+    compute_fresh(estimator, normals);
   });
   result.normal.assign(scan.pixel_count(), Eigen::Vector3f::Zero());
   for (std::size_t i = 0; i < normals.size(); ++i) store_normal(normals[i], i, result);
@@ -130,7 +140,7 @@ PclNormalResult knn_normals(const acquisition::Scan& scan, const PclNormalSettin
     estimator.setKSearch(settings.k_neighbours);
     estimator.setInputCloud(cloud);
     estimator.setViewPoint(0.0f, 0.0f, 0.0f);
-    estimator.compute(normals);
+    compute_fresh(estimator, normals);
   });
   result.normal.assign(scan.pixel_count(), Eigen::Vector3f::Zero());
   for (std::size_t i = 0; i < normals.size(); ++i)
