@@ -54,6 +54,9 @@ void run_register(const RegisterOptions& options) {
   } else if (s.coarse == registration::CoarseMethod::kPointPairs) {
     throw CLI::ValidationError("--coarse pairs", "needs --pairs FILE");
   }
+  if (options.unlevelled && s.coarse != registration::CoarseMethod::kFeatures) {
+    throw CLI::ValidationError("--unlevelled", "applies to --coarse features only");
+  }
   s.features.levelled = !options.unlevelled;
   s.refine_globally = !options.no_global;
   s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;

@@ -39,6 +39,7 @@ std::size_t count_inliers(std::span<const FeatureMatch> matches, const Eigen::Is
 
 PoseHypothesis refine_hypothesis(std::span<const FeatureMatch> matches, const Eigen::Isometry3d& T,
                                  double distance_m) {
+  const PoseHypothesis given{T, count_inliers(matches, T.cast<float>(), distance_m)};
   PoseHypothesis refined{T, 0};
   std::vector<PointPair> pairs;
   for (const double scale : {2.0, 1.5, 1.0}) {
@@ -54,7 +55,7 @@ PoseHypothesis refine_hypothesis(std::span<const FeatureMatch> matches, const Ei
     if (fit.valid) refined.T_target_source = fit.T_target_source;
   }
   refined.inliers = count_inliers(matches, refined.T_target_source.cast<float>(), distance_m);
-  return refined;
+  return refined.inliers >= given.inliers ? refined : given;
 }
 
 std::vector<PoseHypothesis> distinct_hypotheses(std::vector<PoseHypothesis> hypotheses,

@@ -77,6 +77,7 @@ std::vector<FeatureMatch> match_features(Described source, Described target,
   pcl::KdTreeFLANN<pcl::FPFHSignature33> index;
   index.setInputCloud(target.features);
   const auto k = static_cast<std::size_t>(std::max(1, settings.neighbours));
+  // Unit normals' vertical components differ by at most 2: no filter.
   const double max_dz = settings.levelled ? settings.max_normal_z_difference : 2.0;
   // Slot i·k + j holds the source sample i's j-th match, when it has one.
   std::vector<std::optional<FeatureMatch>> slots(source.points->size() * k);
@@ -105,11 +106,24 @@ std::vector<FeatureMatch> match_features(Described source, Described target,
 }
 
 // PCL's prerejective RANSAC: one hypothesis, three matches per draw.
+// Every k-th source sample with its feature, at most `count`.
+std::pair<Cloud::Ptr, Features::Ptr> thinned(Described source, std::size_t count) {
+  const std::size_t stride = std::max<std::size_t>(1, (source.points->size() + count - 1) / count);
+  auto points = std::make_shared<Cloud>();
+  auto features = std::make_shared<Features>();
+  for (std::size_t i = 0; i < source.points->size(); i += stride) {
+    points->push_back((*source.points)[i]);
+    features->push_back((*source.features)[i]);
+  }
+  return {points, features};
+}
+
 std::optional<Eigen::Isometry3d> prerejective_pose(Described source, Described target,
                                                    const FeatureSettings& settings) {
+  const auto [points, features] = thinned(source, settings.ransac_source_points);
   pcl::SampleConsensusPrerejective<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> ransac;
-  ransac.setInputSource(source.points);
-  ransac.setSourceFeatures(source.features);
+  ransac.setInputSource(points);
+  ransac.setSourceFeatures(features);
   ransac.setInputTarget(target.points);
   ransac.setTargetFeatures(target.features);
   ransac.setMaximumIterations(settings.max_iterations);
@@ -118,7 +132,7 @@ std::optional<Eigen::Isometry3d> prerejective_pose(Described source, Described t
   ransac.setSimilarityThreshold(static_cast<float>(settings.similarity));
   ransac.setMaxCorrespondenceDistance(settings.hypotheses.inlier_distance_m);
   ransac.setInlierFraction(static_cast<float>(settings.min_inliers) /
-                           static_cast<float>(source.points->size()));
+                           static_cast<float>(points->size()));
   // PCL draws its samples with std::rand; seeding it makes runs repeatable.
   std::srand(static_cast<unsigned>(settings.hypotheses.seed));
   Cloud aligned;

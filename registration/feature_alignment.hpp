@@ -32,9 +32,12 @@ struct FeatureSettings {
   // Not levelled: every hypothesis of PCL's RANSAC is pre-rejected when the
   // edge lengths of its two triangles differ by more than 1 − similarity;
   // each draws among the `correspondence_randomness` nearest features.
+  // It works on every k-th source sample, at most ransac_source_points: each
+  // draw that passes pre-rejection is scored on all of them.
   int max_iterations = 20000;
   int correspondence_randomness = 3;
   double similarity = 0.9;
+  std::size_t ransac_source_points = 6000;
   // A hypothesis needs at least this many matches within the inlier distance.
   std::size_t min_inliers = 10;
   // Verification (register_scans.cpp): ICP runs from the hypotheses with

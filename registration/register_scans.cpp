@@ -147,7 +147,9 @@ std::optional<Eigen::Isometry3d> feature_start(
   report.success = true;
   report.failure.clear();
   report.count = chosen.inliers;
-  report.inlier_ratio = static_cast<double>(chosen.inliers) / static_cast<double>(aligned.matches);
+  report.inlier_ratio = aligned.matches > 0 ? static_cast<double>(chosen.inliers) /
+                                                  static_cast<double>(aligned.matches)
+                                            : 0.0;
   report.overlap = best->overlap;
   report.free_space_violation = best->free_space_violation;
   report.T_target_source = best->T_target_source;

@@ -108,9 +108,10 @@ struct RegistrationResult {
   std::size_t correspondences = 0;
   int iterations = 0;
   bool converged = false;
-  double coarse_seconds = 0.0;  // sampling, features and RANSAC
-  double fine_seconds = 0.0;    // ICP of every pair and the global refinement
-  double seconds = 0.0;         // everything
+  // Sampling, features, matching, hypotheses and their verifying ICP runs.
+  double coarse_seconds = 0.0;
+  double fine_seconds = 0.0;  // ICP of every pair and the global refinement
+  double seconds = 0.0;       // everything
 };
 
 // Registers `scans` (prepared, with their pose guesses `initial_T_world_scan`,

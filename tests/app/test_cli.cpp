@@ -215,6 +215,18 @@ TEST(Cli, GeometryThenPlyExportCarriesNormalsAndLeavesMixedPixelsOut) {
       2);
 }
 
+TEST(Cli, UnlevelledAppliesToTheFeatureStageOnly) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  const CliResult result =
+      run_cli(dir, {"register", project.string(), "--coarse", "none", "--unlevelled"});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("--unlevelled"), std::string::npos) << result.err;
+}
+
 // Two overlapping scans: the merged model leaves out what the finer scan
 // also sampled, and before a merge the option is refused without output.
 TEST(Cli, MergedExportWritesTheKeptPointsOnly) {

@@ -89,9 +89,10 @@ TEST(CoarseHypotheses, TheRefinementRecoversATiltTheHypothesesLeaveOut) {
   const std::vector<PoseHypothesis> hypotheses = levelled_hypotheses(matches, {});
   ASSERT_FALSE(hypotheses.empty());
   expect_pose(tilted_pose(), hypotheses[0], 1e-3, 1e-4);
-  // Before refinement, the best levelled pose is off by the 2° tilt.
-  const PoseHypothesis levelled{levelled_pose(), 0};
-  expect_pose(tilted_pose(), levelled, 2.01, 1e-9);
+  EXPECT_GE(hypotheses[0].inliers, 200u);
+  // No levelled pose explains them all: the best one, with the true heading
+  // and translation, loses the points tilted more than 0.5 m away.
+  EXPECT_LT(count_inliers(matches, levelled_pose().cast<float>(), 0.5), 150u);
 }
 
 TEST(CoarseHypotheses, MatchesOnHorizontalSurfacesOnlyGiveNoHypothesis) {
@@ -115,6 +116,14 @@ TEST(CoarseHypotheses, TheSameSeedGivesTheSameHypotheses) {
     EXPECT_EQ(a[i].inliers, b[i].inliers);
     EXPECT_TRUE(a[i].T_target_source.isApprox(b[i].T_target_source, 0.0));
   }
+  // Another seed draws other matches: the weaker hypotheses differ.
+  settings.seed = 2;
+  const std::vector<PoseHypothesis> c = levelled_hypotheses(matches, settings);
+  bool differs = c.size() != a.size();
+  for (std::size_t i = 0; !differs && i < a.size(); ++i) {
+    differs = !a[i].T_target_source.isApprox(c[i].T_target_source, 0.0);
+  }
+  EXPECT_TRUE(differs);
 }
 
 TEST(CoarseHypotheses, NearlyEqualPosesCountOnce) {

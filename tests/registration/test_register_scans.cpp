@@ -186,6 +186,35 @@ TEST(RegisterScans, UnlevelledFeaturePosesAreNeverSilentlyWrong) {
   EXPECT_LT(error.translation_m, kMaxTranslationErrorM);
 }
 
+// A scan against a copy of itself, guessed 40° and 4 m off: every feature
+// has its exact twin, so PCL's three-match RANSAC finds the pose, and its
+// verification accepts it.
+TEST(RegisterScans, UnlevelledFeaturesFindAPoseWhenTheMatchesAreRight) {
+  std::vector<PreparedScan> twins;
+  for (int copy = 0; copy < 2; ++copy) {
+    twins.push_back(prepare_scan(campus(1).scans[0], campus(1).geometry[0], 0));
+  }
+  Eigen::Isometry3d off = Eigen::Isometry3d::Identity();
+  off.rotate(Eigen::AngleAxisd(40.0 * test::kDeg, Eigen::Vector3d(0.1, 0.2, 1.0).normalized()));
+  off.pretranslate(Eigen::Vector3d(3.0, -2.5, 0.5));
+  const std::vector<Eigen::Isometry3d> initial{campus().true_poses[0],
+                                               campus().true_poses[0] * off};
+  RegistrationSettings settings;
+  settings.coarse = CoarseMethod::kFeatures;
+  settings.features.levelled = false;
+  // Nearly every draw of exact matches passes PCL's pre-rejection and is
+  // then scored on the whole cloud: a few hundred draws are plenty.
+  settings.features.max_iterations = 200;
+  const RegistrationResult result = register_scans(twins, initial, settings);
+  ASSERT_EQ(result.pairs.size(), 1u);
+  const PairReport& pair = result.pairs[0];
+  EXPECT_TRUE(pair.coarse.success) << pair.coarse.failure;
+  const PoseError coarse = pose_error(Eigen::Isometry3d::Identity(), pair.coarse.T_target_source);
+  EXPECT_LT(coarse.rotation_deg, 0.01);
+  EXPECT_LT(coarse.translation_m, 0.005);
+  EXPECT_TRUE(pair.registered) << pair.failure;
+}
+
 TEST(RegisterScans, TooFewPicksFailThePairWithoutMovingIt) {
   const std::vector<Eigen::Isometry3d> two_initial = perturbed_poses(2, 4, 3.0, 0.5);
   acquisition::sim::Random random(5);
