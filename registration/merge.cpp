@@ -49,10 +49,13 @@ struct Thresholds {
   float tie_high;  // A_o ≤ A_s · tie_high (and not finer): a tie
   float noise_m;   // RangeNoise in float
   float noise_per_m;
+
+  float range_sigma(float range) const { return noise_m + noise_per_m * range; }
 };
 
 // True when spherical o samples the surface at point p (s's point, in o's
-// frame at range r; sigma_s its range noise σ) more coarsely than s samples
+// frame at range r; sigma_p and sigma_s the range noise σ at r and at s's
+// own range) more coarsely than s samples
 // it (area_s), whatever o measured there: p then need not be projected.
 // o's sample area is range_o² Ω / cos θ ≥ range_o² Ω (its value at normal
 // incidence). The range test accepts only range_o ≥ r − tolerance −
@@ -62,10 +65,9 @@ struct Thresholds {
 // pixel row, within half a step of p's elevation el, and r² cos(el') ≥
 // r² cos el − r² |sin el| δ = r (ρ − |z| δ) with δ a full step (ρ: horizontal
 // distance; kBoundSlack covers the second-order rest).
-bool coarser_by_bound(const Eigen::Vector3f& p, float r, float sigma_s, float area_s,
+bool coarser_by_bound(const Eigen::Vector3f& p, float r, float sigma_p, float sigma_s, float area_s,
                       const OtherScan& o, const Thresholds& t) {
   if (o.step_solid_angle <= 0.0f) return false;
-  const float sigma_p = t.noise_m + t.noise_per_m * r;
   const float r_lo = (r - t.range_sigmas * (sigma_p + sigma_s)) * o.inverse_footprint_growth;
   if (r_lo <= 0.0f) return false;
   const float rho = std::sqrt(p.x() * p.x() + p.y() * p.y());
@@ -77,14 +79,14 @@ bool coarser_by_bound(const Eigen::Vector3f& p, float r, float sigma_s, float ar
 // True when o sampled the surface of point i of s more finely (or equally
 // finely and o comes first).
 bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Eigen::Vector3f& p,
-                     float range_p, float sigma_s, const OtherScan& o, const Thresholds& t) {
+                     float range_p, float sigma_p, float sigma_s, const OtherScan& o,
+                     const Thresholds& t) {
   // The grid's projection inlined: the merge runs it for every point and scan.
   const std::int64_t pixel = o.scan->grid ? o.scan->grid->pixel_of(p) : associate(*o.scan, p);
   if (pixel < 0) return false;
   const auto k = static_cast<std::size_t>(pixel);
   if (!o.scan->in_model[k]) return false;
   const float range_o = o.scan->scan->range_m[k];
-  const float sigma_p = t.noise_m + t.noise_per_m * range_p;
   const float sigma = std::sqrt(sigma_p * sigma_p + sigma_s * sigma_s);
   const float tolerance = t.range_sigmas * sigma + o.scan->geometry->footprint_m[k];
   if (std::abs(range_o - range_p) > tolerance) return false;
@@ -109,14 +111,15 @@ std::size_t merge_row(std::span<const PreparedScan> scans, int s_index,
   for (int col = 0; col < columns; ++col) {
     const std::size_t i = s.scan->index(row, col);
     if (!s.in_model[i]) continue;
-    const float sigma_s = t.noise_m + t.noise_per_m * s.scan->range_m[i];
+    const float sigma_s = t.range_sigma(s.scan->range_m[i]);
     bool keep = true;
     for (const OtherScan& o : others) {
       const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
       const float range = p.norm();
-      if (coarser_by_bound(p, range, sigma_s, s.sample_area_m2[i], o, t)) {
+      const float sigma_p = t.range_sigma(range);
+      if (coarser_by_bound(p, range, sigma_p, sigma_s, s.sample_area_m2[i], o, t)) {
         ++bounded;
-      } else if (finer_elsewhere(s, s_index, i, p, range, sigma_s, o, t)) {
+      } else if (finer_elsewhere(s, s_index, i, p, range, sigma_p, sigma_s, o, t)) {
         keep = false;
         break;
       }
