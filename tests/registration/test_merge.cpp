@@ -72,15 +72,13 @@ Eigen::Isometry3d pose_at(double x, double heading_deg = 0.0) {
 }
 
 // Prepares every hand scan (which must stay alive) and merges them at their poses.
-MergeResult merge(const std::vector<HandScan>& hand, int threads = 0) {
+MergeResult merge(const std::vector<HandScan>& hand, const MergeSettings& settings = {}) {
   std::vector<PreparedScan> prepared;
   std::vector<Eigen::Isometry3d> poses;
   for (const HandScan& h : hand) {
     prepared.push_back(prepare_scan(h.scan, h.geometry, 1));
     poses.push_back(h.scan.T_world_scan);
   }
-  MergeSettings settings;
-  settings.threads = threads;
   return merge_by_sampling_rate(prepared, poses, settings);
 }
 
@@ -261,8 +259,10 @@ TEST(MergeBySamplingRate, AnotherSurfaceOnTheBeamIsNotTheSameSurface) {
 TEST(MergeBySamplingRate, ResultsDoNotDependOnTheThreadCount) {
   const std::vector<HandScan> hand{wall_scan(pose_at(5.0)), wall_scan(pose_at(0.0)),
                                    wall_scan(pose_at(2.0, 10.0))};
-  const MergeResult one = merge(hand, 1);
-  const MergeResult all = merge(hand, 0);
+  MergeSettings one_thread;
+  one_thread.threads = 1;
+  const MergeResult one = merge(hand, one_thread);
+  const MergeResult all = merge(hand);
   ASSERT_EQ(one.scans.size(), 3u);
   for (std::size_t s = 0; s < 3; ++s) {
     EXPECT_EQ(one.scans[s].keep, all.scans[s].keep) << s;
@@ -272,15 +272,9 @@ TEST(MergeBySamplingRate, ResultsDoNotDependOnTheThreadCount) {
 
 std::vector<std::uint8_t> merged_keep(const std::vector<HandScan>& hand, std::size_t scan,
                                       bool bound) {
-  std::vector<PreparedScan> prepared;
-  std::vector<Eigen::Isometry3d> poses;
-  for (const HandScan& h : hand) {
-    prepared.push_back(prepare_scan(h.scan, h.geometry, 1));
-    poses.push_back(h.scan.T_world_scan);
-  }
   MergeSettings settings;
   settings.bound_coarser_scans = bound;
-  return merge_by_sampling_rate(prepared, poses, settings).scans[scan].keep;
+  return merge(hand, settings).scans[scan].keep;
 }
 
 // The first scan's ranges read 2 cm short, within the range tolerance: its
