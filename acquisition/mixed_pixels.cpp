@@ -6,7 +6,7 @@
 #include <cstddef>
 
 #include "acquisition/branch_free.hpp"
-#include "acquisition/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -78,7 +78,7 @@ void detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings,
   const auto sigma0_m = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_m);
   const auto sigma1 = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_per_m);
   const int blocks = (scan.rows + kBlockRows - 1) / kBlockRows;
-  parallel_for_index(blocks, settings.threads, [&](int b) {
+  core::parallel_for_index(blocks, settings.threads, [&](int b) {
     const int begin = b * kBlockRows, end = std::min(scan.rows, begin + kBlockRows);
     const PaddedBlock block(scan, begin, end);
     for (int row = begin; row < end; ++row)

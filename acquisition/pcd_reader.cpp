@@ -24,8 +24,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/rigid_transform.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -43,9 +43,9 @@ struct Source {
   std::uint64_t size = 0;
 
   [[noreturn]] void fail(const std::string& problem, std::optional<std::uint64_t> line = {}) const {
-    FilePosition position;
+    core::FilePosition position;
     position.line = line;
-    throw InputError(file, position, problem);
+    throw core::InputError(file, position, problem);
   }
 };
 

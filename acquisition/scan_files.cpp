@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cctype>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/pcd_reader.hpp"
 #include "acquisition/triplet_reader.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 
@@ -16,9 +16,9 @@ ScanFileFormat scan_file_format(const std::filesystem::path& path) {
   if (extension == ".ptx") return ScanFileFormat::kPtx;
   if (extension == ".json") return ScanFileFormat::kTriplet;
   if (extension == ".pcd") return ScanFileFormat::kOrganizedPcd;
-  throw InputError(path.string(), {},
-                   "unknown scan file type \"" + extension +
-                       "\" (expected .ptx, .pcd, or the .json sidecar of an image triplet)");
+  throw core::InputError(path.string(), {},
+                         "unknown scan file type \"" + extension +
+                             "\" (expected .ptx, .pcd, or the .json sidecar of an image triplet)");
 }
 
 void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& settings,

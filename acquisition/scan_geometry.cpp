@@ -39,16 +39,16 @@
 #include "acquisition/branch_free.hpp"
 #include "acquisition/grid_covariance.hpp"
 #include "acquisition/mixed_pixels.hpp"
-#include "acquisition/parallel.hpp"
-#include "acquisition/timing.hpp"
 #include "acquisition/window_moments.hpp"
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
 template <typename Body>
 void parallel_rows(int rows, int threads, Body&& body) {
-  parallel_for_index(rows, threads, body, 8);
+  core::parallel_for_index(rows, threads, body, 8);
 }
 
 // What every fit reads per pixel. Scratch arrays are left uninitialised
@@ -509,7 +509,7 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   }
   result.valid_points = counts.valid, result.normals = counts.normals;
   result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;
-  result.seconds = seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

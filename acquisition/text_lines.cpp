@@ -19,11 +19,11 @@ bool is_blank(char c) {
 TextLineReader::TextLineReader(const std::filesystem::path& path) : file_name_(path.string()) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) {
-    throw InputError(file_name_, {}, "is a directory, not a file");
+    throw core::InputError(file_name_, {}, "is a directory, not a file");
   }
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) {
-    throw InputError(file_name_, {}, std::string("cannot open: ") + std::strerror(errno));
+    throw core::InputError(file_name_, {}, std::string("cannot open: ") + std::strerror(errno));
   }
   file_size_ = std::filesystem::file_size(path, error);
   buffer_.resize(kChunkBytes);
@@ -86,7 +86,7 @@ bool TextLineReader::next(std::string_view& line) {
 }
 
 void TextLineReader::fail(const std::string& problem) const {
-  throw InputError(file_name_, {line_number_, line_offset_, {}}, problem);
+  throw core::InputError(file_name_, {line_number_, line_offset_, {}}, problem);
 }
 
 int parse_numbers(std::string_view line, std::span<double> out) {

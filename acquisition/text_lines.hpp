@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 

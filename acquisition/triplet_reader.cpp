@@ -13,8 +13,8 @@
 #include <string>
 #include <utility>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/rigid_transform.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -30,8 +30,8 @@ std::string utf8(const fs::path& path) {
   return {text.begin(), text.end()};
 }
 
-FilePosition at_detail(std::string detail) {
-  FilePosition position;
+core::FilePosition at_detail(std::string detail) {
+  core::FilePosition position;
   position.detail = std::move(detail);
   return position;
 }
@@ -44,7 +44,7 @@ struct Sidecar {
   json root;
 
   [[noreturn]] void fail(const std::string& key, const std::string& problem) const {
-    throw InputError(file, at_detail("key \"" + key + "\""), problem);
+    throw core::InputError(file, at_detail("key \"" + key + "\""), problem);
   }
   const json& need(const json& object, const std::string& key, const std::string& path) const {
     const auto it = object.find(key);
@@ -92,39 +92,40 @@ struct Sidecar {
 // nlohmann refuses a literal such as 1e999 at parse time, which is the only way
 // JSON can spell a non-finite number. Its message quotes the literal, which
 // locates it in the text.
-InputError overflow_error(const std::string& file, const std::string& text,
-                          const json::out_of_range& e) {
+core::InputError overflow_error(const std::string& file, const std::string& text,
+                                const json::out_of_range& e) {
   const std::string what = e.what();
   const std::size_t open = what.find('\'');
-  FilePosition position;
+  core::FilePosition position;
   if (open != std::string::npos && what.size() > open + 2) {
     const std::size_t at = text.find(what.substr(open + 1, what.size() - open - 2));
     if (at != std::string::npos) position.byte_offset = at;
   }
-  return InputError(file, position, "sidecar holds a number that is not finite (" + what + ")");
+  return core::InputError(file, position,
+                          "sidecar holds a number that is not finite (" + what + ")");
 }
 
 Sidecar parse_sidecar(const fs::path& path) {
   Sidecar sidecar{.path = path, .file = utf8(path), .root = {}};
   if (!fs::is_regular_file(path)) {
-    throw InputError(sidecar.file, {},
-                     fs::exists(path) ? "sidecar is not a file" : "sidecar file is missing");
+    throw core::InputError(sidecar.file, {},
+                           fs::exists(path) ? "sidecar is not a file" : "sidecar file is missing");
   }
   std::ifstream in(path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (text.empty()) throw InputError(sidecar.file, {}, "sidecar file is empty or unreadable");
+  if (text.empty()) throw core::InputError(sidecar.file, {}, "sidecar file is empty or unreadable");
   try {
     sidecar.root = json::parse(text);
   } catch (const json::parse_error& e) {
-    FilePosition position;
+    core::FilePosition position;
     position.byte_offset = e.byte > 0 ? e.byte - 1 : 0;  // nlohmann counts from 1
-    throw InputError(sidecar.file, position,
-                     std::string("sidecar is not valid JSON (") + e.what() + ")");
+    throw core::InputError(sidecar.file, position,
+                           std::string("sidecar is not valid JSON (") + e.what() + ")");
   } catch (const json::out_of_range& e) {
     throw overflow_error(sidecar.file, text, e);
   }
   if (!sidecar.root.is_object())
-    throw InputError(sidecar.file, {}, "sidecar must be a JSON object");
+    throw core::InputError(sidecar.file, {}, "sidecar must be a JSON object");
   return sidecar;
 }
 
@@ -232,29 +233,31 @@ struct Image {
 Image load_image(const Sidecar& s, const std::string& name, const std::string& key, Grid grid) {
   const fs::path path = s.path.parent_path() / fs::path(std::u8string(name.begin(), name.end()));
   Image image{.file = utf8(path), .pixels = {}};
-  const FilePosition where = at_detail("named by key \"" + key + ".file\" of the sidecar");
-  if (!fs::is_regular_file(path)) throw InputError(image.file, where, "image file is missing");
+  const core::FilePosition where = at_detail("named by key \"" + key + ".file\" of the sidecar");
+  if (!fs::is_regular_file(path))
+    throw core::InputError(image.file, where, "image file is missing");
   try {
     image.pixels = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception&) {
     image.pixels.release();  // a decoder that throws is the same as a corrupt file
   }
-  if (image.pixels.empty()) throw InputError(image.file, where, "image is unreadable or corrupt");
+  if (image.pixels.empty())
+    throw core::InputError(image.file, where, "image is unreadable or corrupt");
   auto size = [](int rows, int cols) {
     return std::to_string(rows) + " x " + std::to_string(cols);
   };
   if (image.pixels.rows != grid.rows || image.pixels.cols != grid.columns) {
-    throw InputError(image.file, where,
-                     "image size " + size(image.pixels.rows, image.pixels.cols) +
-                         " differs from the sidecar's " + size(grid.rows, grid.columns));
+    throw core::InputError(image.file, where,
+                           "image size " + size(image.pixels.rows, image.pixels.cols) +
+                               " differs from the sidecar's " + size(grid.rows, grid.columns));
   }
   return image;
 }
 
 void require_type(const Image& image, bool ok, const std::string& expected) {
   if (ok) return;
-  throw InputError(image.file, {},
-                   "wrong image type: " + describe(image.pixels) + ", expected " + expected);
+  throw core::InputError(image.file, {},
+                         "wrong image type: " + describe(image.pixels) + ", expected " + expected);
 }
 
 void decode_range(const Image& image, const RangeSpec& spec, Scan& scan) {

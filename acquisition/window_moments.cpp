@@ -5,7 +5,7 @@
 #include <cstddef>
 
 #include "acquisition/branch_free.hpp"
-#include "acquisition/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -253,8 +253,8 @@ void visit_window_slopes(int rows, int columns, std::span<const int> radii,
   std::transform(radii.begin(), radii.end(), inverse.begin(), inverse_sxx);
   const Grid grid{rows, columns, clean.data(), value.data()};
   const std::vector<Tile> tiles = make_tiles(rows, columns);
-  parallel_for_index(static_cast<int>(tiles.size()), threads,
-                     [&](int t) { visit_tile(grid, tiles[t], radii, inverse, visit); });
+  core::parallel_for_index(static_cast<int>(tiles.size()), threads,
+                           [&](int t) { visit_tile(grid, tiles[t], radii, inverse, visit); });
 }
 
 std::vector<WindowSlope> window_slopes(int rows, int columns, std::span<const int> radii,

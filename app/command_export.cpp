@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/point_export.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/triplet_writer.hpp"
 #include "app/commands.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::app {
@@ -59,15 +59,15 @@ std::vector<std::vector<std::uint8_t>> load_keep_masks(const ExportOptions& opti
                                                        const modeling::Project& project) {
   if (!options.merged) return {};
   if (options.format != ExportFormat::kPly && options.format != ExportFormat::kCsv) {
-    throw acquisition::InputError(options.project, {},
-                                  "--merged writes a point list: use --format ply or csv");
+    throw core::InputError(options.project, {},
+                           "--merged writes a point list: use --format ply or csv");
   }
   std::vector<std::vector<std::uint8_t>> masks;
   for (const auto& stored : project.scans()) {
     if (options.scan_id && stored.id != *options.scan_id) continue;
     std::optional<std::vector<std::uint8_t>> mask = project.load_keep_mask(stored.id);
     if (!mask) {
-      throw acquisition::InputError(
+      throw core::InputError(
           options.project, {0, 0, "scan " + std::to_string(stored.id)},
           "no merged model for this scan: run `scanbench merge` after the last registration");
     }
@@ -92,14 +92,13 @@ void write_scans(const ExportOptions& options, const std::vector<acquisition::Sc
       return acquisition::write_csv(options.output, scans, pointers, masks);
     case ExportFormat::kTriplet:
       if (scans.size() != 1) {
-        throw acquisition::InputError(options.project, {},
-                                      "a triplet holds one scan: choose it with --scan ID");
+        throw core::InputError(options.project, {},
+                               "a triplet holds one scan: choose it with --scan ID");
       }
       if (!scans.front().is_spherical()) {
-        throw acquisition::InputError(options.project,
-                                      {0, 0, "scan \"" + scans.front().name + "\""},
-                                      "a triplet needs the spherical angle model; this scan has "
-                                      "per-pixel directions (export it as ptx, ply or csv)");
+        throw core::InputError(options.project, {0, 0, "scan \"" + scans.front().name + "\""},
+                               "a triplet needs the spherical angle model; this scan has "
+                               "per-pixel directions (export it as ptx, ply or csv)");
       }
       return acquisition::write_triplet(scans.front(), options.output);
   }

@@ -6,8 +6,8 @@
 #include <CLI/CLI.hpp>
 #include <exception>
 
-#include "acquisition/input_error.hpp"
 #include "app/commands.hpp"
+#include "core/errors.hpp"
 
 namespace {
 
@@ -30,7 +30,9 @@ int main(int argc, char** argv) {
   sb::add_merge_command(app);
   sb::add_export_command(app);
   sb::add_simulate_command(app);
+#ifdef SCANBENCH_WITH_BENCH
   sb::add_bench_command(app);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -38,7 +40,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return sb::kExitBadInput;
-  } catch (const scanbench::acquisition::InputError& e) {
+  } catch (const scanbench::core::InputError& e) {
     return report_error("bad input", e.what(), sb::kExitBadInput);
   } catch (const std::exception& e) {
     return report_error("error", e.what(), sb::kExitFailure);

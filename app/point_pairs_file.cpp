@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -14,7 +14,7 @@ using nlohmann::json;
 
 [[noreturn]] void bad(const std::filesystem::path& file, const std::string& where,
                       const std::string& problem) {
-  throw acquisition::InputError(file.string(), {std::nullopt, std::nullopt, where}, problem);
+  throw core::InputError(file.string(), {std::nullopt, std::nullopt, where}, problem);
 }
 
 Eigen::Vector3d read_point(const json& value, const std::filesystem::path& file,
@@ -71,8 +71,8 @@ std::vector<modeling::ProjectPicks> read_point_pairs_file(const std::filesystem:
   try {
     document = json::parse(in);
   } catch (const json::parse_error& e) {
-    throw acquisition::InputError(
-        file.string(), {std::nullopt, static_cast<std::uint64_t>(e.byte), ""}, "not valid JSON");
+    throw core::InputError(file.string(), {std::nullopt, static_cast<std::uint64_t>(e.byte), ""},
+                           "not valid JSON");
   }
   if (!document.is_object() || !document.contains("pairs") || !document["pairs"].is_array()) {
     bad(file, "pairs", "expected {\"pairs\": [...]}");

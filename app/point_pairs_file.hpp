@@ -14,7 +14,7 @@
 
 namespace scanbench::app {
 
-// Reads FILE. Throws acquisition::InputError naming the file, the entry
+// Reads FILE. Throws core::InputError naming the file, the entry
 // (e.g. "pairs[1].points[0].target_m") and the problem for malformed JSON,
 // missing keys, non-numeric or non-finite coordinates, or fewer than 3 points.
 std::vector<modeling::ProjectPicks> read_point_pairs_file(const std::filesystem::path& file);

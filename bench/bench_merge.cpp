@@ -21,8 +21,8 @@
 #include <cmath>
 #include <vector>
 
-#include "acquisition/parallel.hpp"
 #include "bench/simulated_site.hpp"
+#include "core/parallel.hpp"
 #include "registration/merge.hpp"
 
 namespace scanbench::bench {
@@ -169,8 +169,8 @@ nlohmann::json run_merge_bench(const BenchOptions& options) {
   }
   Tally tally;
   for (std::size_t s = 0; s < site.scans.size(); ++s) {
-    acquisition::parallel_for_index(
-        site.scans[s].rows, 0, [&](int row) { tally_row(context, in_model, kept, s, row, tally); });
+    core::parallel_for_index(site.scans[s].rows, 0,
+                             [&](int row) { tally_row(context, in_model, kept, s, row, tally); });
   }
   std::size_t kept_points = 0;
   for (const auto& scan : merged.scans) kept_points += scan.kept;

@@ -6,7 +6,7 @@
 
 #include <chrono>
 
-#include "acquisition/timing.hpp"
+#include "core/timing.hpp"
 #include "registration/pcl_sample_cloud.hpp"
 
 namespace scanbench::bench {
@@ -29,7 +29,7 @@ PclIcpResult pcl_point_to_plane_icp(const registration::SampleCloud& source,
   Cloud aligned;
   icp.align(aligned, initial.matrix().cast<float>());
   PclIcpResult result;
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   result.converged = icp.hasConverged();
   result.T_target_source.matrix() = icp.getFinalTransformation().cast<double>();
   return result;

@@ -7,7 +7,7 @@
 #include <memory>
 #include <new>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::modeling {
 
@@ -23,9 +23,9 @@ static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
 namespace {
 
 [[noreturn]] void throw_bad_blob(const BlobContext& context, const std::string& problem) {
-  acquisition::FilePosition position;
+  core::FilePosition position;
   position.detail = context.location;
-  throw acquisition::InputError(context.file, position, "damaged channel data: " + problem);
+  throw core::InputError(context.file, position, "damaged channel data: " + problem);
 }
 
 // Checked before allocating, so that a damaged size field cannot make us

@@ -36,7 +36,7 @@ std::vector<std::uint8_t> compress(std::span<const std::byte> raw,
                                    int level = kDefaultCompressionLevel);
 
 // Decodes `blob` into `out`, which must have exactly the expected decompressed
-// size. Throws acquisition::InputError naming `context` when the blob is not a
+// size. Throws core::InputError naming `context` when the blob is not a
 // single zstd frame, its recorded size differs from out.size(), or it is
 // truncated or damaged; `out` is then unspecified.
 void decompress_into(std::span<const std::uint8_t> blob, std::span<std::byte> out,

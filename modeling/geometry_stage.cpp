@@ -3,7 +3,7 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 
-#include "acquisition/timing.hpp"
+#include "core/timing.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::modeling {
@@ -40,7 +40,7 @@ GeometryStageResult compute_project_geometry(const std::filesystem::path& projec
     if (settings.on_scan_done) settings.on_scan_done(result.scans.size(), scans.size(), scan.name);
   }
   transaction.commit();
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

@@ -37,7 +37,7 @@ struct GeometryStageResult {
 
 // Computes and stores the geometry of every scan of the project, replacing
 // earlier results, in one transaction: on any error nothing is stored.
-// Throws acquisition::InputError for a missing, foreign or damaged project.
+// Throws core::InputError for a missing, foreign or damaged project.
 GeometryStageResult compute_project_geometry(const std::filesystem::path& project_path,
                                              const GeometryStageSettings& settings = {});
 

@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "acquisition/timing.hpp"
+#include "core/timing.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::modeling {
@@ -44,7 +44,7 @@ ImportResult import_scan_files(const std::filesystem::path& project_path,
     throw;
   }
   result.created_project = created;
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

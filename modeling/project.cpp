@@ -9,7 +9,7 @@
 #include <cstring>
 #include <utility>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/project_schema.hpp"
 #include "modeling/sqlite_statement.hpp"
 
@@ -27,9 +27,9 @@ sqlite3* connect(const std::filesystem::path& file) {
   if (code != SQLITE_OK) {
     const std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
     sqlite3_close(db);
-    acquisition::FilePosition position;
+    core::FilePosition position;
     position.detail = "opening the project";
-    throw acquisition::InputError(file.string(), position, message);
+    throw core::InputError(file.string(), position, message);
   }
   sqlite3_extended_result_codes(db, 1);
   return db;
@@ -44,7 +44,7 @@ void create_exclusively(const std::filesystem::path& file) {
     const std::string problem =
         error == EEXIST ? "file already exists; a new project never overwrites a file"
                         : std::string("cannot create the project: ") + std::strerror(error);
-    throw acquisition::InputError(file.string(), {}, problem);
+    throw core::InputError(file.string(), {}, problem);
   }
   ::close(fd);
 }

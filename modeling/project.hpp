@@ -56,14 +56,14 @@ class Project {
   class Transaction;
 
   // Opens an existing project for reading and writing. Never creates or
-  // recreates the file. Throws acquisition::InputError, leaving the file
+  // recreates the file. Throws core::InputError, leaving the file
   // untouched, when it is missing, a directory, empty, not an SQLite
   // database, another application's database, a project of a newer schema
   // version, damaged, or locked by another writer for longer than
   // kBusyTimeoutMs. Older schema versions are migrated in one transaction.
   static Project open(const std::filesystem::path& file);
 
-  // Creates a new, empty project. Throws acquisition::InputError when the
+  // Creates a new, empty project. Throws core::InputError when the
   // file already exists (it is never overwritten) or cannot be created; a
   // half-created file is removed again.
   static Project create(const std::filesystem::path& file);
@@ -83,48 +83,48 @@ class Project {
 
   // Every scan's summary (sizes, channel presence, pose, world bounds,
   // scanner metadata) ordered by id, without reading channel data. Throws
-  // acquisition::InputError when the file is damaged.
+  // core::InputError when the file is damaged.
   std::vector<StoredScanSummary> scans() const;
 
   // The scan stored under `id`, bit-identical to what insert_scan stored.
-  // Throws acquisition::InputError "no scan with id N" when there is none,
+  // Throws core::InputError "no scan with id N" when there is none,
   // and names the scan and channel when its data is damaged.
   acquisition::Scan load_scan(std::int64_t id) const;
 
   // Starts a write transaction (BEGIN IMMEDIATE: takes the write lock now, so
   // a commit never fails for a concurrent writer). Asserts that no
-  // transaction is open. Throws acquisition::InputError when another process
+  // transaction is open. Throws core::InputError when another process
   // keeps the write lock for longer than kBusyTimeoutMs.
   Transaction begin();
 
   // Stores `scan` (metadata, pose, summary, channels as zstd blobs) and
   // returns its new id. Asserts that a Transaction is open and that the scan
-  // passes acquisition::check_consistency. Throws acquisition::InputError
+  // passes acquisition::check_consistency. Throws core::InputError
   // when SQLite fails (disk full, blob larger than SQLite's 1 GB limit); the
   // caller's Transaction then rolls everything back.
   std::int64_t insert_scan(const acquisition::Scan& scan);
 
   // Stores (replacing any earlier) the geometry of scan `id`, with the
   // settings that produced it as JSON text. Asserts a Transaction is open and
-  // the arrays match the scan's pixel count; throws acquisition::InputError
+  // the arrays match the scan's pixel count; throws core::InputError
   // when there is no such scan or SQLite fails.
   void store_geometry(std::int64_t id, const acquisition::GeometryResult& geometry,
                       const std::string& settings_json);
 
   // The stored geometry of scan `id`, or none when `scanbench geometry` has
-  // not run on it. Throws acquisition::InputError naming the scan when the
+  // not run on it. Throws core::InputError naming the scan when the
   // stored data is damaged.
   std::optional<acquisition::ScanGeometry> load_geometry(std::int64_t id) const;
 
   // Moves scan `id` to scan.T_world_scan: stores the pose, the scanner
   // position (the pose's origin) and the world bounds of `scan`, which must
   // be the stored scan with only its pose changed (asserted on size). Asserts
-  // a Transaction is open; throws acquisition::InputError when there is no
+  // a Transaction is open; throws core::InputError when there is no
   // such scan or SQLite fails.
   void update_pose(std::int64_t id, const acquisition::Scan& scan);
 
   // Appends a registration run: its settings and report as JSON text.
-  // Asserts a Transaction is open; throws acquisition::InputError when SQLite fails.
+  // Asserts a Transaction is open; throws core::InputError when SQLite fails.
   void store_registration(const std::string& settings_json, const std::string& report_json);
 
   // The report of the latest registration run, or none.
@@ -133,12 +133,12 @@ class Project {
   // Stores (replacing any earlier) the merge keep mask of scan `id`: one
   // byte per pixel, 1 = in the merged model. Asserts a Transaction is open
   // and the mask matches the scan's pixel count; throws
-  // acquisition::InputError when there is no such scan or SQLite fails.
+  // core::InputError when there is no such scan or SQLite fails.
   void store_keep_mask(std::int64_t id, std::span<const std::uint8_t> keep,
                        const std::string& settings_json);
 
   // The keep mask of scan `id`, or none when `scanbench merge` has not run
-  // since its pose last changed. Throws acquisition::InputError when damaged.
+  // since its pose last changed. Throws core::InputError when damaged.
   std::optional<std::vector<std::uint8_t>> load_keep_mask(std::int64_t id) const;
 
   // Deletes every keep mask (poses changed: the masks are stale). Asserts a
@@ -154,7 +154,7 @@ class Project {
   Project(std::filesystem::path file, Connection db);
   sqlite3* db() const;
   std::string file_name() const { return file_.string(); }
-  // rows × columns of scan `id`; throws acquisition::InputError when there is none.
+  // rows × columns of scan `id`; throws core::InputError when there is none.
   std::size_t stored_pixel_count(std::int64_t id) const;
 
   std::filesystem::path file_;
@@ -171,7 +171,7 @@ class Project::Transaction {
   ~Transaction();
 
   // Makes the changes durable. Asserts the transaction is still open. Throws
-  // acquisition::InputError when SQLite cannot commit (I/O error, disk full);
+  // core::InputError when SQLite cannot commit (I/O error, disk full);
   // the changes are then rolled back when the Transaction is destroyed.
   void commit();
 

@@ -1,6 +1,6 @@
 #include "modeling/project_channels.hpp"
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/blob_codec.hpp"
 #include "modeling/sqlite_statement.hpp"
 
@@ -17,9 +17,9 @@ struct ChannelsFound {
 };
 
 [[noreturn]] void damaged(const BlobContext& context, const std::string& problem) {
-  acquisition::FilePosition position;
+  core::FilePosition position;
   position.detail = context.location;
-  throw acquisition::InputError(context.file, position, "project is damaged: " + problem);
+  throw core::InputError(context.file, position, "project is damaged: " + problem);
 }
 
 void check_count(std::size_t stored, std::size_t expected, const BlobContext& context) {

@@ -19,13 +19,13 @@
 namespace scanbench::modeling {
 
 // Compresses and stores every channel of `scan` under scan id `id`, inside
-// the caller's transaction. Throws acquisition::InputError when SQLite fails.
+// the caller's transaction. Throws core::InputError when SQLite fails.
 void insert_channels(sqlite3* db, const std::string& file, std::int64_t id,
                      const acquisition::Scan& scan);
 
 // Fills the channels of `scan`, whose rows, columns and angle model are
 // already set from the scans row; `has_intensity` / `has_color` are that
-// row's flags. Throws acquisition::InputError naming the scan and channel
+// row's flags. Throws core::InputError naming the scan and channel
 // when a channel is missing, unexpected, of the wrong size or damaged.
 void read_channels(sqlite3* db, const std::string& file, std::int64_t id, bool has_intensity,
                    bool has_color, acquisition::Scan& scan);

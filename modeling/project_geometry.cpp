@@ -4,7 +4,7 @@
 
 #include <cassert>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/blob_codec.hpp"
 #include "modeling/project.hpp"
 #include "modeling/sqlite_statement.hpp"
@@ -29,7 +29,7 @@ std::size_t Project::stored_pixel_count(std::int64_t id) const {
   sqlite::Statement statement(db(), "SELECT rows * columns FROM scans WHERE id = ?1", file_name());
   statement.bind_int(1, id);
   if (!statement.step()) {
-    throw acquisition::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
+    throw core::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
   }
   return static_cast<std::size_t>(statement.column_int(0));
 }

@@ -5,7 +5,7 @@
 
 #include <cassert>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/blob_codec.hpp"
 #include "modeling/project.hpp"
 #include "modeling/sqlite_statement.hpp"

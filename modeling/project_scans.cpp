@@ -5,8 +5,8 @@
 #include <climits>
 #include <cstring>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/rigid_transform.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 #include "modeling/project_channels.hpp"
 #include "modeling/sqlite_statement.hpp"
@@ -62,9 +62,9 @@ const std::string kInsertScan = std::string("INSERT INTO scans (") + kScanColumn
 constexpr std::size_t kPoseBytes = 16 * sizeof(double);
 
 [[noreturn]] void damaged(const std::string& file, std::int64_t id, const std::string& problem) {
-  acquisition::FilePosition position;
+  core::FilePosition position;
   position.detail = "scan " + std::to_string(id);
-  throw acquisition::InputError(file, position, "project is damaged: " + problem);
+  throw core::InputError(file, position, "project is damaged: " + problem);
 }
 
 // Row-major 4x4, raw doubles: bit-exact, including -0.0.
@@ -200,8 +200,8 @@ WHERE id = ?1 AND rows = ?12 AND columns = ?13)sql",
   }
   update.bind_int(12, scan.rows).bind_int(13, scan.columns).run();
   if (sqlite3_changes(db()) != 1) {
-    throw acquisition::InputError(file_name(), {},
-                                  "no scan with id " + std::to_string(id) + " of that size");
+    throw core::InputError(file_name(), {},
+                           "no scan with id " + std::to_string(id) + " of that size");
   }
 }
 
@@ -218,7 +218,7 @@ acquisition::Scan Project::load_scan(std::int64_t id) const {
   sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
   if (!select.step()) {
-    throw acquisition::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
+    throw core::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
   }
   const acquisition::ScanSummary summary = read_summary(select, file_name()).summary;
   acquisition::Scan scan;

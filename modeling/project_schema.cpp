@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 #include "modeling/sqlite_statement.hpp"
 
@@ -79,7 +79,7 @@ constexpr std::array<const char*, 3> kLaterTables = {"scan_geometry", "registrat
                                                      "merge_masks"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
-  throw acquisition::InputError(file, {}, problem);
+  throw core::InputError(file, {}, problem);
 }
 
 std::uint32_t big_endian_u32(const char* bytes) {

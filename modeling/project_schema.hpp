@@ -19,27 +19,27 @@ namespace scanbench::modeling::schema {
 
 // Reads the 100-byte SQLite header of `file` without SQLite, so that nothing
 // (not even a -wal or -shm file) is created beside files we refuse. Throws
-// acquisition::InputError when the file is missing, not a regular file,
+// core::InputError when the file is missing, not a regular file,
 // empty, not an SQLite database, another application's database, or a
 // project of a schema version newer than kProjectSchemaVersion or below 1.
 void check_file_header(const std::filesystem::path& file);
 
 // Sets the per-connection settings every project connection needs: foreign
-// keys on, synchronous=FULL, busy timeout. Throws acquisition::InputError.
+// keys on, synchronous=FULL, busy timeout. Throws core::InputError.
 void configure_connection(sqlite3* db, const std::string& file);
 
 // Creates the current schema in the empty database `db` in one transaction
 // (version 1 script, then every migration step), then switches it to
 // write-ahead logging. The application id and version are
 // committed through the rollback journal, so they are in the main file even if
-// a -wal file is lost later. Throws acquisition::InputError.
+// a -wal file is lost later. Throws core::InputError.
 void create_schema(sqlite3* db, const std::string& file);
 
 // For a freshly opened existing project: repeats the identity checks on what
 // SQLite reads (a -wal file can hold a newer version than the main file's
 // header), checks the expected tables exist, turns on write-ahead logging if
 // it was off, and migrates an older schema to kProjectSchemaVersion in one
-// transaction. Throws acquisition::InputError.
+// transaction. Throws core::InputError.
 void check_and_migrate(sqlite3* db, const std::string& file);
 
 // PRAGMA user_version.

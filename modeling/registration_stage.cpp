@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::modeling {
@@ -22,10 +22,9 @@ LoadedScans load_scans(const Project& project, int threads) {
   for (const StoredScanSummary& stored : project.scans()) {
     std::optional<acquisition::ScanGeometry> geometry = project.load_geometry(stored.id);
     if (!geometry) {
-      throw acquisition::InputError(project.path().string(), {},
-                                    "scan " + std::to_string(stored.id) + " (" +
-                                        stored.summary.name +
-                                        ") has no geometry: run scanbench geometry first");
+      throw core::InputError(project.path().string(), {},
+                             "scan " + std::to_string(stored.id) + " (" + stored.summary.name +
+                                 ") has no geometry: run scanbench geometry first");
     }
     loaded.ids.push_back(stored.id);
     loaded.scans.push_back(project.load_scan(stored.id));
@@ -42,7 +41,7 @@ int index_of(const std::vector<std::int64_t>& ids, std::int64_t id, const std::s
   for (std::size_t k = 0; k < ids.size(); ++k) {
     if (ids[k] == id) return static_cast<int>(k);
   }
-  throw acquisition::InputError(
+  throw core::InputError(
       file, {}, "picked pairs name scan " + std::to_string(id) + ", which is not in the project");
 }
 
@@ -56,7 +55,7 @@ std::vector<registration::PickedPairs> picks_by_index(const RegisterStageSetting
     const int source = index_of(ids, p.source_id, file);
     const int target = index_of(ids, p.target_id, file);
     if (target >= source) {
-      throw acquisition::InputError(
+      throw core::InputError(
           file, {},
           "picked pairs of scan " + std::to_string(p.source_id) + " must target an earlier scan");
     }
@@ -67,7 +66,7 @@ std::vector<registration::PickedPairs> picks_by_index(const RegisterStageSetting
         std::any_of(picks.begin(), picks.end(),
                     [k](const registration::PickedPairs& p) { return p.source == k; });
     if (!found) {
-      throw acquisition::InputError(
+      throw core::InputError(
           file, {}, "no picked pairs for scan " + std::to_string(ids[static_cast<std::size_t>(k)]));
     }
   }

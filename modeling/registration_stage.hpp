@@ -39,7 +39,7 @@ struct RegisterStageResult {
 // reference and keeps its pose), then in one transaction stores the new
 // poses, the report, and drops the now stale merge keep masks. A failed pair
 // is reported, and its scan keeps its pose relative to its target. Throws
-// acquisition::InputError for a missing, foreign or damaged project, a scan
+// core::InputError for a missing, foreign or damaged project, a scan
 // without geometry ("run scanbench geometry first"), or picks that do not
 // name the project's scans as the settings require; the project is then
 // unchanged.
@@ -59,7 +59,7 @@ struct MergeStageResult {
 };
 
 // Computes the keep mask of every scan at its stored pose and stores them in
-// one transaction, replacing earlier masks. Throws acquisition::InputError
+// one transaction, replacing earlier masks. Throws core::InputError
 // as register_project does.
 MergeStageResult merge_project(const std::filesystem::path& project_path,
                                const registration::MergeSettings& settings);

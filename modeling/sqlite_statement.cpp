@@ -2,7 +2,7 @@
 
 #include <cassert>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::modeling::sqlite {
 
@@ -18,9 +18,9 @@ bool is_damage(int code) {
 void throw_error(sqlite3* db, int code, const std::string& file, const std::string& action) {
   std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
   if (is_damage(code)) message = "project file is damaged (" + message + ")";
-  acquisition::FilePosition position;
+  core::FilePosition position;
   position.detail = action;
-  throw acquisition::InputError(file, position, message);
+  throw core::InputError(file, position, message);
 }
 
 void execute(sqlite3* db, const char* sql, const std::string& file) {

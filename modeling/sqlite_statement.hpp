@@ -2,7 +2,7 @@
 // Internal to scanbench_modeling (which links SQLite privately): nothing
 // outside modeling/ should include this header.
 //
-// Every SQLite failure becomes an acquisition::InputError naming the project
+// Every SQLite failure becomes an core::InputError naming the project
 // file, the action that failed and SQLite's message, so that the CLI and the
 // workbench report a damaged, locked or unwritable project like any other bad
 // file instead of crashing.

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "acquisition/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -104,7 +104,7 @@ std::vector<BlockResult> associate_blocks(const SampleCloud& source, const Prepa
   const Eigen::Isometry3f T = T_target_source.cast<float>();
   const int blocks = static_cast<int>((source.size() + kBlock - 1) / kBlock);
   std::vector<BlockResult> found(static_cast<std::size_t>(blocks));
-  acquisition::parallel_for_index(blocks, threads, [&](int b) {
+  core::parallel_for_index(blocks, threads, [&](int b) {
     const std::size_t begin = static_cast<std::size_t>(b) * kBlock;
     const std::size_t end = std::min(source.size(), begin + kBlock);
     associate_block(source, target, nearest, T, gate, free_space, begin, end,

@@ -39,7 +39,7 @@ struct SampleIndex {
 // Every sample whose associated target pixel is usable and passes the gate,
 // in sample order (deterministic for any thread count). T_target_source maps
 // the samples' scan frame into the target's scan frame. `threads` as in
-// acquisition::parallel_for_index. With `nearest`, samples are associated
+// core::parallel_for_index. With `nearest`, samples are associated
 // with the closest indexed target sample instead of by projection.
 std::vector<Correspondence> associate_samples(const SampleCloud& source, const PreparedScan& target,
                                               const Eigen::Isometry3d& T_target_source,

@@ -16,8 +16,8 @@
 #include <iterator>
 #include <optional>
 
-#include "acquisition/parallel.hpp"
-#include "acquisition/timing.hpp"
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
 #include "registration/pcl_sample_cloud.hpp"
 
 namespace scanbench::registration {
@@ -35,7 +35,7 @@ FeatureCloud::FeatureCloud(const SampleCloud& sample, const FeatureSettings& set
   impl_->points = to_pcl_cloud(sample);
   if (impl_->points->empty()) return;
   pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> estimator;
-  estimator.setNumberOfThreads(static_cast<unsigned>(acquisition::worker_count(settings.threads)));
+  estimator.setNumberOfThreads(static_cast<unsigned>(core::worker_count(settings.threads)));
   estimator.setInputCloud(impl_->points);
   estimator.setInputNormals(impl_->points);
   estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointNormal>>());
@@ -81,7 +81,7 @@ std::vector<FeatureMatch> match_features(Described source, Described target,
   const double max_dz = settings.levelled ? settings.max_normal_z_difference : 2.0;
   // Slot i·k + j holds the source sample i's j-th match, when it has one.
   std::vector<std::optional<FeatureMatch>> slots(source.points->size() * k);
-  acquisition::parallel_for_index(
+  core::parallel_for_index(
       static_cast<int>(source.points->size()), settings.threads,
       [&](int i) {
         const pcl::FPFHSignature33& feature = (*source.features)[static_cast<std::size_t>(i)];
@@ -175,7 +175,7 @@ FeatureAlignmentResult align_features(const FeatureCloud& source, const FeatureC
                        std::to_string(matches.size()) + " feature matches";
     }
   }
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

@@ -10,8 +10,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "acquisition/parallel.hpp"
-#include "acquisition/timing.hpp"
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
 #include "registration/association.hpp"
 #include "registration/point_to_plane_costs.hpp"
 #include "registration/pose_parameters.hpp"
@@ -31,7 +31,7 @@ ceres::Solver::Options solver_options(const GlobalSettings& settings) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = settings.solver_iterations;
-  options.num_threads = acquisition::worker_count(settings.icp.threads);
+  options.num_threads = core::worker_count(settings.icp.threads);
   options.logging_type = ceres::SILENT;
   return options;
 }
@@ -120,7 +120,7 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples,
     }
   }
   result.T_first_scan = std::move(T_first_scan);
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

@@ -13,8 +13,8 @@
 #include <optional>
 #include <vector>
 
-#include "acquisition/parallel.hpp"
-#include "acquisition/timing.hpp"
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
 #include "registration/association.hpp"
 #include "registration/point_to_plane_costs.hpp"
 #include "registration/pose_parameters.hpp"
@@ -46,7 +46,7 @@ ceres::Solver::Options solver_options(const IcpSettings& settings) {
   // Six unknowns: the normal equations are a 6 × 6 dense system.
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = settings.solver_iterations;
-  options.num_threads = acquisition::worker_count(settings.threads);
+  options.num_threads = core::worker_count(settings.threads);
   options.logging_type = ceres::SILENT;
   return options;
 }
@@ -121,7 +121,7 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
   result.rms_m = quality.rms_m;
   result.free_space_violation = quality.free_space_violation;
   result.converged = result.converged && quality.correspondences >= settings.min_correspondences;
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

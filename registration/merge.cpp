@@ -16,8 +16,8 @@
 #include <numbers>
 #include <variant>
 
-#include "acquisition/parallel.hpp"
-#include "acquisition/timing.hpp"
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -190,7 +190,7 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
       static_cast<float>(settings.noise.noise_per_m)};
   std::vector<float> footprint_per_m(scans.size(), 0.0f);
   if (settings.bound_coarser_scans) {
-    acquisition::parallel_for_index(static_cast<int>(scans.size()), settings.threads, [&](int s) {
+    core::parallel_for_index(static_cast<int>(scans.size()), settings.threads, [&](int s) {
       footprint_per_m[static_cast<std::size_t>(s)] =
           max_footprint_per_m(scans[static_cast<std::size_t>(s)]);
     });
@@ -203,7 +203,7 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
     MergeScanResult out;
     out.keep.assign(scan.in_model.size(), 0);
     std::atomic<std::size_t> bounded{0};
-    acquisition::parallel_for_index(
+    core::parallel_for_index(
         scan.scan->rows, settings.threads,
         [&](int row) { bounded += merge_row(scans, s, others, thresholds, row, out); }, 4);
     out.decided_by_bound = bounded;
@@ -211,7 +211,7 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
     result.points += out.in_model;
     result.scans.push_back(std::move(out));
   }
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

@@ -4,7 +4,7 @@
 #include <cassert>
 #include <cmath>
 
-#include "acquisition/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -59,7 +59,7 @@ PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::Scan
   out.in_model.assign(n, 0);
   out.usable.assign(n, 0);
   out.sample_area_m2.assign(n, 0.0f);
-  acquisition::parallel_for_index(
+  core::parallel_for_index(
       scan.rows, threads, [&](int row) { prepare_row(scan, geometry, row, out); }, 8);
   if (scan.is_spherical()) {
     out.grid.emplace(scan);

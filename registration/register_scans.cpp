@@ -6,7 +6,7 @@
 #include <cmath>
 #include <optional>
 
-#include "acquisition/timing.hpp"
+#include "core/timing.hpp"
 #include "registration/pose_parameters.hpp"
 #include "registration/sample_cloud.hpp"
 
@@ -132,7 +132,7 @@ std::optional<Eigen::Isometry3d> feature_start(
       best_index = i;
     }
   }
-  report.seconds = acquisition::seconds_since(start);
+  report.seconds = core::seconds_since(start);
   if (!best) {
     if (!aligned.hypotheses.empty()) {
       report.failure = "none of " + std::to_string(aligned.hypotheses.size()) +
@@ -236,7 +236,7 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
       report.start = start.start;
     }
   }
-  report.seconds = acquisition::seconds_since(start);
+  report.seconds = core::seconds_since(start);
   if (report.coarse.method == "features" && from_coarse) {
     confirm_coarse(*from_coarse, *best, report.coarse);
   }
@@ -322,7 +322,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
     }
   }
   RegistrationResult result;
-  result.coarse_seconds = acquisition::seconds_since(start);
+  result.coarse_seconds = core::seconds_since(start);
   std::vector<Eigen::Isometry3d> T_first_scan(n, Eigen::Isometry3d::Identity());
   std::vector<bool> registered(n, true);
   for (std::size_t k = 1; k < n; ++k) {
@@ -363,7 +363,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
   }
   result.converged = std::all_of(registered.begin(), registered.end(), [](bool r) { return r; }) &&
                      (!settings.refine_globally || n == 1 || result.global.converged);
-  result.seconds = acquisition::seconds_since(start);
+  result.seconds = core::seconds_since(start);
   return result;
 }
 

@@ -6,14 +6,14 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/simulation/pose_error.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/truth_images.hpp"
-#include "acquisition/timing.hpp"
 #include "acquisition/triplet_writer.hpp"
+#include "core/errors.hpp"
+#include "core/timing.hpp"
 
 namespace scanbench::acquisition::sim {
 namespace {
@@ -134,7 +134,7 @@ CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::pat
     const auto cast_start = std::chrono::steady_clock::now();
     SimulatedScan sim = simulate_scan(site.scene, site.scan_poses[k], settings.scanner, lighting,
                                       scan_seed, settings.simulation);
-    result.simulate_seconds += seconds_since(cast_start);
+    result.simulate_seconds += core::seconds_since(cast_start);
     sim.scan.name = scan_name(settings.site, k);
     const Eigen::Isometry3d true_pose = sim.scan.T_world_scan;
     if (k > 0 && (settings.pose_error_deg > 0.0 || settings.pose_error_m > 0.0)) {
@@ -156,7 +156,7 @@ CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::pat
                                  {"noise", noise_json(settings.scanner)},
                                  {"scans", scans},
                                  {"objects", objects_json(site.scene)}});
-  result.total_seconds = seconds_since(start);
+  result.total_seconds = core::seconds_since(start);
   return result;
 }
 

@@ -3,10 +3,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/simulation/campaign.hpp"
 #include "acquisition/simulation/truth_images.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition::sim {
 namespace {
@@ -19,11 +19,11 @@ class TruthJson {
  public:
   explicit TruthJson(fs::path path) : path_(std::move(path)) {
     std::ifstream in(path_, std::ios::binary);
-    if (!in) throw InputError(path_.string(), {}, "cannot open");
+    if (!in) throw core::InputError(path_.string(), {}, "cannot open");
     try {
       root_ = json::parse(in);
     } catch (const json::parse_error& e) {
-      throw InputError(path_.string(), {std::nullopt, e.byte, {}}, "not valid JSON");
+      throw core::InputError(path_.string(), {std::nullopt, e.byte, {}}, "not valid JSON");
     }
   }
 
@@ -40,8 +40,8 @@ class TruthJson {
   }
 
   [[noreturn]] void fail(const char* key, const std::string& problem) const {
-    throw InputError(path_.string(),
-                     {std::nullopt, std::nullopt, std::string("key \"") + key + "\""}, problem);
+    throw core::InputError(
+        path_.string(), {std::nullopt, std::nullopt, std::string("key \"") + key + "\""}, problem);
   }
 
   fs::path resolve(const std::string& relative) const { return path_.parent_path() / relative; }

@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition::sim {
 namespace {
@@ -22,10 +22,12 @@ void write_image(const std::filesystem::path& path, const cv::Mat& image) {
 
 cv::Mat read_image(const std::filesystem::path& path, int type, int rows, int columns) {
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw InputError(path.string(), {}, "missing or unreadable truth image");
-  if (image.type() != type) throw InputError(path.string(), {}, "truth image has the wrong type");
+  if (image.empty()) throw core::InputError(path.string(), {}, "missing or unreadable truth image");
+  if (image.type() != type)
+    throw core::InputError(path.string(), {}, "truth image has the wrong type");
   if (image.rows != rows || image.cols != columns) {
-    throw InputError(path.string(), {}, "truth image size differs from the scan's rows x columns");
+    throw core::InputError(path.string(), {},
+                           "truth image size differs from the scan's rows x columns");
   }
   return image;
 }

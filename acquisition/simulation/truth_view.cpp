@@ -8,9 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
-#include "acquisition/input_error.hpp"
-#include "acquisition/parallel.hpp"
 #include "acquisition/rigid_transform.hpp"
+#include "core/errors.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::acquisition::sim {
 namespace {
@@ -21,7 +21,8 @@ using nlohmann::json;
 constexpr std::uint8_t kSky[3] = {170, 200, 235};
 
 [[noreturn]] void fail(const fs::path& file, const std::string& key, const std::string& problem) {
-  throw InputError(file.string(), {std::nullopt, std::nullopt, "key \"" + key + "\""}, problem);
+  throw core::InputError(file.string(), {std::nullopt, std::nullopt, "key \"" + key + "\""},
+                         problem);
 }
 
 Eigen::Vector3d vector_at(const fs::path& file, const json& root, const std::string& key) {
@@ -80,14 +81,14 @@ T number_at(const fs::path& file, const json& root, const std::string& key, T lo
 
 CameraView read_camera_view(const fs::path& view_json) {
   std::ifstream in(view_json, std::ios::binary);
-  if (!in) throw InputError(view_json.string(), {}, "cannot open");
+  if (!in) throw core::InputError(view_json.string(), {}, "cannot open");
   json root;
   try {
     root = json::parse(in);
   } catch (const json::parse_error& e) {
-    throw InputError(view_json.string(), {std::nullopt, e.byte, {}}, "not valid JSON");
+    throw core::InputError(view_json.string(), {std::nullopt, e.byte, {}}, "not valid JSON");
   }
-  if (!root.is_object()) throw InputError(view_json.string(), {}, "must hold a JSON object");
+  if (!root.is_object()) throw core::InputError(view_json.string(), {}, "must hold a JSON object");
   CameraView view;
   view.width = number_at(view_json, root, "width", 1, 16384);
   view.height = number_at(view_json, root, "height", 1, 16384);
@@ -128,7 +129,7 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
       for (int c = 0; c < 3; ++c) image.rgb[3 * i + c] = rgb[c];
     }
   };
-  parallel_for_index(view.height, settings.threads, render_row);
+  core::parallel_for_index(view.height, settings.threads, render_row);
   return image;
 }
 

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "acquisition/parallel.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/textures.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::acquisition::sim {
 namespace {
@@ -132,7 +132,7 @@ bool mixed_echo(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
 
 template <typename Body>
 void parallel_rows(int rows, const SimulationSettings& settings, Body&& body) {
-  parallel_for_index(rows, settings.threads, body);
+  core::parallel_for_index(rows, settings.threads, body);
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/pcd_reader.hpp"
+#include "core/errors.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
@@ -108,14 +108,14 @@ TEST(PcdReader, ReadsPathWithSpacesAndNonAscii) {
 
 TEST(PcdReader, MissingFileIsAnInputError) {
   const ScratchDir dir;
-  EXPECT_THROW(read_organized_pcd(dir / "absent.pcd"), InputError);
+  EXPECT_THROW(read_organized_pcd(dir / "absent.pcd"), core::InputError);
 }
 
 TEST(PcdReader, NonNumericValueReportsItsLine) {
   try {
     read_organized_pcd(fixture("bad/pcd_non_numeric.pcd"));
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
     ASSERT_TRUE(e.position().line.has_value()) << e.what();
     EXPECT_EQ(*e.position().line, 17u) << e.what();
   }
@@ -134,8 +134,8 @@ TEST(PcdReader, RefusesCompressedBodyWhoseSizeWordLies) {
   std::ofstream(path, std::ios::binary) << bytes;
   try {
     read_organized_pcd(path);
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
     EXPECT_NE(e.problem().find("disagrees"), std::string::npos) << e.what();
   }
 }
@@ -152,8 +152,8 @@ TEST_P(PcdBadInput, ThrowsInputErrorNamingFileAndProblem) {
   const std::string name = std::string(c.fixture) + ".pcd";
   try {
     read_organized_pcd(fixture("bad/" + name));
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
     EXPECT_NE(e.problem().find(c.problem), std::string::npos) << e.what();
   }

@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <numbers>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/ptx_reader.hpp"
 #include "acquisition/ptx_writer.hpp"
+#include "core/errors.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
@@ -165,7 +165,7 @@ TEST_P(PtxBadInput, IsRefusedWithFileLineAndProblem) {
   try {
     read_ptx(path);
     FAIL() << bad.file << " was accepted";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find(bad.file), std::string::npos) << message;
     EXPECT_NE(message.find(bad.problem), std::string::npos) << message;
@@ -202,14 +202,14 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(PtxReader, MissingFileIsRefusedWithItsName) {
   ScratchDir dir;
-  EXPECT_THROW(read_ptx(dir / "absent.ptx"), InputError);
+  EXPECT_THROW(read_ptx(dir / "absent.ptx"), core::InputError);
 }
 
 TEST(PtxReader, TruncationIsReportedAtTheLastLine) {
   try {
     read_ptx(fixture("bad/ptx_truncated_body.ptx"));
     FAIL();
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_EQ(e.position().line, 14u);  // 10 header lines + 4 point lines
     EXPECT_NE(std::string(e.what()).find("declares 6 points, found 4"), std::string::npos);
   }

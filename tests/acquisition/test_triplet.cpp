@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/triplet_reader.hpp"
 #include "acquisition/triplet_writer.hpp"
+#include "core/errors.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
@@ -260,8 +260,8 @@ TEST_P(TripletBadSidecar, ThrowsInputErrorNamingFileAndProblem) {
   const BadSidecar& c = GetParam();
   try {
     read_triplet(fixture(std::string("bad/") + c.fixture + ".json"));
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find(c.named_file), std::string::npos) << e.what();
     EXPECT_NE(e.problem().find(c.problem), std::string::npos) << e.what();
   }
@@ -301,8 +301,8 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(TripletReader, NotJsonReportsTheParserByteOffset) {
   try {
     read_triplet(fixture("bad/triplet_not_json.json"));
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
     ASSERT_TRUE(e.position().byte_offset.has_value()) << e.what();
     EXPECT_EQ(*e.position().byte_offset, 57u) << e.what();  // the 'o' of "oops"
   }
@@ -310,7 +310,7 @@ TEST(TripletReader, NotJsonReportsTheParserByteOffset) {
 
 TEST(TripletReader, MissingSidecarIsAnInputError) {
   const ScratchDir dir;
-  EXPECT_THROW(read_triplet(dir / "nothing here.json"), InputError);
+  EXPECT_THROW(read_triplet(dir / "nothing here.json"), core::InputError);
 }
 
 // ---- malformed images: one fixture folder each -------------------------
@@ -327,8 +327,8 @@ TEST_P(TripletBadImage, ThrowsInputErrorNamingTheImage) {
   const BadImage& c = GetParam();
   try {
     read_triplet(fixture(std::string("bad/triplet_image_") + c.name + "/scan.json"));
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
     EXPECT_NE(e.file().find(c.file), std::string::npos) << e.what();
     EXPECT_NE(e.problem().find(c.problem), std::string::npos) << e.what();
   }

@@ -5,13 +5,13 @@
 #include <cstring>
 #include <limits>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/blob_codec.hpp"
 
 namespace scanbench::modeling {
 namespace {
 
-using acquisition::InputError;
+using core::InputError;
 using ::testing::HasSubstr;
 
 const BlobContext kContext{"site.sbproj", "scan 3, channel range_m"};
@@ -69,8 +69,8 @@ TEST(BlobCodec, WrongExpectedSizeIsAnInputErrorNamingTheChannel) {
   const auto blob = compress_floats(std::vector<float>(10, 1.0f));
   try {
     decompress_floats(blob, 11, kContext);
-    FAIL() << "expected InputError";
-  } catch (const InputError& error) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
     EXPECT_EQ(error.file(), "site.sbproj");
     EXPECT_EQ(error.position().detail, "scan 3, channel range_m");
     EXPECT_THAT(error.what(), HasSubstr("holds 40 bytes, expected 44"));
@@ -82,7 +82,7 @@ TEST(BlobCodec, TruncatedBlobIsAnInputError) {
   for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::sin(static_cast<float>(i));
   auto blob = compress_floats(values);
   blob.resize(blob.size() / 2);
-  EXPECT_THROW(decompress_floats(blob, values.size(), kContext), InputError);
+  EXPECT_THROW(decompress_floats(blob, values.size(), kContext), core::InputError);
 }
 
 TEST(BlobCodec, FlippedBitsAreCaughtNeverDecodedWrong) {
@@ -100,7 +100,7 @@ TEST(BlobCodec, FlippedBitsAreCaughtNeverDecodedWrong) {
       try {
         EXPECT_TRUE(same_bits(decompress_floats(damaged, values.size(), kContext), values))
             << "byte " << i << " bit " << int{bit};
-      } catch (const InputError&) {
+      } catch (const core::InputError&) {
         ++caught;
       }
     }
@@ -110,21 +110,21 @@ TEST(BlobCodec, FlippedBitsAreCaughtNeverDecodedWrong) {
 
 TEST(BlobCodec, GarbageAndEmptyBlobsAreInputErrors) {
   const std::vector<std::uint8_t> garbage = {'n', 'o', 't', ' ', 'z', 's', 't', 'd'};
-  EXPECT_THROW(decompress_bytes(garbage, 8, kContext), InputError);
-  EXPECT_THROW(decompress_bytes({}, 0, kContext), InputError);
+  EXPECT_THROW(decompress_bytes(garbage, 8, kContext), core::InputError);
+  EXPECT_THROW(decompress_bytes({}, 0, kContext), core::InputError);
 }
 
 TEST(BlobCodec, TrailingBytesAreAnInputError) {
   auto blob = compress_bytes(std::vector<std::uint8_t>(64, 1));
   const auto second = compress_bytes(std::vector<std::uint8_t>(64, 2));
   blob.insert(blob.end(), second.begin(), second.end());
-  EXPECT_THROW(decompress_bytes(blob, 64, kContext), InputError);
+  EXPECT_THROW(decompress_bytes(blob, 64, kContext), core::InputError);
 }
 
 TEST(BlobCodec, ImpossibleCountIsAnInputErrorNotAnAllocation) {
   const auto blob = compress_floats(std::vector<float>(4, 1.0f));
   EXPECT_THROW(decompress_floats(blob, std::numeric_limits<std::size_t>::max() / 2, kContext),
-               InputError);
+               core::InputError);
 }
 
 }  // namespace

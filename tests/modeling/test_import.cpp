@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/import_scans.hpp"
 #include "modeling/project.hpp"
 #include "support/test_support.hpp"
@@ -41,7 +41,7 @@ TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
                     std::vector<std::filesystem::path>{fixture("good/ptx/tiny_color.ptx")});
   const std::vector<std::filesystem::path> files{fixture("good/ptx/two_scans.ptx"),
                                                  fixture("bad/ptx_color_out_of_range.ptx")};
-  EXPECT_THROW(import_scan_files(project, files), acquisition::InputError);
+  EXPECT_THROW(import_scan_files(project, files), core::InputError);
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
 }
 

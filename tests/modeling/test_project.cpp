@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "acquisition/input_error.hpp"
 #include "acquisition/scan_summary.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 #include "modeling/project_test_support.hpp"
 #include "support/test_support.hpp"
@@ -15,7 +15,7 @@
 namespace scanbench::modeling {
 namespace {
 
-using acquisition::InputError;
+using core::InputError;
 using test::expect_identical;
 using test::RawDatabase;
 using test::ScratchDir;
@@ -76,8 +76,8 @@ TEST(Project, CreateRefusesAnExistingFileAndLeavesItAlone) {
   const std::string before = test::read_file_bytes(file);
   try {
     Project::create(file);
-    FAIL() << "expected InputError";
-  } catch (const InputError& error) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
     EXPECT_EQ(error.file(), file.string());
     EXPECT_THAT(error.what(), HasSubstr("already exists"));
   }
@@ -87,7 +87,7 @@ TEST(Project, CreateRefusesAnExistingFileAndLeavesItAlone) {
 
 TEST(Project, CreateInAMissingFolderIsAnInputError) {
   const ScratchDir dir;
-  EXPECT_THROW(Project::create(dir / "no such folder" / "site.sbproj"), InputError);
+  EXPECT_THROW(Project::create(dir / "no such folder" / "site.sbproj"), core::InputError);
 }
 
 // (spherical, intensity, color)
@@ -166,8 +166,8 @@ TEST(Project, LoadingAMissingIdIsAnInputError) {
   const Project project = Project::create(file);
   try {
     project.load_scan(42);
-    FAIL() << "expected InputError";
-  } catch (const InputError& error) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
     EXPECT_EQ(error.file(), file.string());
     EXPECT_THAT(error.what(), HasSubstr("no scan with id 42"));
   }
@@ -237,8 +237,8 @@ TEST(Project, ADamagedChannelNamesTheScanAndChannel) {
   EXPECT_EQ(project.scans().size(), 1u);  // summaries do not touch channel data
   try {
     project.load_scan(id);
-    FAIL() << "expected InputError";
-  } catch (const InputError& error) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
     EXPECT_EQ(error.file(), file.string());
     EXPECT_EQ(error.position().detail, "scan " + std::to_string(id) + ", channel intensity");
   }
@@ -253,7 +253,7 @@ TEST(Project, AMissingChannelIsAnInputError) {
     id = insert_committed(project, tiny_scan(false, false, false));
   }
   { RawDatabase(file).execute("DELETE FROM scan_channels WHERE channel = 'directions'"); }
-  EXPECT_THROW(Project::open(file).load_scan(id), InputError);
+  EXPECT_THROW(Project::open(file).load_scan(id), core::InputError);
 }
 
 TEST(ProjectDeathTest, InsertingOutsideATransactionIsAProgrammerError) {

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <random>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 #include "modeling/project_test_support.hpp"
 #include "support/test_support.hpp"
@@ -16,7 +16,7 @@
 namespace scanbench::modeling {
 namespace {
 
-using acquisition::InputError;
+using core::InputError;
 using test::RawDatabase;
 using test::ScratchDir;
 using test::tiny_scan;
@@ -34,8 +34,8 @@ void expect_refused(const std::filesystem::path& file, const std::string& proble
   for (const auto opener : {&Project::open, &Project::open_or_create}) {
     try {
       opener(file);
-      ADD_FAILURE() << "expected InputError for " << file;
-    } catch (const InputError& error) {
+      ADD_FAILURE() << "expected core::InputError for " << file;
+    } catch (const core::InputError& error) {
       EXPECT_EQ(error.file(), file.string());
       EXPECT_THAT(error.what(), HasSubstr(problem));
     }
@@ -70,15 +70,15 @@ TEST(ProjectFiles, RefusesADirectory) {
   const ScratchDir dir;
   const auto folder = dir / "folder.sbproj";
   std::filesystem::create_directory(folder);
-  EXPECT_THROW(Project::open(folder), InputError);
-  EXPECT_THROW(Project::open_or_create(folder), InputError);
+  EXPECT_THROW(Project::open(folder), core::InputError);
+  EXPECT_THROW(Project::open_or_create(folder), core::InputError);
   EXPECT_TRUE(std::filesystem::is_empty(folder));
 }
 
 TEST(ProjectFiles, RefusesAMissingFileWithoutCreatingIt) {
   const ScratchDir dir;
   const auto file = dir / "gone.sbproj";
-  EXPECT_THROW(Project::open(file), InputError);
+  EXPECT_THROW(Project::open(file), core::InputError);
   EXPECT_FALSE(std::filesystem::exists(file));
 }
 
@@ -118,8 +118,8 @@ TEST(ProjectFiles, RefusesANewerSchemaThatIsOnlyInTheLog) {
   const std::string before = test::read_file_bytes(file);
   try {
     Project::open(file);
-    FAIL() << "expected InputError";
-  } catch (const InputError& error) {
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr("project schema version 7 is newer"));
   }
   EXPECT_EQ(test::read_file_bytes(file), before);

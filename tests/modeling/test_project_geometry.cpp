@@ -1,7 +1,7 @@
 // Schema version 2: per-point geometry stored beside the scans.
 #include <gtest/gtest.h>
 
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 #include "modeling/geometry_stage.hpp"
 #include "modeling/import_scans.hpp"
 #include "modeling/project.hpp"
@@ -91,7 +91,7 @@ TEST(GeometryStage, ComputesAndStoresEveryScanInOneTransaction) {
 TEST(GeometryStage, AForeignFileIsRefused) {
   const ScratchDir dir;
   EXPECT_THROW(compute_project_geometry(test::fixture("bad/project_not_sqlite.sbproj")),
-               acquisition::InputError);
+               core::InputError);
 }
 
 }  // namespace

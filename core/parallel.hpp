@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <thread>
 
-namespace scanbench::acquisition {
+namespace scanbench::core {
 
 // The number of workers `threads` stands for: itself when positive, else
 // every core (at least 1).
@@ -32,4 +32,4 @@ void parallel_for_index(int count, int threads, Body&& body, int grain = 1) {
   });
 }
 
-}  // namespace scanbench::acquisition
+}  // namespace scanbench::core

@@ -1,8 +1,8 @@
-#include "acquisition/input_error.hpp"
+#include "core/errors.hpp"
 
 #include <sstream>
 
-namespace scanbench::acquisition {
+namespace scanbench::core {
 
 std::string format_input_error(const std::string& file, const FilePosition& position,
                                const std::string& problem) {
@@ -18,8 +18,8 @@ std::string format_input_error(const std::string& file, const FilePosition& posi
     where += where.empty() ? "" : ", ";
     where += position.detail;
   }
-  if (!where.empty()) out << ": " << where;
-  out << ": " << problem;
+  if (!where.empty()) out << (file.empty() ? "" : ": ") << where;
+  out << (file.empty() && where.empty() ? "" : ": ") << problem;
   return out.str();
 }
 
@@ -29,4 +29,12 @@ InputError::InputError(std::string file, FilePosition position, std::string prob
       position_(std::move(position)),
       problem_(std::move(problem)) {}
 
-}  // namespace scanbench::acquisition
+RuntimeFailure::RuntimeFailure(std::string file, FilePosition position, std::string problem)
+    : std::runtime_error(format_input_error(file, position, problem)),
+      file_(std::move(file)),
+      problem_(std::move(problem)) {}
+
+Cancelled::Cancelled(const std::string& stage)
+    : std::runtime_error(stage + " cancelled; nothing was changed") {}
+
+}  // namespace scanbench::core

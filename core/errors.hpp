@@ -1,0 +1,69 @@
+// The two kinds of failure that reach a user, written once (docs/CONTRIBUTING.md,
+// "Errors"). Programmer errors are assertions, never one of these.
+//
+//   InputError      bad data from outside the program: a malformed file, an
+//                   impossible header, a damaged project or one from a newer
+//                   version, a bad argument. The CLI exits with 2.
+//   RuntimeFailure  the input was fine but the work could not be done: a full
+//                   disk, an I/O error, a lock held by another process, out of
+//                   memory. The CLI exits with 1.
+//   Cancelled       the user asked a stage to stop (core/progress.hpp); the
+//                   stage changed nothing.
+//
+// Whoever throws one of them has changed nothing the caller owns.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace scanbench::core {
+
+// Where in a file the problem was found. Lines are 1-based; byte offsets are
+// 0-based from the start of the file. Either may be absent when it does not
+// apply (an image has no lines, a JSON key has no useful offset).
+struct FilePosition {
+  std::optional<std::uint64_t> line;
+  std::optional<std::uint64_t> byte_offset;
+  std::string detail;  // free-form position, e.g. "key \"angles.azimuth_step_deg\""
+};
+
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string file, FilePosition position, std::string problem);
+
+  const std::string& file() const { return file_; }
+  const FilePosition& position() const { return position_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  std::string file_;
+  FilePosition position_;
+  std::string problem_;
+};
+
+class RuntimeFailure : public std::runtime_error {
+ public:
+  // `file` names what could not be read or written ("" when none applies).
+  RuntimeFailure(std::string file, FilePosition position, std::string problem);
+
+  const std::string& file() const { return file_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  std::string file_;
+  std::string problem_;
+};
+
+class Cancelled : public std::runtime_error {
+ public:
+  // `stage` names what was stopped ("geometry", "merge").
+  explicit Cancelled(const std::string& stage);
+};
+
+// "FILE: line 12 (byte 340): problem" — the form every message takes.
+std::string format_input_error(const std::string& file, const FilePosition& position,
+                               const std::string& problem);
+
+}  // namespace scanbench::core
