@@ -75,8 +75,10 @@ void detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings,
                          std::span<std::uint8_t> mixed) {
   assert(check_consistency(scan).empty() && mixed.size() == scan.pixel_count() &&
          "a consistent scan and one output per pixel");
-  const auto sigma0_m = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_m);
-  const auto sigma1 = static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise_per_m);
+  const auto sigma0_m =
+      static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise.noise_m);
+  const auto sigma1 =
+      static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise.noise_per_m);
   const int blocks = (scan.rows + kBlockRows - 1) / kBlockRows;
   core::parallel_for_index(blocks, settings.threads, [&](int b) {
     const int begin = b * kBlockRows, end = std::min(scan.rows, begin + kBlockRows);

@@ -47,7 +47,7 @@ void for_each_point(std::span<const Scan> scans, std::span<const ScanGeometry* c
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.columns; ++col) {
         const std::size_t i = scan.index(row, col);
-        if (!scan.valid[i] || (channels.geometry && geometry[s]->is_mixed(i))) continue;
+        if (channels.geometry ? !in_model(scan, *geometry[s], i) : !scan.valid[i]) continue;
         if (mask != nullptr && (*mask)[i] == 0) continue;
         visit(s, i, point_in_world(scan, row, col));
       }

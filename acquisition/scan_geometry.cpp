@@ -114,8 +114,9 @@ struct JumpTest {
 
   explicit JumpTest(const GeometrySettings& s)
       : relative(static_cast<float>(s.depth_jump_relative)),
-        noise0_m(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_m)),
-        noise1(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise_per_m)) {}
+        noise0_m(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_m)),
+        noise1(
+            static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_per_m)) {}
 
   bool operator()(float before, float centre, float after, float range_m) const {
     const float d = std::abs(before - 2.0f * centre + after);

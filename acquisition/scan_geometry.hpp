@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "acquisition/range_noise.hpp"
 #include "acquisition/scan.hpp"
 
 namespace scanbench::acquisition {
@@ -38,6 +39,13 @@ struct ScanGeometry {
   bool has_normal(std::size_t i) const { return confidence[i] > 0.0f; }
   bool is_mixed(std::size_t i) const { return (flags[i] & kFlagMixedPixel) != 0; }
 };
+
+// The rule for which points belong in a model (registration, the merge,
+// segmentation, rendering): a return that is not a mixed pixel. Asserts
+// nothing; `i` must index both.
+inline bool in_model(const Scan& scan, const ScanGeometry& geometry, std::size_t i) {
+  return scan.valid[i] != 0 && !geometry.is_mixed(i);
+}
 
 // Window counts are 16-bit: (2 · 127 + 1)² < 65536.
 inline constexpr int kMaxWindowRadius = 127;
@@ -70,12 +78,10 @@ struct GeometrySettings {
   // Detect and flag mixed pixels (they stay in the scan; later stages leave
   // them out of the model).
   bool flag_mixed_pixels = true;
-  // The scanner's range noise, σ = range_noise_m + range_noise_per_m · range
-  // (defaults: the RIEGL LMS-Z360 and our virtual scanner). A pixel is a mixed
-  // pixel when, along some grid line, it lies between its neighbours and off
-  // the linear continuation of both sides by more than mixed_pixel_sigmas · σ.
-  double range_noise_m = 0.005;
-  double range_noise_per_m = 5e-5;
+  // The scanner's range noise σ. A pixel is a mixed pixel when, along some
+  // grid line, it lies between its neighbours and off the linear continuation
+  // of both sides by more than mixed_pixel_sigmas · σ.
+  RangeNoise range_noise;
   double mixed_pixel_sigmas = 8.0;
   // Worker threads; 0 = all cores. Results do not depend on it.
   int threads = 0;

@@ -16,8 +16,8 @@ std::string geometry_settings_json(const acquisition::GeometrySettings& s) {
                         {"min_neighbours", s.min_neighbours},
                         {"max_footprint_stretch", s.max_footprint_stretch},
                         {"flag_mixed_pixels", s.flag_mixed_pixels},
-                        {"range_noise_m", s.range_noise_m},
-                        {"range_noise_per_m", s.range_noise_per_m},
+                        {"range_noise_m", s.range_noise.noise_m},
+                        {"range_noise_per_m", s.range_noise.noise_per_m},
                         {"mixed_pixel_sigmas", s.mixed_pixel_sigmas}}
       .dump();
 }

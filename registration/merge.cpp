@@ -47,10 +47,9 @@ struct Thresholds {
   float min_normal_cos;
   float tie_low;   // A_o < A_s · tie_low: o is finer (1 / tie_high: symmetric)
   float tie_high;  // A_o ≤ A_s · tie_high (and not finer): a tie
-  float noise_m;   // RangeNoise in float
-  float noise_per_m;
+  acquisition::RangeNoise noise;
 
-  float range_sigma(float range) const { return noise_m + noise_per_m * range; }
+  float range_sigma(float range) const { return noise.sigma(range); }
 };
 
 // True when spherical o samples the surface at point p (s's point, in o's
@@ -185,9 +184,7 @@ MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
       static_cast<float>(settings.range_sigmas),
       static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0)),
       static_cast<float>(1.0 / (1.0 + settings.tie_tolerance)),
-      static_cast<float>(1.0 + settings.tie_tolerance),
-      static_cast<float>(settings.noise.noise_m),
-      static_cast<float>(settings.noise.noise_per_m)};
+      static_cast<float>(1.0 + settings.tie_tolerance), settings.noise};
   std::vector<float> footprint_per_m(scans.size(), 0.0f);
   if (settings.bound_coarser_scans) {
     core::parallel_for_index(static_cast<int>(scans.size()), settings.threads, [&](int s) {

@@ -9,12 +9,13 @@
 #include <span>
 #include <vector>
 
+#include "acquisition/range_noise.hpp"
 #include "registration/prepared_scan.hpp"
 
 namespace scanbench::registration {
 
 struct MergeSettings {
-  RangeNoise noise;
+  acquisition::RangeNoise noise;
   // Same surface: the ranges along the other scan's beam agree within
   // range_sigmas combined noise σ plus that beam's footprint (the beam
   // centre and the point may be half a pixel apart on a slanted surface)...

@@ -11,8 +11,8 @@
 
 #include "acquisition/scan.hpp"
 #include "acquisition/scan_geometry.hpp"
+#include "acquisition/spherical_grid.hpp"
 #include "registration/point_index.hpp"
-#include "registration/spherical_grid.hpp"
 
 namespace scanbench::registration {
 
@@ -33,7 +33,7 @@ struct PreparedScan {
   // determinant of the map between two range images is a ratio of these.
   std::vector<float> sample_area_m2;
   // Association: a spherical grid projects, other grids use the kd-tree.
-  std::optional<SphericalGrid> grid;
+  std::optional<acquisition::SphericalGrid> grid;
   std::unique_ptr<PointIndex> tree;
 };
 
@@ -48,12 +48,5 @@ PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::Scan
 // (projective association, O(1)), otherwise the nearest usable point. -1 when
 // there is none. The pixel may be unusable; callers check.
 std::int64_t associate(const PreparedScan& target, const Eigen::Vector3f& p_target);
-
-// The scanner's range noise, σ(range) = noise_m + noise_per_m · range [m].
-struct RangeNoise {
-  double noise_m = 0.005;
-  double noise_per_m = 5e-5;
-  double sigma(double range_m) const { return noise_m + noise_per_m * range_m; }
-};
 
 }  // namespace scanbench::registration

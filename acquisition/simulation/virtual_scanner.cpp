@@ -126,7 +126,7 @@ bool mixed_echo(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
   echo.range_m /= static_cast<float>(returns);
   echo.intensity /= static_cast<float>(returns);
   echo.radiance /= static_cast<float>(returns);
-  const double sigma = model.range_noise_m + model.range_noise_per_m * centre.range_m;
+  const double sigma = model.range_noise.sigma(static_cast<double>(centre.range_m));
   return straddles && std::abs(echo.range_m - centre.range_m) > 3.0 * sigma;
 }
 
@@ -230,7 +230,7 @@ SimulatedScan simulate_scan(const Scene& scene, const Eigen::Isometry3d& T_world
       truth.object_id[i] = centre.object;
       truth.normal_scan[i] = centre.normal_scan;
       truth.range_m[i] = centre.range_m;
-      const double sigma = model.range_noise_m + model.range_noise_per_m * measured.range_m;
+      const double sigma = model.range_noise.sigma(static_cast<double>(measured.range_m));
       scan.range_m[i] = static_cast<float>(measured.range_m + sigma * rng.normal());
       scan.valid[i] = scan.range_m[i] > 0.0f;
       scan.intensity[i] = static_cast<float>(

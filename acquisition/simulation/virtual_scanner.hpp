@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/range_noise.hpp"
 #include "acquisition/scan.hpp"
 #include "acquisition/simulation/scene.hpp"
 
@@ -23,9 +24,8 @@ struct ScannerModel {
   double elevation_max_deg = 50.0;   // upper edge of the window
   double min_range_m = 1.0;          // closer surfaces give no return
   double max_range_m = 200.0;        // farther surfaces give no return
-  // Range noise: Gaussian, σ = range_noise_m + range_noise_per_m · range.
-  double range_noise_m = 0.005;
-  double range_noise_per_m = 5e-5;
+  // Range noise: Gaussian with standard deviation σ(range).
+  RangeNoise range_noise;
   // Share of depth-discontinuity pixels whose beam returns one blended echo
   // (a "mixed pixel" floating between foreground and background) instead of
   // the surface under the beam centre.

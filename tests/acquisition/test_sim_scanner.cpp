@@ -45,7 +45,7 @@ TEST(SimScanner, MeasuredRangesLieOnTheTrueSurfaceWithinTheNoise) {
   std::size_t checked = 0;
   for (std::size_t i = 0; i < sim.scan.pixel_count(); ++i) {
     if (!sim.scan.valid[i] || sim.truth.mixed[i]) continue;
-    const double sigma = model.range_noise_m + model.range_noise_per_m * sim.truth.range_m[i];
+    const double sigma = model.range_noise.sigma(sim.truth.range_m[i]);
     ASSERT_LT(std::abs(sim.scan.range_m[i] - sim.truth.range_m[i]), 6.0 * sigma) << i;
     ++checked;
   }

@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <numbers>
 
-#include "registration/spherical_grid.hpp"
+#include "acquisition/spherical_grid.hpp"
 
-namespace scanbench::registration {
+namespace scanbench::acquisition {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -16,12 +16,11 @@ constexpr double kDeg = kPi / 180.0;
 
 // A full panorama laid out like the virtual scanner's: column c looks at
 // azimuth −(c + 0.5) · 360° / columns, row r at 45° − (r + 0.5) · 7.5°.
-acquisition::Scan panorama(int rows = 12, int columns = 36) {
-  acquisition::Scan scan = acquisition::make_empty_scan(rows, columns, false, false);
+Scan panorama(int rows = 12, int columns = 36) {
+  Scan scan = make_empty_scan(rows, columns, false, false);
   const double az_step = 2.0 * kPi / columns;
   const double el_step = 7.5 * kDeg;
-  scan.angles =
-      acquisition::SphericalAngles{-0.5 * az_step, -az_step, 45.0 * kDeg - 0.5 * el_step, -el_step};
+  scan.angles = SphericalAngles{-0.5 * az_step, -az_step, 45.0 * kDeg - 0.5 * el_step, -el_step};
   return scan;
 }
 
@@ -31,24 +30,24 @@ Eigen::Vector3d along(double azimuth, double elevation, double range = 1.0) {
 }
 
 TEST(SphericalGrid, EveryPixelCentreMapsBackToItsPixel) {
-  const acquisition::Scan scan = panorama();
+  const Scan scan = panorama();
   const SphericalGrid grid(scan);
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.columns; ++col) {
       const auto expected = static_cast<std::int64_t>(scan.index(row, col));
-      const Eigen::Vector3d d = acquisition::direction_precise(scan, row, col);
+      const Eigen::Vector3d d = direction_precise(scan, row, col);
       EXPECT_EQ(grid.pixel_of(d), expected) << row << "," << col;
       EXPECT_EQ(grid.pixel_of(Eigen::Vector3d(37.5 * d)), expected) << row << "," << col;
-      const Eigen::Vector3f f = acquisition::direction(scan, row, col) * 2.5f;
+      const Eigen::Vector3f f = direction(scan, row, col) * 2.5f;
       EXPECT_EQ(grid.pixel_of(f), expected) << row << "," << col;
     }
   }
 }
 
 TEST(SphericalGrid, DirectionsWithinHalfAStepMapToTheNearestPixel) {
-  const acquisition::Scan scan = panorama();
+  const Scan scan = panorama();
   const SphericalGrid grid(scan);
-  const auto& a = std::get<acquisition::SphericalAngles>(scan.angles);
+  const auto& a = std::get<SphericalAngles>(scan.angles);
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.columns; ++col) {
       for (const auto& [du, dv] : {std::pair{0.45, 0.45}, std::pair{-0.45, 0.45},
@@ -65,7 +64,7 @@ TEST(SphericalGrid, DirectionsWithinHalfAStepMapToTheNearestPixel) {
 TEST(SphericalGrid, PointsAcrossTheAzimuthSeamWrapAround) {
   // Column 0 looks at −5°, the last column at −355° ≡ +5°: the seam at
   // azimuth 0 lies between them.
-  const acquisition::Scan scan = panorama();
+  const Scan scan = panorama();
   const SphericalGrid grid(scan);
   const int last = scan.columns - 1;
   for (int row = 0; row < scan.rows; ++row) {
@@ -82,15 +81,13 @@ TEST(SphericalGrid, PointsAcrossTheAzimuthSeamWrapAround) {
   }
 }
 
-// Disabled: exposes a bug in SphericalGrid::pixel_of (registration/spherical_grid.hpp).
-// For azimuth exactly 0, u wraps to exactly period − 0.5, the seam test
-// `u > period − 0.5` misses it, and the column rounds to `columns`: −1.
-// Enable once the seam test is `>=` (or the column wraps modulo the period).
+// For azimuth exactly 0, u wraps to exactly period − 0.5: the seam test must
+// take it to column 0 rather than round it to column `columns`.
 TEST(SphericalGrid, DirectionStraightAlongTheSeamFindsABorderPixel) {
   // Azimuth exactly 0 (y = 0, as any point on the x-z plane ahead gives) lies
   // half-way between the last column and column 0; either is a right answer,
   // none is not.
-  const acquisition::Scan scan = panorama();
+  const Scan scan = panorama();
   const SphericalGrid grid(scan);
   for (int row = 0; row < scan.rows; ++row) {
     const double el = 45.0 * kDeg - (row + 0.5) * 7.5 * kDeg;
@@ -104,7 +101,7 @@ TEST(SphericalGrid, DirectionStraightAlongTheSeamFindsABorderPixel) {
 
 TEST(SphericalGrid, DirectionsOutsideTheElevationWindowAndTheOriginGiveNone) {
   // Rows cover elevations 45° down to −45°; pixel centres from 41.25° to −41.25°.
-  const acquisition::Scan scan = panorama();
+  const Scan scan = panorama();
   const SphericalGrid grid(scan);
   for (const double az : {-170.0, -90.0, -5.0, 0.3, 60.0, 135.0}) {
     EXPECT_EQ(grid.pixel_of(along(az * kDeg, 45.5 * kDeg)), -1) << az;
@@ -121,13 +118,12 @@ TEST(SphericalGrid, DirectionsOutsideTheElevationWindowAndTheOriginGiveNone) {
 
 TEST(SphericalGrid, PartialPanoramaDoesNotWrap) {
   // 20 columns of 1° from +10° to −9° (positive step too: 10 rows upward).
-  acquisition::Scan scan = acquisition::make_empty_scan(10, 20, false, false);
-  scan.angles = acquisition::SphericalAngles{10.0 * kDeg, -1.0 * kDeg, -5.0 * kDeg, 1.0 * kDeg};
+  Scan scan = make_empty_scan(10, 20, false, false);
+  scan.angles = SphericalAngles{10.0 * kDeg, -1.0 * kDeg, -5.0 * kDeg, 1.0 * kDeg};
   const SphericalGrid grid(scan);
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.columns; ++col) {
-      EXPECT_EQ(grid.pixel_of(acquisition::direction_precise(scan, row, col)),
-                scan.index(row, col));
+      EXPECT_EQ(grid.pixel_of(direction_precise(scan, row, col)), scan.index(row, col));
     }
   }
   EXPECT_EQ(grid.pixel_of(along(10.4 * kDeg, 0.0)), scan.index(5, 0));
@@ -139,12 +135,6 @@ TEST(SphericalGrid, PartialPanoramaDoesNotWrap) {
   EXPECT_EQ(grid.pixel_of(along(0.0, -5.6 * kDeg)), -1);
   EXPECT_EQ(grid.pixel_of(along(0.0, 4.6 * kDeg)), -1);
 }
-
-}  // namespace
-}  // namespace scanbench::registration
-
-namespace scanbench::registration {
-namespace {
 
 TEST(FastAtan2, FollowsTheLibraryWithinItsBoundEverywhere) {
   double worst = 0.0;
@@ -166,4 +156,4 @@ TEST(FastAtan2, FollowsTheLibraryWithinItsBoundEverywhere) {
 }
 
 }  // namespace
-}  // namespace scanbench::registration
+}  // namespace scanbench::acquisition

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace scanbench::registration {
+namespace scanbench::acquisition {
 
 // atan2(y, x) [rad] within 6·10⁻⁷ of the exact value (measured; a
 // three-thousandth of a pixel at 0.1° steps), with the signs of std::atan2, and 0 for (0, 0).
@@ -34,4 +34,4 @@ inline float fast_atan2(float y, float x) {
   return std::copysign(a, y);
 }
 
-}  // namespace scanbench::registration
+}  // namespace scanbench::acquisition

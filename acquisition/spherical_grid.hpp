@@ -10,16 +10,16 @@
 #include <numbers>
 #include <type_traits>
 
+#include "acquisition/fast_atan2.hpp"
 #include "acquisition/scan.hpp"
-#include "registration/fast_atan2.hpp"
 
-namespace scanbench::registration {
+namespace scanbench::acquisition {
 
 class SphericalGrid {
  public:
   // Asserts that `scan` has a spherical angle model with non-zero steps.
-  explicit SphericalGrid(const acquisition::Scan& scan) {
-    const auto& model = std::get<acquisition::SphericalAngles>(scan.angles);
+  explicit SphericalGrid(const Scan& scan) {
+    const auto& model = std::get<SphericalAngles>(scan.angles);
     assert(model.azimuth_step_rad != 0.0 && model.elevation_step_rad != 0.0);
     rows_ = scan.rows;
     columns_ = scan.columns;
@@ -108,4 +108,4 @@ class SphericalGrid {
   double half_diagonal_rad_ = 0.0;
 };
 
-}  // namespace scanbench::registration
+}  // namespace scanbench::acquisition
