@@ -2,6 +2,7 @@
 //                            [--no-global] [--threads N] [--json]
 #include <fmt/core.h>
 
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -15,7 +16,7 @@ namespace {
 
 struct RegisterOptions {
   std::string project;
-  std::string coarse = "features";
+  registration::CoarseMethod coarse = registration::CoarseMethod::kFeatures;
   std::string pairs_file;
   bool unlevelled = false;
   bool no_global = false;
@@ -31,8 +32,9 @@ void print_table(const modeling::RegisterStageResult& out) {
     fmt::print("{:>6} {:>6}  {:<10} {:<8} {:>9.2f} {:>8.3f} {:>8} {:>5}  {}\n",
                out.ids[static_cast<std::size_t>(p.source)],
                out.ids[static_cast<std::size_t>(p.target)],
-               p.coarse.success ? p.coarse.method : "failed", p.start, 1000.0 * p.icp.rms_m,
-               p.icp.overlap, p.icp.correspondences, p.icp.iterations,
+               p.coarse.success ? registration::coarse_method_name(p.coarse.method) : "failed",
+               registration::icp_start_name(p.start), 1000.0 * p.icp.rms_m, p.icp.overlap,
+               p.icp.correspondences, p.icp.iterations,
                p.registered ? "registered" : "FAILED: " + p.failure);
   }
   fmt::print("global refinement: {} rounds, {}; {} overlapping pairs\n", r.global.rounds,
@@ -45,9 +47,7 @@ void print_table(const modeling::RegisterStageResult& out) {
 void run_register(const RegisterOptions& options) {
   modeling::RegisterStageSettings settings;
   registration::RegistrationSettings& s = settings.registration;
-  s.coarse = options.coarse == "none"    ? registration::CoarseMethod::kNone
-             : options.coarse == "pairs" ? registration::CoarseMethod::kPointPairs
-                                         : registration::CoarseMethod::kFeatures;
+  s.coarse = options.coarse;
   if (!options.pairs_file.empty()) {
     s.coarse = registration::CoarseMethod::kPointPairs;
     settings.picks = read_point_pairs_file(options.pairs_file);
@@ -80,9 +80,13 @@ void add_register_command(CLI::App& app) {
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--coarse", options->coarse, "Coarse stage")
-      ->check(CLI::IsMember({"features", "pairs", "none"}))
-      ->capture_default_str();
+  const std::map<std::string, registration::CoarseMethod> coarse_methods{
+      {"features", registration::CoarseMethod::kFeatures},
+      {"pairs", registration::CoarseMethod::kPointPairs},
+      {"none", registration::CoarseMethod::kNone}};
+  command
+      ->add_option("--coarse", options->coarse, "Coarse stage: features (default), pairs or none")
+      ->transform(CLI::CheckedTransformer(coarse_methods, CLI::ignore_case));
   command
       ->add_option("--pairs", options->pairs_file,
                    "Picked point pairs (JSON, see docs/registration.md); implies --coarse pairs")

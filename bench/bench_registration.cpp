@@ -105,8 +105,9 @@ std::vector<Eigen::Isometry3d> pcl_chain(const SiteScans& site,
     const auto t = static_cast<std::size_t>(pair.target);
     // Where our chosen ICP run started: the coarse pose, or the source's
     // initial pose against where PCL put the target.
-    const Eigen::Isometry3d start =
-        pair.start == "coarse" ? pair.coarse.T_target_source : poses[t].inverse() * initial[s];
+    const Eigen::Isometry3d start = pair.start == registration::IcpStart::kCoarse
+                                        ? pair.coarse.T_target_source
+                                        : poses[t].inverse() * initial[s];
     const PclIcpResult icp = pcl_point_to_plane_icp(site.samples[s], site.samples[t], start, {});
     seconds += icp.seconds;
     poses.push_back(poses[t] * icp.T_target_source);

@@ -87,9 +87,9 @@ nlohmann::json pair_json(const registration::PairReport& p, const std::vector<st
           {"target", id(p.target)},
           {"registered", p.registered},
           {"failure", p.failure},
-          {"start", p.start},
+          {"start", registration::icp_start_name(p.start)},
           {"coarse",
-           {{"method", p.coarse.method},
+           {{"method", registration::coarse_method_name(p.coarse.method)},
             {"success", p.coarse.success},
             {"inlier_ratio", p.coarse.inlier_ratio},
             {"overlap", p.coarse.overlap},
@@ -140,10 +140,7 @@ std::string report_json(const registration::RegistrationResult& r,
 }
 
 nlohmann::json settings_json(const registration::RegistrationSettings& s) {
-  const char* coarse = s.coarse == registration::CoarseMethod::kNone         ? "none"
-                       : s.coarse == registration::CoarseMethod::kPointPairs ? "point_pairs"
-                                                                             : "features";
-  return {{"coarse", coarse},
+  return {{"coarse", registration::coarse_method_name(s.coarse)},
           {"icp_sample_voxel_m", s.icp_sample.voxel_m},
           {"icp_max_samples", s.icp_sample.max_points},
           {"min_gate_m", s.icp.min_gate_m},

@@ -16,7 +16,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Candidate {
-  std::string start;
+  IcpStart start;
   Eigen::Isometry3d T_target_source;
 };
 
@@ -44,11 +44,11 @@ std::vector<Candidate> coarse_stage(int source, const Eigen::Isometry3d& initial
                                     const RegistrationSettings& settings, CoarseReport& report) {
   switch (settings.coarse) {
     case CoarseMethod::kNone:
-      report.method = "none";
+      report.method = CoarseMethod::kNone;
       report.success = true;
-      return {{"initial", initial}};
+      return {{IcpStart::kInitial, initial}};
     case CoarseMethod::kPointPairs: {
-      report.method = "point_pairs";
+      report.method = CoarseMethod::kPointPairs;
       const PickedPairs* picks = picks_for(settings, source);
       assert(picks != nullptr && "every scan after the first needs picked pairs");
       const RigidFitResult fit = fit_rigid(picks->pairs);
@@ -60,12 +60,12 @@ std::vector<Candidate> coarse_stage(int source, const Eigen::Isometry3d& initial
         report.failure = "fewer than 3 point pairs, or the picked points lie on a line";
         return {};
       }
-      return {{"coarse", fit.T_target_source}};
+      return {{IcpStart::kCoarse, fit.T_target_source}};
     }
     case CoarseMethod::kFeatures:
       // The feature pose is added by feature_start, after verification.
-      report.method = "features";
-      return {{"initial", initial}};
+      report.method = CoarseMethod::kFeatures;
+      return {{IcpStart::kInitial, initial}};
   }
   return {};
 }
@@ -218,26 +218,26 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
   if (settings.coarse == CoarseMethod::kFeatures) {
     if (const std::optional<Eigen::Isometry3d> pose = feature_start(
             features[s], features[t], estimate, scans[t], samples[t], settings, report.coarse)) {
-      starts.push_back({"coarse", *pose});
+      starts.push_back({IcpStart::kCoarse, *pose});
     }
   }
   std::optional<IcpResult> best;
   std::optional<IcpResult> from_coarse;
   for (const Candidate& start : starts) {
-    if (start.start == "coarse" && report.coarse.method == "features" && best &&
-        decided_without_coarse_icp(*best, estimate, scans[t], settings, report.coarse)) {
+    if (start.start == IcpStart::kCoarse && report.coarse.method == CoarseMethod::kFeatures &&
+        best && decided_without_coarse_icp(*best, estimate, scans[t], settings, report.coarse)) {
       continue;
     }
     IcpResult icp =
         point_to_plane_icp(samples[s], scans[t], start.T_target_source, settings.icp, &samples[t]);
-    if (start.start == "coarse") from_coarse = icp;
+    if (start.start == IcpStart::kCoarse) from_coarse = icp;
     if (!best || better(icp, *best, settings.max_free_space_violation)) {
       best = icp;
       report.start = start.start;
     }
   }
   report.seconds = core::seconds_since(start);
-  if (report.coarse.method == "features" && from_coarse) {
+  if (report.coarse.method == CoarseMethod::kFeatures && from_coarse) {
     confirm_coarse(*from_coarse, *best, report.coarse);
   }
   if (!best) {
@@ -306,6 +306,23 @@ void report_edges(std::span<const PreparedScan> scans, const std::vector<SampleC
 }
 
 }  // namespace
+
+const char* coarse_method_name(CoarseMethod method) {
+  switch (method) {
+    case CoarseMethod::kNone:
+      return "none";
+    case CoarseMethod::kPointPairs:
+      return "point_pairs";
+    case CoarseMethod::kFeatures:
+      return "features";
+  }
+  assert(false && "unknown CoarseMethod");
+  return "";
+}
+
+const char* icp_start_name(IcpStart start) {
+  return start == IcpStart::kCoarse ? "coarse" : "initial";
+}
 
 RegistrationResult register_scans(std::span<const PreparedScan> scans,
                                   std::span<const Eigen::Isometry3d> initial_T_world_scan,

@@ -23,6 +23,17 @@ enum class CoarseMethod {
   kFeatures,    // FPFH + RANSAC, verified by ICP; ICP also tries the initial pose, the better wins
 };
 
+// Where the fine stage of a pair started.
+enum class IcpStart {
+  kInitial,  // the source's initial pose against the target's registered pose
+  kCoarse,   // the coarse stage's pose
+};
+
+// "none", "point_pairs", "features": the names in reports and settings.
+const char* coarse_method_name(CoarseMethod method);
+// "initial", "coarse".
+const char* icp_start_name(IcpStart start);
+
 // Points picked in scan `source` and scan `target` (indices into the scan
 // list), each in its own scan frame [m].
 struct PickedPairs {
@@ -58,7 +69,7 @@ struct RegistrationSettings {
 };
 
 struct CoarseReport {
-  std::string method;  // "none", "point_pairs" or "features"
+  CoarseMethod method = CoarseMethod::kNone;
   // The coarse pose was produced and passed its tests; for features also:
   // ICP from it ended at the chosen pose (not beaten by the initial pose).
   bool success = false;
@@ -81,8 +92,8 @@ struct PairReport {
   int source = 0;
   int target = 0;
   CoarseReport coarse;
-  IcpResult icp;      // the fine stage from the chosen start
-  std::string start;  // "initial" or "coarse": where ICP started
+  IcpResult icp;  // the fine stage from the chosen start
+  IcpStart start = IcpStart::kInitial;
   bool registered = false;
   std::string failure;   // why registered is false
   double seconds = 0.0;  // coarse stage and every ICP run of the pair

@@ -59,8 +59,8 @@ TEST(RegisterScans, WithoutCoarseStageEveryScanReachesTheTruth) {
       EXPECT_TRUE(pair.registered) << pair.source << ": " << pair.failure;
       EXPECT_TRUE(pair.failure.empty()) << pair.failure;
       EXPECT_EQ(pair.target, pair.source - 1);
-      EXPECT_EQ(pair.coarse.method, "none");
-      EXPECT_EQ(pair.start, "initial");
+      EXPECT_EQ(pair.coarse.method, CoarseMethod::kNone);
+      EXPECT_EQ(pair.start, IcpStart::kInitial);
       EXPECT_TRUE(pair.icp.converged);
     }
     EXPECT_TRUE(result.converged);
@@ -110,7 +110,7 @@ TEST(RegisterScans, PickedPointPairsStartIcpFromFarOff) {
   ASSERT_EQ(result.pairs.size(), 2u);
   for (const PairReport& pair : result.pairs) {
     SCOPED_TRACE(::testing::Message() << "pair " << pair.source << " → " << pair.target);
-    EXPECT_EQ(pair.coarse.method, "point_pairs");
+    EXPECT_EQ(pair.coarse.method, CoarseMethod::kPointPairs);
     EXPECT_TRUE(pair.coarse.success) << pair.coarse.failure;
     EXPECT_EQ(pair.coarse.count, 6u);
     EXPECT_LT(pair.coarse.rms_m, 0.06);
@@ -118,7 +118,7 @@ TEST(RegisterScans, PickedPointPairsStartIcpFromFarOff) {
         pose_error(campus().true_relative(pair.target, pair.source), pair.coarse.T_target_source);
     EXPECT_LT(coarse.rotation_deg, 0.5);    // measured 0.08°
     EXPECT_LT(coarse.translation_m, 0.06);  // measured 9 and 19 mm
-    EXPECT_EQ(pair.start, "coarse");
+    EXPECT_EQ(pair.start, IcpStart::kCoarse);
     EXPECT_TRUE(pair.registered) << pair.failure;
   }
   EXPECT_TRUE(result.converged);
@@ -139,7 +139,7 @@ TEST(RegisterScans, FeaturesRegisterScansWithoutAPoseGuess) {
   ASSERT_EQ(result.pairs.size(), 2u);
   for (const PairReport& pair : result.pairs) {
     SCOPED_TRACE(::testing::Message() << "pair " << pair.source << " -> " << pair.target);
-    EXPECT_EQ(pair.coarse.method, "features");
+    EXPECT_EQ(pair.coarse.method, CoarseMethod::kFeatures);
     if (pair.source == 1) {
       EXPECT_TRUE(pair.coarse.success) << pair.coarse.failure;
     }
@@ -148,7 +148,7 @@ TEST(RegisterScans, FeaturesRegisterScansWithoutAPoseGuess) {
       EXPECT_FALSE(pair.registered);
       continue;
     }
-    EXPECT_EQ(pair.start, "coarse");
+    EXPECT_EQ(pair.start, IcpStart::kCoarse);
     EXPECT_TRUE(pair.registered) << pair.failure;
     EXPECT_GT(pair.coarse.count, 0u);
     EXPECT_LE(pair.coarse.free_space_violation, settings.max_free_space_violation);
@@ -172,7 +172,7 @@ TEST(RegisterScans, UnlevelledFeaturePosesAreNeverSilentlyWrong) {
   const RegistrationResult result = register_scans(two, two_initial, settings);
   ASSERT_EQ(result.pairs.size(), 1u);
   const PairReport& pair = result.pairs[0];
-  EXPECT_EQ(pair.coarse.method, "features");
+  EXPECT_EQ(pair.coarse.method, CoarseMethod::kFeatures);
   if (pair.coarse.success) {
     const PoseError coarse = pose_error(campus().true_relative(0, 1), pair.coarse.T_target_source);
     EXPECT_LT(coarse.rotation_deg, 0.1);
