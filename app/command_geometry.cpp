@@ -13,23 +13,20 @@ namespace {
 
 struct GeometryOptions {
   std::string project;
-  modeling::GeometryStageSettings stage;
+  acquisition::GeometrySettings geometry;
   bool no_mixed_pixels = false;
 };
 
 void run_geometry(GeometryOptions& options) {
-  const acquisition::GeometrySettings& g = options.stage.geometry;
+  const acquisition::GeometrySettings& g = options.geometry;
   if (g.edge_window_radius > g.window_radius) {
     throw CLI::ValidationError("--edge-window", "must not exceed --window");
   }
-  options.stage.geometry.flag_mixed_pixels = !options.no_mixed_pixels;
-  ProgressBar progress("geometry");
-  options.stage.on_scan_done = [&progress](std::size_t done, std::size_t total,
-                                           const std::string& name) {
-    progress.update(done, total, name);
-  };
+  options.geometry.flag_mixed_pixels = !options.no_mixed_pixels;
+  modeling::Project project = modeling::Project::open(options.project);
+  ProgressBar progress;
   const modeling::GeometryStageResult result =
-      modeling::compute_project_geometry(options.project, options.stage);
+      modeling::run_geometry_stage(project, options.geometry, progress);
   fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8}\n", "id", "name", "valid", "normals",
              "mixed", "edges", "seconds");
   for (const modeling::GeometryStageScan& s : result.scans) {
@@ -47,11 +44,12 @@ void add_geometry_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "geometry",
       "Compute every scan's per-point footprint, normal (from its neighbours in the scan grid), "
-      "confidence and mixed-pixel/edge flags, and store them in the project (one transaction).");
+      "confidence and mixed-pixel/edge flags, and store them in the project (one command, "
+      "undoable).");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
-  acquisition::GeometrySettings& g = options->stage.geometry;
+  acquisition::GeometrySettings& g = options->geometry;
   command->add_option("--window", g.window_radius, "Radius of the widest fitting window [pixels]")
       ->check(CLI::Range(1, acquisition::kMaxWindowRadius))
       ->capture_default_str();

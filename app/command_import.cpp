@@ -20,13 +20,9 @@ struct ImportOptions {
 
 void run_import(const ImportOptions& options) {
   const std::vector<std::filesystem::path> files(options.files.begin(), options.files.end());
-  ProgressBar progress("import");
-  modeling::ImportSettings settings;
-  settings.on_scan_stored = [&progress](const modeling::ImportProgress& p) {
-    progress.update(p.file_index + 1, p.file_count, "stored " + p.scan_name);
-  };
+  ProgressBar progress;
   const modeling::ImportResult result =
-      modeling::import_scan_files(options.project, files, settings);
+      modeling::import_scan_files(options.project, files, modeling::ImportSettings{}, progress);
   fmt::print("{} {} scan(s) from {} file(s) into {} in {:.2f} s\n",
              result.created_project ? "created project; imported" : "imported",
              result.scan_ids.size(), files.size(), options.project, result.seconds);

@@ -2,10 +2,10 @@
 #include <fmt/core.h>
 
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/progress_bar.hpp"
 #include "modeling/registration_stage.hpp"
 
 namespace scanbench::app {
@@ -18,23 +18,16 @@ struct MergeOptions {
 };
 
 void run_merge(const MergeOptions& options) {
-  const modeling::MergeStageResult out = modeling::merge_project(options.project, options.settings);
-  std::size_t kept = 0;
-  nlohmann::json scans = nlohmann::json::array();
-  for (const modeling::MergeStageScan& s : out.scans) {
-    kept += s.counts.kept;
-    scans.push_back({{"id", s.id},
-                     {"name", s.name},
-                     {"in_model", s.counts.in_model},
-                     {"kept", s.counts.kept},
-                     {"redundant", s.counts.redundant}});
-  }
+  modeling::Project project = modeling::Project::open(options.project);
+  ProgressBar progress;
+  const modeling::MergeStageResult out =
+      modeling::merge_project(project, options.settings, progress);
   if (options.json) {
-    const nlohmann::json report = {
-        {"scans", scans}, {"points", out.points}, {"kept", kept}, {"seconds", out.seconds}};
-    fmt::print("{}\n", report.dump());
+    fmt::print("{}\n", modeling::merge_result_json(out));
     return;
   }
+  std::size_t kept = 0;
+  for (const modeling::MergeStageScan& s : out.scans) kept += s.counts.kept;
   fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>10}\n", "id", "name", "in model", "kept", "redundant");
   for (const modeling::MergeStageScan& s : out.scans) {
     fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>10}\n", s.id, s.name, s.counts.in_model,
@@ -51,8 +44,8 @@ void add_merge_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "merge",
       "Decide the merged model: keep each point only if no other scan sampled its surface more "
-      "finely (seed 004 §4.3), and store a keep mask per scan (one transaction). Scans are never "
-      "changed.");
+      "finely (seed 004 §4.3), and store a keep mask per scan (one command, undoable). Scans are "
+      "never changed.");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -9,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "app/point_pairs_file.hpp"
+#include "app/progress_bar.hpp"
 #include "modeling/registration_stage.hpp"
 
 namespace scanbench::app {
@@ -60,7 +61,9 @@ void run_register(const RegisterOptions& options) {
   s.features.levelled = !options.unlevelled;
   s.refine_globally = !options.no_global;
   s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;
-  const modeling::RegisterStageResult out = modeling::register_project(options.project, settings);
+  modeling::Project project = modeling::Project::open(options.project);
+  ProgressBar progress;
+  const modeling::RegisterStageResult out = modeling::register_project(project, settings, progress);
   if (options.json) {
     fmt::print("{}\n", out.report_json);
   } else {
@@ -76,7 +79,7 @@ void add_register_command(CLI::App& app) {
       "register",
       "Align every scan of the project to the first: coarse (features or picked point pairs), "
       "point-to-plane ICP, then a global refinement over all overlapping pairs. Stores the poses "
-      "and the report (one transaction); merge keep masks become stale and are dropped.");
+      "and the report (one command, undoable); merge keep masks become stale and are dropped.");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);

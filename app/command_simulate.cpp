@@ -29,12 +29,9 @@ struct SimulateOptions {
 void run_campaign(SimulateOptions& options) {
   if (options.out_dir.empty())
     throw CLI::ValidationError("--out", "is required (the output folder)");
-  ProgressBar progress("simulate");
-  options.campaign.on_scan_written = [&progress](int k, int count) {
-    progress.update(static_cast<std::size_t>(k + 1), static_cast<std::size_t>(count),
-                    "scans written");
-  };
-  const sim::CampaignResult result = sim::simulate_campaign(options.campaign, options.out_dir);
+  ProgressBar progress;
+  const sim::CampaignResult result =
+      sim::simulate_campaign(options.campaign, options.out_dir, progress);
   fmt::print("simulated {} scan(s) of {} (seed {}, {} x {}) in {:.1f} s ({:.1f} s ray casting)\n",
              options.campaign.scans, options.campaign.site, options.campaign.seed,
              options.campaign.scanner.rows, options.campaign.scanner.columns, result.total_seconds,

@@ -20,5 +20,7 @@ void add_simulate_command(CLI::App& app);
 void add_geometry_command(CLI::App& app);
 void add_register_command(CLI::App& app);
 void add_merge_command(CLI::App& app);
+// history, undo and redo.
+void add_history_commands(CLI::App& app);
 
 }  // namespace scanbench::app

@@ -1,5 +1,6 @@
 // scanbench command line: one subcommand per pipeline stage
-// (simulate → import → geometry → register → merge → info → export today;
+// (simulate → import → geometry → register → merge → info → export, and
+// history / undo / redo over all of them;
 // segment and render join as their stages land).
 #include <fmt/core.h>
 
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   sb::add_register_command(app);
   sb::add_merge_command(app);
   sb::add_export_command(app);
+  sb::add_history_commands(app);
   sb::add_simulate_command(app);
 #ifdef SCANBENCH_WITH_BENCH
   sb::add_bench_command(app);

@@ -1,24 +1,22 @@
-// A one-line progress bar on stderr, drawn only when stderr is a terminal so
-// that logs and pipes stay clean.
+// The CLI's view of core::Progress: a one-line progress bar on stderr, drawn
+// only when stderr is a terminal so that logs and pipes stay clean.
 #pragma once
 
-#include <cstddef>
 #include <string>
+
+#include "core/progress.hpp"
 
 namespace scanbench::app {
 
-class ProgressBar {
+class ProgressBar : public core::Progress {
  public:
-  explicit ProgressBar(std::string label);
-  ~ProgressBar();  // ends the line when anything was drawn
-  ProgressBar(const ProgressBar&) = delete;
-  ProgressBar& operator=(const ProgressBar&) = delete;
+  ProgressBar();
+  ~ProgressBar() override;  // ends the line when anything was drawn
 
-  // Redraws as "label [#####.....] done/total note"; total 0 draws no bar.
-  void update(std::size_t done, std::size_t total, const std::string& note = {});
+  // Redraws as "stage [#####.....] done/total note"; total 0 draws no bar.
+  void update(const core::ProgressStep& step) override;
 
  private:
-  std::string label_;
   bool enabled_ = false;
   bool drawn_ = false;
 };

@@ -24,7 +24,7 @@
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
 #include "bench/pcl_normals.hpp"
-#include "modeling/geometry_stage.hpp"
+#include "modeling/settings_json.hpp"
 
 namespace scanbench::bench {
 namespace {
@@ -100,7 +100,7 @@ nlohmann::json settings_json(const PclNormalSettings& s) {
 }
 
 nlohmann::json settings_json(const acquisition::GeometrySettings& s) {
-  nlohmann::json settings = nlohmann::json::parse(modeling::geometry_settings_json(s));
+  nlohmann::json settings = nlohmann::json::parse(modeling::settings_to_json(s));
   settings["note"] = "time includes footprints and mixed-pixel flags";
   return settings;
 }

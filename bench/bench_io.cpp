@@ -124,9 +124,9 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   {
     modeling::Project project = modeling::Project::create(project_path);
     store_s = best_seconds(1, [&] {
-      auto transaction = project.begin();
-      project.insert_scan(scan);
-      transaction.commit();
+      modeling::Project::Edit edit = project.begin_command("import", "{}");
+      project.insert_scan(edit, modeling::encode_scan(scan));
+      edit.commit("{}");
     });
   }
   const std::int64_t id = modeling::Project::open(project_path).scans().front().id;

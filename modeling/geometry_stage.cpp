@@ -4,43 +4,55 @@
 #include <nlohmann/json.hpp>
 
 #include "core/timing.hpp"
-#include "modeling/project.hpp"
+#include "modeling/scan_layers.hpp"
+#include "modeling/settings_json.hpp"
 
 namespace scanbench::modeling {
+namespace {
 
-std::string geometry_settings_json(const acquisition::GeometrySettings& s) {
-  return nlohmann::json{{"window_radius", s.window_radius},
-                        {"edge_window_radius", s.edge_window_radius},
-                        {"depth_jump_sigmas", s.depth_jump_sigmas},
-                        {"depth_jump_relative", s.depth_jump_relative},
-                        {"min_neighbours", s.min_neighbours},
-                        {"max_footprint_stretch", s.max_footprint_stretch},
-                        {"flag_mixed_pixels", s.flag_mixed_pixels},
-                        {"range_noise_m", s.range_noise.noise_m},
-                        {"range_noise_per_m", s.range_noise.noise_per_m},
-                        {"mixed_pixel_sigmas", s.mixed_pixel_sigmas}}
-      .dump();
+constexpr const char* kStage = "geometry";
+
+std::string result_json(const GeometryStageResult& result) {
+  nlohmann::json scans = nlohmann::json::array();
+  for (const GeometryStageScan& s : result.scans) {
+    scans.push_back({{"id", s.id},
+                     {"valid_points", s.valid_points},
+                     {"normals", s.normals},
+                     {"mixed_pixels", s.mixed_pixels},
+                     {"edge_pixels", s.edge_pixels}});
+  }
+  return nlohmann::json{{"scans", scans}, {"seconds", result.seconds}}.dump();
 }
 
-GeometryStageResult compute_project_geometry(const std::filesystem::path& project_path,
-                                             const GeometryStageSettings& settings) {
+}  // namespace
+
+GeometryStageResult run_geometry_stage(Project& project,
+                                       const acquisition::GeometrySettings& settings,
+                                       core::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  Project project = Project::open(project_path);
+  const std::int64_t revision = project.revision();
   const std::vector<StoredScanSummary> scans = project.scans();
-  const std::string settings_json = geometry_settings_json(settings.geometry);
   GeometryStageResult result;
-  Project::Transaction transaction = project.begin();
+  std::vector<std::vector<EncodedLayer>> layers;
   for (const StoredScanSummary& stored : scans) {
+    progress.throw_if_cancelled(kStage);
     const acquisition::Scan scan = project.load_scan(stored.id);
-    const acquisition::GeometryResult geometry =
-        acquisition::compute_geometry(scan, settings.geometry);
-    project.store_geometry(stored.id, geometry, settings_json);
+    const acquisition::GeometryResult geometry = acquisition::compute_geometry(scan, settings);
+    layers.push_back(encode_geometry(geometry.geometry));
     result.scans.push_back({stored.id, scan.name, geometry.valid_points, geometry.normals,
                             geometry.mixed_pixels, geometry.edge_pixels, geometry.seconds});
-    if (settings.on_scan_done) settings.on_scan_done(result.scans.size(), scans.size(), scan.name);
+    progress.update({kStage, result.scans.size(), scans.size(), scan.name});
   }
-  transaction.commit();
+  progress.throw_if_cancelled(kStage);
+
+  Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
+  result.command_id = edit.command_id();
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    for (const EncodedLayer& layer : layers[k]) project.put_layer(edit, scans[k].id, layer);
+    project.remove_layer(edit, scans[k].id, layer::kKeep);
+  }
   result.seconds = core::seconds_since(start);
+  edit.commit(result_json(result));
   return result;
 }
 

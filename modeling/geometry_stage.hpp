@@ -1,24 +1,17 @@
 // The geometry stage: footprints, normals and mixed-pixel flags for every
-// scan of a project, stored in it (seed 004 §4.2).
+// scan of a project (seed 004 §4.2), stored as the command "geometry".
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
 #include "acquisition/scan_geometry.hpp"
+#include "core/progress.hpp"
+#include "modeling/project.hpp"
 
 namespace scanbench::modeling {
-
-struct GeometryStageSettings {
-  acquisition::GeometrySettings geometry;
-  // Called after each scan's geometry is stored (inside the transaction). Optional.
-  std::function<void(std::size_t done, std::size_t total, const std::string& scan_name)>
-      on_scan_done;
-};
 
 struct GeometryStageScan {
   std::int64_t id = 0;
@@ -31,18 +24,19 @@ struct GeometryStageScan {
 };
 
 struct GeometryStageResult {
+  std::int64_t command_id = 0;  // the journal entry
   std::vector<GeometryStageScan> scans;
   double seconds = 0.0;
 };
 
-// Computes and stores the geometry of every scan of the project, replacing
-// earlier results, in one transaction: on any error nothing is stored.
-// Throws core::InputError for a missing, foreign or damaged project.
-GeometryStageResult compute_project_geometry(const std::filesystem::path& project_path,
-                                             const GeometryStageSettings& settings = {});
-
-// The settings as the JSON text stored beside the results (without
-// `threads`: the results do not depend on it).
-std::string geometry_settings_json(const acquisition::GeometrySettings& settings);
+// Computes the geometry of every scan of `project` (reporting one unit of
+// `progress` per scan), then stores it as one command, with the settings in
+// the journal: new versions of the four geometry layers of every scan, and
+// the merge's keep masks removed (they were decided on the old geometry).
+// Nothing is stored on any error or when cancelled (core::Cancelled); throws
+// core::RuntimeFailure when another process changed the project meanwhile.
+GeometryStageResult run_geometry_stage(Project& project,
+                                       const acquisition::GeometrySettings& settings,
+                                       core::Progress& progress);
 
 }  // namespace scanbench::modeling

@@ -1,44 +1,40 @@
-// The import stage: raw scan files into a project, all or nothing.
+// The import stage: raw scan files into a project as the command "import",
+// all or nothing.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <span>
-#include <string>
 #include <vector>
 
 #include "acquisition/scan_files.hpp"
+#include "core/progress.hpp"
+#include "modeling/project.hpp"
 
 namespace scanbench::modeling {
 
-struct ImportProgress {
-  std::size_t file_index = 0;  // 0-based index into the file list
-  std::size_t file_count = 0;
-  std::string scan_name;         // the scan just stored
-  std::size_t scans_stored = 0;  // so far in this import
-};
-
 struct ImportSettings {
   acquisition::ScanFileSettings readers;
-  // Called after each scan is stored (inside the transaction, so a kill here
-  // must leave the project unchanged). Optional.
-  std::function<void(const ImportProgress&)> on_scan_stored;
 };
 
 struct ImportResult {
+  std::int64_t command_id = 0;         // the journal entry
   std::vector<std::int64_t> scan_ids;  // new ids, in file order
-  bool created_project = false;
+  bool created_project = false;        // import_scan_files only
   double seconds = 0.0;
 };
 
-// Imports every scan of `files` into the project at `project_path` in one
-// transaction. Creates the project when it does not exist. On any error
-// (InputError from a reader or the project, or a write failure) nothing is
-// stored: the transaction rolls back, and a project this call created is
-// removed again, then the error propagates.
+// Reads and encodes every scan of `files` (one unit of `progress` per
+// file), then stores them all as one command. On any error (core::InputError
+// from a reader, a write failure) or cancellation nothing is stored.
+ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
+                          const ImportSettings& settings, core::Progress& progress);
+
+// import_scans into the project at `project_path`, which is created when it
+// does not exist; a project this call created is removed again when the
+// import fails.
 ImportResult import_scan_files(const std::filesystem::path& project_path,
                                std::span<const std::filesystem::path> files,
-                               const ImportSettings& settings = {});
+                               const ImportSettings& settings, core::Progress& progress);
 
 }  // namespace scanbench::modeling

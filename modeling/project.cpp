@@ -29,7 +29,7 @@ sqlite3* connect(const std::filesystem::path& file) {
     sqlite3_close(db);
     core::FilePosition position;
     position.detail = "opening the project";
-    throw core::InputError(file.string(), position, message);
+    throw core::RuntimeFailure(file.string(), position, message);
   }
   sqlite3_extended_result_codes(db, 1);
   return db;
@@ -104,35 +104,30 @@ int Project::schema_version() const {
   return schema::read_schema_version(db(), file_name());
 }
 
-Project::Transaction Project::begin() {
-  assert(sqlite3_get_autocommit(db()) != 0 && "a Transaction is already open on this project");
-  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
-  return Transaction(db(), file_name());
+void Project::check_edit([[maybe_unused]] const Edit& edit) const {
+  assert(edit.active() && edit.db_ == db() && "writes need an open Edit of this project");
 }
 
-Project::Transaction::Transaction(Transaction&& other) noexcept
-    : db_(std::exchange(other.db_, nullptr)), file_(std::move(other.file_)) {}
+Project::Edit::Edit(Edit&& other) noexcept
+    : db_(std::exchange(other.db_, nullptr)),
+      file_(std::move(other.file_)),
+      command_id_(other.command_id_) {}
 
-Project::Transaction& Project::Transaction::operator=(Transaction&& other) noexcept {
+Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
   if (this != &other) {
     roll_back();
     db_ = std::exchange(other.db_, nullptr);
     file_ = std::move(other.file_);
+    command_id_ = other.command_id_;
   }
   return *this;
 }
 
-Project::Transaction::~Transaction() {
+Project::Edit::~Edit() {
   roll_back();
 }
 
-void Project::Transaction::commit() {
-  assert(active() && "commit on a committed or moved-from Transaction");
-  sqlite::execute(db_, "COMMIT", file_);
-  db_ = nullptr;
-}
-
-void Project::Transaction::roll_back() noexcept {
+void Project::Edit::roll_back() noexcept {
   // SQLite may already have rolled back by itself after an I/O error or a
   // full disk; ROLLBACK would then fail, so only issue it when still open.
   if (db_ != nullptr && sqlite3_get_autocommit(db_) == 0) {

@@ -1,11 +1,21 @@
-// The project file (.sbproj): one SQLite database holding the scans (metadata,
-// pose, channels as zstd blobs) and, in later schema versions, geometry,
-// objects, edits and the command journal.
+// The project file (.sbproj): one SQLite database holding the scans, their
+// poses and per-pixel layers, and the journal of every command that changed
+// them.
 //
-// Durability: the database runs in write-ahead-log mode with synchronous=FULL,
-// so every committed Transaction survives a crash or power loss, and a process
-// killed mid-transaction leaves the file exactly as it was at the last commit.
-// Every user-level change is one Transaction.
+// Commands and undo: every change is a command (import, geometry, register,
+// merge, …) made through one Project::Edit, which records the command in the
+// journal and commits it with its effect in one transaction. Nothing is ever
+// overwritten: every row a command writes (a scan, a pose, a layer version)
+// carries the command's id, and what the project holds is, for each scan and
+// layer, the newest row of a command that is not undone. Undo marks the
+// newest done command undone; redo marks the oldest undone command done
+// again; a new command discards the undone ones (and, by cascade, their
+// rows). Undo and redo therefore work across processes and restore the
+// earlier state exactly. (docs/CONTRIBUTING.md shows how a stage uses this.)
+//
+// Durability: write-ahead-log mode with synchronous=FULL, so every committed
+// Edit survives a crash or power loss, and a process killed mid-edit leaves
+// the file exactly as it was at the last commit.
 //
 // Threading: a Project is one SQLite connection opened without SQLite's own
 // mutexes (SQLITE_OPEN_NOMUTEX); use it from one thread at a time. Several
@@ -13,17 +23,20 @@
 // kBusyTimeoutMs.
 #pragma once
 
+#include <cassert>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "acquisition/scan.hpp"
-#include "acquisition/scan_geometry.hpp"
 #include "acquisition/scan_summary.hpp"
+#include "modeling/layers.hpp"
 
 struct sqlite3;
 
@@ -35,8 +48,9 @@ inline constexpr std::uint32_t kProjectApplicationId = 0x53424E43;
 
 // PRAGMA user_version written by this build. Older projects are migrated on
 // open; newer ones are refused.
-// 2: scan_geometry; 3: registration_runs, merge_masks.
-inline constexpr int kProjectSchemaVersion = 3;
+// 2: scan_geometry; 3: registration_runs, merge_masks; 4: the command journal,
+// versioned poses and the per-scan layer store.
+inline constexpr int kProjectSchemaVersion = 4;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
@@ -46,6 +60,32 @@ struct StoredScanSummary {
   acquisition::ScanSummary summary;
 };
 
+enum class CommandState { kDone, kUndone };
+
+// One journal entry.
+struct CommandRecord {
+  std::int64_t id = 0;   // increasing in the order the commands were applied
+  std::string name;      // "import", "geometry", "register", "merge", "migrate", …
+  std::string settings;  // JSON: the command's whole settings, enough to replay it
+  std::string result;    // JSON: what it did (counts, report)
+  CommandState state = CommandState::kDone;
+  bool undoable = true;    // false for the migration of a project older than the journal
+  std::string created_at;  // UTC, ISO 8601
+};
+
+// A scan ready to be stored: its metadata and summary, and every channel
+// encoded as a layer (range_m, valid, intensity, rgb, directions). Encoding
+// (compression) is the expensive part, so it happens before the write.
+struct EncodedScan {
+  acquisition::Scan metadata;  // channels left empty; pose, angles, names as the scan's
+  acquisition::ScanSummary summary;
+  std::vector<EncodedLayer> layers;
+};
+
+// Encodes every channel of `scan`. Asserts the scan is consistent
+// (acquisition::check_consistency).
+EncodedScan encode_scan(const acquisition::Scan& scan);
+
 // Deletes a project file with its SQLite side files (-journal, -wal, -shm).
 // For a project the caller itself created and must not leave behind; errors
 // are ignored (the files may not exist).
@@ -53,18 +93,19 @@ void remove_project_files(const std::filesystem::path& file);
 
 class Project {
  public:
-  class Transaction;
+  class Edit;
 
   // Opens an existing project for reading and writing. Never creates or
-  // recreates the file. Throws core::InputError, leaving the file
-  // untouched, when it is missing, a directory, empty, not an SQLite
-  // database, another application's database, a project of a newer schema
-  // version, damaged, or locked by another writer for longer than
-  // kBusyTimeoutMs. Older schema versions are migrated in one transaction.
+  // recreates the file. Throws core::InputError, leaving the file untouched,
+  // when it is missing, a directory, empty, not an SQLite database, another
+  // application's database, a project of a newer schema version, or damaged;
+  // core::RuntimeFailure when it cannot be opened for writing or another
+  // writer keeps it locked for longer than kBusyTimeoutMs. Older schema
+  // versions are migrated in one transaction.
   static Project open(const std::filesystem::path& file);
 
-  // Creates a new, empty project. Throws core::InputError when the
-  // file already exists (it is never overwritten) or cannot be created; a
+  // Creates a new, empty project. Throws core::InputError when the file
+  // already exists (it is never overwritten) or cannot be created; a
   // half-created file is removed again.
   static Project create(const std::filesystem::path& file);
 
@@ -73,7 +114,7 @@ class Project {
 
   Project(Project&&) noexcept = default;
   Project& operator=(Project&&) noexcept = default;
-  ~Project();  // closes the connection; an open Transaction must be gone by then
+  ~Project();  // closes the connection; an open Edit must be gone by then
 
   // The file as passed to open/create.
   const std::filesystem::path& path() const { return file_; }
@@ -81,69 +122,93 @@ class Project {
   // PRAGMA user_version of the open file; kProjectSchemaVersion after open().
   int schema_version() const;
 
-  // Every scan's summary (sizes, channel presence, pose, world bounds,
-  // scanner metadata) ordered by id, without reading channel data. Throws
-  // core::InputError when the file is damaged.
+  // A number that changes with every committed edit, undo and redo, from
+  // any process. A stage reads it before computing and passes it to
+  // begin_command, which refuses to write over a project that changed since.
+  std::int64_t revision() const;
+
+  // ---- Scans -------------------------------------------------------------
+
+  // Every scan's summary (sizes, channel presence, current pose and world
+  // bounds, scanner metadata) ordered by id, without reading channel data.
   std::vector<StoredScanSummary> scans() const;
 
-  // The scan stored under `id`, bit-identical to what insert_scan stored.
-  // Throws core::InputError "no scan with id N" when there is none,
-  // and names the scan and channel when its data is damaged.
+  // The scan stored under `id` at its current pose, its channels
+  // bit-identical to what insert_scan stored. Throws core::InputError "no
+  // scan with id N" when there is none (or its import was undone), and names
+  // the scan and layer when its data is damaged.
   acquisition::Scan load_scan(std::int64_t id) const;
 
-  // Starts a write transaction (BEGIN IMMEDIATE: takes the write lock now, so
-  // a commit never fails for a concurrent writer). Asserts that no
-  // transaction is open. Throws core::InputError when another process
-  // keeps the write lock for longer than kBusyTimeoutMs.
-  Transaction begin();
+  // Stores a new scan (metadata, pose, summary, channel layers) as part of
+  // `edit` and returns its id.
+  std::int64_t insert_scan(Edit& edit, const EncodedScan& scan);
 
-  // Stores `scan` (metadata, pose, summary, channels as zstd blobs) and
-  // returns its new id. Asserts that a Transaction is open and that the scan
-  // passes acquisition::check_consistency. Throws core::InputError
-  // when SQLite fails (disk full, blob larger than SQLite's 1 GB limit); the
-  // caller's Transaction then rolls everything back.
-  std::int64_t insert_scan(const acquisition::Scan& scan);
+  // Moves scan `id` to scan.T_world_scan as part of `edit`: a new pose
+  // version with the scanner position (the pose's origin) and the world
+  // bounds of `scan`, which must be the stored scan with only its pose
+  // changed (asserted on size). Throws core::InputError when there is no
+  // such scan.
+  void set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& scan);
 
-  // Stores (replacing any earlier) the geometry of scan `id`, with the
-  // settings that produced it as JSON text. Asserts a Transaction is open and
-  // the arrays match the scan's pixel count; throws core::InputError
-  // when there is no such scan or SQLite fails.
-  void store_geometry(std::int64_t id, const acquisition::GeometryResult& geometry,
-                      const std::string& settings_json);
+  // ---- Layers (modeling/layers.hpp) -----------------------------------------
 
-  // The stored geometry of scan `id`, or none when `scanbench geometry` has
-  // not run on it. Throws core::InputError naming the scan when the
-  // stored data is damaged.
-  std::optional<acquisition::ScanGeometry> load_geometry(std::int64_t id) const;
+  // Writes a new version of layer `layer.name` of scan `id` as part of
+  // `edit`. Asserts the layer has one element per pixel of the scan; throws
+  // core::InputError when there is no such scan.
+  void put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer);
 
-  // Moves scan `id` to scan.T_world_scan: stores the pose, the scanner
-  // position (the pose's origin) and the world bounds of `scan`, which must
-  // be the stored scan with only its pose changed (asserted on size). Asserts
-  // a Transaction is open; throws core::InputError when there is no
-  // such scan or SQLite fails.
-  void update_pose(std::int64_t id, const acquisition::Scan& scan);
+  // Removes layer `name` of scan `id` as part of `edit` (a version saying
+  // "none": undo brings the earlier version back). No effect on a layer the
+  // scan does not have.
+  void remove_layer(Edit& edit, std::int64_t id, std::string_view name);
 
-  // Appends a registration run: its settings and report as JSON text.
-  // Asserts a Transaction is open; throws core::InputError when SQLite fails.
-  void store_registration(const std::string& settings_json, const std::string& report_json);
+  // The current version of layer `name` of scan `id`, decoded into values
+  // of T as encode_layer took them, and checked against `type` and the
+  // scan's pixel count; none when the scan has no such layer. Throws
+  // core::InputError naming scan and layer when the stored layer has another
+  // type or size, or is damaged.
+  template <typename T>
+  std::optional<std::vector<T>> load_layer(std::int64_t id, std::string_view name,
+                                           ElementType type) const {
+    std::optional<std::vector<T>> values;
+    const bool found = read_layer(id, name, type, [&values](std::size_t bytes) {
+      assert(bytes % sizeof(T) == 0 && "layer elements are not whole values of T");
+      values.emplace(bytes / sizeof(T));
+      return std::as_writable_bytes(std::span<T>(*values));
+    });
+    if (!found) return std::nullopt;
+    return values;
+  }
 
-  // The report of the latest registration run, or none.
-  std::optional<std::string> latest_registration_report() const;
+  // Names of the current layers of scan `id`, sorted.
+  std::vector<std::string> layer_names(std::int64_t id) const;
 
-  // Stores (replacing any earlier) the merge keep mask of scan `id`: one
-  // byte per pixel, 1 = in the merged model. Asserts a Transaction is open
-  // and the mask matches the scan's pixel count; throws
-  // core::InputError when there is no such scan or SQLite fails.
-  void store_keep_mask(std::int64_t id, std::span<const std::uint8_t> keep,
-                       const std::string& settings_json);
+  // ---- Commands and the journal ------------------------------------------
 
-  // The keep mask of scan `id`, or none when `scanbench merge` has not run
-  // since its pose last changed. Throws core::InputError when damaged.
-  std::optional<std::vector<std::uint8_t>> load_keep_mask(std::int64_t id) const;
+  // Starts command `name` (with its whole settings as JSON): takes the write
+  // lock, discards undone commands (they can no longer be redone), and opens
+  // the journal entry. When `based_on_revision` is given and the project's
+  // revision has moved since (another process wrote to it while the caller
+  // computed), throws core::RuntimeFailure and changes nothing. Throws
+  // core::RuntimeFailure when another writer keeps the lock for longer than
+  // kBusyTimeoutMs. Asserts no Edit is open on this project.
+  Edit begin_command(std::string_view name, const std::string& settings_json,
+                     std::optional<std::int64_t> based_on_revision = std::nullopt);
 
-  // Deletes every keep mask (poses changed: the masks are stale). Asserts a
-  // Transaction is open.
-  void clear_keep_masks();
+  // The journal, oldest first (undone commands included, after the done ones).
+  std::vector<CommandRecord> history() const;
+
+  // Marks the newest done command undone, in one transaction, and returns
+  // it; none when there is nothing to undo (no command, or only the
+  // migration of an older project).
+  std::optional<CommandRecord> undo();
+
+  // Marks the oldest undone command done again and returns it; none when
+  // nothing was undone.
+  std::optional<CommandRecord> redo();
+
+  // The result of the newest done command called `name`, or none.
+  std::optional<std::string> latest_result(std::string_view name) const;
 
  private:
   struct CloseConnection {
@@ -154,37 +219,52 @@ class Project {
   Project(std::filesystem::path file, Connection db);
   sqlite3* db() const;
   std::string file_name() const { return file_.string(); }
-  // rows × columns of scan `id`; throws core::InputError when there is none.
+  // rows × columns of live scan `id`; throws core::InputError when there is none.
   std::size_t stored_pixel_count(std::int64_t id) const;
+  // Asserts that `edit` is open on this project.
+  void check_edit(const Edit& edit) const;
+  // Decodes the current version of a layer into the buffer `allocate`
+  // returns for its size in bytes; false when there is none.
+  bool read_layer(std::int64_t id, std::string_view name, ElementType type,
+                  const std::function<std::span<std::byte>(std::size_t bytes)>& allocate) const;
 
   std::filesystem::path file_;
   Connection db_;
 };
 
-// One write transaction: everything done through the Project between begin()
-// and commit() lands in the file together or not at all. Rolled back on
-// destruction unless committed. Must not outlive its Project.
-class Project::Transaction {
+// One command's write transaction: everything written through the Project
+// with this Edit lands in the file together with the command's journal
+// entry, or not at all. Rolled back on destruction unless committed. Must
+// not outlive its Project. The writing methods of Project take an Edit, so
+// no write can happen outside one.
+class Project::Edit {
  public:
-  Transaction(Transaction&& other) noexcept;
-  Transaction& operator=(Transaction&& other) noexcept;
-  ~Transaction();
+  Edit(Edit&& other) noexcept;
+  Edit& operator=(Edit&& other) noexcept;
+  ~Edit();
 
-  // Makes the changes durable. Asserts the transaction is still open. Throws
-  // core::InputError when SQLite cannot commit (I/O error, disk full);
-  // the changes are then rolled back when the Transaction is destroyed.
-  void commit();
+  // The journal id of the command being recorded; rows written through this
+  // Edit carry it.
+  std::int64_t command_id() const { return command_id_; }
+
+  // Stores `result_json` as the command's result and makes everything
+  // durable. Asserts the edit is still open. Throws core::RuntimeFailure
+  // when SQLite cannot commit (I/O error, disk full); the changes are then
+  // rolled back when the Edit is destroyed.
+  void commit(const std::string& result_json);
 
   // False once committed or moved from.
   bool active() const { return db_ != nullptr; }
 
  private:
   friend class Project;
-  Transaction(sqlite3* db, std::string file) : db_(db), file_(std::move(file)) {}
+  Edit(sqlite3* db, std::string file, std::int64_t command_id)
+      : db_(db), file_(std::move(file)), command_id_(command_id) {}
   void roll_back() noexcept;
 
   sqlite3* db_ = nullptr;
   std::string file_;
+  std::int64_t command_id_ = 0;
 };
 
 }  // namespace scanbench::modeling

@@ -1,4 +1,7 @@
-// The scans and scan_channels tables: Project::insert_scan, scans, load_scan.
+// The scans and scan_poses tables: encode_scan, Project::insert_scan,
+// set_pose, scans, load_scan.
+#include <sqlite3.h>
+
 #include <array>
 #include <bit>
 #include <cassert>
@@ -8,7 +11,6 @@
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
-#include "modeling/project_channels.hpp"
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling {
@@ -18,7 +20,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "poses are stored as little-endian doubles");
 
-// Column order of kSelectScans; also the parameter numbers of kInsertScan.
+// Column order of kSelectScans.
 enum Column : int {
   kId = 0,
   kName,
@@ -29,15 +31,15 @@ enum Column : int {
   kAzimuthStep,
   kElevationStart,
   kElevationStep,
-  kPose,
   kScannerName,
   kSourceFile,
-  kScannerX,
-  kScannerY,
-  kScannerZ,
   kValidPoints,
   kHasColor,
   kHasIntensity,
+  kPose,
+  kScannerX,
+  kScannerY,
+  kScannerZ,
   kBboxMinX,
   kBboxMinY,
   kBboxMinZ,
@@ -46,18 +48,30 @@ enum Column : int {
   kBboxMaxZ,
 };
 
-constexpr const char* kScanColumns = R"sql(
-  name, rows, columns, angle_model,
-  azimuth_start_rad, azimuth_step_rad, elevation_start_rad, elevation_step_rad,
-  T_world_scan, scanner_name, source_file, scanner_x, scanner_y, scanner_z,
-  valid_points, has_color, has_intensity,
-  bbox_min_x, bbox_min_y, bbox_min_z, bbox_max_x, bbox_max_y, bbox_max_z)sql";
+// Every live scan (its import not undone) with its current pose: the newest
+// pose row of a done command.
+constexpr const char* kSelectScans = R"sql(
+SELECT s.id, s.name, s.rows, s.columns, s.angle_model,
+       s.azimuth_start_rad, s.azimuth_step_rad, s.elevation_start_rad, s.elevation_step_rad,
+       s.scanner_name, s.source_file, s.valid_points, s.has_color, s.has_intensity,
+       p.T_world_scan, p.scanner_x, p.scanner_y, p.scanner_z,
+       p.bbox_min_x, p.bbox_min_y, p.bbox_min_z, p.bbox_max_x, p.bbox_max_y, p.bbox_max_z
+FROM scans s JOIN scan_poses p ON p.scan_id = s.id
+WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
+  AND p.command_id = (SELECT max(q.command_id) FROM scan_poses q WHERE q.scan_id = s.id
+                      AND q.command_id IN (SELECT id FROM commands WHERE state = 'done')))sql";
 
-const std::string kSelectScans = std::string("SELECT id, ") + kScanColumns + " FROM scans";
+constexpr const char* kInsertScan = R"sql(
+INSERT INTO scans (created_by, name, rows, columns, angle_model, azimuth_start_rad,
+                   azimuth_step_rad, elevation_start_rad, elevation_step_rad, scanner_name,
+                   source_file, valid_points, has_color, has_intensity)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14))sql";
 
-const std::string kInsertScan = std::string("INSERT INTO scans (") + kScanColumns +
-                                ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
-                                "?13, ?14, ?15, ?16, ?17, ?18, ?19, ?20, ?21, ?22, ?23)";
+constexpr const char* kInsertPose = R"sql(
+INSERT OR REPLACE INTO scan_poses (scan_id, command_id, T_world_scan, scanner_x, scanner_y,
+                                   scanner_z, bbox_min_x, bbox_min_y, bbox_min_z, bbox_max_x,
+                                   bbox_max_y, bbox_max_z)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12))sql";
 
 constexpr std::size_t kPoseBytes = 16 * sizeof(double);
 
@@ -85,38 +99,38 @@ Eigen::Isometry3d decode_pose(std::span<const std::uint8_t> bytes, const std::st
   return pose;
 }
 
-void bind_scan_row(sqlite::Statement& insert, const acquisition::Scan& scan,
-                   const acquisition::ScanSummary& summary,
-                   std::span<const std::uint8_t> pose_bytes) {
-  insert.bind_text(kName, scan.name).bind_int(kRows, scan.rows).bind_int(kColumns, scan.columns);
-  insert.bind_text(kAngleModel, acquisition::angle_model_name(scan.is_spherical()));
+void bind_scan_row(sqlite::Statement& insert, std::int64_t command_id, const EncodedScan& encoded) {
+  const acquisition::Scan& scan = encoded.metadata;
+  const acquisition::ScanSummary& summary = encoded.summary;
+  insert.bind_int(1, command_id).bind_text(2, scan.name);
+  insert.bind_int(3, scan.rows).bind_int(4, scan.columns);
+  insert.bind_text(5, acquisition::angle_model_name(scan.is_spherical()));
   const auto* angles = std::get_if<acquisition::SphericalAngles>(&scan.angles);
   const auto angle = [&](double acquisition::SphericalAngles::*field) {
     return angles != nullptr ? std::optional<double>(angles->*field) : std::nullopt;
   };
-  insert
-      .bind_optional_double(kAzimuthStart, angle(&acquisition::SphericalAngles::azimuth_start_rad))
-      .bind_optional_double(kAzimuthStep, angle(&acquisition::SphericalAngles::azimuth_step_rad))
-      .bind_optional_double(kElevationStart,
-                            angle(&acquisition::SphericalAngles::elevation_start_rad))
-      .bind_optional_double(kElevationStep,
-                            angle(&acquisition::SphericalAngles::elevation_step_rad));
-  insert.bind_blob(kPose, pose_bytes).bind_text(kScannerName, scan.scanner.name);
-  insert.bind_text(kSourceFile, scan.scanner.source_file);
+  insert.bind_optional_double(6, angle(&acquisition::SphericalAngles::azimuth_start_rad))
+      .bind_optional_double(7, angle(&acquisition::SphericalAngles::azimuth_step_rad))
+      .bind_optional_double(8, angle(&acquisition::SphericalAngles::elevation_start_rad))
+      .bind_optional_double(9, angle(&acquisition::SphericalAngles::elevation_step_rad));
+  insert.bind_text(10, scan.scanner.name).bind_text(11, scan.scanner.source_file);
+  insert.bind_int(12, static_cast<std::int64_t>(summary.valid_points))
+      .bind_int(13, summary.has_color)
+      .bind_int(14, summary.has_intensity);
+}
+
+void insert_pose(sqlite3* db, const std::string& file, std::int64_t id, std::int64_t command_id,
+                 const Eigen::Isometry3d& T_world_scan, const Eigen::Vector3d& scanner_world,
+                 const std::optional<Eigen::AlignedBox3d>& box) {
+  const auto pose_bytes = encode_pose(T_world_scan);
+  sqlite::Statement insert(db, kInsertPose, file);
+  insert.bind_int(1, id).bind_int(2, command_id).bind_blob(3, pose_bytes);
+  for (int axis = 0; axis < 3; ++axis) insert.bind_double(4 + axis, scanner_world[axis]);
   for (int axis = 0; axis < 3; ++axis) {
-    insert.bind_double(kScannerX + axis, scan.scanner.position_world[axis]);
+    insert.bind_optional_double(7 + axis, box ? std::optional(box->min()[axis]) : std::nullopt)
+        .bind_optional_double(10 + axis, box ? std::optional(box->max()[axis]) : std::nullopt);
   }
-  insert.bind_int(kValidPoints, static_cast<std::int64_t>(summary.valid_points))
-      .bind_int(kHasColor, summary.has_color)
-      .bind_int(kHasIntensity, summary.has_intensity);
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto& box = summary.bbox_world;
-    insert
-        .bind_optional_double(kBboxMinX + axis,
-                              box ? std::optional(box->min()[axis]) : std::nullopt)
-        .bind_optional_double(kBboxMaxX + axis,
-                              box ? std::optional(box->max()[axis]) : std::nullopt);
-  }
+  insert.run();
 }
 
 int read_dimension(const sqlite::Statement& row, int column, const std::string& file,
@@ -164,49 +178,80 @@ acquisition::AngleModel read_angles(const sqlite::Statement& row, bool spherical
       row.column_double(kElevationStart), row.column_double(kElevationStep)};
 }
 
+// Loads a channel layer that must be there.
+template <typename T>
+std::vector<T> required_layer(const Project& project, std::int64_t id, const char* name,
+                              ElementType type) {
+  std::optional<std::vector<T>> values = project.load_layer<T>(id, name, type);
+  if (!values) damaged(project.path().string(), id, std::string("layer ") + name + " is missing");
+  return std::move(*values);
+}
+
 }  // namespace
 
-std::int64_t Project::insert_scan(const acquisition::Scan& scan) {
-  assert(sqlite3_get_autocommit(db()) == 0 && "insert_scan needs an open Project::Transaction");
+EncodedScan encode_scan(const acquisition::Scan& scan) {
   assert(acquisition::check_consistency(scan).empty() &&
-         "insert_scan needs a consistent scan (see acquisition::check_consistency)");
-  const acquisition::ScanSummary summary = acquisition::summarize(scan);
-  const auto pose_bytes = encode_pose(scan.T_world_scan);
-  sqlite::Statement insert(db(), kInsertScan.c_str(), file_name());
-  bind_scan_row(insert, scan, summary, pose_bytes);
+         "only a consistent scan is stored (see acquisition::check_consistency)");
+  EncodedScan encoded;
+  encoded.summary = acquisition::summarize(scan);
+  encoded.metadata.name = scan.name;
+  encoded.metadata.rows = scan.rows;
+  encoded.metadata.columns = scan.columns;
+  encoded.metadata.T_world_scan = scan.T_world_scan;
+  encoded.metadata.scanner = scan.scanner;
+  auto& layers = encoded.layers;
+  layers.push_back(encode_layer<float>(layer::kRange, ElementType::kF32, scan.range_m));
+  layers.push_back(encode_layer<std::uint8_t>(layer::kValid, ElementType::kU8, scan.valid));
+  if (scan.has_intensity()) {
+    layers.push_back(encode_layer<float>(layer::kIntensity, ElementType::kF32, scan.intensity));
+  }
+  if (scan.has_color()) {
+    layers.push_back(encode_layer<std::uint8_t>(layer::kRgb, ElementType::kU8x3, scan.rgb));
+  }
+  if (const auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&scan.angles)) {
+    layers.push_back(encode_layer<Eigen::Vector3f>(layer::kDirections, ElementType::kF32x3,
+                                                   per_pixel->directions));
+    encoded.metadata.angles = acquisition::PerPixelDirections{};
+  } else {
+    encoded.metadata.angles = scan.angles;
+  }
+  return encoded;
+}
+
+std::size_t Project::stored_pixel_count(std::int64_t id) const {
+  sqlite::Statement statement(db(), R"sql(
+SELECT rows * columns FROM scans
+WHERE id = ?1 AND created_by IN (SELECT id FROM commands WHERE state = 'done'))sql",
+                              file_name());
+  statement.bind_int(1, id);
+  if (!statement.step()) {
+    throw core::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
+  }
+  return static_cast<std::size_t>(statement.column_int(0));
+}
+
+std::int64_t Project::insert_scan(Edit& edit, const EncodedScan& scan) {
+  check_edit(edit);
+  sqlite::Statement insert(db(), kInsertScan, file_name());
+  bind_scan_row(insert, edit.command_id(), scan);
   insert.run();
   const std::int64_t id = sqlite3_last_insert_rowid(db());
-  insert_channels(db(), file_name(), id, scan);
+  insert_pose(db(), file_name(), id, edit.command_id(), scan.metadata.T_world_scan,
+              scan.metadata.scanner.position_world, scan.summary.bbox_world);
+  for (const EncodedLayer& layer : scan.layers) put_layer(edit, id, layer);
   return id;
 }
 
-void Project::update_pose(std::int64_t id, const acquisition::Scan& scan) {
-  assert(sqlite3_get_autocommit(db()) == 0 && "update_pose needs an open Project::Transaction");
-  const acquisition::ScanSummary summary = acquisition::summarize(scan);
-  const auto pose_bytes = encode_pose(scan.T_world_scan);
-  sqlite::Statement update(db(), R"sql(
-UPDATE scans SET T_world_scan = ?2, scanner_x = ?3, scanner_y = ?4, scanner_z = ?5,
-  bbox_min_x = ?6, bbox_min_y = ?7, bbox_min_z = ?8, bbox_max_x = ?9, bbox_max_y = ?10,
-  bbox_max_z = ?11
-WHERE id = ?1 AND rows = ?12 AND columns = ?13)sql",
-                           file_name());
-  update.bind_int(1, id).bind_blob(2, pose_bytes);
-  const Eigen::Vector3d origin = scan.T_world_scan.translation();
-  for (int axis = 0; axis < 3; ++axis) update.bind_double(3 + axis, origin[axis]);
-  const auto& box = summary.bbox_world;
-  for (int axis = 0; axis < 3; ++axis) {
-    update.bind_optional_double(6 + axis, box ? std::optional(box->min()[axis]) : std::nullopt)
-        .bind_optional_double(9 + axis, box ? std::optional(box->max()[axis]) : std::nullopt);
-  }
-  update.bind_int(12, scan.rows).bind_int(13, scan.columns).run();
-  if (sqlite3_changes(db()) != 1) {
-    throw core::InputError(file_name(), {},
-                           "no scan with id " + std::to_string(id) + " of that size");
-  }
+void Project::set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& scan) {
+  check_edit(edit);
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id);  // throws when there is none
+  assert(n == scan.pixel_count() && "set_pose takes the stored scan");
+  insert_pose(db(), file_name(), id, edit.command_id(), scan.T_world_scan,
+              scan.T_world_scan.translation(), acquisition::world_bounds(scan));
 }
 
 std::vector<StoredScanSummary> Project::scans() const {
-  const std::string sql = kSelectScans + " ORDER BY id";
+  const std::string sql = std::string(kSelectScans) + " ORDER BY s.id";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   std::vector<StoredScanSummary> result;
   while (select.step()) result.push_back(read_summary(select, file_name()));
@@ -214,7 +259,7 @@ std::vector<StoredScanSummary> Project::scans() const {
 }
 
 acquisition::Scan Project::load_scan(std::int64_t id) const {
-  const std::string sql = kSelectScans + " WHERE id = ?1";
+  const std::string sql = std::string(kSelectScans) + " AND s.id = ?1";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
   if (!select.step()) {
@@ -228,7 +273,18 @@ acquisition::Scan Project::load_scan(std::int64_t id) const {
   scan.angles = read_angles(select, summary.spherical);
   scan.T_world_scan = summary.T_world_scan;
   scan.scanner = summary.scanner;
-  read_channels(db(), file_name(), id, summary.has_intensity, summary.has_color, scan);
+  scan.range_m = required_layer<float>(*this, id, layer::kRange, ElementType::kF32);
+  scan.valid = required_layer<std::uint8_t>(*this, id, layer::kValid, ElementType::kU8);
+  if (summary.has_intensity) {
+    scan.intensity = required_layer<float>(*this, id, layer::kIntensity, ElementType::kF32);
+  }
+  if (summary.has_color) {
+    scan.rgb = required_layer<std::uint8_t>(*this, id, layer::kRgb, ElementType::kU8x3);
+  }
+  if (!summary.spherical) {
+    std::get<acquisition::PerPixelDirections>(scan.angles).directions =
+        required_layer<Eigen::Vector3f>(*this, id, layer::kDirections, ElementType::kF32x3);
+  }
   return scan;
 }
 

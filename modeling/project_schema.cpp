@@ -72,11 +72,11 @@ INSERT INTO meta (key, value) VALUES
   ('created_schema_version', ?1)
 )sql";
 
-// Tables every version has (checked before migrating) and those of later
-// versions (checked after).
-constexpr std::array<const char*, 3> kVersion1Tables = {"meta", "scans", "scan_channels"};
-constexpr std::array<const char*, 3> kLaterTables = {"scan_geometry", "registration_runs",
-                                                     "merge_masks"};
+// Tables every version has (checked before migrating) and those of the
+// current version (checked after).
+constexpr std::array<const char*, 2> kEveryVersionTables = {"meta", "scans"};
+constexpr std::array<const char*, 5> kCurrentTables = {"meta", "scans", "commands", "scan_poses",
+                                                       "scan_layers"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
   throw core::InputError(file, {}, problem);
@@ -159,15 +159,135 @@ CREATE TABLE merge_masks (
 );
 )sql";
 
+// Version 4: the command journal, and nothing overwritten any more. The
+// scans table keeps what an import fixes for good; poses move to
+// scan_poses and every per-pixel array (channels, geometry, keep masks) to
+// scan_layers, one version per command that wrote it (project.hpp).
+// Everything stored before the journal existed belongs to one "migrate"
+// command that cannot be undone (created only when there is such data);
+// the reports of earlier registration runs become "register" entries of the
+// journal, also not undoable. ?1: the schema version the file had.
+constexpr const char* kMigrate3To4 = R"sql(
+CREATE TABLE commands (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,  -- never reused: a journal id names one command for good
+  name TEXT NOT NULL,
+  settings TEXT NOT NULL,
+  result TEXT NOT NULL DEFAULT '{}',
+  state TEXT NOT NULL CHECK (state IN ('done', 'undone')),
+  undoable INTEGER NOT NULL CHECK (undoable IN (0, 1)),
+  created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+);
+INSERT INTO commands (id, name, settings, result, state, undoable)
+  SELECT 1, 'migrate', '{"from_schema_version":' || ?1 || '}', '{}', 'done', 0
+  WHERE EXISTS (SELECT 1 FROM scans);
+INSERT INTO commands (name, settings, result, state, undoable, created_at)
+  SELECT 'register', settings, report, 'done', 0, created_at FROM registration_runs ORDER BY id;
+
+ALTER TABLE scans RENAME TO scans_v3;
+CREATE TABLE scans (
+  id INTEGER PRIMARY KEY,
+  created_by INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
+  name TEXT NOT NULL,
+  rows INTEGER NOT NULL CHECK (rows >= 0),
+  columns INTEGER NOT NULL CHECK (columns >= 0),
+  angle_model TEXT NOT NULL CHECK (angle_model IN ('spherical', 'per_pixel')),
+  azimuth_start_rad CHECK (typeof(azimuth_start_rad) IN ('real', 'null')),
+  azimuth_step_rad CHECK (typeof(azimuth_step_rad) IN ('real', 'null')),
+  elevation_start_rad CHECK (typeof(elevation_start_rad) IN ('real', 'null')),
+  elevation_step_rad CHECK (typeof(elevation_step_rad) IN ('real', 'null')),
+  scanner_name TEXT NOT NULL,
+  source_file TEXT NOT NULL,
+  valid_points INTEGER NOT NULL CHECK (valid_points >= 0),
+  has_color INTEGER NOT NULL CHECK (has_color IN (0, 1)),
+  has_intensity INTEGER NOT NULL CHECK (has_intensity IN (0, 1)),
+  created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+  CHECK ((angle_model = 'spherical') =
+         (azimuth_start_rad IS NOT NULL AND azimuth_step_rad IS NOT NULL AND
+          elevation_start_rad IS NOT NULL AND elevation_step_rad IS NOT NULL))
+);
+CREATE INDEX scans_by_command ON scans (created_by);
+CREATE TABLE scan_poses (
+  scan_id INTEGER NOT NULL REFERENCES scans (id) ON DELETE CASCADE,
+  command_id INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
+  T_world_scan BLOB NOT NULL CHECK (length(T_world_scan) = 128),
+  scanner_x NOT NULL CHECK (typeof(scanner_x) = 'real'),
+  scanner_y NOT NULL CHECK (typeof(scanner_y) = 'real'),
+  scanner_z NOT NULL CHECK (typeof(scanner_z) = 'real'),
+  bbox_min_x CHECK (typeof(bbox_min_x) IN ('real', 'null')),
+  bbox_min_y CHECK (typeof(bbox_min_y) IN ('real', 'null')),
+  bbox_min_z CHECK (typeof(bbox_min_z) IN ('real', 'null')),
+  bbox_max_x CHECK (typeof(bbox_max_x) IN ('real', 'null')),
+  bbox_max_y CHECK (typeof(bbox_max_y) IN ('real', 'null')),
+  bbox_max_z CHECK (typeof(bbox_max_z) IN ('real', 'null')),
+  CHECK ((bbox_min_x IS NULL) = (bbox_max_z IS NULL)),
+  PRIMARY KEY (scan_id, command_id)
+);
+CREATE INDEX scan_poses_by_command ON scan_poses (command_id);
+CREATE TABLE scan_layers (
+  scan_id INTEGER NOT NULL REFERENCES scans (id) ON DELETE CASCADE,
+  name TEXT NOT NULL CHECK (length(name) BETWEEN 1 AND 64),
+  command_id INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
+  element_type TEXT NOT NULL CHECK (element_type IN ('u8', 'u8x3', 'u32', 'f32', 'f32x3')),
+  element_count INTEGER NOT NULL CHECK (element_count >= 0),
+  codec TEXT NOT NULL CHECK (codec IN ('zstd', 'removed')),
+  data BLOB CHECK ((codec = 'removed') = (data IS NULL)),
+  PRIMARY KEY (scan_id, name, command_id)
+);
+CREATE INDEX scan_layers_by_command ON scan_layers (command_id);
+
+INSERT INTO scans (id, created_by, name, rows, columns, angle_model, azimuth_start_rad,
+                   azimuth_step_rad, elevation_start_rad, elevation_step_rad, scanner_name,
+                   source_file, valid_points, has_color, has_intensity, created_at)
+  SELECT id, 1, name, rows, columns, angle_model, azimuth_start_rad, azimuth_step_rad,
+         elevation_start_rad, elevation_step_rad, scanner_name, source_file, valid_points,
+         has_color, has_intensity, created_at
+  FROM scans_v3;
+INSERT INTO scan_poses
+  SELECT id, 1, T_world_scan, scanner_x, scanner_y, scanner_z, bbox_min_x, bbox_min_y,
+         bbox_min_z, bbox_max_x, bbox_max_y, bbox_max_z
+  FROM scans_v3;
+INSERT INTO scan_layers
+  SELECT scan_id, channel, 1,
+         CASE channel WHEN 'valid' THEN 'u8' WHEN 'rgb' THEN 'u8x3'
+                      WHEN 'directions' THEN 'f32x3' ELSE 'f32' END,
+         CASE channel WHEN 'rgb' THEN element_count / 3 ELSE element_count END, codec, data
+  FROM scan_channels;
+INSERT INTO scan_layers
+  SELECT g.scan_id, 'footprint_m', 1, 'f32', s.rows * s.columns, 'zstd', g.footprint_m
+  FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
+  UNION ALL
+  SELECT g.scan_id, 'normal', 1, 'f32x3', s.rows * s.columns, 'zstd', g.normal
+  FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
+  UNION ALL
+  SELECT g.scan_id, 'confidence', 1, 'f32', s.rows * s.columns, 'zstd', g.confidence
+  FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
+  UNION ALL
+  SELECT g.scan_id, 'geometry_flags', 1, 'u8', s.rows * s.columns, 'zstd', g.flags
+  FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
+  UNION ALL
+  SELECT m.scan_id, 'keep', 1, 'u8', s.rows * s.columns, 'zstd', m.keep
+  FROM merge_masks m JOIN scans s ON s.id = m.scan_id;
+
+DROP TABLE scan_channels;
+DROP TABLE scan_geometry;
+DROP TABLE merge_masks;
+DROP TABLE registration_runs;
+DROP TABLE scans_v3;
+INSERT OR REPLACE INTO meta (key, value) VALUES ('revision', '0');
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
-// transaction.
-void migrate_step(sqlite3* db, int version, const std::string& file) {
+// transaction; `original_version` is the version the file had when opened.
+void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
   switch (version) {
     case 1:
       sqlite::execute(db, kMigrate1To2, file);
       return;
     case 2:
       sqlite::execute(db, kMigrate2To3, file);
+      return;
+    case 3:
+      sqlite::execute_with_int(db, kMigrate3To4, original_version, file);
       return;
     default:
       assert(false && "no migration step from this schema version");
@@ -193,7 +313,7 @@ void in_versioned_transaction(sqlite3* db, const std::string& file, Steps steps)
 
 void migrate_from(sqlite3* db, int from_version, const std::string& file) {
   for (int version = from_version; version < kProjectSchemaVersion; ++version) {
-    migrate_step(db, version, file);
+    migrate_step(db, version, from_version, file);
   }
 }
 
@@ -257,12 +377,12 @@ void check_and_migrate(sqlite3* db, const std::string& file) {
       static_cast<std::uint32_t>(pragma_value(db, "PRAGMA application_id", file));
   const int version = read_schema_version(db, file);
   check_identity(application_id, version, file);
-  check_tables(db, file, kVersion1Tables);
+  check_tables(db, file, kEveryVersionTables);
   enable_wal(db, file);
   if (version < kProjectSchemaVersion) {
     in_versioned_transaction(db, file, [&] { migrate_from(db, version, file); });
   }
-  check_tables(db, file, kLaterTables);
+  check_tables(db, file, kCurrentTables);
 }
 
 int read_schema_version(sqlite3* db, const std::string& file) {

@@ -4,6 +4,9 @@
 // Schema history (PRAGMA user_version):
 //   1  meta, scans, scan_channels.
 //   2  scan_geometry (per-point footprint, normal, confidence, flags).
+//   3  registration_runs, merge_masks.
+//   4  commands (the journal), scan_poses, scan_layers; scan_channels,
+//      scan_geometry, merge_masks and registration_runs move into them.
 // To change the schema: bump kProjectSchemaVersion and add a case to
 // migrate_step() in project_schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by

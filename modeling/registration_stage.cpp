@@ -4,7 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
+#include "modeling/scan_layers.hpp"
+#include "modeling/settings_json.hpp"
 
 namespace scanbench::modeling {
 namespace {
@@ -17,10 +18,13 @@ struct LoadedScans {
   std::vector<registration::PreparedScan> prepared;
 };
 
-LoadedScans load_scans(const Project& project, int threads) {
+LoadedScans load_scans(const Project& project, int threads, const char* stage,
+                       core::Progress& progress) {
   LoadedScans loaded;
-  for (const StoredScanSummary& stored : project.scans()) {
-    std::optional<acquisition::ScanGeometry> geometry = project.load_geometry(stored.id);
+  const std::vector<StoredScanSummary> scans = project.scans();
+  for (const StoredScanSummary& stored : scans) {
+    progress.throw_if_cancelled(stage);
+    std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
     if (!geometry) {
       throw core::InputError(project.path().string(), {},
                              "scan " + std::to_string(stored.id) + " (" + stored.summary.name +
@@ -29,6 +33,7 @@ LoadedScans load_scans(const Project& project, int threads) {
     loaded.ids.push_back(stored.id);
     loaded.scans.push_back(project.load_scan(stored.id));
     loaded.geometry.push_back(std::move(*geometry));
+    progress.update({stage, loaded.ids.size(), scans.size(), "loaded " + stored.summary.name});
   }
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
     loaded.prepared.push_back(
@@ -136,29 +141,19 @@ std::string report_json(const registration::RegistrationResult& r,
                                {"initial_T_world_scan", pose_json(scans[k].T_world_scan)},
                                {"T_world_scan", pose_json(r.T_world_scan[k])}});
   }
-  return report.dump();
-}
-
-nlohmann::json settings_json(const registration::RegistrationSettings& s) {
-  return {{"coarse", registration::coarse_method_name(s.coarse)},
-          {"icp_sample_voxel_m", s.icp_sample.voxel_m},
-          {"icp_max_samples", s.icp_sample.max_points},
-          {"min_gate_m", s.icp.min_gate_m},
-          {"loss_scale_m", s.icp.loss_scale_m},
-          {"min_overlap", s.min_overlap},
-          {"max_free_space_violation", s.max_free_space_violation},
-          {"refine_globally", s.refine_globally}};
+  return report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace
 
-RegisterStageResult register_project(const std::filesystem::path& project_path,
-                                     const RegisterStageSettings& settings) {
-  Project project = Project::open(project_path);
-  LoadedScans loaded = load_scans(project, settings.registration.icp.threads);
+RegisterStageResult register_project(Project& project, const RegisterStageSettings& settings,
+                                     core::Progress& progress) {
+  constexpr const char* kStage = "register";
+  const std::int64_t revision = project.revision();
+  LoadedScans loaded = load_scans(project, settings.registration.icp.threads, kStage, progress);
   registration::RegistrationSettings run = settings.registration;
   if (run.coarse == registration::CoarseMethod::kPointPairs) {
-    run.picks = picks_by_index(settings, loaded.ids, project_path.string());
+    run.picks = picks_by_index(settings, loaded.ids, project.path().string());
   }
   std::vector<Eigen::Isometry3d> initial;
   for (const acquisition::Scan& scan : loaded.scans) initial.push_back(scan.T_world_scan);
@@ -166,42 +161,64 @@ RegisterStageResult register_project(const std::filesystem::path& project_path,
   out.ids = loaded.ids;
   out.result = registration::register_scans(loaded.prepared, initial, run);
   out.report_json = report_json(out.result, loaded.ids, loaded.scans);
+  progress.throw_if_cancelled(kStage);
 
-  Project::Transaction transaction = project.begin();
+  Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
+  out.command_id = edit.command_id();
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
     out.names.push_back(loaded.scans[k].name);
     loaded.scans[k].T_world_scan = out.result.T_world_scan[k];
-    project.update_pose(loaded.ids[k], loaded.scans[k]);
+    project.set_pose(edit, loaded.ids[k], loaded.scans[k]);
+    project.remove_layer(edit, loaded.ids[k], layer::kKeep);
   }
-  project.store_registration(settings_json(run).dump(), out.report_json);
-  project.clear_keep_masks();
-  transaction.commit();
+  edit.commit(out.report_json);
   return out;
 }
 
-MergeStageResult merge_project(const std::filesystem::path& project_path,
-                               const registration::MergeSettings& settings) {
-  Project project = Project::open(project_path);
-  const LoadedScans loaded = load_scans(project, settings.threads);
+MergeStageResult merge_project(Project& project, const registration::MergeSettings& settings,
+                               core::Progress& progress) {
+  constexpr const char* kStage = "merge";
+  const std::int64_t revision = project.revision();
+  const LoadedScans loaded = load_scans(project, settings.threads, kStage, progress);
   std::vector<Eigen::Isometry3d> poses;
   for (const acquisition::Scan& scan : loaded.scans) poses.push_back(scan.T_world_scan);
   registration::MergeResult merged =
       registration::merge_by_sampling_rate(loaded.prepared, poses, settings);
-  const nlohmann::json stored_settings = {{"range_sigmas", settings.range_sigmas},
-                                          {"max_normal_angle_deg", settings.max_normal_angle_deg},
-                                          {"tie_tolerance", settings.tie_tolerance}};
   MergeStageResult out;
   out.points = merged.points;
   out.seconds = merged.seconds;
-  Project::Transaction transaction = project.begin();
+  std::vector<EncodedLayer> masks;
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
-    project.store_keep_mask(loaded.ids[k], merged.scans[k].keep, stored_settings.dump());
+    masks.push_back(
+        encode_layer<std::uint8_t>(layer::kKeep, ElementType::kU8, merged.scans[k].keep));
     MergeStageScan scan{loaded.ids[k], loaded.scans[k].name, std::move(merged.scans[k])};
     scan.counts.keep.clear();
     out.scans.push_back(std::move(scan));
   }
-  transaction.commit();
+  progress.throw_if_cancelled(kStage);
+
+  Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
+  out.command_id = edit.command_id();
+  for (std::size_t k = 0; k < loaded.ids.size(); ++k)
+    project.put_layer(edit, loaded.ids[k], masks[k]);
+  edit.commit(merge_result_json(out));
   return out;
+}
+
+std::string merge_result_json(const MergeStageResult& out) {
+  std::size_t kept = 0;
+  nlohmann::json scans = nlohmann::json::array();
+  for (const MergeStageScan& s : out.scans) {
+    kept += s.counts.kept;
+    scans.push_back({{"id", s.id},
+                     {"name", s.name},
+                     {"in_model", s.counts.in_model},
+                     {"kept", s.counts.kept},
+                     {"redundant", s.counts.redundant}});
+  }
+  return nlohmann::json{
+      {"scans", scans}, {"points", out.points}, {"kept", kept}, {"seconds", out.seconds}}
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace scanbench::modeling

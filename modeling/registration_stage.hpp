@@ -1,14 +1,15 @@
-// The register and merge stages: align every scan of a project (issue #5)
-// and store the poses with a report, then decide the merged model's points
-// and store them as keep masks. Each stage is one transaction.
+// The register and merge stages: align every scan of a project and store
+// the poses with a report (the command "register"), then decide the merged
+// model's points and store them as keep masks (the command "merge").
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "core/progress.hpp"
+#include "modeling/project.hpp"
 #include "registration/merge.hpp"
 #include "registration/register_scans.hpp"
 
@@ -29,22 +30,24 @@ struct RegisterStageSettings {
 };
 
 struct RegisterStageResult {
+  std::int64_t command_id = 0;    // the journal entry
   std::vector<std::int64_t> ids;  // scan ids, in the order of the result's scans
   std::vector<std::string> names;
   registration::RegistrationResult result;
-  std::string report_json;  // as stored in the project
+  std::string report_json;  // as stored in the journal (the command's result)
 };
 
 // Registers every scan of the project (the first scan by id is the
-// reference and keeps its pose), then in one transaction stores the new
-// poses, the report, and drops the now stale merge keep masks. A failed pair
-// is reported, and its scan keeps its pose relative to its target. Throws
-// core::InputError for a missing, foreign or damaged project, a scan
-// without geometry ("run scanbench geometry first"), or picks that do not
-// name the project's scans as the settings require; the project is then
-// unchanged.
-RegisterStageResult register_project(const std::filesystem::path& project_path,
-                                     const RegisterStageSettings& settings);
+// reference and keeps its pose), then as one command stores the new poses
+// (earlier poses stay in the history), the report as the command's result,
+// and removes the now stale merge keep masks. A failed pair is reported, and
+// its scan keeps its pose relative to its target. Throws core::InputError
+// for a damaged project, a scan without geometry ("run scanbench geometry
+// first"), or picks that do not name the project's scans as the settings
+// require; core::RuntimeFailure when another process changed the project
+// meanwhile; core::Cancelled when cancelled. The project is then unchanged.
+RegisterStageResult register_project(Project& project, const RegisterStageSettings& settings,
+                                     core::Progress& progress);
 
 struct MergeStageScan {
   std::int64_t id = 0;
@@ -53,15 +56,21 @@ struct MergeStageScan {
 };
 
 struct MergeStageResult {
+  std::int64_t command_id = 0;  // the journal entry
   std::vector<MergeStageScan> scans;
   std::size_t points = 0;
   double seconds = 0.0;  // the merge decision itself
 };
 
-// Computes the keep mask of every scan at its stored pose and stores them in
-// one transaction, replacing earlier masks. Throws core::InputError
-// as register_project does.
-MergeStageResult merge_project(const std::filesystem::path& project_path,
-                               const registration::MergeSettings& settings);
+// Computes the keep mask of every scan at its current pose and stores them
+// as one command (new versions of the "keep" layers). Throws as
+// register_project does.
+MergeStageResult merge_project(Project& project, const registration::MergeSettings& settings,
+                               core::Progress& progress);
+
+// The merge's result as the JSON object the journal keeps and `scanbench
+// merge --json` prints: {"scans":[{"id","name","in_model","kept","redundant"}],
+// "points","kept","seconds"}.
+std::string merge_result_json(const MergeStageResult& result);
 
 }  // namespace scanbench::modeling

@@ -1,6 +1,8 @@
 #include "modeling/sqlite_statement.hpp"
 
 #include <cassert>
+#include <memory>
+#include <string_view>
 
 #include "core/errors.hpp"
 
@@ -13,6 +15,49 @@ bool is_damage(int code) {
   return primary == SQLITE_CORRUPT || primary == SQLITE_NOTADB;
 }
 
+// Failures of the machine or the environment rather than of the file.
+bool is_runtime_failure(int code) {
+  switch (code & 0xff) {
+    case SQLITE_FULL:
+    case SQLITE_IOERR:
+    case SQLITE_NOMEM:
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+    case SQLITE_READONLY:
+    case SQLITE_CANTOPEN:
+    case SQLITE_PERM:
+    case SQLITE_NOLFS:
+    case SQLITE_INTERRUPT:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// "INSERT INTO scan_layers": the first words of a statement, to name what
+// failed without printing it whole.
+std::string statement_summary(std::string_view sql) {
+  const std::size_t start = sql.find_first_not_of(" \n\t");
+  if (start == std::string_view::npos) return "SQL";
+  sql.remove_prefix(start);
+  std::string words;
+  int count = 0;
+  for (std::size_t i = 0; i < sql.size() && count < 3; ++i) {
+    const char c = sql[i];
+    const bool space = c == ' ' || c == '\n' || c == '\t' || c == '(';
+    if (space) {
+      if (!words.empty() && words.back() != ' ') {
+        words += ' ';
+        ++count;
+      }
+    } else {
+      words += c;
+    }
+  }
+  while (!words.empty() && words.back() == ' ') words.pop_back();
+  return words;
+}
+
 }  // namespace
 
 void throw_error(sqlite3* db, int code, const std::string& file, const std::string& action) {
@@ -20,19 +65,38 @@ void throw_error(sqlite3* db, int code, const std::string& file, const std::stri
   if (is_damage(code)) message = "project file is damaged (" + message + ")";
   core::FilePosition position;
   position.detail = action;
+  if (is_runtime_failure(code)) throw core::RuntimeFailure(file, position, message);
   throw core::InputError(file, position, message);
 }
 
 void execute(sqlite3* db, const char* sql, const std::string& file) {
   const int code = sqlite3_exec(db, sql, nullptr, nullptr, nullptr);
-  if (code != SQLITE_OK) throw_error(db, code, file, std::string("running \"") + sql + "\"");
+  if (code != SQLITE_OK) throw_error(db, code, file, "running " + statement_summary(sql));
+}
+
+void execute_with_int(sqlite3* db, const char* sql, std::int64_t value, const std::string& file) {
+  const char* rest = sql;
+  while (rest != nullptr && *rest != '\0') {
+    sqlite3_stmt* raw = nullptr;
+    const char* next = nullptr;
+    int code = sqlite3_prepare_v2(db, rest, -1, &raw, &next);
+    const std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)> statement(raw,
+                                                                               &sqlite3_finalize);
+    if (code != SQLITE_OK) throw_error(db, code, file, "preparing " + statement_summary(rest));
+    if (!statement) break;  // only whitespace or comments left
+    if (sqlite3_bind_parameter_count(raw) > 0) sqlite3_bind_int64(raw, 1, value);
+    while ((code = sqlite3_step(raw)) == SQLITE_ROW) {
+    }
+    if (code != SQLITE_DONE) throw_error(db, code, file, "running " + statement_summary(rest));
+    rest = next;
+  }
 }
 
 Statement::Statement(sqlite3* db, const char* sql, std::string file)
     : db_(db), file_(std::move(file)), sql_(sql) {
   assert(db != nullptr && "statement on a closed project connection");
   const int code = sqlite3_prepare_v2(db, sql, -1, &statement_, nullptr);
-  if (code != SQLITE_OK) throw_error(db, code, file_, std::string("preparing \"") + sql + "\"");
+  if (code != SQLITE_OK) throw_error(db, code, file_, "preparing " + statement_summary(sql));
 }
 
 Statement::~Statement() {
@@ -81,7 +145,7 @@ bool Statement::step() {
   const int code = sqlite3_step(statement_);
   if (code == SQLITE_ROW) return true;
   if (code == SQLITE_DONE) return false;
-  throw_error(db_, code, file_, std::string("running \"") + sql_ + "\"");
+  throw_error(db_, code, file_, "running " + statement_summary(sql_));
 }
 
 void Statement::run() {

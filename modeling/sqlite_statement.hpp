@@ -2,10 +2,11 @@
 // Internal to scanbench_modeling (which links SQLite privately): nothing
 // outside modeling/ should include this header.
 //
-// Every SQLite failure becomes an core::InputError naming the project
-// file, the action that failed and SQLite's message, so that the CLI and the
-// workbench report a damaged, locked or unwritable project like any other bad
-// file instead of crashing.
+// Every SQLite failure becomes an exception naming the project file, the
+// action that failed and SQLite's message: core::InputError when the file is
+// at fault (damaged, not a database, data refused by the schema),
+// core::RuntimeFailure when the machine is (disk full, I/O error, no
+// permission, locked by another process, out of memory).
 #pragma once
 
 #include <sqlite3.h>
@@ -18,15 +19,19 @@
 
 namespace scanbench::modeling::sqlite {
 
-// Throws InputError(file, detail = action, problem = SQLite's message for
-// `code`). A damaged database (SQLITE_CORRUPT, SQLITE_NOTADB) is called out as
-// such. `db` may be null (the message then comes from `code` alone).
+// Throws InputError or RuntimeFailure (see above) with detail = action and
+// problem = SQLite's message for `code`. A damaged database (SQLITE_CORRUPT,
+// SQLITE_NOTADB) is called out as such. `db` may be null (the message then
+// comes from `code` alone).
 [[noreturn]] void throw_error(sqlite3* db, int code, const std::string& file,
                               const std::string& action);
 
 // Runs SQL that returns no rows (may hold several statements); throws as
 // throw_error on failure.
 void execute(sqlite3* db, const char* sql, const std::string& file);
+
+// As execute, binding `value` to parameter ?1 of every statement that has one.
+void execute_with_int(sqlite3* db, const char* sql, std::int64_t value, const std::string& file);
 
 // One prepared statement, finalized on destruction. Parameter and column
 // indices follow SQLite: parameters from 1, columns from 0. Not copyable or

@@ -122,13 +122,15 @@ std::string scan_name(const std::string& site, int k) {
 
 }  // namespace
 
-CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::path& out_dir) {
+CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::path& out_dir,
+                                 core::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
   fs::create_directories(out_dir / "truth");
   const Site site = make_site(settings.site, settings.seed, settings.scans);
   CampaignResult result;
   json scans = json::array();
   for (int k = 0; k < static_cast<int>(site.scan_poses.size()); ++k) {
+    progress.throw_if_cancelled("simulate");
     const std::uint64_t scan_seed = hash_combine(settings.seed, static_cast<std::uint64_t>(k) + 1);
     const ScanLighting lighting = random_lighting(scan_seed);
     const auto cast_start = std::chrono::steady_clock::now();
@@ -144,8 +146,8 @@ CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::pat
       sim.scan.scanner.position_world = sim.scan.T_world_scan.translation();
     }
     scans.push_back(write_scan(sim, true_pose, settings, out_dir, lighting, result));
-    if (settings.on_scan_written)
-      settings.on_scan_written(k, static_cast<int>(site.scan_poses.size()));
+    progress.update({"simulate", static_cast<std::size_t>(k) + 1, site.scan_poses.size(),
+                     scan_name(settings.site, k)});
   }
   result.truth_json = out_dir / "truth.json";
   write_json(result.truth_json, {{"format", "scanbench-truth"},

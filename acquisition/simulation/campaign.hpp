@@ -16,12 +16,12 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
+#include "core/progress.hpp"
 
 namespace scanbench::acquisition::sim {
 
@@ -39,8 +39,6 @@ struct CampaignSettings {
   // poses): up to this rotation [deg] and translation [m], seeded. 0 = exact.
   double pose_error_deg = 0.0;
   double pose_error_m = 0.0;
-  // Called after each scan is written (k is 0-based). Optional.
-  std::function<void(int k, int count)> on_scan_written;
 };
 
 struct CampaignResult {
@@ -52,10 +50,12 @@ struct CampaignResult {
 
 // Builds the site, simulates every scan of its campaign and writes the layout
 // above into `out_dir` (created when missing; existing files of the same
-// names are replaced). Throws std::runtime_error naming the file when writing
-// fails. Asserts settings.site is a known site and scans ≥ 1.
+// names are replaced), reporting one unit of `progress` per scan written.
+// Throws std::runtime_error naming the file when writing fails,
+// core::Cancelled when cancelled between scans (the scans written so far
+// stay). Asserts settings.site is a known site and scans ≥ 1.
 CampaignResult simulate_campaign(const CampaignSettings& settings,
-                                 const std::filesystem::path& out_dir);
+                                 const std::filesystem::path& out_dir, core::Progress& progress);
 
 // One scan's truth as loaded back from a campaign folder.
 struct TruthScan {

@@ -179,14 +179,15 @@ TEST(SimScanner, TruthViewAndScanAgreeOnObjectIds) {
 TEST(SimCampaign, SameSeedGivesByteIdenticalFiles) {
   ScratchDir a, b;
   CampaignSettings settings;
+  core::Progress quiet;
   settings.scans = 2;
   settings.scanner.columns = 240;
   settings.scanner.rows = 60;
   settings.format = CampaignFormat::kBoth;
   settings.seed = 5;
-  simulate_campaign(settings, a.path());
+  simulate_campaign(settings, a.path(), quiet);
   settings.simulation.threads = 1;
-  simulate_campaign(settings, b.path());
+  simulate_campaign(settings, b.path(), quiet);
   int files = 0;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(a.path())) {
     if (!entry.is_regular_file()) continue;
@@ -201,23 +202,25 @@ TEST(SimCampaign, SameSeedGivesByteIdenticalFiles) {
 TEST(SimCampaign, ADifferentSeedGivesADifferentCampaign) {
   ScratchDir a, b;
   CampaignSettings settings;
+  core::Progress quiet;
   settings.scans = 1;
   settings.scanner.columns = 120;
   settings.scanner.rows = 30;
-  simulate_campaign(settings, a.path());
+  simulate_campaign(settings, a.path(), quiet);
   settings.seed = 2;
-  simulate_campaign(settings, b.path());
+  simulate_campaign(settings, b.path(), quiet);
   EXPECT_NE(test::read_file_bytes(a / "truth.json"), test::read_file_bytes(b / "truth.json"));
 }
 
 TEST(SimCampaign, TruthLoadsBackAndMatchesTheImportedScans) {
   ScratchDir dir;
   CampaignSettings settings;
+  core::Progress quiet;
   settings.site = "street";
   settings.scans = 2;
   settings.scanner.columns = 360;
   settings.scanner.rows = 90;
-  simulate_campaign(settings, dir.path());
+  simulate_campaign(settings, dir.path(), quiet);
   const CampaignTruth truth = load_campaign_truth(dir / "truth.json");
   EXPECT_EQ(truth.site, "street");
   ASSERT_EQ(truth.scans.size(), 2u);

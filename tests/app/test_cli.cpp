@@ -28,7 +28,8 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
-  for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry"}) {
+  for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry",
+                              "register", "merge", "history", "undo", "redo"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
@@ -265,6 +266,62 @@ TEST(Cli, MergedExportWritesTheKeptPointsOnly) {
   for (const auto& scan : report["scans"]) kept += scan["kept"].get<std::size_t>();
   EXPECT_EQ(lines("merged.csv"), kept);
   EXPECT_LT(lines("merged.csv"), lines("all.csv"));
+}
+
+// Every CLI call is a process of its own: undo, redo and history must work
+// from what the project file holds, and restore earlier states exactly.
+TEST(Cli, UndoRedoAndHistoryWorkAcrossProcesses) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
+                          "--scans", "2", "--columns", "240", "--rows", "60", "--pose-error-deg",
+                          "1", "--pose-error-m", "0.2"})
+                .exit_code,
+            0);
+  const std::string project = (dir / "p.sbproj").string();
+  const auto ok = [&](std::vector<std::string> args) {
+    const CliResult result = run_cli(dir, args);
+    EXPECT_EQ(result.exit_code, 0) << args[0] << ": " << result.err;
+    return result;
+  };
+  ok({"import", project, (dir / "sim/campus_scan_01.json").string(),
+      (dir / "sim/campus_scan_02.json").string()});
+  const std::string imported = ok({"info", project, "--json"}).out;
+  ok({"geometry", project});
+  ok({"register", project, "--coarse", "none"});
+  const std::string registered = ok({"info", project, "--json"}).out;
+  EXPECT_NE(registered, imported);  // the poses moved
+  ok({"merge", project});
+  ok({"export", project, "--format", "ply", "--merged", "-o", (dir / "before.ply").string()});
+
+  const nlohmann::json history = nlohmann::json::parse(ok({"history", project, "--json"}).out);
+  ASSERT_EQ(history["commands"].size(), 4u);
+  EXPECT_EQ(history["commands"][2]["name"], "register");
+  EXPECT_EQ(history["commands"][2]["settings"]["registration"]["coarse"], "none");
+  EXPECT_EQ(history["commands"][3]["state"], "done");
+
+  ok({"undo", project});  // merge
+  EXPECT_EQ(run_cli(dir, {"export", project, "--format", "ply", "--merged", "-o",
+                          (dir / "none.ply").string()})
+                .exit_code,
+            2);
+  ok({"undo", project});  // register
+  EXPECT_EQ(ok({"info", project, "--json"}).out, imported);
+  ok({"redo", project});
+  ok({"redo", project});
+  EXPECT_EQ(ok({"info", project, "--json"}).out, registered);
+  ok({"export", project, "--format", "ply", "--merged", "-o", (dir / "after.ply").string()});
+  EXPECT_EQ(test::read_file_bytes(dir / "after.ply"), test::read_file_bytes(dir / "before.ply"));
+
+  for (int k = 0; k < 4; ++k) ok({"undo", project});
+  EXPECT_EQ(info_json(dir, project)["scans"].size(), 0u);
+  const CliResult nothing = run_cli(dir, {"undo", project});
+  EXPECT_EQ(nothing.exit_code, 2);
+  EXPECT_NE(nothing.err.find("nothing to undo"), std::string::npos) << nothing.err;
+  for (int k = 0; k < 4; ++k) ok({"redo", project});
+  EXPECT_EQ(ok({"info", project, "--json"}).out, registered);
+  EXPECT_EQ(run_cli(dir, {"redo", project}).exit_code, 2);
+  const std::string table = ok({"history", project}).out;
+  EXPECT_NE(table.find("points kept"), std::string::npos) << table;
 }
 
 TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {

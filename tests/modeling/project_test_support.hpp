@@ -11,6 +11,7 @@
 #include <string>
 
 #include "acquisition/scan.hpp"
+#include "modeling/project.hpp"
 
 namespace scanbench::test {
 
@@ -55,6 +56,14 @@ inline acquisition::Scan tiny_scan(bool spherical, bool with_intensity, bool wit
   scan.scanner.source_file = "/data/site é/scan 1.ptx";
   scan.scanner.position_world = Eigen::Vector3d(512345.1, 5412345.2, -0.0);
   return scan;
+}
+
+// Stores `scan` as a command of its own ("import") and returns its id.
+inline std::int64_t insert_committed(modeling::Project& project, const acquisition::Scan& scan) {
+  modeling::Project::Edit edit = project.begin_command("import", "{}");
+  const std::int64_t id = project.insert_scan(edit, modeling::encode_scan(scan));
+  edit.commit("{}");
+  return id;
 }
 
 template <typename T>

@@ -23,11 +23,17 @@ std::vector<std::string> scan_names(const std::filesystem::path& project) {
   return names;
 }
 
+ImportResult import_files(const std::filesystem::path& project,
+                          std::vector<std::filesystem::path> files) {
+  core::Progress quiet;
+  return import_scan_files(project, files, {}, quiet);
+}
+
 TEST(ImportScans, AllFilesOfOneCallLandTogether) {
   ScratchDir dir;
   const std::vector<std::filesystem::path> files{fixture("good/ptx/two_scans.ptx"),
                                                  fixture("good/ptx/tiny_color.ptx")};
-  const ImportResult result = import_scan_files(dir / "p.sbproj", files);
+  const ImportResult result = import_files(dir / "p.sbproj", files);
   EXPECT_TRUE(result.created_project);
   EXPECT_EQ(result.scan_ids.size(), 3u);
   EXPECT_EQ(scan_names(dir / "p.sbproj"),
@@ -37,35 +43,44 @@ TEST(ImportScans, AllFilesOfOneCallLandTogether) {
 TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
   ScratchDir dir;
   const std::filesystem::path project = dir / "p.sbproj";
-  import_scan_files(project,
-                    std::vector<std::filesystem::path>{fixture("good/ptx/tiny_color.ptx")});
+  import_files(project, {fixture("good/ptx/tiny_color.ptx")});
   const std::vector<std::filesystem::path> files{fixture("good/ptx/two_scans.ptx"),
                                                  fixture("bad/ptx_color_out_of_range.ptx")};
-  EXPECT_THROW(import_scan_files(project, files), core::InputError);
+  EXPECT_THROW(import_files(project, files), core::InputError);
+  EXPECT_EQ(Project::open(project).history().size(), 1u);
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
 }
 
-// A SIGKILL while the import transaction is open (one of two scans stored)
-// must leave the project exactly as it was before the import began.
+// Blocks the import after its first file: a kill there must leave the
+// project as it was (the write-phase kill is ProjectKill's business).
+class PauseAfterFirstFile : public core::Progress {
+ public:
+  explicit PauseAfterFirstFile(int report_fd) : report_fd_(report_fd) {}
+  void update(const core::ProgressStep&) override {
+    const char read = 'r';
+    if (::write(report_fd_, &read, 1) != 1) ::_exit(3);
+    ::pause();  // wait here for the kill
+  }
+
+ private:
+  int report_fd_;
+};
+
 TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
   ScratchDir dir;
   const std::filesystem::path project = dir / "p.sbproj";
-  import_scan_files(project,
-                    std::vector<std::filesystem::path>{fixture("good/ptx/tiny_color.ptx")});
+  import_files(project, {fixture("good/ptx/tiny_color.ptx")});
   int pipe_fds[2];
   ASSERT_EQ(::pipe(pipe_fds), 0);
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
     ::close(pipe_fds[0]);
-    ImportSettings settings;
-    settings.on_scan_stored = [&](const ImportProgress&) {
-      const char stored = 's';
-      if (::write(pipe_fds[1], &stored, 1) != 1) ::_exit(3);
-      ::pause();  // wait here, mid-transaction, for the kill
-    };
-    import_scan_files(
-        project, std::vector<std::filesystem::path>{fixture("good/ptx/two_scans.ptx")}, settings);
+    PauseAfterFirstFile pause(pipe_fds[1]);
+    import_scan_files(project,
+                      std::vector<std::filesystem::path>{fixture("good/ptx/two_scans.ptx"),
+                                                         fixture("good/ptx/tiny_color.ptx")},
+                      {}, pause);
     ::_exit(4);  // never reached: the parent kills us first
   }
   ::close(pipe_fds[1]);

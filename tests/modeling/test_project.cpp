@@ -1,5 +1,5 @@
-// Project: creation, scan round trips, summaries and transactions. Refusals
-// and crash safety are in test_project_files.cpp.
+// Project: creation, scan round trips, summaries and edits. Refusals and
+// crash safety are in test_project_files.cpp, the journal in test_journal.cpp.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -22,12 +22,7 @@ using test::ScratchDir;
 using test::tiny_scan;
 using ::testing::HasSubstr;
 
-std::int64_t insert_committed(Project& project, const acquisition::Scan& scan) {
-  auto transaction = project.begin();
-  const std::int64_t id = project.insert_scan(scan);
-  transaction.commit();
-  return id;
-}
+using test::insert_committed;
 
 TEST(Project, CreateMakesAnEmptyProjectOfTheCurrentSchema) {
   const ScratchDir dir;
@@ -173,51 +168,52 @@ TEST(Project, LoadingAMissingIdIsAnInputError) {
   }
 }
 
-TEST(Project, AnExceptionInsideATransactionLeavesNoScan) {
+TEST(Project, AnExceptionInsideAnEditLeavesNoScanAndNoJournalEntry) {
   const ScratchDir dir;
   Project project = Project::create(dir / "site.sbproj");
   const auto import_then_fail = [&] {
-    auto transaction = project.begin();
-    project.insert_scan(tiny_scan(true, true, true));
+    Project::Edit edit = project.begin_command("import", "{}");
+    project.insert_scan(edit, encode_scan(tiny_scan(true, true, true)));
     throw std::runtime_error("reader failed on the second file");
   };
   EXPECT_THROW(import_then_fail(), std::runtime_error);
   EXPECT_TRUE(project.scans().empty());
+  EXPECT_TRUE(project.history().empty());
   // The connection is usable again after the rollback.
   EXPECT_EQ(project.load_scan(insert_committed(project, tiny_scan(true, false, false))).rows, 2);
 }
 
-TEST(Project, TwoInsertsInOneTransactionAreAllOrNothing) {
+TEST(Project, TwoInsertsInOneEditAreAllOrNothing) {
   const ScratchDir dir;
   const auto file = dir / "site.sbproj";
   Project project = Project::create(file);
   {
-    auto transaction = project.begin();
-    project.insert_scan(tiny_scan(true, false, false));
-    project.insert_scan(tiny_scan(false, true, true));
-    EXPECT_EQ(project.scans().size(), 2u);  // visible inside the transaction
+    Project::Edit edit = project.begin_command("import", "{}");
+    project.insert_scan(edit, encode_scan(tiny_scan(true, false, false)));
+    project.insert_scan(edit, encode_scan(tiny_scan(false, true, true)));
+    EXPECT_EQ(project.scans().size(), 2u);  // visible inside the edit
   }                                         // not committed
   EXPECT_TRUE(project.scans().empty());
   EXPECT_TRUE(Project::open(file).scans().empty());  // nor to another connection
 
-  auto transaction = project.begin();
-  project.insert_scan(tiny_scan(true, false, false));
-  project.insert_scan(tiny_scan(false, true, true));
-  transaction.commit();
-  EXPECT_FALSE(transaction.active());
+  Project::Edit edit = project.begin_command("import", "{}");
+  project.insert_scan(edit, encode_scan(tiny_scan(true, false, false)));
+  project.insert_scan(edit, encode_scan(tiny_scan(false, true, true)));
+  edit.commit("{}");
+  EXPECT_FALSE(edit.active());
   EXPECT_EQ(Project::open(file).scans().size(), 2u);
 }
 
-TEST(Project, MovedTransactionAndProjectKeepWorking) {
+TEST(Project, MovedEditAndProjectKeepWorking) {
   const ScratchDir dir;
   Project original = Project::create(dir / "site.sbproj");
   Project project = std::move(original);
-  auto first = project.begin();
-  Project::Transaction moved = std::move(first);
+  Project::Edit first = project.begin_command("import", "{}");
+  Project::Edit moved = std::move(first);
   EXPECT_FALSE(first.active());
   EXPECT_TRUE(moved.active());
-  project.insert_scan(tiny_scan(true, false, false));
-  moved.commit();
+  project.insert_scan(moved, encode_scan(tiny_scan(true, false, false)));
+  moved.commit("{}");
   EXPECT_EQ(project.scans().size(), 1u);
 }
 
@@ -231,7 +227,7 @@ TEST(Project, ADamagedChannelNamesTheScanAndChannel) {
   }
   {
     RawDatabase raw(file);
-    raw.execute("UPDATE scan_channels SET data = substr(data, 1, 10) WHERE channel = 'intensity'");
+    raw.execute("UPDATE scan_layers SET data = substr(data, 1, 10) WHERE name = 'intensity'");
   }
   const Project project = Project::open(file);
   EXPECT_EQ(project.scans().size(), 1u);  // summaries do not touch channel data
@@ -240,7 +236,7 @@ TEST(Project, ADamagedChannelNamesTheScanAndChannel) {
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& error) {
     EXPECT_EQ(error.file(), file.string());
-    EXPECT_EQ(error.position().detail, "scan " + std::to_string(id) + ", channel intensity");
+    EXPECT_EQ(error.position().detail, "scan " + std::to_string(id) + ", layer intensity");
   }
 }
 
@@ -252,18 +248,20 @@ TEST(Project, AMissingChannelIsAnInputError) {
     Project project = Project::create(file);
     id = insert_committed(project, tiny_scan(false, false, false));
   }
-  { RawDatabase(file).execute("DELETE FROM scan_channels WHERE channel = 'directions'"); }
+  { RawDatabase(file).execute("DELETE FROM scan_layers WHERE name = 'directions'"); }
   EXPECT_THROW(Project::open(file).load_scan(id), core::InputError);
 }
 
-TEST(ProjectDeathTest, InsertingOutsideATransactionIsAProgrammerError) {
+TEST(ProjectDeathTest, WritingThroughAFinishedEditIsAProgrammerError) {
 #ifdef NDEBUG
   GTEST_SKIP() << "assertions are compiled out in this build";
 #else
   const ScratchDir dir;
   Project project = Project::create(dir / "site.sbproj");
-  EXPECT_DEATH(project.insert_scan(tiny_scan(true, false, false)),
-               "insert_scan needs an open Project::Transaction");
+  Project::Edit edit = project.begin_command("import", "{}");
+  edit.commit("{}");
+  EXPECT_DEATH(project.insert_scan(edit, encode_scan(tiny_scan(true, false, false))),
+               "writes need an open Edit of this project");
 #endif
 }
 

@@ -130,9 +130,7 @@ TEST(ProjectFiles, RefusesADamagedProjectUntouched) {
   const auto file = dir / "damaged.sbproj";
   {
     Project project = Project::create(file);
-    auto transaction = project.begin();
-    project.insert_scan(tiny_scan(true, true, true));
-    transaction.commit();
+    test::insert_committed(project, tiny_scan(true, true, true));
   }
   std::string bytes = test::read_file_bytes(file);
   ASSERT_GT(bytes.size(), 400u);
@@ -171,8 +169,8 @@ acquisition::Scan large_scan() {
   char status = 'E';
   try {
     Project project = Project::open(file);
-    auto transaction = project.begin();
-    project.insert_scan(large_scan());
+    Project::Edit edit = project.begin_command("import", "{}");
+    project.insert_scan(edit, encode_scan(large_scan()));
     status = 'K';
     [[maybe_unused]] const auto ignored = ::write(report_fd, &status, 1);
     for (;;) ::pause();
@@ -211,9 +209,7 @@ TEST_P(ProjectKill, SigkillMidTransactionLeavesTheCommittedStateOnly) {
   {
     Project project = Project::create(file);
     for (int i = 0; i < GetParam(); ++i) {
-      auto transaction = project.begin();
-      ids_before.push_back(project.insert_scan(tiny_scan(i % 2 == 0, true, true)));
-      transaction.commit();
+      ids_before.push_back(test::insert_committed(project, tiny_scan(i % 2 == 0, true, true)));
     }
   }
   kill_during_insert(file);
@@ -228,10 +224,8 @@ TEST_P(ProjectKill, SigkillMidTransactionLeavesTheCommittedStateOnly) {
   for (const std::int64_t id : ids_before) {
     test::expect_identical(project.load_scan(id), tiny_scan(id % 2 == 1, true, true));
   }
-  // The dead writer's lock is gone: a new transaction commits.
-  auto transaction = project.begin();
-  project.insert_scan(tiny_scan(true, false, false));
-  transaction.commit();
+  // The dead writer's lock is gone: a new edit commits.
+  test::insert_committed(project, tiny_scan(true, false, false));
   EXPECT_EQ(project.scans().size(), ids_before.size() + 1);
 }
 

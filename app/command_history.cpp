@@ -1,0 +1,134 @@
+// scanbench undo PROJECT, scanbench redo PROJECT, scanbench history PROJECT [--json]
+#include <fmt/core.h>
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.hpp"
+#include "core/errors.hpp"
+#include "modeling/project.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct HistoryOptions {
+  std::string project;
+  bool json = false;
+};
+
+const char* state_name(modeling::CommandState state) {
+  return state == modeling::CommandState::kDone ? "done" : "undone";
+}
+
+nlohmann::json parsed(const std::string& text) {
+  return nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+}
+
+// One line on what a command did, from its result.
+std::string summary(const modeling::CommandRecord& c) {
+  const nlohmann::json result = parsed(c.result);
+  const nlohmann::json settings = parsed(c.settings);
+  if (!result.is_object()) return "";
+  if (c.name == "migrate" && settings.contains("from_schema_version")) {
+    return fmt::format("data stored before the journal (schema version {})",
+                       settings["from_schema_version"].dump());
+  }
+  if (c.name == "import" && result.contains("scans")) {
+    return fmt::format("{} scan(s)", result["scans"].size());
+  }
+  if (c.name == "geometry" && result.contains("scans")) {
+    return fmt::format("{} scan(s)", result["scans"].size());
+  }
+  if (c.name == "register" && result.contains("overall")) {
+    const nlohmann::json& overall = result["overall"];
+    return fmt::format("rms {:.2f} mm, {}", 1000.0 * overall.value("rms_m", 0.0),
+                       overall.value("converged", false) ? "converged" : "not converged");
+  }
+  if (c.name == "merge" && result.contains("kept")) {
+    return fmt::format("{} of {} points kept", result.value("kept", 0), result.value("points", 0));
+  }
+  return "";
+}
+
+nlohmann::json to_json(const modeling::CommandRecord& c) {
+  return {{"id", c.id},
+          {"name", c.name},
+          {"state", state_name(c.state)},
+          {"undoable", c.undoable},
+          {"created_at", c.created_at},
+          {"settings", parsed(c.settings)},
+          {"result", parsed(c.result)}};
+}
+
+void run_history(const HistoryOptions& options) {
+  const modeling::Project project = modeling::Project::open(options.project);
+  const std::vector<modeling::CommandRecord> history = project.history();
+  if (options.json) {
+    nlohmann::json commands = nlohmann::json::array();
+    for (const modeling::CommandRecord& c : history) commands.push_back(to_json(c));
+    fmt::print("{}\n", nlohmann::json{{"commands", commands}}.dump(
+                           2, ' ', false, nlohmann::json::error_handler_t::replace));
+    return;
+  }
+  fmt::print("{:>4}  {:<7} {:<10} {:<24}  {}\n", "id", "state", "command", "at (UTC)", "what");
+  for (const modeling::CommandRecord& c : history) {
+    fmt::print("{:>4}  {:<7} {:<10} {:<24}  {}\n", c.id, state_name(c.state), c.name, c.created_at,
+               summary(c));
+  }
+}
+
+void run_undo(const std::string& path) {
+  modeling::Project project = modeling::Project::open(path);
+  const std::optional<modeling::CommandRecord> undone = project.undo();
+  if (!undone) {
+    const bool migrated_only = !project.history().empty();
+    throw core::InputError(path, {},
+                           migrated_only ? "nothing to undo: what is left was stored before this "
+                                           "project had a journal (schema version 4)"
+                                         : "nothing to undo");
+  }
+  fmt::print("undid {} {} ({}); `scanbench redo` brings it back\n", undone->id, undone->name,
+             undone->created_at);
+}
+
+void run_redo(const std::string& path) {
+  modeling::Project project = modeling::Project::open(path);
+  const std::optional<modeling::CommandRecord> redone = project.redo();
+  if (!redone) throw core::InputError(path, {}, "nothing to redo");
+  fmt::print("redid {} {} ({})\n", redone->id, redone->name, redone->created_at);
+}
+
+CLI::Option* add_project(CLI::App* command, std::string& project) {
+  return command->add_option("project", project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+}
+
+}  // namespace
+
+void add_history_commands(CLI::App& app) {
+  auto options = std::make_shared<HistoryOptions>();
+  CLI::App* history = app.add_subcommand(
+      "history", "List the project's commands, oldest first, with their settings and results.");
+  add_project(history, options->project);
+  history->add_flag("--json", options->json, "Print one JSON object");
+  history->callback([options] { run_history(*options); });
+
+  auto undo_project = std::make_shared<std::string>();
+  CLI::App* undo = app.add_subcommand(
+      "undo",
+      "Undo the newest command (import, geometry, register, merge, …); works across "
+      "sessions and processes.");
+  add_project(undo, *undo_project);
+  undo->callback([undo_project] { run_undo(*undo_project); });
+
+  auto redo_project = std::make_shared<std::string>();
+  CLI::App* redo = app.add_subcommand("redo",
+                                      "Redo the oldest undone command. A new command ends the redo "
+                                      "chain: what was undone before it cannot be redone.");
+  add_project(redo, *redo_project);
+  redo->callback([redo_project] { run_redo(*redo_project); });
+}
+
+}  // namespace scanbench::app

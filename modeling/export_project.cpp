@@ -1,0 +1,104 @@
+#include "modeling/export_project.hpp"
+
+#include <string>
+#include <vector>
+
+#include "acquisition/point_export.hpp"
+#include "acquisition/ptx_writer.hpp"
+#include "acquisition/triplet_writer.hpp"
+#include "core/errors.hpp"
+#include "modeling/scan_layers.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+// The exported scans' ids, in id order.
+std::vector<std::int64_t> exported_ids(const Project& project, const ExportSettings& settings) {
+  if (settings.scan_id) {
+    static_cast<void>(project.load_scan(*settings.scan_id));  // "no scan with id N"
+    return {*settings.scan_id};
+  }
+  std::vector<std::int64_t> ids;
+  for (const StoredScanSummary& stored : project.scans()) ids.push_back(stored.id);
+  return ids;
+}
+
+// With `merged`, the keep mask of every exported scan; none otherwise.
+std::vector<std::vector<std::uint8_t>> keep_masks(const Project& project,
+                                                  const ExportSettings& settings,
+                                                  const std::vector<std::int64_t>& ids) {
+  if (!settings.merged) return {};
+  const std::string file = project.path().string();
+  if (settings.format != ExportFormat::kPly && settings.format != ExportFormat::kCsv) {
+    throw core::InputError(file, {}, "--merged writes a point list: use --format ply or csv");
+  }
+  std::vector<std::vector<std::uint8_t>> masks;
+  for (const std::int64_t id : ids) {
+    std::optional<std::vector<std::uint8_t>> mask = load_keep_mask(project, id);
+    if (!mask) {
+      throw core::InputError(
+          file, {{}, {}, "scan " + std::to_string(id)},
+          "no merged model for this scan: run `scanbench merge` after the last registration");
+    }
+    masks.push_back(std::move(*mask));
+  }
+  return masks;
+}
+
+void write_triplet(const Project& project, const std::vector<acquisition::Scan>& scans,
+                   const ExportSettings& settings) {
+  const std::string file = project.path().string();
+  if (scans.size() != 1) {
+    throw core::InputError(file, {}, "a triplet holds one scan: choose it with --scan ID");
+  }
+  if (!scans.front().is_spherical()) {
+    throw core::InputError(file, {{}, {}, "scan \"" + scans.front().name + "\""},
+                           "a triplet needs the spherical angle model; this scan has per-pixel "
+                           "directions (export it as ptx, ply or csv)");
+  }
+  acquisition::write_triplet(scans.front(), settings.output);
+}
+
+std::size_t count_points(const std::vector<acquisition::Scan>& scans,
+                         const std::vector<std::vector<std::uint8_t>>& keep) {
+  std::size_t points = 0;
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    const std::vector<std::uint8_t>& counted = keep.empty() ? scans[s].valid : keep[s];
+    for (const std::uint8_t flag : counted) points += flag != 0 ? 1 : 0;
+  }
+  return points;
+}
+
+}  // namespace
+
+ExportResult export_project(const Project& project, const ExportSettings& settings) {
+  const std::vector<std::int64_t> ids = exported_ids(project, settings);
+  const std::vector<std::vector<std::uint8_t>> keep = keep_masks(project, settings, ids);
+  std::vector<acquisition::Scan> scans;
+  std::vector<std::optional<acquisition::ScanGeometry>> geometry;
+  for (const std::int64_t id : ids) {
+    scans.push_back(project.load_scan(id));
+    geometry.push_back(load_geometry(project, id));
+  }
+  std::vector<const acquisition::ScanGeometry*> geometry_of;
+  for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
+  std::vector<const std::vector<std::uint8_t>*> keep_of;
+  for (const auto& mask : keep) keep_of.push_back(&mask);
+  switch (settings.format) {
+    case ExportFormat::kPtx:
+      acquisition::write_ptx(settings.output, scans);
+      break;
+    case ExportFormat::kPly:
+      acquisition::write_ply(settings.output, scans, geometry_of, keep_of);
+      break;
+    case ExportFormat::kCsv:
+      acquisition::write_csv(settings.output, scans, geometry_of, keep_of);
+      break;
+    case ExportFormat::kTriplet:
+      write_triplet(project, scans, settings);
+      break;
+  }
+  return {scans.size(), count_points(scans, keep)};
+}
+
+}  // namespace scanbench::modeling

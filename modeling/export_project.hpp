@@ -1,0 +1,43 @@
+// Exporting a project's scans or its merged model to the interchange formats
+// (acquisition/ writes the files; this decides what goes into them).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "modeling/project.hpp"
+
+namespace scanbench::modeling {
+
+enum class ExportFormat {
+  kPtx,      // scan frame + pose, lossless
+  kPly,      // binary PLY, world coordinates, with normals and footprints after geometry
+  kCsv,      // text, world coordinates
+  kTriplet,  // range/colour/intensity images and a JSON sidecar; one spherical scan
+};
+
+struct ExportSettings {
+  ExportFormat format = ExportFormat::kPly;
+  std::optional<std::int64_t> scan_id;  // only this scan; all scans when empty
+  // Only the points of the merged model (`scanbench merge`); PLY and CSV only.
+  bool merged = false;
+  std::filesystem::path output;  // the file (triplet: the .json sidecar)
+};
+
+struct ExportResult {
+  std::size_t scans = 0;
+  std::size_t points = 0;  // valid points, or with `merged` the merged model's
+};
+
+// Writes the project's scans as the settings say. Where a scan has geometry,
+// the point formats leave its mixed pixels out and PLY carries its normals
+// and footprints. Throws core::InputError (naming the project and, where it
+// applies, the scan) for: no such scan, `merged` with a scan-grid format or
+// before a merge, a triplet of several scans or of a per-pixel scan. Output
+// is all-or-nothing (acquisition/output_file.hpp); write failures throw
+// std::runtime_error naming the file.
+ExportResult export_project(const Project& project, const ExportSettings& settings);
+
+}  // namespace scanbench::modeling

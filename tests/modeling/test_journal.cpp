@@ -1,0 +1,168 @@
+// The command journal: history, undo and redo across connections, the redo
+// branch, and stages as journaled commands (compute first, write after).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "modeling/geometry_stage.hpp"
+#include "modeling/import_scans.hpp"
+#include "modeling/project.hpp"
+#include "modeling/scan_layers.hpp"
+#include "project_test_support.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::fixture;
+using test::ScratchDir;
+using ::testing::HasSubstr;
+
+const std::vector<std::filesystem::path> kTwoScans{fixture("good/ptx/two_scans.ptx")};
+
+acquisition::GeometrySettings small_windows() {
+  acquisition::GeometrySettings settings;
+  settings.window_radius = 2;
+  settings.edge_window_radius = 1;
+  return settings;
+}
+
+std::vector<std::string> names_and_states(const Project& project) {
+  std::vector<std::string> out;
+  for (const CommandRecord& c : project.history()) {
+    out.push_back(c.name + (c.state == CommandState::kDone ? "" : " (undone)"));
+  }
+  return out;
+}
+
+TEST(Journal, EveryStageIsOneCommandWithItsSettingsAndResult) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  const ImportResult imported = import_scans(project, kTwoScans, {}, quiet);
+  const GeometryStageResult geometry = run_geometry_stage(project, small_windows(), quiet);
+  const std::vector<CommandRecord> history = project.history();
+  ASSERT_EQ(history.size(), 2u);
+  EXPECT_EQ(history[0].id, imported.command_id);
+  EXPECT_EQ(history[0].name, "import");
+  EXPECT_THAT(history[0].settings, HasSubstr("two_scans.ptx"));
+  EXPECT_EQ(history[1].id, geometry.command_id);
+  EXPECT_EQ(history[1].name, "geometry");
+  EXPECT_THAT(history[1].settings, HasSubstr("\"window_radius\":2"));
+  EXPECT_THAT(history[1].result, HasSubstr("\"mixed_pixels\""));
+  EXPECT_TRUE(history[1].undoable);
+  EXPECT_FALSE(history[1].created_at.empty());
+}
+
+TEST(Journal, UndoAndRedoWorkAcrossConnectionsAndRestoreTheStateExactly) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  core::Progress quiet;
+  {
+    Project project = Project::create(file);
+    import_scans(project, kTwoScans, {}, quiet);
+  }
+  const acquisition::Scan before = Project::open(file).load_scan(1);
+  {
+    Project project = Project::open(file);
+    run_geometry_stage(project, small_windows(), quiet);
+  }
+  {
+    Project other = Project::open(file);  // another session
+    ASSERT_TRUE(load_geometry(other, 1).has_value());
+    const std::optional<CommandRecord> undone = other.undo();
+    ASSERT_TRUE(undone.has_value());
+    EXPECT_EQ(undone->name, "geometry");
+  }
+  Project project = Project::open(file);
+  EXPECT_FALSE(load_geometry(project, 1).has_value());
+  EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "geometry (undone)"}));
+  ASSERT_TRUE(project.undo().has_value());  // the import
+  EXPECT_TRUE(project.scans().empty());
+  EXPECT_FALSE(project.undo().has_value());  // nothing left
+  ASSERT_TRUE(project.redo().has_value());
+  test::expect_identical(project.load_scan(1), before);
+  ASSERT_TRUE(project.redo().has_value());
+  EXPECT_TRUE(load_geometry(project, 1).has_value());
+  EXPECT_FALSE(project.redo().has_value());
+}
+
+TEST(Journal, ANewCommandEndsTheRedoBranch) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  run_geometry_stage(project, small_windows(), quiet);
+  project.undo();
+  acquisition::GeometrySettings wider = small_windows();
+  wider.window_radius = 3;
+  run_geometry_stage(project, wider, quiet);
+  EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "geometry"}));
+  EXPECT_THAT(project.history().back().settings, HasSubstr("\"window_radius\":3"));
+  EXPECT_FALSE(project.redo().has_value());
+  // Ids are never reused: the discarded command's id stays retired.
+  EXPECT_EQ(project.history().back().id, 3);
+}
+
+TEST(Journal, ARevisionThatMovedRefusesTheWriteAndChangesNothing) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  Project project = Project::create(file);
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  const std::int64_t revision = project.revision();
+  {
+    Project other = Project::open(file);
+    run_geometry_stage(other, small_windows(), quiet);  // meanwhile, another writer
+  }
+  EXPECT_NE(project.revision(), revision);
+  try {
+    project.begin_command("merge", "{}", revision);
+    FAIL() << "expected core::RuntimeFailure";
+  } catch (const core::RuntimeFailure& error) {
+    EXPECT_THAT(error.what(), HasSubstr("the project changed while merge was computing"));
+  }
+  EXPECT_EQ(project.history().size(), 2u);
+}
+
+// Cancels once `after` units were reported.
+class CancelAfter : public core::Progress {
+ public:
+  explicit CancelAfter(std::size_t after) : after_(after) {}
+  void update(const core::ProgressStep& step) override {
+    if (step.done >= after_) request_cancel();
+  }
+
+ private:
+  std::size_t after_;
+};
+
+TEST(Journal, ACancelledStageStoresNothing) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  CancelAfter cancel(1);
+  EXPECT_THROW(run_geometry_stage(project, small_windows(), cancel), core::Cancelled);
+  EXPECT_EQ(project.history().size(), 1u);
+  EXPECT_FALSE(load_geometry(project, 1).has_value());
+}
+
+TEST(Journal, TheMigrationOfAnOlderProjectCannotBeUndone) {
+  const ScratchDir dir;
+  const auto file = dir / "old.sbproj";
+  std::filesystem::copy_file(fixture("projects/version1.sbproj"), file);
+  Project project = Project::open(file);
+  const std::vector<CommandRecord> history = project.history();
+  ASSERT_EQ(history.size(), 1u);
+  EXPECT_EQ(history[0].name, "migrate");
+  EXPECT_FALSE(history[0].undoable);
+  EXPECT_FALSE(project.undo().has_value());
+  EXPECT_EQ(project.scans().size(), 5u);
+}
+
+}  // namespace
+}  // namespace scanbench::modeling

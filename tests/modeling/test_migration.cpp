@@ -1,0 +1,121 @@
+// Real project files written by earlier scanbench versions
+// (fixtures/projects/versionN.sbproj, made by the builds that introduced
+// each schema version) open, migrate in one step, and keep their data.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "modeling/project.hpp"
+#include "modeling/scan_layers.hpp"
+#include "project_test_support.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::ScratchDir;
+
+// A migrated copy of fixtures/projects/version<version>.sbproj.
+std::filesystem::path migrated_copy(const ScratchDir& dir, int version) {
+  const auto file = dir / ("version" + std::to_string(version) + ".sbproj");
+  std::filesystem::copy_file(
+      test::fixture("projects/version" + std::to_string(version) + ".sbproj"), file);
+  return file;
+}
+
+std::vector<std::string> names(const Project& project) {
+  std::vector<std::string> out;
+  for (const StoredScanSummary& s : project.scans()) out.push_back(s.summary.name);
+  return out;
+}
+
+std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
+  return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
+}
+
+class Migration : public ::testing::TestWithParam<int> {};
+
+TEST_P(Migration, OpensAtTheCurrentVersionWithEveryScanLoadable) {
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, GetParam());
+  {
+    const Project project = Project::open(file);
+    EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
+    for (const StoredScanSummary& stored : project.scans()) {
+      const acquisition::Scan scan = project.load_scan(stored.id);
+      EXPECT_EQ(acquisition::count_valid(scan), stored.summary.valid_points) << stored.id;
+    }
+  }
+  test::RawDatabase raw(file);
+  EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
+  EXPECT_EQ(raw.text("PRAGMA foreign_key_check"), "");
+  for (const char* gone :
+       {"scan_channels", "scan_geometry", "merge_masks", "registration_runs", "scans_v3"}) {
+    EXPECT_EQ(raw.text(std::string("SELECT name FROM sqlite_schema WHERE name = '") + gone + "'"),
+              "")
+        << gone;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3));
+
+TEST(Migration, VersionOneKeepsItsScans) {
+  const ScratchDir dir;
+  const Project project = Project::open(migrated_copy(dir, 1));
+  EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color",
+                                                      "lobby", "organized_ascii"}));
+  const acquisition::Scan color = project.load_scan(3);
+  EXPECT_TRUE(color.has_color());
+  EXPECT_FALSE(load_geometry(project, 1).has_value());
+  EXPECT_FALSE(project.load_scan(5).is_spherical());  // the PCD's per-pixel directions
+}
+
+TEST(Migration, VersionTwoKeepsItsGeometry) {
+  const ScratchDir dir;
+  const Project project = Project::open(migrated_copy(dir, 2));
+  ASSERT_EQ(project.scans().size(), 5u);
+  for (const StoredScanSummary& stored : project.scans()) {
+    const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
+    ASSERT_TRUE(geometry.has_value()) << stored.id;
+    EXPECT_EQ(geometry->normal.size(), project.load_scan(stored.id).pixel_count());
+  }
+  // two_scans had 2 normals (scanbench geometry --window 2 --edge-window 1 on v2).
+  const auto geometry = load_geometry(project, 1);
+  EXPECT_EQ(std::count_if(geometry->confidence.begin(), geometry->confidence.end(),
+                          [](float c) { return c > 0.0f; }),
+            2);
+}
+
+TEST(Migration, VersionThreeKeepsPosesKeepMasksAndTheRegistrationReport) {
+  const ScratchDir dir;
+  const Project project = Project::open(migrated_copy(dir, 3));
+  EXPECT_EQ(names(project), (std::vector<std::string>{"campus_scan_01", "campus_scan_02"}));
+  // As `scanbench merge` reported when the fixture was made.
+  EXPECT_EQ(count_ones(*load_keep_mask(project, 1)), 6803u);
+  EXPECT_EQ(count_ones(*load_keep_mask(project, 2)), 6415u);
+  const std::vector<CommandRecord> history = project.history();
+  ASSERT_EQ(history.size(), 2u);
+  EXPECT_EQ(history[0].name, "migrate");
+  EXPECT_THAT(history[0].settings, ::testing::HasSubstr("\"from_schema_version\":3"));
+  EXPECT_EQ(history[1].name, "register");
+  EXPECT_FALSE(history[1].undoable);
+  EXPECT_THAT(history[1].result, ::testing::HasSubstr("\"converged\":true"));
+  EXPECT_EQ(project.latest_result("register"), history[1].result);
+  // The registered pose of the second scan (as the report has it), not the
+  // perturbed one of its file.
+  const nlohmann::json report = nlohmann::json::parse(history[1].result);
+  const nlohmann::json& pose = report["poses"][1];
+  const Eigen::Isometry3d stored = project.scans()[1].summary.T_world_scan;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 4; ++col) {
+      EXPECT_EQ(stored(row, col), pose["T_world_scan"][row][col].get<double>());
+      EXPECT_NE(stored(row, col), pose["initial_T_world_scan"][row][col].get<double>());
+    }
+  }
+}
+
+}  // namespace
+}  // namespace scanbench::modeling
