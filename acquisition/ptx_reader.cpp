@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "acquisition/local_origin.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/text_lines.hpp"
 
@@ -104,30 +105,12 @@ void read_points(TextLineReader& reader, Scan& scan, std::vector<Eigen::Vector3d
     const std::size_t i =
         scan.index(static_cast<int>(k % scan.rows), static_cast<int>(k / scan.rows));
     points[i] = Eigen::Vector3d(v[0], v[1], v[2]);
-    const double range = points[i].norm();
-    scan.valid[i] = range > 0.0;
-    scan.range_m[i] = static_cast<float>(range);
+    scan.valid[i] = !points[i].isZero(0.0);
     scan.intensity[i] = static_cast<float>(v[3]);
     if (expected_fields == 7) {
       for (int c = 0; c < 3; ++c) scan.rgb[3 * i + c] = color_channel(reader, v[4 + c]);
     }
   }
-}
-
-void set_angle_model(Scan& scan, const std::vector<Eigen::Vector3d>& points,
-                     const PtxReadSettings& settings) {
-  const SphericalFitResult fit =
-      fit_spherical_angles(scan.rows, scan.columns, points, scan.valid, settings.angle_fit);
-  if (fit.regular) {
-    scan.angles = fit.angles;
-    return;
-  }
-  PerPixelDirections per_pixel;
-  per_pixel.directions.assign(points.size(), Eigen::Vector3f::Zero());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (scan.valid[i]) per_pixel.directions[i] = (points[i] / points[i].norm()).cast<float>();
-  }
-  scan.angles = std::move(per_pixel);
 }
 
 // Skips blank lines; returns false at the end of the file.
@@ -166,7 +149,10 @@ void read_ptx(const std::filesystem::path& path, const PtxReadSettings& settings
     read_pose(reader, scan);
     std::vector<Eigen::Vector3d> points(scan.pixel_count(), Eigen::Vector3d::Zero());
     read_points(reader, scan, points);
-    set_angle_model(scan, points, settings);
+    // The header's scanner position is the centre of projection of scans
+    // whose points are already in world coordinates.
+    const Eigen::Vector3d centre_file = scan.T_world_scan.inverse() * scan.scanner.position_world;
+    set_grid_from_points(scan, points, centre_file, settings.grid);
     on_scan(std::move(scan));
   }
   if (scan_index == 0) reader.fail("file holds no scan (only blank lines)");

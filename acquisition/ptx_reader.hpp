@@ -10,8 +10,11 @@
 //   columns · rows point lines   "x y z intensity" or "x y z intensity r g b",
 //                                scan frame [m], column after column
 // The pose stays a pose: points are kept in the scan frame, never baked into
-// world coordinates. Lines "0 0 0 ..." are missing returns; they stay in their
-// grid position as invalid pixels. Point k of a scan is grid pixel
+// world coordinates. Where a file gives points already in world coordinates
+// (an identity transform, points at 10^5–10^7 m), the scan frame moves to the
+// header's scanner position or near the points (local_origin.hpp), so every
+// coordinate keeps 0.1 mm. Lines "0 0 0 ..." are missing returns; they stay
+// in their grid position as invalid pixels. Point k of a scan is grid pixel
 // (row k % rows, col k / rows).
 #pragma once
 
@@ -19,15 +22,16 @@
 #include <functional>
 #include <vector>
 
+#include "acquisition/local_origin.hpp"
 #include "acquisition/scan.hpp"
-#include "acquisition/spherical_fit.hpp"
 
 namespace scanbench::acquisition {
 
 struct PtxReadSettings {
-  // When the grid is regular within this tolerance the scan gets the spherical
-  // angle model, otherwise per-pixel directions (see spherical_fit.hpp).
-  SphericalFitSettings angle_fit;
+  // The angle model and the local origin (local_origin.hpp): spherical when
+  // the grid is a regular panorama around the file frame's origin or the
+  // header's scanner position, otherwise per-pixel directions.
+  LocalOriginSettings grid;
 };
 
 // Streams the scans of a PTX file to `on_scan` one at a time, in file order,

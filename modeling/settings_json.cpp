@@ -20,7 +20,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GeometrySettings, window_radius,
                                                 min_neighbours, max_footprint_stretch,
                                                 flag_mixed_pixels, range_noise, mixed_pixel_sigmas)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SphericalFitSettings, max_deviation_m)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PtxReadSettings, angle_fit)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(LocalOriginSettings, angle_fit,
+                                                max_per_pixel_range_m, try_spherical)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PtxReadSettings, grid)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ScanFileSettings, ptx)
 }  // namespace scanbench::acquisition
 

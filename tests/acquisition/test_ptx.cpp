@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "acquisition/ptx_reader.hpp"
 #include "acquisition/ptx_writer.hpp"
@@ -138,6 +141,57 @@ TEST(PtxRoundTrip, GeoreferencedPanoramaKeepsMillimetresAndBits) {
   const Scan back = read_ptx(dir / "geo.ptx").at(0);
   expect_same_scan(scan, back);
   EXPECT_LT((point_in_world(scan, 5, 7) - point_in_world(back, 5, 7)).norm(), 1e-9);
+}
+
+// The x y z of every point line of a one-scan PTX file, in file order.
+std::vector<Eigen::Vector3d> file_points(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (int header = 0; header < 10; ++header) std::getline(in, line);
+  std::vector<Eigen::Vector3d> points;
+  double x = 0, y = 0, z = 0, intensity = 0;
+  while (in >> x >> y >> z >> intensity) points.emplace_back(x, y, z);
+  return points;
+}
+
+// World coordinates at 10^5–10^7 m (identity transform) keep 0.1 mm: the
+// scan frame sits at the header's scanner position, or near the points when
+// the grid has no recoverable centre.
+class PtxWorldCoordinates : public ::testing::TestWithParam<std::pair<const char*, bool>> {};
+
+TEST_P(PtxWorldCoordinates, EveryPointKeepsATenthOfAMillimetre) {
+  const auto [name, spherical] = GetParam();
+  const std::filesystem::path path = fixture(std::string("good/ptx/") + name + ".ptx");
+  const std::vector<Scan> scans = read_ptx(path);
+  ASSERT_EQ(scans.size(), 1u);
+  const Scan& scan = scans[0];
+  EXPECT_EQ(scan.is_spherical(), spherical);
+  const std::vector<Eigen::Vector3d> expected = file_points(path);
+  ASSERT_EQ(expected.size(), scan.pixel_count());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    const int row = static_cast<int>(k % static_cast<std::size_t>(scan.rows));
+    const int col = static_cast<int>(k / static_cast<std::size_t>(scan.rows));
+    worst = std::max(worst, (point_in_world(scan, row, col) - expected[k]).norm());
+  }
+  EXPECT_LT(worst, 1e-4);
+  // The scan frame is near the points, so its ranges are the scanner's.
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) EXPECT_LT(scan.range_m[i], 100.0f);
+}
+
+INSTANTIATE_TEST_SUITE_P(Magnitudes, PtxWorldCoordinates,
+                         ::testing::Values(std::pair{"georef_world_1e5", true},
+                                           std::pair{"georef_world_utm", true},
+                                           std::pair{"georef_world_1e7", true},
+                                           std::pair{"georef_world_unknown_centre", false}));
+
+TEST(PtxRoundTrip, WorldCoordinateScansExportAndReimportLosslessly) {
+  const ScratchDir dir;
+  for (const char* name : {"georef_world_utm", "georef_world_unknown_centre"}) {
+    const std::vector<Scan> first = read_ptx(fixture(std::string("good/ptx/") + name + ".ptx"));
+    write_ptx(dir / "again.ptx", first);
+    expect_same_scan(read_ptx(dir / "again.ptx").at(0), first.at(0));
+  }
 }
 
 TEST(PtxReader, PathsWithSpacesAndNonAsciiCharactersWork) {

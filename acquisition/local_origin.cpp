@@ -1,0 +1,108 @@
+#include "acquisition/local_origin.hpp"
+
+#include <cassert>
+#include <cmath>
+#include <vector>
+
+namespace scanbench::acquisition {
+namespace {
+
+// Points closer than this [m] to a per-pixel origin would have no direction.
+constexpr double kMinRangeM = 1e-3;
+
+std::vector<Eigen::Vector3d> relative_to(std::span<const Eigen::Vector3d> points,
+                                         const std::vector<std::uint8_t>& valid,
+                                         const Eigen::Vector3d& origin) {
+  std::vector<Eigen::Vector3d> out(points.size(), Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (valid[i]) out[i] = points[i] - origin;
+  }
+  return out;
+}
+
+// The largest distance [m] of a valid point from the origin.
+double farthest(std::span<const Eigen::Vector3d> points, const std::vector<std::uint8_t>& valid) {
+  double largest = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (valid[i]) largest = std::max(largest, points[i].squaredNorm());
+  }
+  return std::sqrt(largest);
+}
+
+// The valid points' centroid rounded to whole metres, moved by a metre in z
+// while a point sits on it.
+Eigen::Vector3d centroid_origin(std::span<const Eigen::Vector3d> points,
+                                const std::vector<std::uint8_t>& valid) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (valid[i]) {
+      sum += points[i];
+      ++count;
+    }
+  }
+  if (count == 0) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d origin = (sum / static_cast<double>(count)).array().round().matrix();
+  for (bool clear = false; !clear;) {
+    clear = true;
+    for (std::size_t i = 0; i < points.size() && clear; ++i) {
+      if (valid[i] && (points[i] - origin).norm() < kMinRangeM) clear = false;
+    }
+    if (!clear) origin.z() += 1.0;
+  }
+  return origin;
+}
+
+// Ranges (and, for per-pixel grids, directions) of the points measured from
+// `origin`, in one pass.
+void set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points, const Eigen::Vector3d& origin,
+                bool directions) {
+  scan.range_m.assign(points.size(), 0.0f);
+  std::vector<Eigen::Vector3f> unit;
+  if (directions) unit.assign(points.size(), Eigen::Vector3f::Zero());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!scan.valid[i]) continue;
+    const Eigen::Vector3d p = points[i] - origin;
+    const double range = p.norm();
+    scan.range_m[i] = static_cast<float>(range);
+    if (directions) unit[i] = (p / range).cast<float>();
+  }
+  if (directions) scan.angles = PerPixelDirections{std::move(unit)};
+}
+
+}  // namespace
+
+LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector3d> points_file,
+                                       const std::optional<Eigen::Vector3d>& centre_hint_file,
+                                       const LocalOriginSettings& settings) {
+  assert(points_file.size() == scan.pixel_count() && scan.valid.size() == scan.pixel_count() &&
+         "one point and one validity flag per pixel");
+  std::vector<Eigen::Vector3d> candidates{Eigen::Vector3d::Zero()};
+  if (centre_hint_file && centre_hint_file->allFinite() && !centre_hint_file->isZero(0.0)) {
+    candidates.push_back(*centre_hint_file);
+  }
+  if (!settings.try_spherical) candidates.clear();
+  LocalOriginResult result;
+  for (const Eigen::Vector3d& centre : candidates) {
+    const SphericalFitResult fit =
+        centre.isZero(0.0) ? fit_spherical_angles(scan.rows, scan.columns, points_file, scan.valid,
+                                                  settings.angle_fit)
+                           : fit_spherical_angles(scan.rows, scan.columns,
+                                                  relative_to(points_file, scan.valid, centre),
+                                                  scan.valid, settings.angle_fit);
+    if (fit.regular) {
+      scan.angles = fit.angles;
+      result = {centre, true};
+      break;
+    }
+  }
+  if (!result.spherical) {
+    const bool near = farthest(points_file, scan.valid) <= settings.max_per_pixel_range_m;
+    result.origin_file = near ? Eigen::Vector3d::Zero() : centroid_origin(points_file, scan.valid);
+  }
+  set_ranges(scan, points_file, result.origin_file, !result.spherical);
+  scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result.origin_file);
+  return result;
+}
+
+}  // namespace scanbench::acquisition
