@@ -1,6 +1,6 @@
 // Reading organized point clouds (structured-light and depth-camera captures)
-// from PCD files into a Scan with per-pixel directions. This is the adapter
-// behind which PCL stays: no other file includes PCL headers.
+// from PCD files into a Scan with per-pixel directions. Our own reader of
+// PCL's format (pcd_header.hpp); `scanbench bench io` compares it with PCL's.
 #pragma once
 
 #include <filesystem>
@@ -20,7 +20,10 @@ namespace scanbench::acquisition {
 // Per pixel: a point with a non-finite coordinate or exactly (0, 0, 0) is
 // invalid (range 0, direction the zero vector); otherwise range_m = |p| [m]
 // and direction = p / |p| in the sensor frame. T_world_scan is the VIEWPOINT
-// (translation [m], unit quaternion w x y z), identity when absent.
+// (translation [m], unit quaternion w x y z), identity when absent. Points
+// farther than 500 m from the sensor (a cloud stored in world coordinates)
+// are measured from their centroid instead, which goes into T_world_scan
+// (local_origin.hpp), so every point keeps 0.1 mm of the file's value.
 // name = file stem, scanner.name = "" (unknown), scanner.source_file = path
 // (UTF-8), scanner.position_world = the VIEWPOINT translation.
 //
@@ -30,9 +33,9 @@ namespace scanbench::acquisition {
 // dimensions (over 1,000,000 a side or 2^31 points), WIDTH × HEIGHT ≠ POINTS,
 // missing or non-float x/y/z, a badly sized rgb field, a body shorter than the
 // header promises (truncated), a non-numeric or missing ASCII value, extra
-// ASCII points, and a VIEWPOINT that is non-finite, not numeric or whose
-// quaternion is not unit (within kRigidTolerance). PCL's own failures and
-// exceptions become InputError too; PCL's console output is silenced.
+// ASCII points, a value that does not fit its field's type, a damaged
+// compressed body, and a VIEWPOINT that is non-finite, not numeric or whose
+// quaternion is not unit (within kRigidTolerance).
 Scan read_organized_pcd(const std::filesystem::path& path);
 
 }  // namespace scanbench::acquisition

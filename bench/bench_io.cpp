@@ -8,8 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <numbers>
+#include <vector>
 
+#include "acquisition/pcd_reader.hpp"
 #include "acquisition/ptx_reader.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "bench/pcl_io.hpp"
@@ -52,23 +55,60 @@ Scan synthetic_scan(int rows, int columns) {
   return scan;
 }
 
+double best_seconds(int repeats, const std::function<void()>& work) {
+  double best = 1e30;
+  for (int r = 0; r < repeats; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    best = std::min(
+        best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+// The scan's points as x y z intensity floats, row-major; NaN where invalid.
+std::vector<float> xyzi_of(const Scan& scan) {
+  std::vector<float> xyzi;
+  xyzi.reserve(4 * scan.pixel_count());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      const Eigen::Vector3f p = acquisition::point_in_scan(scan, row, col);
+      xyzi.insert(xyzi.end(), {scan.valid[i] ? p.x() : nan, scan.valid[i] ? p.y() : nan,
+                               scan.valid[i] ? p.z() : nan, scan.intensity[i]});
+    }
+  }
+  return xyzi;
+}
+
 // ASCII organized PCD with x y z intensity: the same points as the PTX.
-void write_ascii_pcd(const std::filesystem::path& path, const Scan& scan) {
+void write_ascii_pcd(const std::filesystem::path& path, const Scan& scan,
+                     const std::vector<float>& xyzi) {
   std::ofstream out(path);
   out << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\n"
       << "COUNT 1 1 1 1\nWIDTH " << scan.columns << "\nHEIGHT " << scan.rows
       << "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << scan.pixel_count() << "\nDATA ascii\n";
-  for (int row = 0; row < scan.rows; ++row) {
-    for (int col = 0; col < scan.columns; ++col) {
-      const std::size_t i = scan.index(row, col);
-      if (!scan.valid[i]) {
-        out << "nan nan nan 0\n";
-        continue;
-      }
-      const Eigen::Vector3f p = acquisition::point_in_scan(scan, row, col);
-      out << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << scan.intensity[i] << '\n';
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+    if (std::isnan(xyzi[4 * i])) {
+      out << "nan nan nan " << xyzi[4 * i + 3] << '\n';
+      continue;
     }
+    out << xyzi[4 * i] << ' ' << xyzi[4 * i + 1] << ' ' << xyzi[4 * i + 2] << ' ' << xyzi[4 * i + 3]
+        << '\n';
   }
+}
+
+// Our PCD reader against PCL's two on one file (single-threaded, all three):
+// points per second, best of `repeats`.
+nlohmann::json compare_pcd_readers(const std::filesystem::path& pcd, double points, int repeats) {
+  const double ours = best_seconds(repeats, [&] { acquisition::read_organized_pcd(pcd); });
+  const double pcl_xyzi = best_seconds(repeats, [&] { read_pcd_xyzi_with_pcl(pcd); });
+  const double pcl_blob = best_seconds(repeats, [&] { read_pcd_blob_with_pcl(pcd); });
+  return {
+      {"bytes", std::filesystem::file_size(pcd)},   {"ours_points_per_s", points / ours},
+      {"pcl_xyzi_points_per_s", points / pcl_xyzi}, {"pcl_blob_points_per_s", points / pcl_blob},
+      {"speedup_vs_pcl_xyzi", pcl_xyzi / ours},     {"speedup_vs_pcl_blob", pcl_blob / ours}};
 }
 
 // A scratch folder removed with everything in it, also when the bench throws.
@@ -91,17 +131,6 @@ class ScratchFolder {
   std::filesystem::path path_;
 };
 
-double best_seconds(int repeats, const std::function<void()>& work) {
-  double best = 1e30;
-  for (int r = 0; r < repeats; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    work();
-    best = std::min(
-        best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
-
 }  // namespace
 
 nlohmann::json run_io_bench(const BenchOptions& options) {
@@ -111,13 +140,17 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   const Scan scan = synthetic_scan(rows, columns);
   const int repeats = options.smoke ? 1 : 3;
 
-  const std::filesystem::path ptx = dir / "room.ptx", pcd = dir / "room.pcd";
+  const std::filesystem::path ptx = dir / "room.ptx", ascii_pcd = dir / "room_ascii.pcd",
+                              binary_pcd = dir / "room_binary.pcd";
   const double write_s = best_seconds(repeats, [&] { acquisition::write_ptx(ptx, {&scan, 1}); });
-  write_ascii_pcd(pcd, scan);
+  const std::vector<float> xyzi = xyzi_of(scan);
+  write_ascii_pcd(ascii_pcd, scan, xyzi);
+  write_binary_pcd_with_pcl(binary_pcd, xyzi, scan.columns, scan.rows);
   const double ptx_bytes = static_cast<double>(std::filesystem::file_size(ptx));
-  const double pcd_bytes = static_cast<double>(std::filesystem::file_size(pcd));
   const double read_s = best_seconds(repeats, [&] { acquisition::read_ptx(ptx); });
-  const double pcl_s = best_seconds(repeats, [&] { read_pcd_with_pcl(pcd); });
+  const double points = static_cast<double>(scan.pixel_count());
+  const nlohmann::json pcd_ascii = compare_pcd_readers(ascii_pcd, points, repeats);
+  const nlohmann::json pcd_binary = compare_pcd_readers(binary_pcd, points, repeats);
 
   const std::filesystem::path project_path = dir / "bench.sbproj";
   double store_s = 0.0;
@@ -134,7 +167,6 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
       best_seconds(repeats, [&] { modeling::Project::open(project_path).load_scan(id); });
   const double project_bytes = static_cast<double>(std::filesystem::file_size(project_path));
 
-  const double points = static_cast<double>(scan.pixel_count());
   return {{"suite", "io"},
           {"rows", rows},
           {"columns", columns},
@@ -143,8 +175,8 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
           {"ptx_read_mb_per_s", ptx_bytes / 1e6 / read_s},
           {"ptx_read_points_per_s", points / read_s},
           {"ptx_write_mb_per_s", ptx_bytes / 1e6 / write_s},
-          {"pcl_pcd_ascii_read_mb_per_s", pcd_bytes / 1e6 / pcl_s},
-          {"ptx_read_speedup_vs_pcl", pcl_s / read_s},
+          {"pcd_ascii", pcd_ascii},
+          {"pcd_binary", pcd_binary},
           {"project_store_seconds", store_s},
           {"project_load_seconds", load_s},
           {"project_bytes_per_point", project_bytes / points}};

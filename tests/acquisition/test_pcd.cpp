@@ -140,6 +140,28 @@ TEST(PcdReader, RefusesCompressedBodyWhoseSizeWordLies) {
   }
 }
 
+// Coordinates at 10^6–10^7 m stored as doubles keep 0.1 mm: the scan frame
+// moves near the points.
+TEST(PcdReader, WorldCoordinatesKeepATenthOfAMillimetre) {
+  const std::filesystem::path path = fixture("good/pcd/world_utm_double.pcd");
+  const Scan scan = read_organized_pcd(path);
+  std::ifstream in(path);
+  std::string line;
+  for (int k = 0; k < 11; ++k) std::getline(in, line);
+  double worst = 0.0;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      Eigen::Vector3d expected;
+      int intensity = 0;
+      in >> expected.x() >> expected.y() >> expected.z() >> intensity;
+      worst = std::max(worst, (point_in_world(scan, row, col) - expected).norm());
+      EXPECT_EQ(scan.intensity[scan.index(row, col)], static_cast<float>(intensity));
+    }
+  }
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_GT(scan.T_world_scan.translation().norm(), 8e6);  // the offset is in the pose
+}
+
 struct BadPcd {
   const char* fixture;  // fixtures/bad/<fixture>.pcd
   const char* problem;  // word(s) describing the problem
@@ -169,6 +191,7 @@ INSTANTIATE_TEST_SUITE_P(
                     BadPcd{"pcd_truncated_binary", "truncated binary body"},
                     BadPcd{"pcd_truncated_compressed", "truncated compressed body"},
                     BadPcd{"pcd_non_numeric", "'abc' is not a number"},
+                    BadPcd{"pcd_value_out_of_type", "'70000' is not a number of the field's type"},
                     BadPcd{"pcd_wrong_value_count", "4 values, the header says 5"},
                     BadPcd{"pcd_extra_points", "more points"},
                     BadPcd{"pcd_points_mismatch", "disagrees with POINTS"},

@@ -75,9 +75,16 @@ TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
   const test::CliResult result = test::run_cli(dir, {"bench", "io", "--json", "--smoke"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
-  for (const char* field : {"ptx_read_mb_per_s", "ptx_write_mb_per_s",
-                            "pcl_pcd_ascii_read_mb_per_s", "ptx_read_speedup_vs_pcl", "points"}) {
+  for (const char* field : {"ptx_read_mb_per_s", "ptx_write_mb_per_s", "points", "pcd_ascii",
+                            "pcd_binary", "project_store_seconds", "project_load_seconds"}) {
     EXPECT_TRUE(bench.contains(field)) << field;
+  }
+  for (const char* format : {"pcd_ascii", "pcd_binary"}) {
+    for (const char* field :
+         {"bytes", "ours_points_per_s", "pcl_xyzi_points_per_s", "pcl_blob_points_per_s",
+          "speedup_vs_pcl_xyzi", "speedup_vs_pcl_blob"}) {
+      EXPECT_GT(bench[format][field].get<double>(), 0.0) << format << " " << field;
+    }
   }
 }
 
