@@ -34,10 +34,11 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SampleSettings, voxel_m, max_poi
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(HypothesisSettings, draws, inlier_distance_m,
                                                 max_vertical_normal, scoring_matches, keep,
                                                 distinct_rotation_rad, distinct_translation_m, seed)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
-    FeatureSettings, sample, feature_radius_m, neighbours, levelled, max_normal_z_difference,
-    hypotheses, max_iterations, correspondence_randomness, similarity, ransac_source_points,
-    min_inliers, verify_by_inliers, verify_by_overlap, screening_samples)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureSettings, sample, feature_radius_m,
+                                                neighbours, levelled, max_normal_z_difference,
+                                                hypotheses, max_iterations, similarity, min_inliers,
+                                                verify_by_inliers, verify_by_overlap,
+                                                screening_samples)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(IcpSettings, initial_gate_m, min_gate_m,
                                                 projective_gate_m, closest_point_samples,
                                                 distance_sigmas, min_gate_ratio,

@@ -25,6 +25,45 @@ bool more_inliers(const PoseHypothesis& a, const PoseHypothesis& b) {
   return a.inliers > b.inliers;
 }
 
+// Every k-th match, at most settings.scoring_matches: what draws are scored on.
+std::vector<FeatureMatch> scoring_subset(std::span<const FeatureMatch> matches,
+                                         const HypothesisSettings& settings) {
+  const std::size_t stride =
+      std::max<std::size_t>(1, (matches.size() + settings.scoring_matches - 1) /
+                                   std::max<std::size_t>(1, settings.scoring_matches));
+  std::vector<FeatureMatch> scoring;
+  for (std::size_t i = 0; i < matches.size(); i += stride) scoring.push_back(matches[i]);
+  return scoring;
+}
+
+// The best distinct drawn hypotheses, each refined on all matches.
+std::vector<PoseHypothesis> keep_and_refine(std::vector<PoseHypothesis> drawn,
+                                            std::span<const FeatureMatch> matches,
+                                            const HypothesisSettings& settings) {
+  std::stable_sort(drawn.begin(), drawn.end(), more_inliers);
+  std::vector<PoseHypothesis> kept = distinct_hypotheses(std::move(drawn), settings);
+  for (PoseHypothesis& hypothesis : kept) {
+    hypothesis = refine_hypothesis(matches, hypothesis.T_target_source, settings.inlier_distance_m);
+  }
+  // Refinement can bring two hypotheses to the same pose.
+  std::stable_sort(kept.begin(), kept.end(), more_inliers);
+  return distinct_hypotheses(std::move(kept), settings);
+}
+
+// True when the triangles of the three matches' source and target points
+// have edges of alike lengths (within 1 − similarity of the longer): a
+// rigid motion keeps lengths, so other triples cannot be all right.
+bool alike_triangles(const FeatureMatch* m[3], double similarity) {
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3;
+    const float source = (m[a]->source_point - m[b]->source_point).norm();
+    const float target = (m[a]->target_point - m[b]->target_point).norm();
+    const float longer = std::max(source, target);
+    if (longer <= 0.0f || std::abs(source - target) > (1.0 - similarity) * longer) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::size_t count_inliers(std::span<const FeatureMatch> matches, const Eigen::Isometry3f& T,
@@ -86,13 +125,7 @@ std::vector<PoseHypothesis> levelled_hypotheses(std::span<const FeatureMatch> ma
   }
   if (drawable.empty() || settings.draws <= 0) return {};
 
-  // Score every draw on an even subset of the matches.
-  const std::size_t stride =
-      std::max<std::size_t>(1, (matches.size() + settings.scoring_matches - 1) /
-                                   std::max<std::size_t>(1, settings.scoring_matches));
-  std::vector<FeatureMatch> scoring;
-  for (std::size_t i = 0; i < matches.size(); i += stride) scoring.push_back(matches[i]);
-
+  const std::vector<FeatureMatch> scoring = scoring_subset(matches, settings);
   std::mt19937_64 random(settings.seed);
   std::vector<PoseHypothesis> drawn;
   drawn.reserve(static_cast<std::size_t>(settings.draws));
@@ -101,15 +134,31 @@ std::vector<PoseHypothesis> levelled_hypotheses(std::span<const FeatureMatch> ma
     const Eigen::Isometry3f T = pose_from_match(sample);
     drawn.push_back({T.cast<double>(), count_inliers(scoring, T, settings.inlier_distance_m)});
   }
-  std::stable_sort(drawn.begin(), drawn.end(), more_inliers);
-  std::vector<PoseHypothesis> kept = distinct_hypotheses(std::move(drawn), settings);
+  return keep_and_refine(std::move(drawn), matches, settings);
+}
 
-  for (PoseHypothesis& hypothesis : kept) {
-    hypothesis = refine_hypothesis(matches, hypothesis.T_target_source, settings.inlier_distance_m);
+std::vector<PoseHypothesis> unlevelled_hypotheses(std::span<const FeatureMatch> matches, int draws,
+                                                  double similarity,
+                                                  const HypothesisSettings& settings) {
+  if (matches.size() < 3 || draws <= 0) return {};
+  const std::vector<FeatureMatch> scoring = scoring_subset(matches, settings);
+  std::mt19937_64 random(settings.seed);
+  std::vector<PoseHypothesis> drawn;
+  for (int draw = 0; draw < draws; ++draw) {
+    const FeatureMatch* sample[3];
+    for (const FeatureMatch*& m : sample) m = &matches[random() % matches.size()];
+    if (sample[0] == sample[1] || sample[1] == sample[2] || sample[0] == sample[2]) continue;
+    if (!alike_triangles(sample, similarity)) continue;
+    std::vector<PointPair> pairs;
+    for (const FeatureMatch* m : sample) {
+      pairs.push_back({m->source_point.cast<double>(), m->target_point.cast<double>()});
+    }
+    const RigidFitResult fit = fit_rigid(pairs);
+    if (!fit.valid) continue;
+    const Eigen::Isometry3f T = fit.T_target_source.cast<float>();
+    drawn.push_back({fit.T_target_source, count_inliers(scoring, T, settings.inlier_distance_m)});
   }
-  // Refinement can bring two hypotheses to the same pose.
-  std::stable_sort(kept.begin(), kept.end(), more_inliers);
-  return distinct_hypotheses(std::move(kept), settings);
+  return keep_and_refine(std::move(drawn), matches, settings);
 }
 
 }  // namespace scanbench::registration

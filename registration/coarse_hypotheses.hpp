@@ -70,6 +70,16 @@ PoseHypothesis refine_hypothesis(std::span<const FeatureMatch> matches, const Ei
 std::vector<PoseHypothesis> levelled_hypotheses(std::span<const FeatureMatch> matches,
                                                 const HypothesisSettings& settings);
 
+// RANSAC over three-match samples, for scans of a scanner that was not
+// levelled: `draws` random triples of matches; a triple whose source and
+// target triangles are not alike (edge lengths within 1 − similarity of the
+// longer; the pre-rejection of Buch et al. 2013) is dropped unfitted, the
+// others are fitted (fit_rigid) and scored. Kept and refined as
+// levelled_hypotheses does. Same seed, same hypotheses.
+std::vector<PoseHypothesis> unlevelled_hypotheses(std::span<const FeatureMatch> matches, int draws,
+                                                  double similarity,
+                                                  const HypothesisSettings& settings);
+
 // Keeps the first of every group of hypotheses closer than the settings'
 // distinct thresholds, in order.
 std::vector<PoseHypothesis> distinct_hypotheses(std::vector<PoseHypothesis> hypotheses,

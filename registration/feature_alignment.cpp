@@ -1,18 +1,16 @@
-// PCL adapter: FPFH features, their matching, and SampleConsensusPrerejective.
-// PCL headers stay in this file.
+// PCL adapter: FPFH features and their matching. PCL headers stay in this
+// file; the hypotheses are ours (coarse_hypotheses.hpp).
 #include "registration/feature_alignment.hpp"
 
 #include <pcl/features/fpfh_omp.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <pcl/registration/sample_consensus_prerejective.h>
 #include <pcl/search/kdtree.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <iterator>
 #include <optional>
 
@@ -105,51 +103,11 @@ std::vector<FeatureMatch> match_features(Described source, Described target,
   return matches;
 }
 
-// PCL's prerejective RANSAC: one hypothesis, three matches per draw.
-// Every k-th source sample with its feature, at most `count`.
-std::pair<Cloud::Ptr, Features::Ptr> thinned(Described source, std::size_t count) {
-  const std::size_t stride = std::max<std::size_t>(1, (source.points->size() + count - 1) / count);
-  auto points = std::make_shared<Cloud>();
-  auto features = std::make_shared<Features>();
-  for (std::size_t i = 0; i < source.points->size(); i += stride) {
-    points->push_back((*source.points)[i]);
-    features->push_back((*source.features)[i]);
-  }
-  return {points, features};
-}
-
-std::optional<Eigen::Isometry3d> prerejective_pose(Described source, Described target,
-                                                   const FeatureSettings& settings) {
-  const auto [points, features] = thinned(source, settings.ransac_source_points);
-  pcl::SampleConsensusPrerejective<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> ransac;
-  ransac.setInputSource(points);
-  ransac.setSourceFeatures(features);
-  ransac.setInputTarget(target.points);
-  ransac.setTargetFeatures(target.features);
-  ransac.setMaximumIterations(settings.max_iterations);
-  ransac.setNumberOfSamples(3);
-  ransac.setCorrespondenceRandomness(settings.correspondence_randomness);
-  ransac.setSimilarityThreshold(static_cast<float>(settings.similarity));
-  ransac.setMaxCorrespondenceDistance(settings.hypotheses.inlier_distance_m);
-  ransac.setInlierFraction(static_cast<float>(settings.min_inliers) /
-                           static_cast<float>(points->size()));
-  // PCL draws its samples with std::rand; seeding it makes runs repeatable.
-  std::srand(static_cast<unsigned>(settings.hypotheses.seed));
-  Cloud aligned;
-  ransac.align(aligned);
-  if (!ransac.hasConverged()) return std::nullopt;
-  Eigen::Isometry3d T;
-  T.matrix() = ransac.getFinalTransformation().cast<double>();
-  return T;
-}
-
-std::vector<PoseHypothesis> hypotheses_from(Described source, Described target,
-                                            std::span<const FeatureMatch> matches,
+std::vector<PoseHypothesis> hypotheses_from(std::span<const FeatureMatch> matches,
                                             const FeatureSettings& settings) {
   if (settings.levelled) return levelled_hypotheses(matches, settings.hypotheses);
-  const std::optional<Eigen::Isometry3d> pose = prerejective_pose(source, target, settings);
-  if (!pose) return {};
-  return {refine_hypothesis(matches, *pose, settings.hypotheses.inlier_distance_m)};
+  return unlevelled_hypotheses(matches, settings.max_iterations, settings.similarity,
+                               settings.hypotheses);
 }
 
 }  // namespace
@@ -165,7 +123,7 @@ FeatureAlignmentResult align_features(const FeatureCloud& source, const FeatureC
   } else {
     const std::vector<FeatureMatch> matches = match_features(from, to, settings);
     result.matches = matches.size();
-    for (PoseHypothesis& hypothesis : hypotheses_from(from, to, matches, settings)) {
+    for (PoseHypothesis& hypothesis : hypotheses_from(matches, settings)) {
       if (hypothesis.inliers >= settings.min_inliers) {
         result.hypotheses.push_back(std::move(hypothesis));
       }

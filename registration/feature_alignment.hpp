@@ -24,20 +24,16 @@ struct FeatureSettings {
   // hypotheses from one match each (coarse_hypotheses.hpp), and matches
   // whose normals differ by more than max_normal_z_difference in their
   // vertical component are dropped (a heading turn leaves it unchanged).
-  // Otherwise PCL's prerejective RANSAC (Buch et al. 2013) draws three
-  // matches per hypothesis and returns its best one.
+  // Otherwise each hypothesis comes from three matches
+  // (unlevelled_hypotheses).
   bool levelled = true;
   double max_normal_z_difference = 0.15;
-  HypothesisSettings hypotheses;  // levelled; inlier_distance_m and seed serve both
-  // Not levelled: every hypothesis of PCL's RANSAC is pre-rejected when the
-  // edge lengths of its two triangles differ by more than 1 − similarity;
-  // each draws among the `correspondence_randomness` nearest features.
-  // It works on every k-th source sample, at most ransac_source_points: each
-  // draw that passes pre-rejection is scored on all of them.
+  HypothesisSettings hypotheses;  // both kinds; max_vertical_normal: levelled only
+  // Not levelled: max_iterations draws of three matches; a draw is
+  // pre-rejected when the edge lengths of its two triangles differ by more
+  // than 1 − similarity.
   int max_iterations = 20000;
-  int correspondence_randomness = 3;
   double similarity = 0.9;
-  std::size_t ransac_source_points = 6000;
   // A hypothesis needs at least this many matches within the inlier distance.
   std::size_t min_inliers = 10;
   // Verification (register_scans.cpp): ICP runs from the hypotheses with
