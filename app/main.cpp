@@ -34,6 +34,13 @@ int main(int argc, char** argv) {
   sb::add_simulate_command(app);
 #ifdef SCANBENCH_WITH_BENCH
   sb::add_bench_command(app);
+#else
+  app.add_subcommand("bench", "Not in this build (configured with -DSCANBENCH_BENCH=OFF)")
+      ->allow_extras()
+      ->callback([] {
+        throw CLI::ValidationError("bench", "this scanbench was built without the benchmark "
+                                            "suites (-DSCANBENCH_BENCH=OFF)");
+      });
 #endif
   try {
     app.parse(argc, argv);

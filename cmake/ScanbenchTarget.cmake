@@ -28,9 +28,18 @@ endfunction()
 
 # A module library: sources beside headers, includes rooted at the repository
 # so that every include names its module ("acquisition/scan.hpp").
+# PRECOMPILE: headers most of its sources include (Eigen, JSON), parsed once
+# per library instead of once per source file.
 function(scanbench_library name)
-  cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;PRECOMPILE" ${ARGN})
   add_library(${name} STATIC ${ARG_SOURCES})
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   scanbench_target_settings(${name})
+  if(ARG_PRECOMPILE)
+    target_precompile_headers(${name} PRIVATE ${ARG_PRECOMPILE})
+  endif()
 endfunction()
+
+# The standard and Eigen headers nearly every source of our libraries includes.
+set(SCANBENCH_COMMON_HEADERS <algorithm> <cmath> <cstdint> <filesystem> <optional> <span>
+    <string> <vector> <Eigen/Core> <Eigen/Geometry>)
