@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "app/cli_runner.hpp"
 #include "support/test_support.hpp"
@@ -20,24 +22,44 @@ TEST(BenchGeometry, SmokeRunReportsEveryMethodAndField) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "geometry");
+  EXPECT_EQ(bench["site"], "campus");
   EXPECT_EQ(bench["columns"], 360);
   EXPECT_EQ(bench["rows"], 90);
+  EXPECT_EQ(bench["scans"], 1);
   EXPECT_GT(bench["points"].get<double>(), 0.0);
-  for (const char* ratio :
-       {"speedup_vs_pcl_integral_covariance", "speedup_vs_pcl_integral_average_3d_gradient"})
-    EXPECT_TRUE(bench.contains(ratio)) << ratio;
-  for (const char* method :
-       {"ours", "pcl_integral_covariance", "pcl_integral_average_3d_gradient", "pcl_knn_omp"}) {
+  const char* const peers[] = {"pcl_integral_covariance", "pcl_integral_average_3d_gradient",
+                               "pcl_knn_omp", "pcl_integral_covariance_smoothing_33",
+                               "pcl_integral_average_3d_gradient_smoothing_33"};
+  for (const std::string peer : peers) {
+    EXPECT_TRUE(bench["speedup_vs_" + peer].is_number()) << peer;
+    // The integral images run on one thread, and get a thread-for-thread ratio.
+    EXPECT_EQ(bench.contains("speedup_vs_" + peer + "_1_thread"), peer != "pcl_knn_omp") << peer;
+  }
+  EXPECT_TRUE(bench["speedup_goal_1_thread"].is_number());
+  for (const char* goal :
+       {"median_below_every_pcl", "speedup_1_thread_at_least_5x_vs_average_3d_gradient",
+        "mixed_recall_at_least_0_9_false_rate_at_most_0_01"})
+    EXPECT_TRUE(bench["goals"][goal].is_boolean()) << goal;
+  std::vector<std::string> methods = {"ours", "ours_1_thread"};
+  methods.insert(methods.end(), std::begin(peers), std::end(peers));
+  for (const std::string& method : methods) {
     ASSERT_TRUE(bench.contains(method)) << method;
     for (const char* field : {"median_error_deg", "p95_error_deg", "planar_median_error_deg",
-                              "coverage", "points_per_second"})
+                              "coverage", "points_per_second", "seconds", "threads"})
       EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+    EXPECT_TRUE(bench[method]["settings"].is_object()) << method;
     const double coverage = bench[method]["coverage"].get<double>();
     EXPECT_GT(coverage, 0.0) << method;
     EXPECT_LE(coverage, 1.0) << method;
   }
-  for (const char* field : {"mixed_pixel_recall", "mixed_pixel_false_rate"})
-    EXPECT_TRUE(bench["ours"][field].is_number()) << field;
+  EXPECT_EQ(bench["ours_1_thread"]["threads"], 1);
+  EXPECT_EQ(bench["pcl_integral_average_3d_gradient"]["threads"], 1);
+  for (const char* method : {"ours", "ours_1_thread"}) {
+    for (const char* field : {"mixed_pixel_recall", "mixed_pixel_false_rate", "truth_mixed_pixels"})
+      EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+    // Same estimator, same settings but threads: the same normals.
+    EXPECT_EQ(bench[method]["median_error_deg"], bench["ours"]["median_error_deg"]) << method;
+  }
 }
 
 TEST(BenchRegistration, SmokeRunReportsBothMethodsAndEveryField) {
