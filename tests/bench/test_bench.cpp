@@ -62,20 +62,46 @@ TEST(BenchGeometry, SmokeRunReportsEveryMethodAndField) {
   }
 }
 
-TEST(BenchRegistration, SmokeRunReportsBothMethodsAndEveryField) {
+TEST(BenchRegistration, SmokeRunReportsEveryMethodAndField) {
   test::ScratchDir dir;
   const test::CliResult result = test::run_cli(dir, {"bench", "registration", "--json", "--smoke"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "registration");
-  for (const char* method : {"ours", "pcl_icp_point_to_plane"}) {
+  EXPECT_EQ(bench["sites"], nlohmann::json::array({"campus"}));
+  EXPECT_EQ(bench["scans_per_site"], 2);
+  for (const char* field : {"columns", "rows", "threads", "speedup_goal"})
+    EXPECT_TRUE(bench[field].is_number()) << field;
+  for (const char* field : {"rotation_deg", "translation_m"})
+    EXPECT_TRUE(bench["max_initial_error"][field].is_number()) << field;
+  for (const char* method : {"ours", "ours_one_thread", "ours_pairwise", "ours_pairwise_one_thread",
+                             "pcl_icp_point_to_plane"}) {
     ASSERT_TRUE(bench.contains(method)) << method;
-    for (const char* field : {"max_rotation_error_deg", "max_translation_error_m",
-                              "median_rotation_error_deg", "median_translation_error_m", "seconds"})
+    for (const char* field :
+         {"max_rotation_error_deg", "max_translation_error_m", "median_rotation_error_deg",
+          "median_translation_error_m", "seconds", "converged_pair_share"})
       EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+    if (std::string(method) != "pcl_icp_point_to_plane") {
+      EXPECT_TRUE(bench[method]["icp_seconds"].is_number()) << method;
+    }
   }
-  EXPECT_TRUE(bench["ours"]["coarse_success_rate"].is_number());
+  for (const char* field : {"coarse_success_rate", "coarse_accepted_but_wrong", "coarse_seconds"})
+    EXPECT_TRUE(bench["ours"][field].is_number()) << field;
   EXPECT_EQ(bench["ours"]["trials"], 1);
+  EXPECT_TRUE(bench["pcl_icp_point_to_plane"]["settings"].is_object());
+  for (const char* ratio :
+       {"fine_speedup_vs_pcl", "fine_speedup_vs_pcl_one_thread", "pairwise_speedup_vs_pcl",
+        "pairwise_speedup_vs_pcl_one_thread", "pairwise_icp_speedup_vs_pcl",
+        "pairwise_icp_speedup_vs_pcl_one_thread"})
+    EXPECT_TRUE(bench[ratio].is_number()) << ratio;
+  for (const char* goal :
+       {"accuracy_within_0_02_deg_and_3_mm", "pairwise_speedup_one_thread_at_least_5x"})
+    EXPECT_TRUE(bench["goals"][goal].is_boolean()) << goal;
+  // Results do not depend on the thread count.
+  for (const char* field : {"max_rotation_error_deg", "max_translation_error_m"}) {
+    EXPECT_EQ(bench["ours_one_thread"][field], bench["ours"][field]) << field;
+    EXPECT_EQ(bench["ours_pairwise_one_thread"][field], bench["ours_pairwise"][field]) << field;
+  }
 }
 
 TEST(BenchMerge, SmokeRunReportsEveryField) {
