@@ -110,12 +110,37 @@ TEST(BenchMerge, SmokeRunReportsEveryField) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "merge");
-  for (const char* field :
-       {"redundant_removed_share", "coverage_before", "coverage_after", "points_per_second"}) {
-    ASSERT_TRUE(bench["ours"][field].is_number()) << field;
-    EXPECT_GE(bench["ours"][field].get<double>(), 0.0) << field;
+  EXPECT_EQ(bench["site"], "campus");
+  EXPECT_EQ(bench["scans"], 2);
+  for (const char* field : {"columns", "rows", "threads"})
+    EXPECT_TRUE(bench[field].is_number()) << field;
+  for (const char* merge : {"ours", "ours_registered"}) {
+    ASSERT_TRUE(bench.contains(merge)) << merge;
+    for (const char* share : {"redundant_removed_share", "redundant_removed_share_by_spacing",
+                              "unique_removed_share", "coverage_before", "coverage_after"}) {
+      ASSERT_TRUE(bench[merge][share].is_number()) << merge << "." << share;
+      EXPECT_GE(bench[merge][share].get<double>(), 0.0) << merge << "." << share;
+      EXPECT_LE(bench[merge][share].get<double>(), 1.0) << merge << "." << share;
+    }
+    for (const char* field :
+         {"coverage_drop", "coverage_samples", "points_per_second", "points", "kept_points",
+          "truth_redundant_points", "truth_redundant_points_by_spacing", "truth_unique_points",
+          "seconds", "prepare_seconds"})
+      EXPECT_TRUE(bench[merge][field].is_number()) << merge << "." << field;
+    EXPECT_GT(bench[merge]["coverage_samples"].get<double>(), 0.0) << merge;
+    EXPECT_LE(bench[merge]["kept_points"].get<double>(), bench[merge]["points"].get<double>());
   }
-  EXPECT_LE(bench["ours"]["coverage_after"].get<double>(), 1.0);
+  // Both merges are judged against the same truth and the same unmerged model.
+  EXPECT_EQ(bench["ours"]["coverage_before"], bench["ours_registered"]["coverage_before"]);
+  for (const char* field : {"max_rotation_error_deg", "max_translation_error_m", "seconds"})
+    EXPECT_TRUE(bench["ours_registered"]["registration"][field].is_number()) << field;
+  EXPECT_TRUE(bench["ours_registered"]["registration"]["converged"].is_boolean());
+  for (const char* goals : {"goals", "goals_registered"}) {
+    for (const char* goal :
+         {"redundant_removed_share_at_least_0_9", "redundant_removed_share_by_spacing_at_least_0_9",
+          "coverage_drop_at_most_0_005", "points_per_second_at_least_20m"})
+      EXPECT_TRUE(bench[goals][goal].is_boolean()) << goals << "." << goal;
+  }
 }
 
 TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
