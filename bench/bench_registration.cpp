@@ -14,8 +14,8 @@
 // coarse pose when the run from it won, else the perturbed pose against
 // where PCL put the target), on the same samples, with our gate schedule
 // (stages of decreasing maximum correspondence distance, pcl_icp.hpp), our
-// stop thresholds and the best of PCL's options we measured
-// (pcl_icp_settings). PCL's ICP runs on one thread.
+// stop thresholds, and PCL's options chosen by the sweep recorded at
+// pcl_icp_settings. PCL's ICP runs on one thread.
 //
 // Times per campaign: "seconds" is the fine stage (ours: every ICP run of
 // every pair — from the initial pose and, when the features found one, from
