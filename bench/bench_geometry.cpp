@@ -6,6 +6,19 @@
 // are left out of the error statistics: their range is a blend of two
 // surfaces, so no estimator can be right there — they are scored as
 // detections instead (recall and false rate of kFlagMixedPixel).
+//
+// Threads: ours runs twice, on every core ("ours") and on one
+// ("ours_1_thread"); PCL's integral-image estimator has no threading, so the
+// speed goal is judged thread for thread: ours_1_thread against PCL's
+// AVERAGE_3D_GRADIENT (its faster variant). The ratios against "ours" are
+// all cores against one and are labelled as such.
+//
+// Support: our fit takes the widest clean window of radius 16, 8, 4 or 2
+// (33 × 33, 17 × 17, 9 × 9 or 5 × 5 pixels; GeometrySettings), else a
+// covariance fit in 5 × 5. PCL's integral image takes a smoothing × smoothing
+// window that shrinks to the distance to the nearest depth change. Neither
+// support equals the other; the entries "…_smoothing_33" only give PCL a
+// window as wide as our widest.
 #include "bench/bench_geometry.hpp"
 
 #include <algorithm>
@@ -16,7 +29,6 @@
 #include <limits>
 #include <numbers>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include "acquisition/scan_geometry.hpp"
@@ -24,6 +36,7 @@
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
 #include "bench/pcl_normals.hpp"
+#include "core/parallel.hpp"
 #include "modeling/settings_json.hpp"
 
 namespace scanbench::bench {
@@ -61,9 +74,12 @@ struct Peer {
 //   coverage to 0.5–0.9; depth-dependent smoothing was worse in every case:
 //   PCL reads z as a camera's depth, and on a panorama z is height.
 // - kNN: k = 16 → 2.5° / 13.4°, 30 → 1.3° / 9.2°, 50 → 0.79° / 11.5°
-//   (chosen; the 7 × 7 = 49 pixels of our default window), 80 → 0.52° / 16.6°.
-// Two extra entries run the integral image on our window (7 × 7 pixels) to
-// compare the estimators at equal support.
+//   (chosen: the lowest median with a p95 below the tutorial's), 80 → 0.52° /
+//   16.6°.
+// Two extra entries run the integral image with smoothing 33, the side of our
+// widest window (radius 16), for a view at PCL's largest window as wide as
+// ours. That is not equal support (see the top of the file), and its wider
+// border leaves more pixels without a normal.
 std::vector<Peer> pcl_peers(int repeats) {
   PclNormalSettings covariance;
   covariance.method = PclNormalMethod::kIntegralCovariance;
@@ -76,13 +92,14 @@ std::vector<Peer> pcl_peers(int repeats) {
   knn.method = PclNormalMethod::kKnnOmp;
   knn.k_neighbours = 50;
   knn.threads = 2;
-  PclNormalSettings covariance_7 = covariance, gradient_7 = gradient;
-  covariance_7.normal_smoothing_size = gradient_7.normal_smoothing_size = 7.0f;
+  const auto widest = static_cast<float>(2 * acquisition::GeometrySettings{}.window_radius + 1);
+  PclNormalSettings covariance_33 = covariance, gradient_33 = gradient;
+  covariance_33.normal_smoothing_size = gradient_33.normal_smoothing_size = widest;
   std::vector<Peer> peers = {{"pcl_integral_covariance", covariance, true},
                              {"pcl_integral_average_3d_gradient", gradient, true},
                              {"pcl_knn_omp", knn, true},
-                             {"pcl_integral_covariance_window_7", covariance_7, false},
-                             {"pcl_integral_average_3d_gradient_window_7", gradient_7, false}};
+                             {"pcl_integral_covariance_smoothing_33", covariance_33, false},
+                             {"pcl_integral_average_3d_gradient_smoothing_33", gradient_33, false}};
   // Best of `repeats` runs; kNN takes seconds per run, where run-to-run
   // noise matters less, and gets at most two.
   for (Peer& peer : peers) {
@@ -173,13 +190,14 @@ struct OursRun {
   double seconds = 0.0;
 };
 
-// compute_geometry with default settings, best of `repeats` wall times.
-OursRun run_ours(const acquisition::Scan& scan, int repeats) {
+// compute_geometry with `settings`, best of `repeats` wall times.
+OursRun run_ours(const acquisition::Scan& scan, const acquisition::GeometrySettings& settings,
+                 int repeats) {
   acquisition::GeometryResult result;
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < repeats; ++r) {
     const auto start = std::chrono::steady_clock::now();
-    result = acquisition::compute_geometry(scan, acquisition::GeometrySettings{});
+    result = acquisition::compute_geometry(scan, settings);
     const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
     best = std::min(best, elapsed.count());
   }
@@ -221,24 +239,47 @@ nlohmann::json method_json(MethodStats& stats, int threads, nlohmann::json setti
       {"settings", std::move(settings)}};
 }
 
-struct BenchTotals {
-  MethodStats ours;
+// Our estimator at default settings on `threads` workers (0 = all cores):
+// "ours" and "ours_1_thread". The results do not depend on the thread count;
+// each variant is scored on its own output all the same.
+struct Ours {
+  const char* key;
+  acquisition::GeometrySettings settings;
+};
+
+std::vector<Ours> our_variants() {
+  acquisition::GeometrySettings one_thread;
+  one_thread.threads = 1;
+  return {{"ours", acquisition::GeometrySettings{}}, {"ours_1_thread", one_thread}};
+}
+
+struct OursTotals {
+  MethodStats stats;
   MixedStats mixed;
+};
+
+struct BenchTotals {
+  std::vector<OursTotals> ours;  // one per our_variants()
   std::vector<MethodStats> peers;
 };
 
 void bench_scan(const sim::SimulatedScan& simulated, const std::vector<std::uint8_t>& planar,
-                const std::vector<Peer>& peers, int repeats, BenchTotals& totals) {
-  {
-    const OursRun ours = run_ours(simulated.scan, repeats);
-    accumulate(simulated, ours.normals, planar, ours.seconds, totals.ours);
-    accumulate_mixed(simulated, ours.flags, totals.mixed);
+                const std::vector<Ours>& ours, const std::vector<Peer>& peers, int repeats,
+                BenchTotals& totals) {
+  for (std::size_t v = 0; v < ours.size(); ++v) {
+    const OursRun run = run_ours(simulated.scan, ours[v].settings, repeats);
+    accumulate(simulated, run.normals, planar, run.seconds, totals.ours[v].stats);
+    accumulate_mixed(simulated, run.flags, totals.ours[v].mixed);
   }
   for (std::size_t p = 0; p < peers.size(); ++p) {
     const PclNormalResult theirs = estimate_pcl_normals(simulated.scan, peers[p].settings);
     accumulate(simulated, theirs.normal, planar, theirs.seconds, totals.peers[p]);
   }
 }
+
+// The speed goal of issue #4, judged thread for thread (issue #11): ours on
+// one thread at least this many times PCL's AVERAGE_3D_GRADIENT on one.
+constexpr double kSpeedupGoal = 5.0;
 
 nlohmann::json goals_json(const nlohmann::json& report, const std::vector<Peer>& peers) {
   bool lower_median = true;
@@ -249,37 +290,51 @@ nlohmann::json goals_json(const nlohmann::json& report, const std::vector<Peer>&
     lower_median = lower_median && ours.is_number() &&
                    (!theirs.is_number() || ours.get<double>() < theirs.get<double>());
   }
-  const double speedup =
-      std::min(report["speedup_vs_pcl_integral_covariance"].get<double>(),
-               report["speedup_vs_pcl_integral_average_3d_gradient"].get<double>());
+  const nlohmann::json& speedup = report["speedup_vs_pcl_integral_average_3d_gradient_1_thread"];
   const nlohmann::json& ours = report["ours"];
   return {{"median_below_every_pcl", lower_median},
-          {"speedup_at_least_5x_vs_integral_image", speedup >= 5.0},
+          {"speedup_1_thread_at_least_5x_vs_average_3d_gradient",
+           speedup.is_number() && speedup.get<double>() >= kSpeedupGoal},
           {"mixed_recall_at_least_0_9_false_rate_at_most_0_01",
            ours["mixed_pixel_recall"].get<double>() >= 0.9 &&
                ours["mixed_pixel_false_rate"].get<double>() <= 0.01}};
 }
 
-nlohmann::json report_json(BenchTotals& totals, const std::vector<Peer>& peers) {
-  nlohmann::json report;
-  const acquisition::GeometrySettings ours_settings;
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  report["ours"] =
-      method_json(totals.ours, ours_settings.threads > 0 ? ours_settings.threads : cores,
-                  settings_json(ours_settings));
-  report["ours"]["mixed_pixel_recall"] = ratio(static_cast<double>(totals.mixed.recalled),
-                                               static_cast<double>(totals.mixed.truth_mixed));
-  report["ours"]["mixed_pixel_false_rate"] =
+nlohmann::json ours_json(OursTotals& totals, const acquisition::GeometrySettings& settings) {
+  nlohmann::json json =
+      method_json(totals.stats, core::worker_count(settings.threads), settings_json(settings));
+  json["mixed_pixel_recall"] = ratio(static_cast<double>(totals.mixed.recalled),
+                                     static_cast<double>(totals.mixed.truth_mixed));
+  json["mixed_pixel_false_rate"] =
       ratio(static_cast<double>(totals.mixed.false_flags), static_cast<double>(totals.mixed.clean));
-  report["ours"]["truth_mixed_pixels"] = totals.mixed.truth_mixed;
+  json["truth_mixed_pixels"] = totals.mixed.truth_mixed;
+  return json;
+}
+
+double points_per_second(const nlohmann::json& method) {
+  return method["points_per_second"].get<double>();
+}
+
+// speedup_vs_PEER: "ours" (all cores) against the peer on its threads;
+// speedup_vs_PEER_1_thread, for the single-threaded peers: "ours_1_thread".
+nlohmann::json report_json(BenchTotals& totals, const std::vector<Ours>& ours,
+                           const std::vector<Peer>& peers) {
+  nlohmann::json report;
+  for (std::size_t v = 0; v < ours.size(); ++v)
+    report[ours[v].key] = ours_json(totals.ours[v], ours[v].settings);
   for (std::size_t p = 0; p < peers.size(); ++p) {
     const PclNormalSettings& s = peers[p].settings;
     const int threads = s.method == PclNormalMethod::kKnnOmp ? s.threads : 1;
-    report[peers[p].key] = method_json(totals.peers[p], threads, settings_json(s));
-    report[std::string("speedup_vs_") + peers[p].key] =
-        ratio(report["ours"]["points_per_second"].get<double>(),
-              report[peers[p].key]["points_per_second"].get<double>());
+    const std::string key = peers[p].key;
+    report[key] = method_json(totals.peers[p], threads, settings_json(s));
+    const double theirs = points_per_second(report[key]);
+    report["speedup_vs_" + key] = ratio(points_per_second(report["ours"]), theirs);
+    if (threads == 1) {
+      report["speedup_vs_" + key + "_1_thread"] =
+          ratio(points_per_second(report["ours_1_thread"]), theirs);
+    }
   }
+  report["speedup_goal_1_thread"] = kSpeedupGoal;
   report["goals"] = goals_json(report, peers);
   return report;
 }
@@ -298,19 +353,21 @@ nlohmann::json run_geometry_bench(const BenchOptions& options) {
   // vary by ±10 %.
   const int repeats = options.smoke ? 1 : 5;
   const std::vector<std::uint8_t> planar = planar_objects(site.scene);
+  const std::vector<Ours> ours = our_variants();
   const std::vector<Peer> peers = pcl_peers(repeats);
   BenchTotals totals;
+  totals.ours.resize(ours.size());
   totals.peers.resize(peers.size());
   for (int k = 0; k < scans; ++k)
-    bench_scan(simulate(site, model, k), planar, peers, repeats, totals);
+    bench_scan(simulate(site, model, k), planar, ours, peers, repeats, totals);
 
-  nlohmann::json report = report_json(totals, peers);
+  nlohmann::json report = report_json(totals, ours, peers);
   report["suite"] = "geometry";
   report["site"] = "campus";
   report["columns"] = model.columns;
   report["rows"] = model.rows;
   report["scans"] = scans;
-  report["points"] = totals.ours.valid;
+  report["points"] = totals.ours.front().stats.valid;
   return report;
 }
 

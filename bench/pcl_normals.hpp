@@ -22,7 +22,9 @@ struct PclNormalSettings {
   // Integral image: depth-change threshold factor (PCL multiplies it by the
   // point's z, which PCL takes as the depth of a camera looking along +z).
   float max_depth_change_factor = 0.02f;
-  // Integral image: side of the smoothing window [pixels].
+  // Integral image: side of the smoothing window [pixels]. PCL shrinks it,
+  // per pixel, to the distance [pixels] to the nearest depth change or
+  // invalid pixel, and gives no normal within this many pixels of the border.
   float normal_smoothing_size = 10.0f;
   // Integral image: grow the window with z (meant for depth cameras).
   bool depth_dependent_smoothing = false;

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "app/cli_runner.hpp"
 #include "support/test_support.hpp"
@@ -20,40 +22,86 @@ TEST(BenchGeometry, SmokeRunReportsEveryMethodAndField) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "geometry");
+  EXPECT_EQ(bench["site"], "campus");
   EXPECT_EQ(bench["columns"], 360);
   EXPECT_EQ(bench["rows"], 90);
+  EXPECT_EQ(bench["scans"], 1);
   EXPECT_GT(bench["points"].get<double>(), 0.0);
-  for (const char* ratio :
-       {"speedup_vs_pcl_integral_covariance", "speedup_vs_pcl_integral_average_3d_gradient"})
-    EXPECT_TRUE(bench.contains(ratio)) << ratio;
-  for (const char* method :
-       {"ours", "pcl_integral_covariance", "pcl_integral_average_3d_gradient", "pcl_knn_omp"}) {
+  const char* const peers[] = {"pcl_integral_covariance", "pcl_integral_average_3d_gradient",
+                               "pcl_knn_omp", "pcl_integral_covariance_smoothing_33",
+                               "pcl_integral_average_3d_gradient_smoothing_33"};
+  for (const std::string peer : peers) {
+    EXPECT_TRUE(bench["speedup_vs_" + peer].is_number()) << peer;
+    // The integral images run on one thread, and get a thread-for-thread ratio.
+    EXPECT_EQ(bench.contains("speedup_vs_" + peer + "_1_thread"), peer != "pcl_knn_omp") << peer;
+  }
+  EXPECT_TRUE(bench["speedup_goal_1_thread"].is_number());
+  for (const char* goal :
+       {"median_below_every_pcl", "speedup_1_thread_at_least_5x_vs_average_3d_gradient",
+        "mixed_recall_at_least_0_9_false_rate_at_most_0_01"})
+    EXPECT_TRUE(bench["goals"][goal].is_boolean()) << goal;
+  std::vector<std::string> methods = {"ours", "ours_1_thread"};
+  methods.insert(methods.end(), std::begin(peers), std::end(peers));
+  for (const std::string& method : methods) {
     ASSERT_TRUE(bench.contains(method)) << method;
     for (const char* field : {"median_error_deg", "p95_error_deg", "planar_median_error_deg",
-                              "coverage", "points_per_second"})
+                              "coverage", "points_per_second", "seconds", "threads"})
       EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+    EXPECT_TRUE(bench[method]["settings"].is_object()) << method;
     const double coverage = bench[method]["coverage"].get<double>();
     EXPECT_GT(coverage, 0.0) << method;
     EXPECT_LE(coverage, 1.0) << method;
   }
-  for (const char* field : {"mixed_pixel_recall", "mixed_pixel_false_rate"})
-    EXPECT_TRUE(bench["ours"][field].is_number()) << field;
+  EXPECT_EQ(bench["ours_1_thread"]["threads"], 1);
+  EXPECT_EQ(bench["pcl_integral_average_3d_gradient"]["threads"], 1);
+  for (const char* method : {"ours", "ours_1_thread"}) {
+    for (const char* field : {"mixed_pixel_recall", "mixed_pixel_false_rate", "truth_mixed_pixels"})
+      EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+    // Same estimator, same settings but threads: the same normals.
+    EXPECT_EQ(bench[method]["median_error_deg"], bench["ours"]["median_error_deg"]) << method;
+  }
 }
 
-TEST(BenchRegistration, SmokeRunReportsBothMethodsAndEveryField) {
+TEST(BenchRegistration, SmokeRunReportsEveryMethodAndField) {
   test::ScratchDir dir;
   const test::CliResult result = test::run_cli(dir, {"bench", "registration", "--json", "--smoke"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "registration");
-  for (const char* method : {"ours", "pcl_icp_point_to_plane"}) {
+  EXPECT_EQ(bench["sites"], nlohmann::json::array({"campus"}));
+  EXPECT_EQ(bench["scans_per_site"], 2);
+  for (const char* field : {"columns", "rows", "threads", "speedup_goal"})
+    EXPECT_TRUE(bench[field].is_number()) << field;
+  for (const char* field : {"rotation_deg", "translation_m"})
+    EXPECT_TRUE(bench["max_initial_error"][field].is_number()) << field;
+  for (const char* method : {"ours", "ours_one_thread", "ours_pairwise", "ours_pairwise_one_thread",
+                             "pcl_icp_point_to_plane"}) {
     ASSERT_TRUE(bench.contains(method)) << method;
-    for (const char* field : {"max_rotation_error_deg", "max_translation_error_m",
-                              "median_rotation_error_deg", "median_translation_error_m", "seconds"})
+    for (const char* field :
+         {"max_rotation_error_deg", "max_translation_error_m", "median_rotation_error_deg",
+          "median_translation_error_m", "seconds", "converged_pair_share"})
       EXPECT_TRUE(bench[method][field].is_number()) << method << "." << field;
+    if (std::string(method) != "pcl_icp_point_to_plane") {
+      EXPECT_TRUE(bench[method]["icp_seconds"].is_number()) << method;
+    }
   }
-  EXPECT_TRUE(bench["ours"]["coarse_success_rate"].is_number());
+  for (const char* field : {"coarse_success_rate", "coarse_accepted_but_wrong", "coarse_seconds"})
+    EXPECT_TRUE(bench["ours"][field].is_number()) << field;
   EXPECT_EQ(bench["ours"]["trials"], 1);
+  EXPECT_TRUE(bench["pcl_icp_point_to_plane"]["settings"].is_object());
+  for (const char* ratio :
+       {"fine_speedup_vs_pcl", "fine_speedup_vs_pcl_one_thread", "pairwise_speedup_vs_pcl",
+        "pairwise_speedup_vs_pcl_one_thread", "pairwise_icp_speedup_vs_pcl",
+        "pairwise_icp_speedup_vs_pcl_one_thread"})
+    EXPECT_TRUE(bench[ratio].is_number()) << ratio;
+  for (const char* goal :
+       {"accuracy_within_0_02_deg_and_3_mm", "pairwise_speedup_one_thread_at_least_5x"})
+    EXPECT_TRUE(bench["goals"][goal].is_boolean()) << goal;
+  // Results do not depend on the thread count.
+  for (const char* field : {"max_rotation_error_deg", "max_translation_error_m"}) {
+    EXPECT_EQ(bench["ours_one_thread"][field], bench["ours"][field]) << field;
+    EXPECT_EQ(bench["ours_pairwise_one_thread"][field], bench["ours_pairwise"][field]) << field;
+  }
 }
 
 TEST(BenchMerge, SmokeRunReportsEveryField) {
@@ -62,12 +110,37 @@ TEST(BenchMerge, SmokeRunReportsEveryField) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json bench = nlohmann::json::parse(result.out);
   EXPECT_EQ(bench["suite"], "merge");
-  for (const char* field :
-       {"redundant_removed_share", "coverage_before", "coverage_after", "points_per_second"}) {
-    ASSERT_TRUE(bench["ours"][field].is_number()) << field;
-    EXPECT_GE(bench["ours"][field].get<double>(), 0.0) << field;
+  EXPECT_EQ(bench["site"], "campus");
+  EXPECT_EQ(bench["scans"], 2);
+  for (const char* field : {"columns", "rows", "threads"})
+    EXPECT_TRUE(bench[field].is_number()) << field;
+  for (const char* merge : {"ours", "ours_registered"}) {
+    ASSERT_TRUE(bench.contains(merge)) << merge;
+    for (const char* share : {"redundant_removed_share", "redundant_removed_share_by_spacing",
+                              "unique_removed_share", "coverage_before", "coverage_after"}) {
+      ASSERT_TRUE(bench[merge][share].is_number()) << merge << "." << share;
+      EXPECT_GE(bench[merge][share].get<double>(), 0.0) << merge << "." << share;
+      EXPECT_LE(bench[merge][share].get<double>(), 1.0) << merge << "." << share;
+    }
+    for (const char* field :
+         {"coverage_drop", "coverage_samples", "points_per_second", "points", "kept_points",
+          "truth_redundant_points", "truth_redundant_points_by_spacing", "truth_unique_points",
+          "seconds", "prepare_seconds"})
+      EXPECT_TRUE(bench[merge][field].is_number()) << merge << "." << field;
+    EXPECT_GT(bench[merge]["coverage_samples"].get<double>(), 0.0) << merge;
+    EXPECT_LE(bench[merge]["kept_points"].get<double>(), bench[merge]["points"].get<double>());
   }
-  EXPECT_LE(bench["ours"]["coverage_after"].get<double>(), 1.0);
+  // Both merges are judged against the same truth and the same unmerged model.
+  EXPECT_EQ(bench["ours"]["coverage_before"], bench["ours_registered"]["coverage_before"]);
+  for (const char* field : {"max_rotation_error_deg", "max_translation_error_m", "seconds"})
+    EXPECT_TRUE(bench["ours_registered"]["registration"][field].is_number()) << field;
+  EXPECT_TRUE(bench["ours_registered"]["registration"]["converged"].is_boolean());
+  for (const char* goals : {"goals", "goals_registered"}) {
+    for (const char* goal :
+         {"redundant_removed_share_at_least_0_9", "redundant_removed_share_by_spacing_at_least_0_9",
+          "coverage_drop_at_most_0_005", "points_per_second_at_least_20m"})
+      EXPECT_TRUE(bench[goals][goal].is_boolean()) << goals << "." << goal;
+  }
 }
 
 TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
