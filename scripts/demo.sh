@@ -8,6 +8,7 @@
 #   geometry  per-point footprints, normals and mixed-pixel flags
 #   register  coarse (features) + point-to-plane ICP + global refinement
 #   merge     keep masks: each surface from the scan that sampled it most finely
+#   history   the journal of those commands; undo and redo of the merge
 #   info      table and JSON
 #   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as PLY
 #   bench     raw-scan I/O throughput against PCL's reader
@@ -43,6 +44,13 @@ phase "register"
 
 phase "merge"
 "$scanbench" merge "$project"
+
+phase "history"
+# Every stage above is a command in the project's journal; undo takes the
+# merge back (its keep masks are gone), redo restores it exactly.
+"$scanbench" history "$project"
+"$scanbench" undo "$project"
+"$scanbench" redo "$project"
 
 phase "info"
 "$scanbench" info "$project"
