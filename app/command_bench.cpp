@@ -17,13 +17,24 @@ struct BenchCommandOptions {
   bench::BenchOptions bench;
 };
 
+// One line per figure; nested objects as "method.field" paths.
+void print_table(const nlohmann::json& value, const std::string& path) {
+  if (value.is_object()) {
+    for (const auto& [key, child] : value.items()) {
+      print_table(child, path.empty() ? key : path + "." + key);
+    }
+    return;
+  }
+  fmt::print("{:<50} {}\n", path, value.dump());
+}
+
 void run_bench(const BenchCommandOptions& options) {
   const nlohmann::json result = bench::run_suite(options.suite, options.bench);
   if (options.json) {
     fmt::print("{}\n", result.dump());
     return;
   }
-  for (const auto& [key, value] : result.items()) fmt::print("{:<34} {}\n", key, value.dump());
+  print_table(result, "");
 }
 
 }  // namespace
