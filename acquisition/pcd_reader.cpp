@@ -51,27 +51,32 @@ Fields check_fields(TextLineReader& reader, const PcdHeader& header) {
   return f;
 }
 
+// Calls visit(T{}) with T the C++ type of `field`'s values (TYPE and SIZE).
+template <typename Visit>
+auto with_value_type(const PcdField& field, Visit&& visit) {
+  switch (field.type) {
+    case 'F':
+      return field.size == 4 ? visit(float{}) : visit(double{});
+    case 'I':
+      return field.size == 1   ? visit(std::int8_t{})
+             : field.size == 2 ? visit(std::int16_t{})
+             : field.size == 4 ? visit(std::int32_t{})
+                               : visit(std::int64_t{});
+    default:
+      return field.size == 1   ? visit(std::uint8_t{})
+             : field.size == 2 ? visit(std::uint16_t{})
+             : field.size == 4 ? visit(std::uint32_t{})
+                               : visit(std::uint64_t{});
+  }
+}
+
 // The first value of `field` from its little-endian bytes at `p`.
 double value_at(const std::uint8_t* p, const PcdField& field) {
-  const auto load = [p]<typename T>(T) {
+  return with_value_type(field, [p]<typename T>(T) {
     T value;
     std::memcpy(&value, p, sizeof(T));
     return static_cast<double>(value);
-  };
-  switch (field.type) {
-    case 'F':
-      return field.size == 4 ? load(float{}) : load(double{});
-    case 'I':
-      return field.size == 1   ? load(std::int8_t{})
-             : field.size == 2 ? load(std::int16_t{})
-             : field.size == 4 ? load(std::int32_t{})
-                               : load(std::int64_t{});
-    default:
-      return field.size == 1   ? load(std::uint8_t{})
-             : field.size == 2 ? load(std::uint16_t{})
-             : field.size == 4 ? load(std::uint32_t{})
-                               : load(std::uint64_t{});
-  }
+  });
 }
 
 // A whole ASCII token as the field's type, stored as its little-endian
@@ -82,26 +87,12 @@ bool parse_token(std::string_view token, const PcdField& field, std::uint8_t* ou
   if (!token.empty() && token.front() == '+') token.remove_prefix(1);
   const char* first = token.data();
   const char* last = first + token.size();
-  const auto store = [&]<typename T>(T value) {
+  return with_value_type(field, [&]<typename T>(T value) {
     const auto [end, error] = std::from_chars(first, last, value);
     if (error != std::errc() || end != last) return false;
     std::memcpy(out, &value, sizeof(T));
     return true;
-  };
-  switch (field.type) {
-    case 'F':
-      return field.size == 4 ? store(float{}) : store(double{});
-    case 'I':
-      return field.size == 1   ? store(std::int8_t{})
-             : field.size == 2 ? store(std::int16_t{})
-             : field.size == 4 ? store(std::int32_t{})
-                               : store(std::int64_t{});
-    default:
-      return field.size == 1   ? store(std::uint8_t{})
-             : field.size == 2 ? store(std::uint16_t{})
-             : field.size == 4 ? store(std::uint32_t{})
-                               : store(std::uint64_t{});
-  }
+  });
 }
 
 // The body as binary points (point_step bytes each, fields at their
