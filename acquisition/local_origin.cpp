@@ -54,9 +54,10 @@ Eigen::Vector3d centroid_origin(std::span<const Eigen::Vector3d> points,
 }
 
 // Ranges (and, for per-pixel grids, directions) of the points measured from
-// `origin`, in one pass.
-void set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points, const Eigen::Vector3d& origin,
-                bool directions) {
+// `origin`, in one pass; returns the largest range [m].
+double set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points,
+                  const Eigen::Vector3d& origin, bool directions) {
+  double farthest = 0.0;
   scan.range_m.assign(points.size(), 0.0f);
   std::vector<Eigen::Vector3f> unit;
   if (directions) unit.assign(points.size(), Eigen::Vector3f::Zero());
@@ -64,10 +65,12 @@ void set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points, const Eigen
     if (!scan.valid[i]) continue;
     const Eigen::Vector3d p = points[i] - origin;
     const double range = p.norm();
+    farthest = std::max(farthest, range);
     scan.range_m[i] = static_cast<float>(range);
     if (directions) unit[i] = (p / range).cast<float>();
   }
   if (directions) scan.angles = PerPixelDirections{std::move(unit)};
+  return farthest;
 }
 
 }  // namespace
@@ -100,7 +103,7 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
     const bool near = farthest(points_file, scan.valid) <= settings.max_per_pixel_range_m;
     result.origin_file = near ? Eigen::Vector3d::Zero() : centroid_origin(points_file, scan.valid);
   }
-  set_ranges(scan, points_file, result.origin_file, !result.spherical);
+  result.farthest_m = set_ranges(scan, points_file, result.origin_file, !result.spherical);
   scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result.origin_file);
   return result;
 }

@@ -1,5 +1,6 @@
 // A scan's grid from points given in a file's frame, with a local origin
-// that keeps every coordinate to 0.1 mm at any magnitude.
+// that keeps every coordinate to 0.1 mm at any magnitude (for points within
+// 900 m of the origin: LocalOriginResult::farthest_m).
 //
 // Ranges and per-pixel directions are floats. Measured from the world's
 // origin, a float range of a point near (637012, 8490281, 431) is off by up
@@ -34,6 +35,11 @@ struct LocalOriginSettings {
 struct LocalOriginResult {
   Eigen::Vector3d origin_file = Eigen::Vector3d::Zero();  // the new scan frame's origin [m]
   bool spherical = false;
+  // The largest range from the origin [m]. Points keep 0.1 mm of their
+  // file values up to 900 m (per-pixel) or 1 km (spherical, whose fit
+  // tolerance takes half the budget); beyond, the float range and direction
+  // let the error grow as about 1.1e-7 × range.
+  double farthest_m = 0.0;
 };
 
 // Sets scan.range_m, scan.angles and scan.T_world_scan of `scan`, whose

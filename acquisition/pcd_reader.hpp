@@ -23,7 +23,8 @@ namespace scanbench::acquisition {
 // (translation [m], unit quaternion w x y z), identity when absent. Points
 // farther than 500 m from the sensor (a cloud stored in world coordinates)
 // are measured from their centroid instead, which goes into T_world_scan
-// (local_origin.hpp), so every point keeps 0.1 mm of the file's value.
+// (local_origin.hpp), so every point within 900 m of it keeps 0.1 mm of
+// the file's value.
 // name = file stem, scanner.name = "" (unknown), scanner.source_file = path
 // (UTF-8), scanner.position_world = the VIEWPOINT translation.
 //

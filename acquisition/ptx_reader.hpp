@@ -13,9 +13,9 @@
 // world coordinates. Where a file gives points already in world coordinates
 // (an identity transform, points at 10^5–10^7 m), the scan frame moves to the
 // header's scanner position or near the points (local_origin.hpp), so every
-// coordinate keeps 0.1 mm. Lines "0 0 0 ..." are missing returns; they stay
-// in their grid position as invalid pixels. Point k of a scan is grid pixel
-// (row k % rows, col k / rows).
+// coordinate keeps 0.1 mm (within a scanner's range: local_origin.hpp). Lines "0 0 0 ..." are
+// missing returns; they stay in their grid position as invalid pixels. Point k of a scan is grid
+// pixel (row k % rows, col k / rows).
 #pragma once
 
 #include <filesystem>

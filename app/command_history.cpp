@@ -18,7 +18,15 @@ struct HistoryOptions {
 };
 
 const char* state_name(modeling::CommandState state) {
-  return state == modeling::CommandState::kDone ? "done" : "undone";
+  switch (state) {
+    case modeling::CommandState::kDone:
+      return "done";
+    case modeling::CommandState::kUndone:
+      return "undone";
+    case modeling::CommandState::kPending:
+      return "pending";
+  }
+  return "";
 }
 
 nlohmann::json parsed(const std::string& text) {
@@ -82,11 +90,16 @@ void run_undo(const std::string& path) {
   modeling::Project project = modeling::Project::open(path);
   const std::optional<modeling::CommandRecord> undone = project.undo();
   if (!undone) {
-    const bool migrated_only = !project.history().empty();
+    // undo() declines only when no command is done or the newest done one
+    // is an older project's history.
+    bool any_done = false;
+    for (const modeling::CommandRecord& c : project.history()) {
+      any_done = any_done || c.state == modeling::CommandState::kDone;
+    }
     throw core::InputError(path, {},
-                           migrated_only ? "nothing to undo: what is left was stored before this "
-                                           "project had a journal (schema version 4)"
-                                         : "nothing to undo");
+                           any_done ? "nothing to undo: what is left was stored before this "
+                                      "project had a journal (schema version 4)"
+                                    : "nothing to undo");
   }
   fmt::print("undid {} {} ({}); `scanbench redo` brings it back\n", undone->id, undone->name,
              undone->created_at);

@@ -86,6 +86,7 @@ void add_register_command(CLI::App& app) {
   const std::map<std::string, registration::CoarseMethod> coarse_methods{
       {"features", registration::CoarseMethod::kFeatures},
       {"pairs", registration::CoarseMethod::kPointPairs},
+      {"point_pairs", registration::CoarseMethod::kPointPairs},
       {"none", registration::CoarseMethod::kNone}};
   command
       ->add_option("--coarse", options->coarse, "Coarse stage: features (default), pairs or none")
@@ -96,7 +97,7 @@ void add_register_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   command->add_flag("--unlevelled", options->unlevelled,
                     "The scanner was not levelled on site: feature poses from three matches each "
-                    "(PCL's RANSAC) instead of one");
+                    "instead of one");
   command->add_flag("--no-global", options->no_global, "Skip the global refinement");
   command->add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   command->add_flag("--json", options->json, "Print the report as one JSON object");

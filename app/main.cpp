@@ -38,8 +38,9 @@ int main(int argc, char** argv) {
   app.add_subcommand("bench", "Not in this build (configured with -DSCANBENCH_BENCH=OFF)")
       ->allow_extras()
       ->callback([] {
-        throw CLI::ValidationError("bench", "this scanbench was built without the benchmark "
-                                            "suites (-DSCANBENCH_BENCH=OFF)");
+        throw CLI::ValidationError("bench",
+                                   "this scanbench was built without the benchmark "
+                                   "suites (-DSCANBENCH_BENCH=OFF)");
       });
 #endif
   try {

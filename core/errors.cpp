@@ -32,6 +32,7 @@ InputError::InputError(std::string file, FilePosition position, std::string prob
 RuntimeFailure::RuntimeFailure(std::string file, FilePosition position, std::string problem)
     : std::runtime_error(format_input_error(file, position, problem)),
       file_(std::move(file)),
+      position_(std::move(position)),
       problem_(std::move(problem)) {}
 
 Cancelled::Cancelled(const std::string& stage)

@@ -49,10 +49,12 @@ class RuntimeFailure : public std::runtime_error {
   RuntimeFailure(std::string file, FilePosition position, std::string problem);
 
   const std::string& file() const { return file_; }
+  const FilePosition& position() const { return position_; }
   const std::string& problem() const { return problem_; }
 
  private:
   std::string file_;
+  FilePosition position_;
   std::string problem_;
 };
 

@@ -14,12 +14,14 @@ namespace {
 
 // The exported scans' ids, in id order.
 std::vector<std::int64_t> exported_ids(const Project& project, const ExportSettings& settings) {
-  if (settings.scan_id) {
-    static_cast<void>(project.load_scan(*settings.scan_id));  // "no scan with id N"
-    return {*settings.scan_id};
-  }
   std::vector<std::int64_t> ids;
-  for (const StoredScanSummary& stored : project.scans()) ids.push_back(stored.id);
+  for (const StoredScanSummary& stored : project.scans()) {
+    if (!settings.scan_id || stored.id == *settings.scan_id) ids.push_back(stored.id);
+  }
+  if (settings.scan_id && ids.empty()) {
+    throw core::InputError(project.path().string(), {},
+                           "no scan with id " + std::to_string(*settings.scan_id));
+  }
   return ids;
 }
 
@@ -72,6 +74,8 @@ std::size_t count_points(const std::vector<acquisition::Scan>& scans,
 }  // namespace
 
 ExportResult export_project(const Project& project, const ExportSettings& settings) {
+  // Masks, poses and channels from one state, whatever commits meanwhile.
+  const Project::ReadSnapshot snapshot = project.read_snapshot();
   const std::vector<std::int64_t> ids = exported_ids(project, settings);
   const std::vector<std::vector<std::uint8_t>> keep = keep_masks(project, settings, ids);
   std::vector<acquisition::Scan> scans;

@@ -31,7 +31,8 @@ struct ExportResult {
   std::size_t points = 0;  // valid points, or with `merged` the merged model's
 };
 
-// Writes the project's scans as the settings say. Where a scan has geometry,
+// Writes the project's scans as the settings say, all read from one state of
+// the project (Project::read_snapshot). Where a scan has geometry,
 // the point formats leave its mixed pixels out and PLY carries its normals
 // and footprints. Throws core::InputError (naming the project and, where it
 // applies, the scan) for: no such scan, `merged` with a scan-grid format or

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 
+#include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "modeling/scan_layers.hpp"
 #include "modeling/settings_json.hpp"
@@ -32,27 +33,33 @@ GeometryStageResult run_geometry_stage(Project& project,
   const auto start = std::chrono::steady_clock::now();
   const std::int64_t revision = project.revision();
   const std::vector<StoredScanSummary> scans = project.scans();
+  if (scans.empty())
+    throw core::InputError(project.path().string(), {}, "the project has no scans");
   GeometryStageResult result;
-  std::vector<std::vector<EncodedLayer>> layers;
+  // One part per scan: one scan's geometry in memory at a time, and the
+  // write lock held only while its layers are written.
+  Project::LongCommand command =
+      project.begin_long_command(kStage, settings_to_json(settings), revision);
+  result.command_id = command.command_id();
   for (const StoredScanSummary& stored : scans) {
     progress.throw_if_cancelled(kStage);
     const acquisition::Scan scan = project.load_scan(stored.id);
     const acquisition::GeometryResult geometry = acquisition::compute_geometry(scan, settings);
-    layers.push_back(encode_geometry(geometry.geometry));
+    const std::vector<EncodedLayer> layers = encode_geometry(geometry.geometry);
+    Project::Edit part = command.part();
+    for (const EncodedLayer& layer : layers) project.put_layer(part, stored.id, layer);
+    part.commit_part();
     result.scans.push_back({stored.id, scan.name, geometry.valid_points, geometry.normals,
                             geometry.mixed_pixels, geometry.edge_pixels, geometry.seconds});
     progress.update({kStage, result.scans.size(), scans.size(), scan.name});
   }
   progress.throw_if_cancelled(kStage);
-
-  Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
-  result.command_id = edit.command_id();
-  for (std::size_t k = 0; k < scans.size(); ++k) {
-    for (const EncodedLayer& layer : layers[k]) project.put_layer(edit, scans[k].id, layer);
-    project.remove_layer(edit, scans[k].id, layer::kKeep);
+  Project::Edit finish = command.finish();  // refuses when the project changed meanwhile
+  for (const StoredScanSummary& stored : scans) {
+    project.remove_layer(finish, stored.id, layer::kKeep);  // decided on the old geometry
   }
   result.seconds = core::seconds_since(start);
-  edit.commit(result_json(result));
+  finish.commit(result_json(result));
   return result;
 }
 

@@ -29,12 +29,14 @@ struct GeometryStageResult {
   double seconds = 0.0;
 };
 
-// Computes the geometry of every scan of `project` (reporting one unit of
-// `progress` per scan), then stores it as one command, with the settings in
-// the journal: new versions of the four geometry layers of every scan, and
-// the merge's keep masks removed (they were decided on the old geometry).
-// Nothing is stored on any error or when cancelled (core::Cancelled); throws
-// core::RuntimeFailure when another process changed the project meanwhile.
+// Computes the geometry of every scan of `project` and stores it as one
+// command, with the settings in the journal: new versions of the four
+// geometry layers of every scan, and the merge's keep masks removed (they
+// were decided on the old geometry). Written scan by scan
+// (Project::LongCommand), one unit of `progress` each. Nothing becomes
+// visible on any error or when cancelled (core::Cancelled). Throws
+// core::InputError when the project has no scans, core::RuntimeFailure when
+// another process changed the project meanwhile.
 GeometryStageResult run_geometry_stage(Project& project,
                                        const acquisition::GeometrySettings& settings,
                                        core::Progress& progress);

@@ -25,23 +25,31 @@ std::string settings_json(std::span<const std::filesystem::path> files,
 ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
                           const ImportSettings& settings, core::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  // Compression is most of the work: done before the write lock is taken.
-  std::vector<EncodedScan> encoded;
+  ImportResult result;
+  // One part per scan: a file of many large scans never sits in memory
+  // whole, and the write lock is held only while a scan's rows are written
+  // (compression, most of the work, happens before).
+  Project::LongCommand command = project.begin_long_command(kStage, settings_json(files, settings));
+  result.command_id = command.command_id();
   for (std::size_t f = 0; f < files.size(); ++f) {
     progress.throw_if_cancelled(kStage);
     acquisition::read_scan_file(files[f], settings.readers, [&](acquisition::Scan&& scan) {
-      encoded.push_back(encode_scan(scan));
+      const EncodedScan encoded = encode_scan(scan);
+      progress.throw_if_cancelled(kStage);
+      Project::Edit part = command.part();
+      result.scan_ids.push_back(project.insert_scan(part, encoded));
+      part.commit_part();
     });
     progress.update({kStage, f + 1, files.size(), files[f].filename().string()});
   }
   progress.throw_if_cancelled(kStage);
-
-  ImportResult result;
-  Project::Edit edit = project.begin_command(kStage, settings_json(files, settings));
-  result.command_id = edit.command_id();
-  for (const EncodedScan& scan : encoded)
-    result.scan_ids.push_back(project.insert_scan(edit, scan));
-  edit.commit(nlohmann::json{{"scans", result.scan_ids}}.dump());
+  // New scans can sample the merged surfaces more finely: the earlier
+  // merge's keep masks no longer hold.
+  Project::Edit finish = command.finish();
+  for (const StoredScanSummary& stored : project.scans()) {
+    project.remove_layer(finish, stored.id, layer::kKeep);
+  }
+  finish.commit(nlohmann::json{{"scans", result.scan_ids}}.dump());
   result.seconds = core::seconds_since(start);
   return result;
 }

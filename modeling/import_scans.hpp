@@ -24,9 +24,12 @@ struct ImportResult {
   double seconds = 0.0;
 };
 
-// Reads and encodes every scan of `files` (one unit of `progress` per
-// file), then stores them all as one command. On any error (core::InputError
-// from a reader, a write failure) or cancellation nothing is stored.
+// Stores every scan of `files` as one command (one unit of `progress` per
+// file), written scan by scan (Project::LongCommand), so memory holds one
+// scan at a time. The merge's keep masks of the scans already there are
+// removed with it: new scans may sample their surfaces more finely. On any
+// error (core::InputError from a reader, a write failure) or cancellation
+// nothing becomes visible, and what was written is removed.
 ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
                           const ImportSettings& settings, core::Progress& progress);
 

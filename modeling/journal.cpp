@@ -1,8 +1,13 @@
-// The commands table: Project::begin_command, Edit::commit, history, undo,
-// redo and latest_result, and the revision every commit advances.
+// The commands table: Project::begin_command, begin_long_command, the
+// Edit's commits, history, undo, redo and latest_result, and the revision
+// every commit advances.
+#include <signal.h>
 #include <sqlite3.h>
+#include <unistd.h>
 
+#include <array>
 #include <cassert>
+#include <cerrno>
 
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
@@ -17,49 +22,78 @@ constexpr const char* kBumpRevision =
 constexpr const char* kSelectCommands =
     "SELECT id, name, settings, result, state, undoable, created_at FROM commands";
 
+// The next place in the journal.
+constexpr const char* kNextSeq = "(SELECT coalesce(max(seq), 0) + 1 FROM commands)";
+
 CommandRecord read_command(const sqlite::Statement& row) {
   CommandRecord record;
   record.id = row.column_int(0);
   record.name = row.column_text(1);
   record.settings = row.column_text(2);
   record.result = row.column_text(3);
-  record.state = row.column_text(4) == "done" ? CommandState::kDone : CommandState::kUndone;
+  const std::string state = row.column_text(4);
+  record.state = state == "done"     ? CommandState::kDone
+                 : state == "undone" ? CommandState::kUndone
+                                     : CommandState::kPending;
   record.undoable = row.column_int(5) != 0;
   record.created_at = row.column_text(6);
   return record;
 }
-
-// BEGIN IMMEDIATE … COMMIT for the journal's own small writes; rolled back
-// unless committed.
-class WriteLock {
- public:
-  WriteLock(sqlite3* db, std::string file) : db_(db), file_(std::move(file)) {
-    sqlite::execute(db_, "BEGIN IMMEDIATE", file_);
-  }
-  ~WriteLock() {
-    if (db_ != nullptr && sqlite3_get_autocommit(db_) == 0) {
-      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    }
-  }
-  WriteLock(const WriteLock&) = delete;
-  WriteLock& operator=(const WriteLock&) = delete;
-
-  void commit() {
-    sqlite::execute(db_, kBumpRevision, file_);
-    sqlite::execute(db_, "COMMIT", file_);
-    db_ = nullptr;
-  }
-
- private:
-  sqlite3* db_;
-  std::string file_;
-};
 
 std::optional<CommandRecord> select_one(sqlite3* db, const std::string& file, const char* where) {
   const std::string sql = std::string(kSelectCommands) + " " + where;
   sqlite::Statement select(db, sql.c_str(), file);
   if (!select.step()) return std::nullopt;
   return read_command(select);
+}
+
+std::int64_t read_revision(sqlite3* db, const std::string& file) {
+  sqlite::Statement select(db, "SELECT CAST(value AS INTEGER) FROM meta WHERE key = 'revision'",
+                           file);
+  if (!select.step()) {
+    throw core::InputError(file, {}, "project is damaged: no revision in table meta");
+  }
+  return select.column_int(0);
+}
+
+void check_revision(sqlite3* db, const std::string& file, std::string_view name,
+                    std::optional<std::int64_t> based_on) {
+  if (based_on && read_revision(db, file) != *based_on) {
+    throw core::RuntimeFailure(file, {},
+                               "the project changed while " + std::string(name) +
+                                   " was computing (another scanbench wrote to it); nothing was "
+                                   "stored: run it again");
+  }
+}
+
+std::string host_name() {
+  std::array<char, 256> name{};
+  if (::gethostname(name.data(), name.size() - 1) != 0) return "";
+  return name.data();
+}
+
+// Removes pending commands (with their rows) whose process on this host is
+// gone: what a killed long command left. Commands of other hosts are left
+// alone (a live process there cannot be told from a dead one).
+void remove_abandoned(sqlite3* db, const std::string& file) {
+  sqlite::Statement select(
+      db, "SELECT id, owner_pid FROM commands WHERE state = 'pending' AND owner_host = ?1", file);
+  select.bind_text(1, host_name());
+  std::vector<std::int64_t> abandoned;
+  while (select.step()) {
+    const auto pid = static_cast<pid_t>(select.column_int(1));
+    if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) abandoned.push_back(select.column_int(0));
+  }
+  for (const std::int64_t id : abandoned) {
+    sqlite::Statement remove(db, "DELETE FROM commands WHERE id = ?1", file);
+    remove.bind_int(1, id).run();
+  }
+}
+
+// A new command ends the redo branch: the undone commands and, by cascade,
+// every row they wrote are gone.
+void end_redo_branch(sqlite3* db, const std::string& file) {
+  sqlite::execute(db, "DELETE FROM commands WHERE state = 'undone'", file);
 }
 
 void set_state(sqlite3* db, const std::string& file, std::int64_t id, const char* state) {
@@ -70,47 +104,112 @@ void set_state(sqlite3* db, const std::string& file, std::int64_t id, const char
 }  // namespace
 
 std::int64_t Project::revision() const {
-  sqlite::Statement select(db(), "SELECT CAST(value AS INTEGER) FROM meta WHERE key = 'revision'",
-                           file_name());
-  if (!select.step()) {
-    throw core::InputError(file_name(), {}, "project is damaged: no revision in table meta");
-  }
-  return select.column_int(0);
+  return read_revision(db(), file_name());
 }
 
 Project::Edit Project::begin_command(std::string_view name, const std::string& settings_json,
                                      std::optional<std::int64_t> based_on_revision) {
   assert(sqlite3_get_autocommit(db()) != 0 && "an Edit is already open on this project");
   sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
-  Edit edit(db(), file_name(), 0);
-  if (based_on_revision && revision() != *based_on_revision) {
-    throw core::RuntimeFailure(file_name(), {},
-                               "the project changed while " + std::string(name) +
-                                   " was computing (another scanbench wrote to it); nothing was "
-                                   "stored: run it again");
-  }
-  // A new command ends the redo branch: the undone commands and, by
-  // cascade, every row they wrote are gone.
-  sqlite::execute(db(), "DELETE FROM commands WHERE state = 'undone'", file_name());
-  sqlite::Statement insert(
-      db(), "INSERT INTO commands (name, settings, state, undoable) VALUES (?1, ?2, 'done', 1)",
-      file_name());
+  Edit edit(db(), file_name(), 0, Edit::Kind::kCommand);
+  check_revision(db(), file_name(), name, based_on_revision);
+  remove_abandoned(db(), file_name());
+  end_redo_branch(db(), file_name());
+  const std::string sql = std::string(
+                              "INSERT INTO commands (seq, name, settings, state, undoable) "
+                              "VALUES (") +
+                          kNextSeq + ", ?1, ?2, 'done', 1)";
+  sqlite::Statement insert(db(), sql.c_str(), file_name());
   insert.bind_text(1, name).bind_text(2, settings_json).run();
   edit.command_id_ = sqlite3_last_insert_rowid(db());
   return edit;
 }
 
+Project::LongCommand Project::begin_long_command(std::string_view name,
+                                                 const std::string& settings_json,
+                                                 std::optional<std::int64_t> based_on_revision) {
+  assert(sqlite3_get_autocommit(db()) != 0 && "an Edit is already open on this project");
+  Edit edit(db(), file_name(), 0, Edit::Kind::kPart);
+  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
+  check_revision(db(), file_name(), name, based_on_revision);
+  remove_abandoned(db(), file_name());
+  sqlite::Statement insert(db(),
+                           "INSERT INTO commands (name, settings, state, undoable, owner_host, "
+                           "owner_pid) VALUES (?1, ?2, 'pending', 1, ?3, ?4)",
+                           file_name());
+  insert.bind_text(1, name).bind_text(2, settings_json).bind_text(3, host_name());
+  insert.bind_int(4, ::getpid()).run();
+  const std::int64_t id = sqlite3_last_insert_rowid(db());
+  edit.commit_part();
+  return LongCommand(db(), file_name(), id, std::string(name), based_on_revision);
+}
+
+Project::LongCommand::LongCommand(LongCommand&& other) noexcept
+    : db_(std::exchange(other.db_, nullptr)),
+      file_(std::move(other.file_)),
+      command_id_(other.command_id_),
+      name_(std::move(other.name_)),
+      revision_(other.revision_) {}
+
+Project::LongCommand::~LongCommand() {
+  if (db_ == nullptr || sqlite3_get_autocommit(db_) == 0) return;
+  // Abandoned: remove the pending command and its rows. Best effort: what
+  // a failure leaves is removed by the next writer once this process is gone.
+  if (sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) != SQLITE_OK) return;
+  const std::string sql =
+      "DELETE FROM commands WHERE state = 'pending' AND id = " + std::to_string(command_id_);
+  const bool removed = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr) == SQLITE_OK;
+  sqlite3_exec(db_, removed ? "COMMIT" : "ROLLBACK", nullptr, nullptr, nullptr);
+}
+
+Project::Edit Project::LongCommand::part() {
+  assert(db_ != nullptr && sqlite3_get_autocommit(db_) != 0 && "an Edit is already open");
+  sqlite::execute(db_, "BEGIN IMMEDIATE", file_);
+  Edit edit(db_, file_, command_id_, Edit::Kind::kPart);
+  if (!select_one(db_, file_,
+                  ("WHERE state = 'pending' AND id = " + std::to_string(command_id_)).c_str())) {
+    throw core::RuntimeFailure(file_, {},
+                               name_ +
+                                   " was removed from the project by another scanbench "
+                                   "while it was being written; nothing was stored");
+  }
+  return edit;
+}
+
+Project::Edit Project::LongCommand::finish() {
+  Edit edit = part();
+  edit.kind_ = Edit::Kind::kFinal;
+  check_revision(db_, file_, name_, revision_);
+  remove_abandoned(db_, file_);
+  end_redo_branch(db_, file_);
+  return edit;
+}
+
 void Project::Edit::commit(const std::string& result_json) {
-  assert(active() && "commit on a committed or moved-from Edit");
-  sqlite::Statement update(db_, "UPDATE commands SET result = ?2 WHERE id = ?1", file_);
+  assert(active() && (kind_ == Kind::kCommand || kind_ == Kind::kFinal) &&
+         "commit on a committed, moved-from or part Edit");
+  const std::string sql = std::string(
+                              "UPDATE commands SET result = ?2, state = 'done', seq = "
+                              "coalesce(seq, ") +
+                          kNextSeq + "), owner_host = NULL, owner_pid = NULL WHERE id = ?1";
+  sqlite::Statement update(db_, sql.c_str(), file_);
   update.bind_int(1, command_id_).bind_text(2, result_json).run();
-  sqlite::execute(db_, kBumpRevision, file_);
+  finish_transaction();
+}
+
+void Project::Edit::commit_part() {
+  assert(active() && kind_ == Kind::kPart && "commit_part on a committed or whole-command Edit");
+  finish_transaction();
+}
+
+void Project::Edit::finish_transaction() {
+  if (kind_ != Kind::kPart) sqlite::execute(db_, kBumpRevision, file_);
   sqlite::execute(db_, "COMMIT", file_);
   db_ = nullptr;
 }
 
 std::vector<CommandRecord> Project::history() const {
-  const std::string sql = std::string(kSelectCommands) + " ORDER BY id";
+  const std::string sql = std::string(kSelectCommands) + " ORDER BY seq IS NULL, seq, id";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   std::vector<CommandRecord> records;
   while (select.step()) records.push_back(read_command(select));
@@ -119,24 +218,26 @@ std::vector<CommandRecord> Project::history() const {
 
 std::optional<CommandRecord> Project::undo() {
   assert(sqlite3_get_autocommit(db()) != 0 && "undo while an Edit is open");
-  WriteLock lock(db(), file_name());
+  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
+  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal);
   std::optional<CommandRecord> last =
-      select_one(db(), file_name(), "WHERE state = 'done' ORDER BY id DESC LIMIT 1");
+      select_one(db(), file_name(), "WHERE state = 'done' ORDER BY seq DESC LIMIT 1");
   if (!last || !last->undoable) return std::nullopt;
   set_state(db(), file_name(), last->id, "undone");
-  lock.commit();
+  journal.finish_transaction();
   last->state = CommandState::kUndone;
   return last;
 }
 
 std::optional<CommandRecord> Project::redo() {
   assert(sqlite3_get_autocommit(db()) != 0 && "redo while an Edit is open");
-  WriteLock lock(db(), file_name());
+  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
+  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal);
   std::optional<CommandRecord> next =
-      select_one(db(), file_name(), "WHERE state = 'undone' ORDER BY id LIMIT 1");
+      select_one(db(), file_name(), "WHERE state = 'undone' ORDER BY seq LIMIT 1");
   if (!next) return std::nullopt;
   set_state(db(), file_name(), next->id, "done");
-  lock.commit();
+  journal.finish_transaction();
   next->state = CommandState::kDone;
   return next;
 }
@@ -144,11 +245,26 @@ std::optional<CommandRecord> Project::redo() {
 std::optional<std::string> Project::latest_result(std::string_view name) const {
   sqlite::Statement select(db(),
                            "SELECT result FROM commands WHERE name = ?1 AND state = 'done' "
-                           "ORDER BY id DESC LIMIT 1",
+                           "ORDER BY seq DESC LIMIT 1",
                            file_name());
   select.bind_text(1, name);
   if (!select.step()) return std::nullopt;
   return select.column_text(0);
+}
+
+Project::ReadSnapshot Project::read_snapshot() const {
+  assert(sqlite3_get_autocommit(db()) != 0 && "a snapshot inside an Edit");
+  sqlite::execute(db(), "BEGIN DEFERRED", file_name());
+  ReadSnapshot snapshot(db());
+  // Under write-ahead logging the snapshot is taken at the first read.
+  static_cast<void>(read_revision(db(), file_name()));
+  return snapshot;
+}
+
+Project::ReadSnapshot::~ReadSnapshot() {
+  if (db_ != nullptr && sqlite3_get_autocommit(db_) == 0) {
+    sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
+  }
 }
 
 }  // namespace scanbench::modeling

@@ -35,11 +35,36 @@ const TypeInfo& info(ElementType type) {
   return kTypes[0];
 }
 
-// The current version of layer (scan, name): the newest row of a done command.
+// The current version of layer (scan, name): the row of the newest done
+// command, in journal order.
 constexpr const char* kSelectCurrent = R"sql(
-SELECT element_type, element_count, codec, data FROM scan_layers
-WHERE scan_id = ?1 AND name = ?2 AND command_id IN (SELECT id FROM commands WHERE state = 'done')
-ORDER BY command_id DESC LIMIT 1)sql";
+SELECT l.element_type, l.element_count, l.codec, l.data
+FROM scan_layers l JOIN commands c ON c.id = l.command_id
+WHERE l.scan_id = ?1 AND l.name = ?2 AND c.state = 'done'
+ORDER BY c.seq DESC LIMIT 1)sql";
+
+// The layers whose name fixes their type (layers.hpp).
+struct KnownLayer {
+  const char* name;
+  ElementType type;
+};
+constexpr std::array<KnownLayer, 10> kKnownLayers = {{{layer::kRange, ElementType::kF32},
+                                                      {layer::kValid, ElementType::kU8},
+                                                      {layer::kIntensity, ElementType::kF32},
+                                                      {layer::kRgb, ElementType::kU8x3},
+                                                      {layer::kDirections, ElementType::kF32x3},
+                                                      {layer::kFootprint, ElementType::kF32},
+                                                      {layer::kNormal, ElementType::kF32x3},
+                                                      {layer::kConfidence, ElementType::kF32},
+                                                      {layer::kGeometryFlags, ElementType::kU8},
+                                                      {layer::kKeep, ElementType::kU8}}};
+
+[[maybe_unused]] bool has_its_type(const EncodedLayer& layer) {
+  for (const KnownLayer& known : kKnownLayers) {
+    if (layer.name == known.name) return layer.type == known.type;
+  }
+  return true;
+}
 
 [[noreturn]] void damaged(const std::string& file, std::int64_t id, std::string_view name,
                           const std::string& problem) {
@@ -78,8 +103,9 @@ EncodedLayer encode_layer_bytes(std::string name, ElementType type,
 
 void Project::put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer) {
   check_edit(edit);
-  [[maybe_unused]] const std::size_t n = stored_pixel_count(id);
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);
   assert(layer.element_count == n && "a layer holds one element per pixel");
+  assert(has_its_type(layer) && "a layer named in layers.hpp has the type listed there");
   sqlite::Statement insert(db(), R"sql(
 INSERT INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec, data)
 VALUES (?1, ?2, ?3, ?4, ?5, 'zstd', ?6)
@@ -96,6 +122,7 @@ ON CONFLICT (scan_id, name, command_id) DO UPDATE SET
 
 void Project::remove_layer(Edit& edit, std::int64_t id, std::string_view name) {
   check_edit(edit);
+  static_cast<void>(stored_pixel_count(id, &edit));  // no such scan: InputError
   const std::vector<std::string> present = layer_names(id);
   if (std::find(present.begin(), present.end(), name) == present.end()) return;
   sqlite::Statement insert(db(), R"sql(
@@ -132,11 +159,11 @@ bool Project::read_layer(
 
 std::vector<std::string> Project::layer_names(std::int64_t id) const {
   sqlite::Statement select(db(), R"sql(
-SELECT name FROM scan_layers l
-WHERE scan_id = ?1 AND codec != 'removed' AND command_id = (
-  SELECT max(command_id) FROM scan_layers v
-  WHERE v.scan_id = l.scan_id AND v.name = l.name
-    AND v.command_id IN (SELECT id FROM commands WHERE state = 'done'))
+SELECT name FROM (
+  SELECT l.name, l.codec, row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
+  FROM scan_layers l JOIN commands c ON c.id = l.command_id
+  WHERE l.scan_id = ?1 AND c.state = 'done')
+WHERE newest = 1 AND codec != 'removed'
 ORDER BY name)sql",
                            file_name());
   select.bind_int(1, id);

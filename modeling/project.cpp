@@ -41,10 +41,17 @@ void create_exclusively(const std::filesystem::path& file) {
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) {
     const int error = errno;
-    const std::string problem =
-        error == EEXIST ? "file already exists; a new project never overwrites a file"
-                        : std::string("cannot create the project: ") + std::strerror(error);
-    throw core::InputError(file.string(), {}, problem);
+    if (error == EEXIST) {
+      throw core::InputError(file.string(), {},
+                             "file already exists; a new project never overwrites a file");
+    }
+    const std::string problem = std::string("cannot create the project: ") + std::strerror(error);
+    // A missing folder or a bad name is the user's; a full, read-only or
+    // failing disk is the machine's.
+    if (error == ENOENT || error == ENOTDIR || error == EISDIR || error == ENAMETOOLONG) {
+      throw core::InputError(file.string(), {}, problem);
+    }
+    throw core::RuntimeFailure(file.string(), {}, problem);
   }
   ::close(fd);
 }
@@ -111,7 +118,8 @@ void Project::check_edit([[maybe_unused]] const Edit& edit) const {
 Project::Edit::Edit(Edit&& other) noexcept
     : db_(std::exchange(other.db_, nullptr)),
       file_(std::move(other.file_)),
-      command_id_(other.command_id_) {}
+      command_id_(other.command_id_),
+      kind_(other.kind_) {}
 
 Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
   if (this != &other) {
@@ -119,6 +127,7 @@ Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
     db_ = std::exchange(other.db_, nullptr);
     file_ = std::move(other.file_);
     command_id_ = other.command_id_;
+    kind_ = other.kind_;
   }
   return *this;
 }

@@ -3,15 +3,21 @@
 // them.
 //
 // Commands and undo: every change is a command (import, geometry, register,
-// merge, …) made through one Project::Edit, which records the command in the
-// journal and commits it with its effect in one transaction. Nothing is ever
+// merge, …) made through a Project::Edit, which records the command in the
+// journal and commits it with its effect in one transaction. Nothing is
 // overwritten: every row a command writes (a scan, a pose, a layer version)
-// carries the command's id, and what the project holds is, for each scan and
-// layer, the newest row of a command that is not undone. Undo marks the
-// newest done command undone; redo marks the oldest undone command done
-// again; a new command discards the undone ones (and, by cascade, their
-// rows). Undo and redo therefore work across processes and restore the
-// earlier state exactly. (docs/CONTRIBUTING.md shows how a stage uses this.)
+// carries the command's id, and what the project holds is, for each scan,
+// pose and layer, the row of the newest done command (newest by journal
+// order, `seq`). Undo marks the newest done command undone; redo marks the
+// oldest undone command done again; a new command discards the undone ones
+// (and, by cascade, their rows). Undo and redo therefore work across
+// processes and restore the earlier state exactly.
+//
+// Long commands (an import of many large scans) write in parts, each its
+// own short transaction, under a command in state "pending" whose rows no
+// reader sees; finishing it makes it done in one last transaction. A
+// pending command whose process died is removed by the next writer.
+// (docs/CONTRIBUTING.md shows how a stage uses this.)
 //
 // Durability: write-ahead-log mode with synchronous=FULL, so every committed
 // Edit survives a crash or power loss, and a process killed mid-edit leaves
@@ -32,6 +38,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "acquisition/scan.hpp"
@@ -60,11 +67,11 @@ struct StoredScanSummary {
   acquisition::ScanSummary summary;
 };
 
-enum class CommandState { kDone, kUndone };
+enum class CommandState { kPending, kDone, kUndone };
 
 // One journal entry.
 struct CommandRecord {
-  std::int64_t id = 0;   // increasing in the order the commands were applied
+  std::int64_t id = 0;   // increasing in the order the commands were begun; never reused
   std::string name;      // "import", "geometry", "register", "merge", "migrate", …
   std::string settings;  // JSON: the command's whole settings, enough to replay it
   std::string result;    // JSON: what it did (counts, report)
@@ -94,6 +101,8 @@ void remove_project_files(const std::filesystem::path& file);
 class Project {
  public:
   class Edit;
+  class LongCommand;
+  class ReadSnapshot;
 
   // Opens an existing project for reading and writing. Never creates or
   // recreates the file. Throws core::InputError, leaving the file untouched,
@@ -140,26 +149,27 @@ class Project {
   acquisition::Scan load_scan(std::int64_t id) const;
 
   // Stores a new scan (metadata, pose, summary, channel layers) as part of
-  // `edit` and returns its id.
+  // `edit` and returns its id, which no other scan of the project ever gets.
   std::int64_t insert_scan(Edit& edit, const EncodedScan& scan);
 
   // Moves scan `id` to scan.T_world_scan as part of `edit`: a new pose
-  // version with the scanner position (the pose's origin) and the world
-  // bounds of `scan`, which must be the stored scan with only its pose
-  // changed (asserted on size). Throws core::InputError when there is no
-  // such scan.
+  // version with the world bounds of `scan`, which must be the stored scan
+  // with only its pose changed (asserted on size, and a finite pose), and
+  // the scanner position carried along rigidly (T_new · T_old⁻¹ applied to
+  // the old one). Throws core::InputError when there is no such scan.
   void set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& scan);
 
   // ---- Layers (modeling/layers.hpp) -----------------------------------------
 
   // Writes a new version of layer `layer.name` of scan `id` as part of
-  // `edit`. Asserts the layer has one element per pixel of the scan; throws
-  // core::InputError when there is no such scan.
+  // `edit`. Asserts the layer has one element per pixel of the scan and,
+  // for the names layers.hpp lists, their type; throws core::InputError when
+  // there is no such scan.
   void put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer);
 
   // Removes layer `name` of scan `id` as part of `edit` (a version saying
   // "none": undo brings the earlier version back). No effect on a layer the
-  // scan does not have.
+  // scan does not have; throws core::InputError when there is no such scan.
   void remove_layer(Edit& edit, std::int64_t id, std::string_view name);
 
   // The current version of layer `name` of scan `id`, decoded into values
@@ -195,12 +205,23 @@ class Project {
   Edit begin_command(std::string_view name, const std::string& settings_json,
                      std::optional<std::int64_t> based_on_revision = std::nullopt);
 
-  // The journal, oldest first (undone commands included, after the done ones).
+  // Starts a command written in parts (see above): records it as pending,
+  // in a transaction of its own. `based_on_revision` is checked now and
+  // again when it finishes. Throws as begin_command.
+  LongCommand begin_long_command(std::string_view name, const std::string& settings_json,
+                                 std::optional<std::int64_t> based_on_revision = std::nullopt);
+
+  // Reads that must agree with each other (an export of masks, poses and
+  // channels) see one state of the project while the returned snapshot
+  // lives, whatever other processes commit meanwhile. Asserts no Edit is open.
+  ReadSnapshot read_snapshot() const;
+
+  // The journal in journal order (done, then undone; pending commands last).
   std::vector<CommandRecord> history() const;
 
   // Marks the newest done command undone, in one transaction, and returns
-  // it; none when there is nothing to undo (no command, or only the
-  // migration of an older project).
+  // it; none when there is nothing to undo: no done command, or the newest
+  // one is what an older project held before it had a journal.
   std::optional<CommandRecord> undo();
 
   // Marks the oldest undone command done again and returns it; none when
@@ -219,10 +240,14 @@ class Project {
   Project(std::filesystem::path file, Connection db);
   sqlite3* db() const;
   std::string file_name() const { return file_.string(); }
-  // rows × columns of live scan `id`; throws core::InputError when there is none.
-  std::size_t stored_pixel_count(std::int64_t id) const;
+  // rows × columns of live scan `id` (or one `edit` is creating); throws
+  // core::InputError when there is none.
+  std::size_t stored_pixel_count(std::int64_t id, const Edit* edit = nullptr) const;
   // Asserts that `edit` is open on this project.
   void check_edit(const Edit& edit) const;
+  // The summary of live scan `id` at its current pose; throws
+  // core::InputError when there is none.
+  StoredScanSummary current_summary(std::int64_t id) const;
   // Decodes the current version of a layer into the buffer `allocate`
   // returns for its size in bytes; false when there is none.
   bool read_layer(std::int64_t id, std::string_view name, ElementType type,
@@ -232,39 +257,100 @@ class Project {
   Connection db_;
 };
 
-// One command's write transaction: everything written through the Project
-// with this Edit lands in the file together with the command's journal
-// entry, or not at all. Rolled back on destruction unless committed. Must
-// not outlive its Project. The writing methods of Project take an Edit, so
-// no write can happen outside one.
+// One write transaction of a command: everything written through the
+// Project with this Edit lands in the file together, or not at all. Rolled
+// back on destruction unless committed. Must not outlive its Project. The
+// writing methods of Project take an Edit, so no write can happen outside one.
 class Project::Edit {
  public:
   Edit(Edit&& other) noexcept;
   Edit& operator=(Edit&& other) noexcept;
   ~Edit();
 
-  // The journal id of the command being recorded; rows written through this
-  // Edit carry it.
+  // The journal id of the command; rows written through this Edit carry it.
   std::int64_t command_id() const { return command_id_; }
 
-  // Stores `result_json` as the command's result and makes everything
-  // durable. Asserts the edit is still open. Throws core::RuntimeFailure
-  // when SQLite cannot commit (I/O error, disk full); the changes are then
-  // rolled back when the Edit is destroyed.
+  // For begin_command's Edit and LongCommand::finish's: stores `result_json`
+  // as the command's result, makes the command done (a long one now takes
+  // its place in the journal), and makes everything durable. Asserts the
+  // edit is open and of that kind. Throws core::RuntimeFailure when SQLite
+  // cannot commit (I/O error, disk full); the changes are then rolled back
+  // when the Edit is destroyed.
   void commit(const std::string& result_json);
+
+  // For LongCommand::part's Edit: makes the part durable; its rows stay
+  // invisible until the command finishes. Throws as commit.
+  void commit_part();
 
   // False once committed or moved from.
   bool active() const { return db_ != nullptr; }
 
  private:
   friend class Project;
-  Edit(sqlite3* db, std::string file, std::int64_t command_id)
-      : db_(db), file_(std::move(file)), command_id_(command_id) {}
+  enum class Kind { kCommand, kPart, kFinal, kJournal };
+  Edit(sqlite3* db, std::string file, std::int64_t command_id, Kind kind)
+      : db_(db), file_(std::move(file)), command_id_(command_id), kind_(kind) {}
+  // Advances the revision (all but parts) and commits.
+  void finish_transaction();
   void roll_back() noexcept;
 
   sqlite3* db_ = nullptr;
   std::string file_;
   std::int64_t command_id_ = 0;
+  Kind kind_ = Kind::kCommand;
+};
+
+// A pending command written in parts. Abandoned (removed with its rows) on
+// destruction unless finished. Must not outlive its Project.
+class Project::LongCommand {
+ public:
+  LongCommand(LongCommand&& other) noexcept;
+  LongCommand& operator=(LongCommand&&) = delete;
+  ~LongCommand();
+
+  std::int64_t command_id() const { return command_id_; }
+
+  // Opens the write transaction of the next part (BEGIN IMMEDIATE). Throws
+  // core::RuntimeFailure when the command is gone (removed as abandoned) or
+  // the lock is held too long. Asserts no Edit is open.
+  Edit part();
+
+  // Opens the last transaction: checks the revision the command was begun
+  // on (core::RuntimeFailure, and nothing becomes visible, when another
+  // process changed the project), ends the redo branch, and returns the
+  // Edit whose commit() makes the command done. The caller may write
+  // through it first. Once the returned Edit commits, the command is no
+  // longer abandoned on destruction.
+  Edit finish();
+
+ private:
+  friend class Project;
+  LongCommand(sqlite3* db, std::string file, std::int64_t command_id, std::string name,
+              std::optional<std::int64_t> revision)
+      : db_(db),
+        file_(std::move(file)),
+        command_id_(command_id),
+        name_(std::move(name)),
+        revision_(revision) {}
+
+  sqlite3* db_ = nullptr;
+  std::string file_;
+  std::int64_t command_id_ = 0;
+  std::string name_;
+  std::optional<std::int64_t> revision_;
+};
+
+// A read transaction (see Project::read_snapshot); ends on destruction.
+class Project::ReadSnapshot {
+ public:
+  ReadSnapshot(ReadSnapshot&& other) noexcept : db_(std::exchange(other.db_, nullptr)) {}
+  ReadSnapshot& operator=(ReadSnapshot&&) = delete;
+  ~ReadSnapshot();
+
+ private:
+  friend class Project;
+  explicit ReadSnapshot(sqlite3* db) : db_(db) {}
+  sqlite3* db_ = nullptr;
 };
 
 }  // namespace scanbench::modeling

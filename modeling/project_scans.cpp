@@ -48,8 +48,8 @@ enum Column : int {
   kBboxMaxZ,
 };
 
-// Every live scan (its import not undone) with its current pose: the newest
-// pose row of a done command.
+// Every live scan (its import done) with its current pose: the pose row of
+// the newest done command, in journal order.
 constexpr const char* kSelectScans = R"sql(
 SELECT s.id, s.name, s.rows, s.columns, s.angle_model,
        s.azimuth_start_rad, s.azimuth_step_rad, s.elevation_start_rad, s.elevation_step_rad,
@@ -58,8 +58,9 @@ SELECT s.id, s.name, s.rows, s.columns, s.angle_model,
        p.bbox_min_x, p.bbox_min_y, p.bbox_min_z, p.bbox_max_x, p.bbox_max_y, p.bbox_max_z
 FROM scans s JOIN scan_poses p ON p.scan_id = s.id
 WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
-  AND p.command_id = (SELECT max(q.command_id) FROM scan_poses q WHERE q.scan_id = s.id
-                      AND q.command_id IN (SELECT id FROM commands WHERE state = 'done')))sql";
+  AND p.command_id = (SELECT q.command_id FROM scan_poses q JOIN commands c ON c.id = q.command_id
+                      WHERE q.scan_id = s.id AND c.state = 'done'
+                      ORDER BY c.seq DESC LIMIT 1))sql";
 
 constexpr const char* kInsertScan = R"sql(
 INSERT INTO scans (created_by, name, rows, columns, angle_model, azimuth_start_rad,
@@ -218,12 +219,12 @@ EncodedScan encode_scan(const acquisition::Scan& scan) {
   return encoded;
 }
 
-std::size_t Project::stored_pixel_count(std::int64_t id) const {
+std::size_t Project::stored_pixel_count(std::int64_t id, const Edit* edit) const {
   sqlite::Statement statement(db(), R"sql(
 SELECT rows * columns FROM scans
-WHERE id = ?1 AND created_by IN (SELECT id FROM commands WHERE state = 'done'))sql",
+WHERE id = ?1 AND (created_by = ?2 OR created_by IN (SELECT id FROM commands WHERE state = 'done')))sql",
                               file_name());
-  statement.bind_int(1, id);
+  statement.bind_int(1, id).bind_int(2, edit != nullptr ? edit->command_id() : -1);
   if (!statement.step()) {
     throw core::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
   }
@@ -244,10 +245,25 @@ std::int64_t Project::insert_scan(Edit& edit, const EncodedScan& scan) {
 
 void Project::set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& scan) {
   check_edit(edit);
-  [[maybe_unused]] const std::size_t n = stored_pixel_count(id);  // throws when there is none
+  assert(scan.T_world_scan.matrix().allFinite() && "set_pose takes a finite pose");
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);  // throws when none
   assert(n == scan.pixel_count() && "set_pose takes the stored scan");
-  insert_pose(db(), file_name(), id, edit.command_id(), scan.T_world_scan,
-              scan.T_world_scan.translation(), acquisition::world_bounds(scan));
+  // The scanner moves with its scan: its position in the scan frame stays.
+  const StoredScanSummary before = current_summary(id);
+  const Eigen::Vector3d scanner_world = scan.T_world_scan * before.summary.T_world_scan.inverse() *
+                                        before.summary.scanner.position_world;
+  insert_pose(db(), file_name(), id, edit.command_id(), scan.T_world_scan, scanner_world,
+              acquisition::world_bounds(scan));
+}
+
+StoredScanSummary Project::current_summary(std::int64_t id) const {
+  const std::string sql = std::string(kSelectScans) + " AND s.id = ?1";
+  sqlite::Statement select(db(), sql.c_str(), file_name());
+  select.bind_int(1, id);
+  if (!select.step()) {
+    throw core::InputError(file_name(), {}, "no scan with id " + std::to_string(id));
+  }
+  return read_summary(select, file_name());
 }
 
 std::vector<StoredScanSummary> Project::scans() const {

@@ -163,29 +163,53 @@ CREATE TABLE merge_masks (
 // scans table keeps what an import fixes for good; poses move to
 // scan_poses and every per-pixel array (channels, geometry, keep masks) to
 // scan_layers, one version per command that wrote it (project.hpp).
-// Everything stored before the journal existed belongs to one "migrate"
-// command that cannot be undone (created only when there is such data);
-// the reports of earlier registration runs become "register" entries of the
-// journal, also not undoable. ?1: the schema version the file had.
+//
+// What an older project holds becomes journal entries that cannot be
+// undone, in the order it was made: "migrate" (id 1: the scans and their
+// current poses, at the project's creation time), "geometry" (id 2: the
+// geometry layers, with the settings and counts stored beside them), one
+// "register" per registration run (ids from 4, with its report), and
+// "merge" (id 3: the keep masks, with their settings). Each exists only when
+// there is such data. ?1: the schema version the file had.
 constexpr const char* kMigrate3To4 = R"sql(
 CREATE TABLE commands (
   id INTEGER PRIMARY KEY AUTOINCREMENT,  -- never reused: a journal id names one command for good
+  seq INTEGER UNIQUE,                    -- journal order, given when the command is done
   name TEXT NOT NULL,
   settings TEXT NOT NULL,
   result TEXT NOT NULL DEFAULT '{}',
-  state TEXT NOT NULL CHECK (state IN ('done', 'undone')),
+  state TEXT NOT NULL CHECK (state IN ('pending', 'done', 'undone')),
   undoable INTEGER NOT NULL CHECK (undoable IN (0, 1)),
-  created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+  owner_host TEXT,     -- pending: the host and process writing it
+  owner_pid INTEGER,
+  created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+  CHECK ((state = 'pending') = (seq IS NULL))
 );
-INSERT INTO commands (id, name, settings, result, state, undoable)
-  SELECT 1, 'migrate', '{"from_schema_version":' || ?1 || '}', '{}', 'done', 0
+INSERT INTO commands (id, seq, name, settings, result, state, undoable, created_at)
+  SELECT 1, 1, 'migrate', '{"from_schema_version":' || ?1 || '}', '{}', 'done', 0,
+         coalesce((SELECT value FROM meta WHERE key = 'created_at'),
+                  strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
   WHERE EXISTS (SELECT 1 FROM scans);
-INSERT INTO commands (name, settings, result, state, undoable, created_at)
-  SELECT 'register', settings, report, 'done', 0, created_at FROM registration_runs ORDER BY id;
+INSERT INTO commands (id, seq, name, settings, result, state, undoable, created_at)
+  SELECT 2, 2, 'geometry', (SELECT settings FROM scan_geometry ORDER BY scan_id LIMIT 1),
+         '{"scans":[' || group_concat('{"id":' || scan_id || ',"normals":' || normals ||
+                                      ',"mixed_pixels":' || mixed_pixels || ',"edge_pixels":' ||
+                                      edge_pixels || '}') || ']}',
+         'done', 0, max(computed_at)
+  FROM scan_geometry HAVING count(*) > 0;
+INSERT INTO commands (id, seq, name, settings, result, state, undoable, created_at)
+  SELECT 3 + row_number() OVER (ORDER BY id), 2 + row_number() OVER (ORDER BY id), 'register',
+         settings, report, 'done', 0, created_at
+  FROM registration_runs;
+INSERT INTO commands (id, seq, name, settings, result, state, undoable, created_at)
+  SELECT 3, 3 + (SELECT count(*) FROM registration_runs),
+         'merge', (SELECT settings FROM merge_masks ORDER BY scan_id LIMIT 1),
+         '{"kept":' || sum(kept_points) || '}', 'done', 0, max(computed_at)
+  FROM merge_masks HAVING count(*) > 0;
 
 ALTER TABLE scans RENAME TO scans_v3;
 CREATE TABLE scans (
-  id INTEGER PRIMARY KEY,
+  id INTEGER PRIMARY KEY AUTOINCREMENT,  -- never reused: a scan id names one scan for good
   created_by INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
   name TEXT NOT NULL,
   rows INTEGER NOT NULL CHECK (rows >= 0),
@@ -253,19 +277,19 @@ INSERT INTO scan_layers
          CASE channel WHEN 'rgb' THEN element_count / 3 ELSE element_count END, codec, data
   FROM scan_channels;
 INSERT INTO scan_layers
-  SELECT g.scan_id, 'footprint_m', 1, 'f32', s.rows * s.columns, 'zstd', g.footprint_m
+  SELECT g.scan_id, 'footprint_m', 2, 'f32', s.rows * s.columns, 'zstd', g.footprint_m
   FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
   UNION ALL
-  SELECT g.scan_id, 'normal', 1, 'f32x3', s.rows * s.columns, 'zstd', g.normal
+  SELECT g.scan_id, 'normal', 2, 'f32x3', s.rows * s.columns, 'zstd', g.normal
   FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
   UNION ALL
-  SELECT g.scan_id, 'confidence', 1, 'f32', s.rows * s.columns, 'zstd', g.confidence
+  SELECT g.scan_id, 'confidence', 2, 'f32', s.rows * s.columns, 'zstd', g.confidence
   FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
   UNION ALL
-  SELECT g.scan_id, 'geometry_flags', 1, 'u8', s.rows * s.columns, 'zstd', g.flags
+  SELECT g.scan_id, 'geometry_flags', 2, 'u8', s.rows * s.columns, 'zstd', g.flags
   FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
   UNION ALL
-  SELECT m.scan_id, 'keep', 1, 'u8', s.rows * s.columns, 'zstd', m.keep
+  SELECT m.scan_id, 'keep', 3, 'u8', s.rows * s.columns, 'zstd', m.keep
   FROM merge_masks m JOIN scans s ON s.id = m.scan_id;
 
 DROP TABLE scan_channels;
@@ -294,15 +318,22 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
   }
 }
 
-// Runs `steps` inside a transaction that ends with the project identity at
-// the current version, or rolls everything back.
+// Runs steps(version), with the schema version read under the write lock,
+// inside a transaction that ends with the project identity at the current
+// version, or rolls everything back. Nothing runs when another process
+// brought the file to the current version first.
 template <typename Steps>
 void in_versioned_transaction(sqlite3* db, const std::string& file, Steps steps) {
   const std::string identity = "PRAGMA application_id = " + std::to_string(kProjectApplicationId) +
                                "; PRAGMA user_version = " + std::to_string(kProjectSchemaVersion);
   sqlite::execute(db, "BEGIN IMMEDIATE", file);
   try {
-    steps();
+    const int version = read_schema_version(db, file);
+    if (version == kProjectSchemaVersion) {
+      sqlite::execute(db, "COMMIT", file);
+      return;
+    }
+    steps(version);
     sqlite::execute(db, identity.c_str(), file);
     sqlite::execute(db, "COMMIT", file);
   } catch (...) {
@@ -320,7 +351,8 @@ void migrate_from(sqlite3* db, int from_version, const std::string& file) {
 void enable_wal(sqlite3* db, const std::string& file) {
   sqlite::Statement statement(db, "PRAGMA journal_mode = WAL", file);
   if (!statement.step() || statement.column_text(0) != "wal") {
-    refuse(file, "cannot use write-ahead logging for this file (network file system?)");
+    throw core::RuntimeFailure(
+        file, {}, "cannot use write-ahead logging for this file (network file system?)");
   }
 }
 
@@ -336,7 +368,7 @@ void check_file_header(const std::filesystem::path& file) {
 
   std::array<char, 100> header{};
   std::ifstream in(file, std::ios::binary);
-  if (!in) refuse(name, "cannot read the project file");
+  if (!in) throw core::RuntimeFailure(name, {}, "cannot read the project file");
   in.read(header.data(), header.size());
   const auto got = in.gcount();
   if (got == 0) refuse(name, "file is empty, not a scanbench project");
@@ -363,7 +395,7 @@ void configure_connection(sqlite3* db, const std::string& file) {
 // every migration step, so each migration runs in every test that creates a
 // project.
 void create_schema(sqlite3* db, const std::string& file) {
-  in_versioned_transaction(db, file, [&] {
+  in_versioned_transaction(db, file, [&](int) {
     sqlite::execute(db, kCreateVersion1, file);
     migrate_from(db, 1, file);
     sqlite::Statement record(db, kRecordCreation, file);
@@ -378,10 +410,11 @@ void check_and_migrate(sqlite3* db, const std::string& file) {
   const int version = read_schema_version(db, file);
   check_identity(application_id, version, file);
   check_tables(db, file, kEveryVersionTables);
-  enable_wal(db, file);
   if (version < kProjectSchemaVersion) {
-    in_versioned_transaction(db, file, [&] { migrate_from(db, version, file); });
+    in_versioned_transaction(db, file, [&](int current) { migrate_from(db, current, file); });
   }
+  // After the migration: a refused migration leaves the file in its own mode.
+  enable_wal(db, file);
   check_tables(db, file, kCurrentTables);
 }
 

@@ -28,21 +28,25 @@ namespace scanbench::modeling::schema {
 void check_file_header(const std::filesystem::path& file);
 
 // Sets the per-connection settings every project connection needs: foreign
-// keys on, synchronous=FULL, busy timeout. Throws core::InputError.
+// keys on, synchronous=FULL, busy timeout. Throws as sqlite::throw_error.
 void configure_connection(sqlite3* db, const std::string& file);
 
 // Creates the current schema in the empty database `db` in one transaction
 // (version 1 script, then every migration step), then switches it to
 // write-ahead logging. The application id and version are
 // committed through the rollback journal, so they are in the main file even if
-// a -wal file is lost later. Throws core::InputError.
+// a -wal file is lost later. Throws as sqlite::throw_error, and
+// core::RuntimeFailure when the file system cannot do write-ahead logging.
 void create_schema(sqlite3* db, const std::string& file);
 
 // For a freshly opened existing project: repeats the identity checks on what
 // SQLite reads (a -wal file can hold a newer version than the main file's
-// header), checks the expected tables exist, turns on write-ahead logging if
-// it was off, and migrates an older schema to kProjectSchemaVersion in one
-// transaction. Throws core::InputError.
+// header), checks the expected tables exist, and migrates an older schema to
+// kProjectSchemaVersion in one transaction (then turns on write-ahead
+// logging if it was off, so a refused
+// migration leaves the file as it was). Throws core::InputError for a file
+// that is not a project of a version this build reads or is damaged, and as
+// sqlite::throw_error.
 void check_and_migrate(sqlite3* db, const std::string& file);
 
 // PRAGMA user_version.

@@ -22,6 +22,8 @@ LoadedScans load_scans(const Project& project, int threads, const char* stage,
                        core::Progress& progress) {
   LoadedScans loaded;
   const std::vector<StoredScanSummary> scans = project.scans();
+  if (scans.empty())
+    throw core::InputError(project.path().string(), {}, "the project has no scans");
   for (const StoredScanSummary& stored : scans) {
     progress.throw_if_cancelled(stage);
     std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);

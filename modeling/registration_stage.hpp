@@ -42,8 +42,8 @@ struct RegisterStageResult {
 // (earlier poses stay in the history), the report as the command's result,
 // and removes the now stale merge keep masks. A failed pair is reported, and
 // its scan keeps its pose relative to its target. Throws core::InputError
-// for a damaged project, a scan without geometry ("run scanbench geometry
-// first"), or picks that do not name the project's scans as the settings
+// for a damaged project, a project without scans, a scan without geometry
+// ("run scanbench geometry first"), or picks that do not name the project's scans as the settings
 // require; core::RuntimeFailure when another process changed the project
 // meanwhile; core::Cancelled when cancelled. The project is then unchanged.
 RegisterStageResult register_project(Project& project, const RegisterStageSettings& settings,

@@ -27,9 +27,18 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ScanFileSettings, ptx)
 }  // namespace scanbench::acquisition
 
 namespace scanbench::registration {
-NLOHMANN_JSON_SERIALIZE_ENUM(CoarseMethod, {{CoarseMethod::kNone, "none"},
-                                            {CoarseMethod::kPointPairs, "point_pairs"},
-                                            {CoarseMethod::kFeatures, "features"}})
+// The method's name as reports spell it (coarse_method_name).
+static void to_json(nlohmann::json& j, CoarseMethod method) {
+  j = coarse_method_name(method);
+}
+static void from_json(const nlohmann::json& j, CoarseMethod& method) {
+  const std::optional<CoarseMethod> named = coarse_method_from_name(j.get<std::string>());
+  if (!named) {
+    throw core::InputError("", {{}, {}, "key \"coarse\""},
+                           "unknown coarse method '" + j.get<std::string>() + "'");
+  }
+  method = *named;
+}
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SampleSettings, voxel_m, max_points)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(HypothesisSettings, draws, inlier_distance_m,
                                                 max_vertical_normal, scoring_matches, keep,

@@ -320,6 +320,14 @@ const char* coarse_method_name(CoarseMethod method) {
   return "";
 }
 
+std::optional<CoarseMethod> coarse_method_from_name(std::string_view name) {
+  for (const CoarseMethod method :
+       {CoarseMethod::kNone, CoarseMethod::kPointPairs, CoarseMethod::kFeatures}) {
+    if (name == coarse_method_name(method)) return method;
+  }
+  return std::nullopt;
+}
+
 const char* icp_start_name(IcpStart start) {
   return start == IcpStart::kCoarse ? "coarse" : "initial";
 }

@@ -5,8 +5,10 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "registration/feature_alignment.hpp"
@@ -31,6 +33,8 @@ enum class IcpStart {
 
 // "none", "point_pairs", "features": the names in reports and settings.
 const char* coarse_method_name(CoarseMethod method);
+// The method coarse_method_name names, or none for any other text.
+std::optional<CoarseMethod> coarse_method_from_name(std::string_view name);
 // "initial", "coarse".
 const char* icp_start_name(IcpStart start);
 

@@ -121,7 +121,7 @@ TEST(PcdReader, NonNumericValueReportsItsLine) {
   }
 }
 
-// A compressed body whose size word claims 4 GB must be refused before PCL
+// A compressed body whose size word claims 4 GB must be refused before the reader
 // allocates for it.
 TEST(PcdReader, RefusesCompressedBodyWhoseSizeWordLies) {
   const ScratchDir dir;
@@ -137,6 +137,26 @@ TEST(PcdReader, RefusesCompressedBodyWhoseSizeWordLies) {
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& e) {
     EXPECT_NE(e.problem().find("disagrees"), std::string::npos) << e.what();
+  }
+}
+
+// A compressed body whose LZF runs are damaged (a back reference before the
+// start) is refused, never followed out of the buffer.
+TEST(PcdReader, RefusesADamagedCompressedBody) {
+  const ScratchDir dir;
+  std::string bytes = test::read_file_bytes(fixture("good/pcd/organized_compressed.pcd"));
+  const std::string data_line = "DATA binary_compressed\n";
+  const std::size_t body = bytes.find(data_line) + data_line.size();
+  ASSERT_LT(body + 10, bytes.size());
+  bytes[body + 8] = static_cast<char>(0xff);  // first run: a back reference 8 KB back
+  bytes[body + 9] = static_cast<char>(0xff);
+  const auto path = dir / "damaged.pcd";
+  std::ofstream(path, std::ios::binary) << bytes;
+  try {
+    read_organized_pcd(path);
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(e.problem().find("damaged compressed body"), std::string::npos) << e.what();
   }
 }
 

@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "modeling/import_scans.hpp"
 #include "modeling/project.hpp"
+#include "modeling/project_test_support.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -51,8 +52,9 @@ TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
 }
 
-// Blocks the import after its first file: a kill there must leave the
-// project as it was (the write-phase kill is ProjectKill's business).
+// Blocks the import after its first file, whose two scans are then written
+// (committed parts of a pending command): a kill there must leave the
+// project as it was, and the next writer must clear what the dead import left.
 class PauseAfterFirstFile : public core::Progress {
  public:
   explicit PauseAfterFirstFile(int report_fd) : report_fd_(report_fd) {}
@@ -95,6 +97,18 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
   const acquisition::Scan kept =
       Project::open(project).load_scan(Project::open(project).scans()[0].id);
   EXPECT_EQ(kept.rows, 2);
+  // The dead import's committed parts are there but invisible ...
+  const auto raw_count = [&] {
+    return test::RawDatabase(project).text("SELECT count(*) FROM scans");
+  };
+  EXPECT_EQ(raw_count(), "3");
+  EXPECT_EQ(Project::open(project).history().back().state, CommandState::kPending);
+  // ... until the next writer removes them.
+  import_files(project, {fixture("good/ptx/tiny_color.ptx")});
+  EXPECT_EQ(raw_count(), "2");
+  for (const CommandRecord& c : Project::open(project).history()) {
+    EXPECT_EQ(c.state, CommandState::kDone) << c.id;
+  }
 }
 
 }  // namespace

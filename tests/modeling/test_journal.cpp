@@ -3,7 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
+#include <thread>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -22,6 +24,7 @@ using test::ScratchDir;
 using ::testing::HasSubstr;
 
 const std::vector<std::filesystem::path> kTwoScans{fixture("good/ptx/two_scans.ptx")};
+const std::vector<std::filesystem::path> kTinyColor{fixture("good/ptx/tiny_color.ptx")};
 
 acquisition::GeometrySettings small_windows() {
   acquisition::GeometrySettings settings;
@@ -149,6 +152,106 @@ TEST(Journal, ACancelledStageStoresNothing) {
   EXPECT_THROW(run_geometry_stage(project, small_windows(), cancel), core::Cancelled);
   EXPECT_EQ(project.history().size(), 1u);
   EXPECT_FALSE(load_geometry(project, 1).has_value());
+}
+
+TEST(Journal, ScanIdsAreNeverReused) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  const ImportResult first = import_scans(project, kTwoScans, {}, quiet);
+  project.undo();
+  const ImportResult second = import_scans(project, kTwoScans, {}, quiet);  // ends the redo branch
+  ASSERT_EQ(first.scan_ids.size(), 2u);
+  ASSERT_EQ(second.scan_ids.size(), 2u);
+  EXPECT_GT(second.scan_ids.front(), first.scan_ids.back());
+  EXPECT_THROW(project.load_scan(first.scan_ids.front()), core::InputError);
+}
+
+TEST(Journal, AnImportMakesTheEarlierKeepMasksStale) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  const ImportResult first = import_scans(project, kTwoScans, {}, quiet);
+  const std::int64_t id = first.scan_ids.front();
+  const std::vector<std::uint8_t> keep(project.load_scan(id).pixel_count(), 1);
+  {
+    Project::Edit edit = project.begin_command("merge", "{}");
+    project.put_layer(edit, id, encode_layer<std::uint8_t>(layer::kKeep, ElementType::kU8, keep));
+    edit.commit("{}");
+  }
+  import_scans(project, kTinyColor, {}, quiet);
+  EXPECT_FALSE(load_keep_mask(project, id).has_value());
+  project.undo();
+  EXPECT_EQ(load_keep_mask(project, id), keep);
+}
+
+// Imports a scan through another connection when the first scan is done:
+// another process writing while the stage computes.
+class WriteMeanwhile : public core::Progress {
+ public:
+  explicit WriteMeanwhile(std::filesystem::path file) : file_(std::move(file)) {}
+  void update(const core::ProgressStep& step) override {
+    if (step.done != 1) return;
+    Project other = Project::open(file_);
+    core::Progress quiet;
+    import_scans(other, kTinyColor, {}, quiet);
+  }
+
+ private:
+  std::filesystem::path file_;
+};
+
+TEST(Journal, AStageWhoseProjectChangedMeanwhileStoresNothing) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  Project project = Project::create(file);
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  WriteMeanwhile meanwhile(file);
+  try {
+    run_geometry_stage(project, small_windows(), meanwhile);
+    FAIL() << "expected core::RuntimeFailure";
+  } catch (const core::RuntimeFailure& error) {
+    EXPECT_THAT(error.what(), HasSubstr("changed while geometry was computing"));
+  }
+  EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "import"}));
+  for (const StoredScanSummary& stored : project.scans()) {
+    EXPECT_FALSE(load_geometry(project, stored.id).has_value()) << stored.id;
+  }
+  // The written parts went with the refused command.
+  EXPECT_EQ(test::RawDatabase(file).text("SELECT count(*) FROM scan_layers WHERE name = 'normal'"),
+            "0");
+}
+
+TEST(Journal, UndoStopsAtAnOlderProjectsHistory) {
+  const ScratchDir dir;
+  const auto file = dir / "old.sbproj";
+  std::filesystem::copy_file(fixture("projects/version2.sbproj"), file);
+  Project project = Project::open(file);
+  core::Progress quiet;
+  run_geometry_stage(project, small_windows(), quiet);
+  const std::optional<CommandRecord> undone = project.undo();
+  ASSERT_TRUE(undone.has_value());
+  EXPECT_EQ(undone->name, "geometry");
+  EXPECT_TRUE(undone->undoable);
+  EXPECT_FALSE(project.undo().has_value());  // the migrated geometry stays
+  EXPECT_TRUE(load_geometry(project, 1).has_value());
+}
+
+TEST(Journal, TwoProcessesMigratingOneFileAtOnceBothOpenIt) {
+  const ScratchDir dir;
+  const auto file = dir / "old.sbproj";
+  std::filesystem::copy_file(fixture("projects/version3.sbproj"), file);
+  std::vector<std::thread> openers;
+  std::atomic<int> opened{0};
+  for (int k = 0; k < 4; ++k) {
+    openers.emplace_back([&] {
+      if (Project::open(file).schema_version() == kProjectSchemaVersion) ++opened;
+    });
+  }
+  for (std::thread& t : openers) t.join();
+  EXPECT_EQ(opened.load(), 4);
+  EXPECT_EQ(Project::open(file).history().size(), 4u);  // migrated once
 }
 
 TEST(Journal, TheMigrationOfAnOlderProjectCannotBeUndone) {

@@ -96,17 +96,24 @@ TEST(Migration, VersionThreeKeepsPosesKeepMasksAndTheRegistrationReport) {
   // As `scanbench merge` reported when the fixture was made.
   EXPECT_EQ(count_ones(*load_keep_mask(project, 1)), 6803u);
   EXPECT_EQ(count_ones(*load_keep_mask(project, 2)), 6415u);
+  // What the project held, as the journal entries that made it, in order.
   const std::vector<CommandRecord> history = project.history();
-  ASSERT_EQ(history.size(), 2u);
+  ASSERT_EQ(history.size(), 4u);
   EXPECT_EQ(history[0].name, "migrate");
   EXPECT_THAT(history[0].settings, ::testing::HasSubstr("\"from_schema_version\":3"));
-  EXPECT_EQ(history[1].name, "register");
-  EXPECT_FALSE(history[1].undoable);
-  EXPECT_THAT(history[1].result, ::testing::HasSubstr("\"converged\":true"));
-  EXPECT_EQ(project.latest_result("register"), history[1].result);
+  EXPECT_EQ(history[1].name, "geometry");
+  EXPECT_THAT(history[1].settings, ::testing::HasSubstr("\"window_radius\":16"));
+  EXPECT_THAT(history[1].result, ::testing::HasSubstr("\"mixed_pixels\""));
+  EXPECT_EQ(history[2].name, "register");
+  EXPECT_THAT(history[2].result, ::testing::HasSubstr("\"converged\":true"));
+  EXPECT_EQ(history[3].name, "merge");
+  EXPECT_THAT(history[3].result, ::testing::HasSubstr("\"kept\":13218"));
+  for (const CommandRecord& c : history) EXPECT_FALSE(c.undoable) << c.name;
+  EXPECT_LE(history[0].created_at, history[1].created_at);
+  EXPECT_EQ(project.latest_result("register"), history[2].result);
   // The registered pose of the second scan (as the report has it), not the
   // perturbed one of its file.
-  const nlohmann::json report = nlohmann::json::parse(history[1].result);
+  const nlohmann::json report = nlohmann::json::parse(history[2].result);
   const nlohmann::json& pose = report["poses"][1];
   const Eigen::Isometry3d stored = project.scans()[1].summary.T_world_scan;
   for (int row = 0; row < 3; ++row) {

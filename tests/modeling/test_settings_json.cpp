@@ -62,6 +62,62 @@ TEST(SettingsJson, RegistrationWithPicksRoundTrips) {
   EXPECT_EQ(back.picks[0].pairs[0].target, Eigen::Vector3d(4.0, 5.0, 6.5));
 }
 
+// The number of fields of aggregate T: the most initializers T{…} takes
+// (each AnyField converts to whatever its field is).
+struct AnyField {
+  template <typename T>
+  operator T() const;  // never called: only asked about
+};
+
+template <typename T, typename... Fields>
+constexpr std::size_t field_count(Fields... fields) {
+  if constexpr (requires { T{fields..., AnyField{}}; }) {
+    return field_count<T>(fields..., AnyField{});
+  } else {
+    return sizeof...(Fields);
+  }
+}
+
+// Every field of S is in its JSON object `j`, but `threads`.
+template <typename S>
+void expect_whole(const nlohmann::json& j, const char* what) {
+  constexpr bool has_threads = requires(S s) {
+    s.threads;
+  };
+  EXPECT_EQ(j.size() + (has_threads ? 1 : 0), field_count<S>())
+      << what << ": a field is missing from modeling/settings_json.cpp";
+}
+
+TEST(SettingsJson, EveryFieldOfEveryStructIsWritten) {
+  const nlohmann::json geometry =
+      nlohmann::json::parse(settings_to_json(acquisition::GeometrySettings{}));
+  expect_whole<acquisition::GeometrySettings>(geometry, "GeometrySettings");
+  expect_whole<acquisition::RangeNoise>(geometry["range_noise"], "RangeNoise");
+  const nlohmann::json readers =
+      nlohmann::json::parse(settings_to_json(acquisition::ScanFileSettings{}));
+  expect_whole<acquisition::ScanFileSettings>(readers, "ScanFileSettings");
+  expect_whole<acquisition::PtxReadSettings>(readers["ptx"], "PtxReadSettings");
+  expect_whole<acquisition::LocalOriginSettings>(readers["ptx"]["grid"], "LocalOriginSettings");
+  expect_whole<acquisition::SphericalFitSettings>(readers["ptx"]["grid"]["angle_fit"],
+                                                  "SphericalFitSettings");
+  expect_whole<registration::MergeSettings>(
+      nlohmann::json::parse(settings_to_json(registration::MergeSettings{})), "MergeSettings");
+  RegisterStageSettings stage;
+  stage.picks.push_back({2, 1, {{}}});
+  stage.registration.picks.push_back({1, 0, {{}}});
+  const nlohmann::json register_ = nlohmann::json::parse(settings_to_json(stage));
+  const nlohmann::json& r = register_["registration"];
+  expect_whole<RegisterStageSettings>(register_, "RegisterStageSettings");
+  expect_whole<ProjectPicks>(register_["picks"][0], "ProjectPicks");
+  expect_whole<registration::RegistrationSettings>(r, "RegistrationSettings");
+  expect_whole<registration::PickedPairs>(r["picks"][0], "PickedPairs");
+  expect_whole<registration::FeatureSettings>(r["features"], "FeatureSettings");
+  expect_whole<registration::SampleSettings>(r["features"]["sample"], "SampleSettings");
+  expect_whole<registration::HypothesisSettings>(r["features"]["hypotheses"], "HypothesisSettings");
+  expect_whole<registration::IcpSettings>(r["icp"], "IcpSettings");
+  expect_whole<registration::GlobalSettings>(r["global"], "GlobalSettings");
+}
+
 TEST(SettingsJson, ThreadCountsAreNotPartOfTheSettings) {
   acquisition::GeometrySettings settings;
   settings.threads = 7;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "acquisition/simulation/random.hpp"
@@ -124,6 +125,46 @@ TEST(CoarseHypotheses, TheSameSeedGivesTheSameHypotheses) {
     differs = !a[i].T_target_source.isApprox(c[i].T_target_source, 0.0);
   }
   EXPECT_TRUE(differs);
+}
+
+// A general (tilted, turned) pose, which no levelled hypothesis explains.
+Eigen::Isometry3d general_pose() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(35.0 * kDeg, Eigen::Vector3d(0.3, -0.5, 1.0).normalized())
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(-3.0, 8.0, 1.2);
+  return T;
+}
+
+TEST(UnlevelledHypotheses, FindAGeneralPoseAmongMostlyWrongMatches) {
+  // A third right: one triple in 27 is all right, so 2000 draws find it.
+  const std::vector<FeatureMatch> matches = matches_of(general_pose(), 300, 600, 5);
+  const std::vector<PoseHypothesis> hypotheses = unlevelled_hypotheses(matches, 2000, 0.9, {});
+  ASSERT_FALSE(hypotheses.empty());
+  expect_pose(general_pose(), hypotheses[0], 1e-3, 1e-4);
+  EXPECT_GE(hypotheses[0].inliers, 300u);
+  EXPECT_LE(hypotheses[0].inliers, 310u);  // a wrong match may land near by chance
+}
+
+TEST(UnlevelledHypotheses, PreRejectionDropsTriplesOfUnlikeTriangles) {
+  // Only wrong matches: with similarity 1 (edge lengths must agree exactly)
+  // no triple of unrelated points survives to be fitted.
+  const std::vector<FeatureMatch> wrong = matches_of(general_pose(), 0, 500, 6);
+  EXPECT_TRUE(unlevelled_hypotheses(wrong, 2000, 1.0, {}).empty());
+  EXPECT_FALSE(unlevelled_hypotheses(wrong, 2000, 0.0, {}).empty());
+}
+
+TEST(UnlevelledHypotheses, TooFewMatchesGiveNoneAndTheSameSeedTheSameOnes) {
+  const std::vector<FeatureMatch> matches = matches_of(general_pose(), 30, 300, 7);
+  EXPECT_TRUE(unlevelled_hypotheses(std::span(matches).first(2), 100, 0.9, {}).empty());
+  EXPECT_TRUE(unlevelled_hypotheses(matches, 0, 0.9, {}).empty());
+  const std::vector<PoseHypothesis> a = unlevelled_hypotheses(matches, 500, 0.9, {});
+  const std::vector<PoseHypothesis> b = unlevelled_hypotheses(matches, 500, 0.9, {});
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].inliers, b[i].inliers);
+    EXPECT_TRUE(a[i].T_target_source.isApprox(b[i].T_target_source, 0.0));
+  }
 }
 
 TEST(CoarseHypotheses, NearlyEqualPosesCountOnce) {

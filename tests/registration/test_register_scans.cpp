@@ -159,7 +159,7 @@ TEST(RegisterScans, FeaturesRegisterScansWithoutAPoseGuess) {
   }
 }
 
-// Without the levelled-scanner assumption the hypotheses come from PCL's
+// Without the levelled-scanner assumption the hypotheses come from
 // three-match RANSAC, which rarely finds the pose on these repetitive
 // scenes; whatever it finds is verified the same way, so it is either near
 // the truth or reported failed, and ICP from the pose guess still registers.
@@ -187,7 +187,7 @@ TEST(RegisterScans, UnlevelledFeaturePosesAreNeverSilentlyWrong) {
 }
 
 // A scan against a copy of itself, guessed 40° and 4 m off: every feature
-// has its exact twin, so PCL's three-match RANSAC finds the pose, and its
+// has its exact twin, so three-match RANSAC finds the pose, and its
 // verification accepts it.
 TEST(RegisterScans, UnlevelledFeaturesFindAPoseWhenTheMatchesAreRight) {
   std::vector<PreparedScan> twins;
