@@ -288,6 +288,68 @@ nlohmann::json goals_json(const nlohmann::json& report) {
 
 }  // namespace
 
+namespace {
+
+// What every trial adds to, method by method.
+struct Tally {
+  OursErrors full, full_one_thread, pairwise, pairwise_one_thread;
+  MethodErrors pcl;
+  CoarseTally coarse;
+  double coarse_seconds = 0.0;
+};
+
+// Registers `site` from `trials` perturbed starts with every configuration
+// of ours and with PCL, adding to `tally`.
+void run_trials(const SiteScans& site, const Configurations& configurations,
+                const PclIcpSettings& pcl_settings, int trials, Tally& tally) {
+  for (int trial = 0; trial < trials; ++trial) {
+    const std::vector<Eigen::Isometry3d> initial = perturbed(site.truth(), trial);
+    const auto seed = static_cast<std::uint64_t>(trial) + 1;
+    const auto run = [&](registration::RegistrationSettings settings, OursErrors& errors) {
+      settings.features.hypotheses.seed = seed;
+      registration::RegistrationResult result =
+          registration::register_scans(site.prepared, initial, settings);
+      errors.add(site.truth(), result);
+      return result;
+    };
+    const registration::RegistrationResult result = run(configurations.full, tally.full);
+    run(configurations.full_one_thread, tally.full_one_thread);
+    const registration::RegistrationResult pairs = run(configurations.pairwise, tally.pairwise);
+    run(configurations.pairwise_one_thread, tally.pairwise_one_thread);
+    tally.coarse_seconds += result.coarse_seconds;
+    tally_coarse(site, result, tally.coarse);
+    tally.pcl.add(site.truth(), pcl_chain(site, initial, pairs, pcl_settings, tally.pcl));
+    ++tally.pcl.runs;
+  }
+}
+
+// The methods' figures and the speed ratios between them.
+nlohmann::json methods_json(const Tally& t, const PclIcpSettings& pcl_settings) {
+  nlohmann::json ours = t.full.json();
+  ours["coarse_success_rate"] =
+      t.coarse.pairs > 0 ? static_cast<double>(t.coarse.successes) / t.coarse.pairs : 0.0;
+  ours["coarse_accepted_but_wrong"] = t.coarse.wrong;
+  ours["coarse_seconds"] = ratio(t.coarse_seconds, t.full.errors.runs);
+  ours["trials"] = t.full.errors.runs;
+  nlohmann::json pcl = errors_json(t.pcl);
+  pcl["settings"] = settings_json(pcl_settings);
+  const double peer = t.pcl.seconds;
+  return {
+      {"ours", ours},
+      {"ours_one_thread", t.full_one_thread.json()},
+      {"ours_pairwise", t.pairwise.json()},
+      {"ours_pairwise_one_thread", t.pairwise_one_thread.json()},
+      {"pcl_icp_point_to_plane", pcl},
+      {"fine_speedup_vs_pcl", ratio(peer, t.full.errors.seconds)},
+      {"fine_speedup_vs_pcl_one_thread", ratio(peer, t.full_one_thread.errors.seconds)},
+      {"pairwise_speedup_vs_pcl", ratio(peer, t.pairwise.errors.seconds)},
+      {"pairwise_speedup_vs_pcl_one_thread", ratio(peer, t.pairwise_one_thread.errors.seconds)},
+      {"pairwise_icp_speedup_vs_pcl", ratio(peer, t.pairwise.icp_seconds)},
+      {"pairwise_icp_speedup_vs_pcl_one_thread", ratio(peer, t.pairwise_one_thread.icp_seconds)}};
+}
+
+}  // namespace
+
 nlohmann::json run_registration_bench(const BenchOptions& options) {
   sim::ScannerModel model;
   if (options.smoke) {
@@ -301,40 +363,11 @@ nlohmann::json run_registration_bench(const BenchOptions& options) {
                                              : std::vector<std::string>{"campus", "street"};
   const Configurations configurations = our_configurations();
   const PclIcpSettings pcl_settings = pcl_icp_settings(configurations.full.icp);
-  OursErrors full, full_one_thread, pairwise, pairwise_one_thread;
-  MethodErrors pcl;
-  CoarseTally coarse;
-  double coarse_seconds = 0.0;
+  Tally tally;
   for (const std::string& name : sites) {
     const SiteScans site = scan_site(name, model, scan_count, configurations.full.icp_sample);
-    for (int trial = 0; trial < trials_per_site; ++trial) {
-      const std::vector<Eigen::Isometry3d> initial = perturbed(site.truth(), trial);
-      const auto seed = static_cast<std::uint64_t>(trial) + 1;
-      const auto run = [&](registration::RegistrationSettings settings, OursErrors& errors) {
-        settings.features.hypotheses.seed = seed;
-        registration::RegistrationResult result =
-            registration::register_scans(site.prepared, initial, settings);
-        errors.add(site.truth(), result);
-        return result;
-      };
-      const registration::RegistrationResult result = run(configurations.full, full);
-      run(configurations.full_one_thread, full_one_thread);
-      const registration::RegistrationResult pairs = run(configurations.pairwise, pairwise);
-      run(configurations.pairwise_one_thread, pairwise_one_thread);
-      coarse_seconds += result.coarse_seconds;
-      tally_coarse(site, result, coarse);
-      pcl.add(site.truth(), pcl_chain(site, initial, pairs, pcl_settings, pcl));
-      ++pcl.runs;
-    }
+    run_trials(site, configurations, pcl_settings, trials_per_site, tally);
   }
-  nlohmann::json ours_json = full.json();
-  ours_json["coarse_success_rate"] =
-      coarse.pairs > 0 ? static_cast<double>(coarse.successes) / coarse.pairs : 0.0;
-  ours_json["coarse_accepted_but_wrong"] = coarse.wrong;
-  ours_json["coarse_seconds"] = ratio(coarse_seconds, full.errors.runs);
-  ours_json["trials"] = full.errors.runs;
-  nlohmann::json pcl_json = errors_json(pcl);
-  pcl_json["settings"] = settings_json(pcl_settings);
   nlohmann::json report = {
       {"suite", "registration"},
       {"sites", sites},
@@ -344,20 +377,8 @@ nlohmann::json run_registration_bench(const BenchOptions& options) {
       {"threads", core::worker_count(0)},
       {"max_initial_error",
        {{"rotation_deg", kMaxRotationErrorDeg}, {"translation_m", kMaxTranslationErrorM}}},
-      {"ours", ours_json},
-      {"ours_one_thread", full_one_thread.json()},
-      {"ours_pairwise", pairwise.json()},
-      {"ours_pairwise_one_thread", pairwise_one_thread.json()},
-      {"pcl_icp_point_to_plane", pcl_json},
-      {"fine_speedup_vs_pcl", ratio(pcl.seconds, full.errors.seconds)},
-      {"fine_speedup_vs_pcl_one_thread", ratio(pcl.seconds, full_one_thread.errors.seconds)},
-      {"pairwise_speedup_vs_pcl", ratio(pcl.seconds, pairwise.errors.seconds)},
-      {"pairwise_speedup_vs_pcl_one_thread",
-       ratio(pcl.seconds, pairwise_one_thread.errors.seconds)},
-      {"pairwise_icp_speedup_vs_pcl", ratio(pcl.seconds, pairwise.icp_seconds)},
-      {"pairwise_icp_speedup_vs_pcl_one_thread",
-       ratio(pcl.seconds, pairwise_one_thread.icp_seconds)},
       {"speedup_goal", kSpeedupGoal}};
+  report.update(methods_json(tally, pcl_settings));
   report["goals"] = goals_json(report);
   return report;
 }

@@ -161,7 +161,7 @@ RegisterStageResult register_project(Project& project, const RegisterStageSettin
   for (const acquisition::Scan& scan : loaded.scans) initial.push_back(scan.T_world_scan);
   RegisterStageResult out;
   out.ids = loaded.ids;
-  out.result = registration::register_scans(loaded.prepared, initial, run);
+  out.result = registration::register_scans(loaded.prepared, initial, run, &progress);
   out.report_json = report_json(out.result, loaded.ids, loaded.scans);
   progress.throw_if_cancelled(kStage);
 

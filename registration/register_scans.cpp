@@ -334,10 +334,17 @@ const char* icp_start_name(IcpStart start) {
 
 RegistrationResult register_scans(std::span<const PreparedScan> scans,
                                   std::span<const Eigen::Isometry3d> initial_T_world_scan,
-                                  const RegistrationSettings& settings) {
+                                  const RegistrationSettings& settings, core::Progress* progress) {
   assert(scans.size() == initial_T_world_scan.size() && !scans.empty());
   const Clock::time_point start = Clock::now();
   const std::size_t n = scans.size();
+  std::size_t done = 0;
+  const std::size_t units = 2 * n;  // scans made ready, pairs, the global refinement
+  const auto step = [&](const std::string& note) {
+    if (progress == nullptr) return;
+    progress->update({"register", ++done, units, note});
+    progress->throw_if_cancelled("register");
+  };
   std::vector<SampleCloud> samples;
   std::vector<FeatureCloud> features;
   for (const PreparedScan& scan : scans) {
@@ -345,6 +352,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
     if (settings.coarse == CoarseMethod::kFeatures) {
       features.emplace_back(sample_scan(scan, settings.features.sample), settings.features);
     }
+    step("features of " + scan.scan->name);
   }
   RegistrationResult result;
   result.coarse_seconds = core::seconds_since(start);
@@ -371,6 +379,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
     result.coarse_seconds += pair.coarse.seconds;
     result.fine_seconds += pair.seconds - pair.coarse.seconds;
     result.pairs.push_back(std::move(pair));
+    step("registered " + scans[k].scan->name);
   }
 
   const std::vector<ScanEdge> edges =
@@ -382,6 +391,7 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
     result.fine_seconds += result.global.seconds;
   }
   report_edges(scans, samples, T_first_scan, edges, settings, result);
+  step("global refinement");
 
   for (std::size_t k = 0; k < n; ++k) {
     result.T_world_scan.push_back(initial_T_world_scan[0] * T_first_scan[k]);

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "registration/feature_alignment.hpp"
 #include "registration/global_refinement.hpp"
 #include "registration/icp.hpp"
@@ -133,9 +134,12 @@ struct RegistrationResult {
 // one per scan; asserted). The first scan is the reference and keeps its
 // pose. For kPointPairs, asserts a pick for every later scan (the caller
 // validates user input first). Non-convergence and failed pairs are fields
-// of the result, not errors.
+// of the result, not errors. With `progress`, reports one unit per scan
+// made ready, per pair and for the global refinement, and throws
+// core::Cancelled between them once cancellation is requested.
 RegistrationResult register_scans(std::span<const PreparedScan> scans,
                                   std::span<const Eigen::Isometry3d> initial_T_world_scan,
-                                  const RegistrationSettings& settings);
+                                  const RegistrationSettings& settings,
+                                  core::Progress* progress = nullptr);
 
 }  // namespace scanbench::registration

@@ -12,6 +12,7 @@
 #include "modeling/geometry_stage.hpp"
 #include "modeling/import_scans.hpp"
 #include "modeling/project.hpp"
+#include "modeling/registration_stage.hpp"
 #include "modeling/scan_layers.hpp"
 #include "project_test_support.hpp"
 #include "support/test_support.hpp"
@@ -152,6 +153,19 @@ TEST(Journal, ACancelledStageStoresNothing) {
   EXPECT_THROW(run_geometry_stage(project, small_windows(), cancel), core::Cancelled);
   EXPECT_EQ(project.history().size(), 1u);
   EXPECT_FALSE(load_geometry(project, 1).has_value());
+}
+
+TEST(Journal, ACancelledRegistrationStoresNothing) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  run_geometry_stage(project, small_windows(), quiet);
+  RegisterStageSettings settings;
+  settings.registration.coarse = registration::CoarseMethod::kNone;
+  CancelAfter cancel(3);  // past loading the two scans, inside the registration
+  EXPECT_THROW(register_project(project, settings, cancel), core::Cancelled);
+  EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "geometry"}));
 }
 
 TEST(Journal, ScanIdsAreNeverReused) {
