@@ -12,8 +12,10 @@ namespace scanbench::acquisition {
 
 class OutputFile {
  public:
-  // Creates "<target>.partial"; throws std::runtime_error naming the file
-  // when it cannot be created.
+  // Creates "<target>.partial" (replacing what a killed run of the same
+  // export left under that name). Throws core::InputError when `target` is
+  // empty, a directory or an existing file that is not a regular file, and
+  // std::runtime_error naming the file when it cannot be created.
   explicit OutputFile(std::filesystem::path target);
   // Removes the temporary file unless commit() succeeded.
   ~OutputFile();
@@ -22,7 +24,11 @@ class OutputFile {
 
   // Buffered; throws std::runtime_error on a write error (disk full).
   void write(std::string_view bytes);
-  // Flushes, closes and renames onto the target.
+  // Flushes and closes the temporary file; throws std::runtime_error on a
+  // write error. Outputs that belong together (a triplet) close all before
+  // any replaces its target, so a full disk leaves none of them behind.
+  void close();
+  // close() when still open, then renames onto the target.
   void commit();
 
   // Appends to an internal buffer that is flushed in large blocks: the text
@@ -37,6 +43,7 @@ class OutputFile {
   std::filesystem::path target_;
   std::filesystem::path partial_;
   std::FILE* file_ = nullptr;
+  bool closed_ = false;  // closed, not yet renamed: the partial file is still there
   std::string buffer_;
 };
 

@@ -17,6 +17,7 @@
 #include "acquisition/lzf.hpp"
 #include "acquisition/pcd_header.hpp"
 #include "acquisition/text_lines.hpp"
+#include "core/memory.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -204,23 +205,56 @@ std::vector<std::uint8_t> read_compressed_body(const Body& source, const PcdHead
   return body;
 }
 
-Scan to_scan(const std::vector<std::uint8_t>& body, const PcdHeader& h, const Fields& f) {
+// Coordinates beyond this [m] are no place on or near the Earth: a corrupt
+// value, refused before it makes a range that no float holds.
+constexpr double kMaxCoordinateM = 1e8;
+
+// Refuses a point whose values do not fit what the scan stores.
+void check_fits(TextLineReader& reader, const Eigen::Vector3d& p, double intensity, std::size_t i,
+                const PcdHeader& h) {
+  const auto where = [&] {
+    return "point " + std::to_string(i) + " (row " + std::to_string(i / h.width) + ", col " +
+           std::to_string(i % h.width) + "): ";
+  };
+  if (p.allFinite() && p.cwiseAbs().maxCoeff() > kMaxCoordinateM) {
+    reader.fail(where() + "coordinate beyond 10^8 m (a corrupt value?)");
+  }
+  if (std::abs(intensity) > std::numeric_limits<float>::max()) {
+    reader.fail(where() + "intensity does not fit a float");
+  }
+}
+
+// x, y, z of one point: the common 4-byte floats read directly.
+Eigen::Vector3d coordinates(const std::uint8_t* point, const Fields& f, bool floats) {
+  if (floats) {
+    float v[3];
+    std::memcpy(&v[0], point + f.x->offset, 4);
+    std::memcpy(&v[1], point + f.y->offset, 4);
+    std::memcpy(&v[2], point + f.z->offset, 4);
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  return {value_at(point + f.x->offset, *f.x), value_at(point + f.y->offset, *f.y),
+          value_at(point + f.z->offset, *f.z)};
+}
+
+Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, const PcdHeader& h,
+             const Fields& f) {
   Scan scan = make_empty_scan(static_cast<int>(h.height), static_cast<int>(h.width),
                               f.intensity != nullptr, f.rgb != nullptr);
   const std::size_t n = scan.pixel_count();
+  const bool floats = f.x->size == 4 && f.y->size == 4 && f.z->size == 4;
   std::vector<Eigen::Vector3d> points(n, Eigen::Vector3d::Zero());
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* point = body.data() + i * h.point_step;
-    const Eigen::Vector3d p(value_at(point + f.x->offset, *f.x),
-                            value_at(point + f.y->offset, *f.y),
-                            value_at(point + f.z->offset, *f.z));
+    const Eigen::Vector3d p = coordinates(point, f, floats);
+    const double intensity =
+        f.intensity != nullptr ? value_at(point + f.intensity->offset, *f.intensity) : 0.0;
+    check_fits(reader, p, intensity, i, h);
     if (p.allFinite() && !p.isZero(0.0)) {
       points[i] = p;
       scan.valid[i] = 1;
     }
-    if (f.intensity != nullptr) {
-      scan.intensity[i] = static_cast<float>(value_at(point + f.intensity->offset, *f.intensity));
-    }
+    if (f.intensity != nullptr) scan.intensity[i] = static_cast<float>(intensity);
     if (f.rgb != nullptr) {
       std::uint32_t packed = 0;  // the bits of the field, whatever its declared type
       std::memcpy(&packed, point + f.rgb->offset, 4);
@@ -249,6 +283,12 @@ Scan read_organized_pcd(const std::filesystem::path& path) {
   if (reader.file_size() == 0) reader.fail("empty file");
   const PcdHeader header = read_pcd_header(reader);
   const Fields fields = check_fields(reader, header);
+  // The body (twice while a compressed one is decoded), then the scan and
+  // the points in double: about 48 bytes per pixel beside the body.
+  const std::uint64_t body_bytes = header.points * header.point_step;
+  core::check_memory(
+      (header.data == PcdData::kBinaryCompressed ? 2 : 1) * body_bytes + 48 * header.points,
+      reader.file_name());
   std::vector<std::uint8_t> body;
   switch (header.data) {
     case PcdData::kAscii:
@@ -261,7 +301,7 @@ Scan read_organized_pcd(const std::filesystem::path& path) {
       body = read_compressed_body({reader, path}, header);
       break;
   }
-  Scan scan = to_scan(body, header, fields);
+  Scan scan = to_scan(reader, body, header, fields);
   const std::u8string stem = path.stem().u8string();
   const std::u8string utf8 = path.u8string();
   scan.name = std::string(stem.begin(), stem.end());

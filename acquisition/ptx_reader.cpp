@@ -3,16 +3,22 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "acquisition/local_origin.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/text_lines.hpp"
+#include "core/memory.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
 constexpr std::int64_t kMaxDimension = 1'000'000;
+// Coordinates beyond this [m] are no place on or near the Earth (geocentric
+// coordinates stay within 10^7 m): a corrupt value, refused before it makes a
+// range that no float holds.
+constexpr double kMaxCoordinateM = 1e8;
 constexpr std::int64_t kMaxPixels = std::int64_t{1} << 31;
 constexpr std::uint64_t kMinPointLineBytes = 8;  // "0 0 0 0\n"
 
@@ -91,6 +97,13 @@ void read_points(TextLineReader& reader, Scan& scan, std::vector<Eigen::Vector3d
     }
     const int fields = parse_numbers(line, v);
     if (fields < 0) reader.fail("non-numeric, NaN or infinite value in a point line");
+    if (std::abs(v[0]) > kMaxCoordinateM || std::abs(v[1]) > kMaxCoordinateM ||
+        std::abs(v[2]) > kMaxCoordinateM) {
+      reader.fail("coordinate beyond 10^8 m (a corrupt value?)");
+    }
+    if (std::abs(v[3]) > std::numeric_limits<float>::max()) {
+      reader.fail("intensity does not fit a float");
+    }
     if (expected_fields == 0) {
       if (fields != 4 && fields != 7) {
         reader.fail("a point line needs 4 (x y z intensity) or 7 (with r g b) fields, found " +
@@ -143,6 +156,9 @@ void read_ptx(const std::filesystem::path& path, const PtxReadSettings& settings
                   " points cannot fit in the " + std::to_string(remaining) +
                   " bytes left in the file (truncated file or wrong header)");
     }
+    // The scan's channels and colour, and the points in double while the
+    // angle model is fitted: 48 bytes per pixel at most.
+    core::check_memory(static_cast<std::uint64_t>(rows * columns) * 48, reader.file_name());
     Scan scan = make_empty_scan(static_cast<int>(rows), static_cast<int>(columns), true, false);
     scan.name = scan_index == 0 ? stem : stem + "-" + std::to_string(scan_index + 1);
     scan.scanner.source_file = path.string();

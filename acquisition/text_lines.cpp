@@ -18,8 +18,14 @@ bool is_blank(char c) {
 
 TextLineReader::TextLineReader(const std::filesystem::path& path) : file_name_(path.string()) {
   std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
+  const auto status = std::filesystem::status(path, error);
+  if (std::filesystem::is_directory(status)) {
     throw core::InputError(file_name_, {}, "is a directory, not a file");
+  }
+  // A pipe with no writer would block the read forever, and a device has no
+  // end: only regular files are scan files.
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    throw core::InputError(file_name_, {}, "is not a regular file (a pipe or a device)");
   }
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) {

@@ -20,7 +20,8 @@ namespace scanbench::acquisition {
 
 class TextLineReader {
  public:
-  // Opens `path`; throws InputError when it cannot be opened or is a directory.
+  // Opens `path`; throws InputError when it cannot be opened, is a directory,
+  // or is not a regular file (a pipe would block, a device never ends).
   explicit TextLineReader(const std::filesystem::path& path);
   ~TextLineReader();
   TextLineReader(const TextLineReader&) = delete;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
@@ -15,6 +16,7 @@
 
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -102,14 +104,17 @@ core::InputError overflow_error(const std::string& file, const std::string& text
     if (at != std::string::npos) position.byte_offset = at;
   }
   return core::InputError(file, position,
-                          "sidecar holds a number that is not finite (" + what + ")");
+                          "sidecar holds a number that is not finite (too large for a double)");
 }
 
 Sidecar parse_sidecar(const fs::path& path) {
   Sidecar sidecar{.path = path, .file = utf8(path), .root = {}};
-  if (!fs::is_regular_file(path)) {
-    throw core::InputError(sidecar.file, {},
-                           fs::exists(path) ? "sidecar is not a file" : "sidecar file is missing");
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (!fs::is_regular_file(status)) {
+    throw core::InputError(
+        sidecar.file, {},
+        fs::exists(status) ? "sidecar is not a regular file" : "sidecar file is missing");
   }
   std::ifstream in(path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -119,8 +124,10 @@ Sidecar parse_sidecar(const fs::path& path) {
   } catch (const json::parse_error& e) {
     core::FilePosition position;
     position.byte_offset = e.byte > 0 ? e.byte - 1 : 0;  // nlohmann counts from 1
-    throw core::InputError(sidecar.file, position,
-                           std::string("sidecar is not valid JSON (") + e.what() + ")");
+    const std::size_t at = std::min<std::size_t>(*position.byte_offset, text.size());
+    position.line =
+        1 + static_cast<std::uint64_t>(std::count(text.begin(), text.begin() + at, '\n'));
+    throw core::InputError(sidecar.file, position, "sidecar is not valid JSON (syntax error)");
   } catch (const json::out_of_range& e) {
     throw overflow_error(sidecar.file, text, e);
   }
@@ -161,6 +168,21 @@ SphericalAngles read_angles(const Sidecar& s) {
                       .elevation_step_rad = get("elevation_step_rad")};
   if (out.azimuth_step_rad == 0.0) s.fail("angles.azimuth_step_rad", "step must not be zero");
   if (out.elevation_step_rad == 0.0) s.fail("angles.elevation_step_rad", "step must not be zero");
+  // Every direction the grid names must be an angle: beyond these, sines and
+  // cosines of start + k · step are no longer numbers to trust (1e308 · k is
+  // not even finite).
+  constexpr double kTurn = 2.0 * std::numbers::pi;
+  for (const auto& [key, value] : {std::pair{"azimuth_step_rad", out.azimuth_step_rad},
+                                   std::pair{"elevation_step_rad", out.elevation_step_rad}}) {
+    if (std::abs(value) > kTurn)
+      s.fail(std::string("angles.") + key, "step is more than a full turn");
+  }
+  for (const auto& [key, value] : {std::pair{"azimuth_start_rad", out.azimuth_start_rad},
+                                   std::pair{"elevation_start_rad", out.elevation_start_rad}}) {
+    if (std::abs(value) > 2.0 * kTurn) {
+      s.fail(std::string("angles.") + key, "start is more than two turns from zero");
+    }
+  }
   return out;
 }
 
@@ -234,8 +256,18 @@ Image load_image(const Sidecar& s, const std::string& name, const std::string& k
   const fs::path path = s.path.parent_path() / fs::path(std::u8string(name.begin(), name.end()));
   Image image{.file = utf8(path), .pixels = {}};
   const core::FilePosition where = at_detail("named by key \"" + key + ".file\" of the sidecar");
-  if (!fs::is_regular_file(path))
-    throw core::InputError(image.file, where, "image file is missing");
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (error && error != std::errc::no_such_file_or_directory) {
+    // ENAMETOOLONG and the like: the name in the sidecar is the problem.
+    s.fail(key + ".file", "cannot be an image file name (" + error.message() + ")");
+  }
+  if (!fs::exists(status)) throw core::InputError(image.file, where, "image file is missing");
+  if (!fs::is_regular_file(status)) {
+    throw core::InputError(image.file, where,
+                           fs::is_directory(status) ? "is a directory, not an image file"
+                                                    : "is not a regular file (a pipe or a device)");
+  }
   try {
     image.pixels = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception&) {
@@ -385,6 +417,8 @@ Scan read_triplet(const std::filesystem::path& sidecar_json) {
   const Eigen::Vector3d position = read_position(s, pose);
   const std::string name = optional_string(s, "name", utf8(sidecar_json.stem()));
   const std::string scanner = optional_string(s, "scanner", "");
+  // Decoded images (up to 8 bytes a pixel each, three of them) and the scan.
+  core::check_memory(static_cast<std::uint64_t>(grid.rows) * grid.columns * 40, s.file);
   const Channels channels = load_channels(s, grid);
   Scan scan = make_empty_scan(grid.rows, grid.columns, channels.intensity.has_value(),
                               channels.color.has_value());

@@ -169,15 +169,16 @@ void write_triplet(const Scan& scan, const std::filesystem::path& sidecar_json,
   // Encode everything first: an unencodable range must not leave half a triplet.
   const cv::Mat range = float32 ? encode_range_float(scan) : encode_range_uint16(scan, settings);
   const std::string stem = utf8(sidecar_json.stem());
-  const fs::path folder = sidecar_json.parent_path();
+  const std::vector<fs::path> paths = triplet_files(scan, sidecar_json, settings);
   std::vector<std::pair<fs::path, std::string>> files;
-  const auto add_image = [&](const std::string& name, const cv::Mat& image) {
-    const fs::path path = folder / from_utf8(stem + name);
+  std::size_t next = 0;
+  const auto add_image = [&](const cv::Mat& image) {
+    const fs::path& path = paths[next++];
     files.emplace_back(path, encode_image(path, image));
   };
-  add_image(float32 ? "_range.tiff" : "_range.png", range);
-  if (scan.has_intensity()) add_image("_intensity.png", encode_intensity(scan));
-  if (scan.has_color()) add_image("_color.png", encode_color(scan));
+  add_image(range);
+  if (scan.has_intensity()) add_image(encode_intensity(scan));
+  if (scan.has_color()) add_image(encode_color(scan));
   files.emplace_back(sidecar_json, make_sidecar(scan, stem, settings).dump(2) + "\n");
   // Every file is written in full beside its target before any replaces it,
   // the sidecar last: a failure leaves the old triplet (or nothing) behind.
@@ -186,7 +187,21 @@ void write_triplet(const Scan& scan, const std::filesystem::path& sidecar_json,
     outputs.push_back(std::make_unique<OutputFile>(path));
     outputs.back()->write(bytes);
   }
+  for (auto& output : outputs) output->close();  // all on disk before any replaces its target
   for (auto& output : outputs) output->commit();
+}
+
+std::vector<std::filesystem::path> triplet_files(const Scan& scan,
+                                                 const std::filesystem::path& sidecar_json,
+                                                 const TripletWriteSettings& settings) {
+  const std::string stem = utf8(sidecar_json.stem());
+  const fs::path folder = sidecar_json.parent_path();
+  const bool float32 = settings.range_encoding == Encoding::kFloat32;
+  std::vector<fs::path> paths{folder / from_utf8(stem + (float32 ? "_range.tiff" : "_range.png"))};
+  if (scan.has_intensity()) paths.push_back(folder / from_utf8(stem + "_intensity.png"));
+  if (scan.has_color()) paths.push_back(folder / from_utf8(stem + "_color.png"));
+  paths.push_back(sidecar_json);
+  return paths;
 }
 
 }  // namespace scanbench::acquisition

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <vector>
 
 #include "acquisition/scan.hpp"
 
@@ -38,5 +39,10 @@ struct TripletWriteSettings {
 // A failure to write a file throws std::runtime_error naming that file.
 void write_triplet(const Scan& scan, const std::filesystem::path& sidecar_json,
                    const TripletWriteSettings& settings = {});
+
+// The files write_triplet writes for `scan`: its images, then the sidecar.
+std::vector<std::filesystem::path> triplet_files(const Scan& scan,
+                                                 const std::filesystem::path& sidecar_json,
+                                                 const TripletWriteSettings& settings = {});
 
 }  // namespace scanbench::acquisition

@@ -70,7 +70,7 @@ nlohmann::json to_json(const modeling::CommandRecord& c) {
 }
 
 void run_history(const HistoryOptions& options) {
-  const modeling::Project project = modeling::Project::open(options.project);
+  const modeling::Project project = modeling::Project::open_for_reading(options.project);
   const std::vector<modeling::CommandRecord> history = project.history();
   if (options.json) {
     nlohmann::json commands = nlohmann::json::array();

@@ -30,7 +30,7 @@ struct Entry {
 
 std::vector<Entry> project_entries(const std::filesystem::path& path) {
   std::vector<Entry> entries;
-  for (auto& stored : modeling::Project::open(path).scans()) {
+  for (auto& stored : modeling::Project::open_for_reading(path).scans()) {
     entries.push_back({stored.id, std::move(stored.summary)});
   }
   return entries;
@@ -98,7 +98,8 @@ void run_info(const InfoOptions& options) {
   }
   nlohmann::json scans = nlohmann::json::array();
   for (const Entry& e : entries) scans.push_back(to_json(e));
-  fmt::print("{}\n", nlohmann::json{{"scans", scans}}.dump(2));
+  fmt::print("{}\n", nlohmann::json{{"scans", scans}}.dump(
+                         2, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 }  // namespace

@@ -6,15 +6,48 @@
 
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <string>
+#include <string_view>
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
 
 namespace {
 
-int report_error(const char* kind, const char* message, int exit_code) {
+int report_error(const char* kind, const std::string& message, int exit_code) {
   fmt::print(stderr, "scanbench: {}: {}\n", kind, message);
   return exit_code;
+}
+
+// The word the user got wrong, when there is one: an unknown command, or an
+// option the command does not have. CLI11 would report the rule that broke
+// next ("A subcommand is required", "project is required") instead.
+std::string unknown_word(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return "";
+  const std::string_view command = argv[1];
+  const CLI::App* sub = nullptr;
+  for (const CLI::App* candidate : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (candidate->get_name() == command) sub = candidate;
+  }
+  if (sub == nullptr) {
+    std::string known;
+    for (const CLI::App* c : app.get_subcommands([](const CLI::App*) { return true; })) {
+      known += (known.empty() ? "" : ", ") + c->get_name();
+    }
+    return "unknown command '" + std::string(command) + "' (commands: " + known + ")";
+  }
+  for (int k = 2; k < argc; ++k) {
+    const std::string_view word = argv[k];
+    if (word == "--") break;
+    if (word.size() < 2 || word[0] != '-' || (word[1] >= '0' && word[1] <= '9')) continue;
+    const std::string name(word.substr(0, word.find('=')));
+    bool known = name == "-h" || name == "--help";
+    for (const CLI::Option* option : sub->get_options()) {
+      known = known || option->check_name(name);
+    }
+    if (!known) return "unknown option '" + name + "' for '" + std::string(command) + "'";
+  }
+  return "";
 }
 
 }  // namespace
@@ -48,8 +81,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return sb::kExitBadInput;
+    const std::string unknown = unknown_word(app, argc, argv);
+    std::string message = unknown.empty() ? e.what() : unknown;
+    if (message.empty()) message = "bad arguments";
+    return report_error("usage", message + " (see scanbench --help)", sb::kExitBadInput);
   } catch (const scanbench::core::InputError& e) {
     return report_error("bad input", e.what(), sb::kExitBadInput);
   } catch (const std::exception& e) {

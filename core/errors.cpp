@@ -4,8 +4,31 @@
 
 namespace scanbench::core {
 
-std::string format_input_error(const std::string& file, const FilePosition& position,
-                               const std::string& problem) {
+namespace {
+
+// A part of a message cut to `limit` characters around its middle: a
+// 5,000-character file name or a 200 KB token must not flood the terminal.
+std::string shortened(std::string text, std::size_t limit) {
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 0x20) c = '?';  // one line, whatever a name holds
+  }
+  if (text.size() <= limit) return text;
+  const std::size_t half = limit / 2;
+  std::size_t head = half, tail = text.size() - half;
+  // Cut between UTF-8 characters, never inside one.
+  while (head > 0 && (static_cast<unsigned char>(text[head]) & 0xC0) == 0x80) --head;
+  while (tail < text.size() && (static_cast<unsigned char>(text[tail]) & 0xC0) == 0x80) ++tail;
+  return text.substr(0, head) + "…" + text.substr(tail);
+}
+
+constexpr std::size_t kMaxPartChars = 240;
+
+}  // namespace
+
+std::string format_input_error(const std::string& file_name, const FilePosition& position,
+                               const std::string& problem_text) {
+  const std::string file = shortened(file_name, kMaxPartChars);
+  const std::string problem = shortened(problem_text, kMaxPartChars);
   std::ostringstream out;
   out << file;
   std::string where;
@@ -16,7 +39,7 @@ std::string format_input_error(const std::string& file, const FilePosition& posi
   }
   if (!position.detail.empty()) {
     where += where.empty() ? "" : ", ";
-    where += position.detail;
+    where += shortened(position.detail, kMaxPartChars);
   }
   if (!where.empty()) out << (file.empty() ? "" : ": ") << where;
   out << (file.empty() && where.empty() ? "" : ": ") << problem;

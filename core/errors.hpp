@@ -64,7 +64,8 @@ class Cancelled : public std::runtime_error {
   explicit Cancelled(const std::string& stage);
 };
 
-// "FILE: line 12 (byte 340): problem" — the form every message takes.
+// "FILE: line 12 (byte 340): problem" — the form every message takes, on
+// one line; parts longer than 240 characters are cut in the middle.
 std::string format_input_error(const std::string& file, const FilePosition& position,
                                const std::string& problem);
 

@@ -7,6 +7,7 @@
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/triplet_writer.hpp"
 #include "core/errors.hpp"
+#include "modeling/project_schema.hpp"
 #include "modeling/scan_layers.hpp"
 
 namespace scanbench::modeling {
@@ -61,6 +62,25 @@ void write_triplet(const Project& project, const std::vector<acquisition::Scan>&
   acquisition::write_triplet(scans.front(), settings.output);
 }
 
+// Refuses (core::InputError, nothing written) an output that would replace
+// the project being exported, by any path (a symlink, a hard link, "./"), or
+// any other scanbench project.
+void refuse_to_replace_projects(const Project& project,
+                                std::span<const std::filesystem::path> outputs) {
+  for (const std::filesystem::path& output : outputs) {
+    std::error_code error;
+    if (!std::filesystem::exists(output, error)) continue;
+    if (std::filesystem::equivalent(output, project.path(), error)) {
+      throw core::InputError(output.string(), {},
+                             "is the project being exported; an export never replaces its input");
+    }
+    if (schema::has_project_header(output)) {
+      throw core::InputError(output.string(), {},
+                             "is a scanbench project; an export never replaces a project");
+    }
+  }
+}
+
 std::size_t count_points(const std::vector<acquisition::Scan>& scans,
                          const std::vector<std::vector<std::uint8_t>>& keep) {
   std::size_t points = 0;
@@ -84,6 +104,11 @@ ExportResult export_project(const Project& project, const ExportSettings& settin
     scans.push_back(project.load_scan(id));
     geometry.push_back(load_geometry(project, id));
   }
+  const std::vector<std::filesystem::path> outputs =
+      settings.format == ExportFormat::kTriplet && scans.size() == 1
+          ? acquisition::triplet_files(scans.front(), settings.output)
+          : std::vector<std::filesystem::path>{settings.output};
+  refuse_to_replace_projects(project, outputs);
   std::vector<const acquisition::ScanGeometry*> geometry_of;
   for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
   std::vector<const std::vector<std::uint8_t>*> keep_of;

@@ -32,7 +32,9 @@ struct ExportResult {
 };
 
 // Writes the project's scans as the settings say, all read from one state of
-// the project (Project::read_snapshot). Where a scan has geometry,
+// the project (Project::read_snapshot). An output is never the project
+// itself (by any path: a symlink, a hard link, "./") or any other scanbench
+// project: core::InputError, nothing written. Where a scan has geometry,
 // the point formats leave its mixed pixels out and PLY carries its normals
 // and footprints. Throws core::InputError (naming the project and, where it
 // applies, the scan) for: no such scan, `merged` with a scan-grid format or

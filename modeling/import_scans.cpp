@@ -20,6 +20,15 @@ std::string settings_json(std::span<const std::filesystem::path> files,
   return document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+// True when the project holds no command at all (not even a pending one).
+bool still_empty(const std::filesystem::path& project_path) noexcept {
+  try {
+    return Project::open(project_path).history().empty();
+  } catch (...) {
+    return false;
+  }
+}
+
 }  // namespace
 
 ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
@@ -57,18 +66,17 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
 ImportResult import_scan_files(const std::filesystem::path& project_path,
                                std::span<const std::filesystem::path> files,
                                const ImportSettings& settings, core::Progress& progress) {
-  const bool existed = std::filesystem::exists(project_path);
-  // Only a project this call created is removed on failure: if another
-  // process creates the file first, create() refuses and nothing is removed.
+  // Only a project this call created, and nobody has written to since, is
+  // removed on failure: when another process creates the file first, this
+  // import goes into that one.
   bool created = false;
   try {
-    Project project = existed ? Project::open(project_path) : Project::create(project_path);
-    created = !existed;
+    Project project = Project::open_or_create(project_path, &created);
     ImportResult result = import_scans(project, files, settings, progress);
     result.created_project = created;
     return result;
   } catch (...) {
-    if (created) remove_project_files(project_path);
+    if (created && still_empty(project_path)) remove_project_files(project_path);
     throw;
   }
 }

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sqlite3.h>
+#include <stdio.h>
 #include <unistd.h>
 
 #include <cassert>
@@ -20,10 +21,9 @@ namespace {
 // Read-write without SQLITE_OPEN_CREATE: a project deleted between our header
 // check and this call must not be recreated empty. NOMUTEX: one connection
 // per Project, used from one thread at a time (see project.hpp).
-sqlite3* connect(const std::filesystem::path& file) {
+sqlite3* connect(const std::filesystem::path& file, int flags = SQLITE_OPEN_READWRITE) {
   sqlite3* db = nullptr;
-  const int code =
-      sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, nullptr);
+  const int code = sqlite3_open_v2(file.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr);
   if (code != SQLITE_OK) {
     const std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
     sqlite3_close(db);
@@ -35,25 +35,84 @@ sqlite3* connect(const std::filesystem::path& file) {
   return db;
 }
 
-// O_EXCL makes "refuse an existing file" atomic: no other process can slip a
-// file in between a check and SQLite's open.
-void create_exclusively(const std::filesystem::path& file) {
-  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) {
-    const int error = errno;
-    if (error == EEXIST) {
-      throw core::InputError(file.string(), {},
-                             "file already exists; a new project never overwrites a file");
+// "file:/path?immutable=1": SQLite then reads without any lock or
+// shared-memory file, as a write-protected medium needs.
+std::string immutable_uri(const std::filesystem::path& file) {
+  std::string uri = "file:";
+  for (const char c : std::filesystem::absolute(file).string()) {
+    if (c == '%' || c == '?' || c == '#') {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      uri += '%';
+      uri += kHex[(static_cast<unsigned char>(c) >> 4) & 15];
+      uri += kHex[static_cast<unsigned char>(c) & 15];
+    } else {
+      uri += c;
     }
-    const std::string problem = std::string("cannot create the project: ") + std::strerror(error);
-    // A missing folder or a bad name is the user's; a full, read-only or
-    // failing disk is the machine's.
-    if (error == ENOENT || error == ENOTDIR || error == EISDIR || error == ENAMETOOLONG) {
-      throw core::InputError(file.string(), {}, problem);
-    }
-    throw core::RuntimeFailure(file.string(), {}, problem);
   }
-  ::close(fd);
+  return uri + "?immutable=1";
+}
+
+// True when this process may write the file and create files beside it
+// (SQLite's -wal and -shm).
+bool writable(const std::filesystem::path& file) {
+  const std::filesystem::path folder =
+      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  return ::access(file.c_str(), W_OK) == 0 && ::access(folder.c_str(), W_OK) == 0;
+}
+
+// Moves the finished `temporary` to `file` unless `file` exists. Returns
+// false when it exists. Where the file system can rename without replacing,
+// that is one step; elsewhere a hard link does the same.
+bool place_without_replacing(const std::filesystem::path& temporary,
+                             const std::filesystem::path& file) {
+  if (::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, file.c_str(), RENAME_NOREPLACE) == 0) {
+    return true;
+  }
+  if (errno == EEXIST) return false;
+  if (errno != EINVAL && errno != ENOSYS) {
+    throw core::RuntimeFailure(file.string(), {},
+                               std::string("cannot create the project: ") + std::strerror(errno));
+  }
+  if (::link(temporary.c_str(), file.c_str()) != 0) {
+    if (errno == EEXIST) return false;
+    throw core::RuntimeFailure(file.string(), {},
+                               std::string("cannot create the project: ") + std::strerror(errno));
+  }
+  std::error_code ignored;
+  std::filesystem::remove(temporary, ignored);
+  return true;
+}
+
+void refuse_existing(const std::filesystem::path& file) {
+  throw core::InputError(file.string(), {},
+                         "file already exists; a new project never overwrites a file");
+}
+
+// The folder must be there: a missing one is the user's mistake.
+void check_folder(const std::filesystem::path& file) {
+  const std::filesystem::path folder =
+      file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error)) {
+    throw core::InputError(file.string(), {}, "cannot create the project: no such folder");
+  }
+}
+
+// Builds a new, empty project at a temporary name beside `file` and closes
+// it (its write-ahead log checkpointed away). Returns the temporary path.
+std::filesystem::path build_empty_project(const std::filesystem::path& file) {
+  const std::filesystem::path temporary = file.string() + ".creating-" + std::to_string(::getpid());
+  remove_project_files(temporary);  // what a killed earlier attempt of ours left
+  try {
+    sqlite3* raw = connect(temporary, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+    const std::unique_ptr<sqlite3, decltype(&sqlite3_close)> db(raw, &sqlite3_close);
+    schema::configure_connection(raw, file.string());
+    schema::create_schema(raw, file.string());
+  } catch (...) {
+    remove_project_files(temporary);
+    throw;
+  }
+  return temporary;
 }
 
 }  // namespace
@@ -83,6 +142,11 @@ sqlite3* Project::db() const {
 
 Project Project::open(const std::filesystem::path& file) {
   schema::check_file_header(file);
+  if (!writable(file)) {
+    throw core::RuntimeFailure(file.string(), {},
+                               "cannot write the project: it, or its folder, is read-only here "
+                               "(info, export and history still read it)");
+  }
   Project project(file, Connection(connect(file)));
   schema::configure_connection(project.db(), project.file_name());
   schema::check_and_migrate(project.db(), project.file_name());
@@ -90,21 +154,55 @@ Project Project::open(const std::filesystem::path& file) {
 }
 
 Project Project::create(const std::filesystem::path& file) {
-  create_exclusively(file);
+  std::error_code error;
+  if (std::filesystem::exists(std::filesystem::symlink_status(file, error))) refuse_existing(file);
+  check_folder(file);
+  const std::filesystem::path temporary = build_empty_project(file);
+  bool placed = false;
   try {
-    Project project(file, Connection(connect(file)));
-    schema::configure_connection(project.db(), project.file_name());
-    schema::create_schema(project.db(), project.file_name());
-    return project;
+    placed = place_without_replacing(temporary, file);
   } catch (...) {
-    remove_project_files(file);
+    remove_project_files(temporary);
     throw;
   }
+  if (!placed) {
+    remove_project_files(temporary);
+    refuse_existing(file);
+  }
+  return open(file);
 }
 
-Project Project::open_or_create(const std::filesystem::path& file) {
+Project Project::open_or_create(const std::filesystem::path& file, bool* created) {
   std::error_code error;
-  return std::filesystem::exists(file, error) ? open(file) : create(file);
+  if (created != nullptr) *created = false;
+  if (std::filesystem::exists(std::filesystem::symlink_status(file, error))) return open(file);
+  check_folder(file);
+  const std::filesystem::path temporary = build_empty_project(file);
+  bool placed = false;
+  try {
+    placed = place_without_replacing(temporary, file);
+  } catch (...) {
+    remove_project_files(temporary);
+    throw;
+  }
+  if (!placed) remove_project_files(temporary);  // another process made it first
+  if (created != nullptr) *created = placed;
+  return open(file);
+}
+
+Project Project::open_for_reading(const std::filesystem::path& file) {
+  if (writable(file)) return open(file);
+  schema::check_file_header(file);
+  // Read-only: SQLite still needs the shared-memory file of the write-ahead
+  // log; where it cannot make one, the file is read as immutable.
+  Connection db(connect(file, SQLITE_OPEN_READONLY));
+  try {
+    schema::check_readable(db.get(), file.string());
+  } catch (const core::RuntimeFailure&) {
+    db = Connection(connect(immutable_uri(file), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI));
+    schema::check_readable(db.get(), file.string());
+  }
+  return Project(file, std::move(db));
 }
 
 int Project::schema_version() const {

@@ -113,13 +113,25 @@ class Project {
   // versions are migrated in one transaction.
   static Project open(const std::filesystem::path& file);
 
-  // Creates a new, empty project. Throws core::InputError when the file
-  // already exists (it is never overwritten) or cannot be created; a
-  // half-created file is removed again.
+  // Opens a project for reading only (info, export, history): as open()
+  // where the file and its folder are writable; otherwise read-only, which
+  // also works on write-protected media (as SQLite's "immutable" file when
+  // not even its shared-memory file can be made). A read-only project of an
+  // older schema version cannot be migrated: core::InputError saying so.
+  // Writing through it throws core::RuntimeFailure.
+  static Project open_for_reading(const std::filesystem::path& file);
+
+  // Creates a new, empty project. The file appears complete or not at all
+  // (built under a temporary name, then moved into place without replacing
+  // anything), so another process never sees it half made. Throws
+  // core::InputError when the file already exists (it is never overwritten)
+  // or its folder does not exist, core::RuntimeFailure when it cannot be
+  // written; nothing is left behind.
   static Project create(const std::filesystem::path& file);
 
-  // open() when `file` exists, else create().
-  static Project open_or_create(const std::filesystem::path& file);
+  // open() when `file` exists, else create(); when another process creates
+  // it first, opens that one. `created` (when given) tells which happened.
+  static Project open_or_create(const std::filesystem::path& file, bool* created = nullptr);
 
   Project(Project&&) noexcept = default;
   Project& operator=(Project&&) noexcept = default;

@@ -358,6 +358,18 @@ void enable_wal(sqlite3* db, const std::string& file) {
 
 }  // namespace
 
+bool has_project_header(const std::filesystem::path& file) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) return false;
+  std::array<char, 100> header{};
+  std::ifstream in(file, std::ios::binary);
+  in.read(header.data(), header.size());
+  constexpr char kMagic[16] = "SQLite format 3";
+  return in.gcount() == static_cast<std::streamsize>(header.size()) &&
+         std::equal(kMagic, kMagic + 16, header.begin()) &&
+         big_endian_u32(header.data() + 68) == kProjectApplicationId;
+}
+
 void check_file_header(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code error;
@@ -415,6 +427,20 @@ void check_and_migrate(sqlite3* db, const std::string& file) {
   }
   // After the migration: a refused migration leaves the file in its own mode.
   enable_wal(db, file);
+  check_tables(db, file, kCurrentTables);
+}
+
+void check_readable(sqlite3* db, const std::string& file) {
+  const auto application_id =
+      static_cast<std::uint32_t>(pragma_value(db, "PRAGMA application_id", file));
+  const int version = read_schema_version(db, file);
+  check_identity(application_id, version, file);
+  if (version < kProjectSchemaVersion) {
+    refuse(file, "project of schema version " + std::to_string(version) +
+                     " on read-only storage: open it once where it can be written to bring it "
+                     "to version " +
+                     std::to_string(kProjectSchemaVersion));
+  }
   check_tables(db, file, kCurrentTables);
 }
 

@@ -27,6 +27,10 @@ namespace scanbench::modeling::schema {
 // project of a schema version newer than kProjectSchemaVersion or below 1.
 void check_file_header(const std::filesystem::path& file);
 
+// True when `file` is a regular file that starts like a scanbench project
+// (SQLite header with our application id), of whatever version.
+bool has_project_header(const std::filesystem::path& file);
+
 // Sets the per-connection settings every project connection needs: foreign
 // keys on, synchronous=FULL, busy timeout. Throws as sqlite::throw_error.
 void configure_connection(sqlite3* db, const std::string& file);
@@ -48,6 +52,12 @@ void create_schema(sqlite3* db, const std::string& file);
 // that is not a project of a version this build reads or is damaged, and as
 // sqlite::throw_error.
 void check_and_migrate(sqlite3* db, const std::string& file);
+
+// For a project opened read-only: the identity checks of check_and_migrate,
+// with an older schema refused (core::InputError: it cannot be migrated
+// without writing) rather than migrated. core::RuntimeFailure when SQLite
+// cannot read it as it is (no shared-memory file can be made).
+void check_readable(sqlite3* db, const std::string& file);
 
 // PRAGMA user_version.
 int read_schema_version(sqlite3* db, const std::string& file);

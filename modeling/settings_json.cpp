@@ -98,7 +98,10 @@ Settings settings_from_json(const std::string& json, const std::string& origin) 
     return document.get<Settings>();
   } catch (const nlohmann::json::exception& e) {
     // The library's own text names the key path (".icp.min_gate_m") where it knows it.
-    throw core::InputError("", position, std::string("unreadable settings: ") + e.what());
+    // The library's text names the key path where it knows it; cut, it stays one line.
+    std::string what = e.what();
+    if (what.size() > 120) what = what.substr(0, 120) + "…";
+    throw core::InputError("", position, "unreadable settings: " + what);
   }
 }
 

@@ -63,6 +63,19 @@ std::string statement_summary(std::string_view sql) {
 void throw_error(sqlite3* db, int code, const std::string& file, const std::string& action) {
   std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
   if (is_damage(code)) message = "project file is damaged (" + message + ")";
+  const int primary = code & 0xff;
+  if (primary == SQLITE_FULL || primary == SQLITE_IOERR) {
+    // Say what it means for the user; SQLite's words stay in brackets.
+    throw core::RuntimeFailure(
+        file, {}, "cannot write the project: the disk is full or failing (" + message + ")");
+  }
+  if (primary == SQLITE_READONLY) {
+    throw core::RuntimeFailure(file, {}, "cannot write the project: it is read-only here");
+  }
+  if (primary == SQLITE_BUSY || primary == SQLITE_LOCKED) {
+    throw core::RuntimeFailure(
+        file, {}, "another scanbench keeps the project locked; try again when it has finished");
+  }
   core::FilePosition position;
   position.detail = action;
   if (is_runtime_failure(code)) throw core::RuntimeFailure(file, position, message);

@@ -248,7 +248,9 @@ INSTANTIATE_TEST_SUITE_P(
                     BadPtx{"ptx_bad_field_count.ptx", "4 (x y z intensity) or 7", true},
                     BadPtx{"ptx_mixed_field_count.ptx", "first has 4", true},
                     BadPtx{"ptx_color_out_of_range.ptx", "0 to 255", true},
-                    BadPtx{"ptx_header_field_count.ptx", "needs 3 numbers", true}),
+                    BadPtx{"ptx_header_field_count.ptx", "needs 3 numbers", true},
+                    BadPtx{"ptx_coordinate_beyond_float.ptx", "beyond 10^8 m", true},
+                    BadPtx{"ptx_intensity_beyond_float.ptx", "does not fit a float", true}),
     [](const testing::TestParamInfo<BadPtx>& info) {
       std::string name = std::filesystem::path(info.param.file).stem().string();
       return name;

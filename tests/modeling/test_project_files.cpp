@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <functional>
 #include <random>
 
 #include "core/errors.hpp"
@@ -31,7 +32,11 @@ void write_file(const std::filesystem::path& file, const std::string& bytes) {
 // refuse it the same way rather than overwrite it.
 void expect_refused(const std::filesystem::path& file, const std::string& problem) {
   const std::string before = test::read_file_bytes(file);
-  for (const auto opener : {&Project::open, &Project::open_or_create}) {
+  const std::function<Project(const std::filesystem::path&)> openers[] = {
+      [](const std::filesystem::path& f) { return Project::open(f); },
+      [](const std::filesystem::path& f) { return Project::open_or_create(f); },
+      [](const std::filesystem::path& f) { return Project::open_for_reading(f); }};
+  for (const auto& opener : openers) {
     try {
       opener(file);
       ADD_FAILURE() << "expected core::InputError for " << file;

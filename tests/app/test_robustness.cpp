@@ -1,0 +1,198 @@
+// What a hostile user found, each as it was reproduced: an export over its
+// own project, non-UTF-8 names, a FIFO, exit codes that lied, partial
+// outputs, a header that asks for 128 GB, two imports creating one project.
+// Each runs the scanbench executable as a user would.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "app/cli_runner.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench {
+namespace {
+
+using test::CliResult;
+using test::fixture;
+using test::run_cli;
+using test::ScratchDir;
+using test::shell_quote;
+
+// Runs `shell` (with $SCANBENCH set to the executable) under /bin/sh.
+CliResult run_shell(const ScratchDir& dir, const std::string& shell) {
+  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string command = "SCANBENCH=" + shell_quote(SCANBENCH_BINARY) + " /bin/sh -c " +
+                              shell_quote(shell) + " >" + shell_quote(out.string()) + " 2>" +
+                              shell_quote(err.string());
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, test::read_file_bytes(out),
+          test::read_file_bytes(err)};
+}
+
+// A project holding the tiny colour scan, and what `info --json` says of it.
+std::string make_project(const ScratchDir& dir, const std::filesystem::path& project) {
+  EXPECT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  return run_cli(dir, {"info", project.string(), "--json"}).out;
+}
+
+void expect_one_line_error(const CliResult& result, int exit_code, const std::string& words) {
+  EXPECT_EQ(result.exit_code, exit_code) << result.err;
+  EXPECT_EQ(result.err.rfind("scanbench: ", 0), 0u) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_NE(result.err.find(words), std::string::npos) << result.err;
+}
+
+TEST(Robustness, AnExportNeverReplacesItsProjectOrAnyProject) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj", other = dir / "other.sbproj";
+  const std::string before = make_project(dir, project);
+  make_project(dir, other);
+  std::filesystem::create_symlink(project, dir / "link.sbproj");
+  std::filesystem::create_hard_link(project, dir / "hard.sbproj");
+  const std::string dotted = (dir.path() / "." / "p.sbproj").string();
+  for (const std::string& output :
+       {project.string(), dotted, (dir / "link.sbproj").string(), (dir / "hard.sbproj").string()}) {
+    const CliResult result =
+        run_cli(dir, {"export", project.string(), "--format", "ply", "-o", output});
+    expect_one_line_error(result, 2, "never replaces its input");
+  }
+  expect_one_line_error(
+      run_cli(dir, {"export", project.string(), "--format", "csv", "-o", other.string()}), 2,
+      "never replaces a project");
+  EXPECT_EQ(run_cli(dir, {"info", project.string(), "--json"}).out, before);
+  EXPECT_EQ(run_cli(dir, {"info", other.string(), "--json"}).exit_code, 0);
+}
+
+TEST(Robustness, AnExportToAFolderOrToNothingIsBadInput) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  make_project(dir, project);
+  std::filesystem::create_directory(dir / "folder");
+  expect_one_line_error(run_cli(dir, {"export", project.string(), "--format", "ply", "-o",
+                                      (dir / "folder").string()}),
+                        2, "is a directory");
+  expect_one_line_error(run_cli(dir, {"export", project.string(), "--format", "ply", "-o", ""}), 2,
+                        "no output file given");
+}
+
+TEST(Robustness, NamesThatAreNotUtf8KeepEveryJsonReportValid) {
+  ScratchDir dir;
+  const std::filesystem::path bad = dir / "\xff\xfe_bad.ptx";
+  std::filesystem::copy_file(fixture("good/ptx/two_scans.ptx"), bad);
+  const std::string project = (dir / "p.sbproj").string();
+  ASSERT_EQ(run_cli(dir, {"import", project, bad.string()}).exit_code, 0);
+  ASSERT_EQ(run_cli(dir, {"geometry", project, "--window", "2", "--edge-window", "1"}).exit_code,
+            0);
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"info", project, "--json"},
+        std::vector<std::string>{"register", project, "--coarse", "none", "--json"},
+        std::vector<std::string>{"merge", project, "--json"},
+        std::vector<std::string>{"history", project, "--json"}}) {
+    const CliResult result = run_cli(dir, command);
+    ASSERT_EQ(result.exit_code, 0) << command[0] << ": " << result.err;
+    EXPECT_TRUE(nlohmann::json::accept(result.out)) << command[0] << ": " << result.out;
+  }
+}
+
+TEST(Robustness, APipeIsRefusedAtOnceAndLeavesNoProject) {
+  ScratchDir dir;
+  const std::filesystem::path fifo = dir / "scan.ptx";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const CliResult result = run_shell(dir, "timeout 20 \"$SCANBENCH\" import " +
+                                              shell_quote((dir / "new.sbproj").string()) + " " +
+                                              shell_quote(fifo.string()));
+  expect_one_line_error(result, 2, "not a regular file");
+  EXPECT_FALSE(std::filesystem::exists(dir / "new.sbproj"));
+}
+
+// RLIMIT_FSIZE makes writes past a size fail as a full disk does (EFBIG).
+TEST(Robustness, AFullDiskIsARuntimeFailureAndChangesNothing) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  const std::string before = make_project(dir, project);
+  ASSERT_EQ(run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
+                          "--scans", "1", "--columns", "720", "--rows", "180"})
+                .exit_code,
+            0);
+  const std::string limited = "trap '' XFSZ; ulimit -f 256; exec \"$SCANBENCH\" ";
+  const CliResult import =
+      run_shell(dir, limited + "import " + shell_quote(project.string()) + " " +
+                         shell_quote((dir / "sim/campus_scan_01.json").string()));
+  expect_one_line_error(import, 1, "p.sbproj");
+  EXPECT_EQ(run_cli(dir, {"info", project.string(), "--json"}).out, before);
+  // A triplet export that does not fit leaves none of its files behind.
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), (dir / "sim/campus_scan_01.json").string()})
+                .exit_code,
+            0);
+  std::filesystem::create_directory(dir / "out");
+  const CliResult triplet =
+      run_shell(dir, "trap '' XFSZ; ulimit -f 64; exec \"$SCANBENCH\" export " +
+                         shell_quote(project.string()) + " --format triplet --scan 2 -o " +
+                         shell_quote((dir / "out/t.json").string()));
+  expect_one_line_error(triplet, 1, "cannot write");
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "out"));
+}
+
+TEST(Robustness, TheNextRunOfAnExportRemovesWhatAKilledOneLeft) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  make_project(dir, project);
+  const std::filesystem::path csv = dir / "points.csv";
+  { std::ofstream(csv.string() + ".partial") << "half of an earlier, killed export"; }
+  ASSERT_EQ(
+      run_cli(dir, {"export", project.string(), "--format", "csv", "-o", csv.string()}).exit_code,
+      0);
+  EXPECT_FALSE(std::filesystem::exists(csv.string() + ".partial"));
+  EXPECT_TRUE(std::filesystem::exists(csv));
+}
+
+// Another user, who may read the project but not write it or its folder (a
+// write-protected USB stick on site), can still describe and export it.
+TEST(Robustness, AReadOnlyProjectCanBeDescribedAndExported) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  const std::string before = make_project(dir, project);
+  std::filesystem::create_directory(dir / "out");
+  ::chmod((dir / "out").c_str(), 0777);
+  const std::string as_nobody =
+      "exec setpriv --reuid=65534 --regid=65534 --clear-groups \"$SCANBENCH\" ";
+  const CliResult info =
+      run_shell(dir, as_nobody + "info " + shell_quote(project.string()) + " --json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_EQ(info.out, before);
+  const CliResult exported =
+      run_shell(dir, as_nobody + "export " + shell_quote(project.string()) + " --format csv -o " +
+                         shell_quote((dir / "out/p.csv").string()));
+  ASSERT_EQ(exported.exit_code, 0) << exported.err;
+  EXPECT_EQ(run_shell(dir, as_nobody + "history " + shell_quote(project.string())).exit_code, 0);
+  // Writing is a runtime failure, not bad input, and changes nothing.
+  const CliResult write = run_shell(dir, as_nobody + "geometry " + shell_quote(project.string()));
+  EXPECT_EQ(write.exit_code, 1) << write.err;
+  EXPECT_EQ(run_cli(dir, {"info", project.string(), "--json"}).out, before);
+}
+
+TEST(Robustness, TwoImportsCreatingOneProjectAtOnceBothLand) {
+  ScratchDir dir;
+  const std::string project = shell_quote((dir / "new.sbproj").string());
+  const std::string scan = shell_quote(fixture("good/ptx/tiny_color.ptx").string());
+  const CliResult both =
+      run_shell(dir, "\"$SCANBENCH\" import " + project + " " + scan + " & \"$SCANBENCH\" import " +
+                         project + " " + scan + " & wait %1 && wait %2");
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  const CliResult info = run_cli(dir, {"info", (dir / "new.sbproj").string(), "--json"});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out)["scans"].size(), 2u);
+}
+
+}  // namespace
+}  // namespace scanbench
