@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <string>
 #include <utility>
 
+#include "acquisition/png_decoder.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
@@ -267,6 +269,16 @@ Image load_image(const Sidecar& s, const std::string& name, const std::string& k
     throw core::InputError(image.file, where,
                            fs::is_directory(status) ? "is a directory, not an image file"
                                                     : "is not a regular file (a pipe or a device)");
+  }
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".png") {
+    // libpng through our handlers: its reason goes into our message.
+    PngDecodeResult png = decode_png(path, grid.rows, grid.columns);
+    if (png.pixels.empty()) throw core::InputError(image.file, where, png.problem);
+    image.pixels = std::move(png.pixels);
+    return image;
   }
   try {
     image.pixels = cv::imread(path.string(), cv::IMREAD_UNCHANGED);

@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <exception>
 #include <string>
 #include <string_view>
@@ -54,6 +55,9 @@ std::string unknown_word(const CLI::App& app, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   namespace sb = scanbench::app;
+  // Libraries report through our errors; their own logging would print
+  // before our one line (a process-wide setting: it belongs here, not in them).
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   CLI::App app{"scanbench: a workbench for terrestrial laser scans", "scanbench"};
   app.set_version_flag("--version", "scanbench 0.1.0");
   app.require_subcommand(1, 1);

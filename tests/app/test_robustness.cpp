@@ -104,6 +104,15 @@ TEST(Robustness, NamesThatAreNotUtf8KeepEveryJsonReportValid) {
   }
 }
 
+// libpng used to print "libpng error: Read Error" before our line.
+TEST(Robustness, ADamagedImageGivesOneLineWithTheDecodersReason) {
+  ScratchDir dir;
+  const CliResult result =
+      run_cli(dir, {"import", (dir / "p.sbproj").string(),
+                    fixture("bad/triplet_image_corrupt_png/scan.json").string()});
+  expect_one_line_error(result, 2, "unreadable or corrupt (libpng:");
+}
+
 TEST(Robustness, APipeIsRefusedAtOnceAndLeavesNoProject) {
   ScratchDir dir;
   const std::filesystem::path fifo = dir / "scan.ptx";
