@@ -16,13 +16,14 @@ namespace {
 struct ImportOptions {
   std::string project;
   std::vector<std::string> files;
+  modeling::ImportSettings settings;
 };
 
 void run_import(const ImportOptions& options) {
   const std::vector<std::filesystem::path> files(options.files.begin(), options.files.end());
   ProgressBar progress;
   const modeling::ImportResult result =
-      modeling::import_scan_files(options.project, files, modeling::ImportSettings{}, progress);
+      modeling::import_scan_files(options.project, files, options.settings, progress);
   fmt::print("{} {} scan(s) from {} file(s) into {} in {:.2f} s\n",
              result.created_project ? "created project; imported" : "imported",
              result.scan_ids.size(), files.size(), options.project, result.seconds);
@@ -39,6 +40,9 @@ void add_import_command(CLI::App& app) {
       "on any error the project is left unchanged.");
   command->add_option("project", options->project, "Project file (.sbproj)")->required();
   command->add_option("files", options->files, "Scan files")->required()->check(CLI::ExistingFile);
+  command->add_flag("--allow-duplicate", options->settings.allow_duplicates,
+                    "Import a scan even when the project already holds the same data (by "
+                    "default that is refused: a file imported twice by mistake)");
   command->callback([options] { run_import(*options); });
 }
 

@@ -5,8 +5,8 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
-#include <opencv2/core/utils/logger.hpp>
 #include <exception>
+#include <opencv2/core/utils/logger.hpp>
 #include <string>
 #include <string_view>
 
@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
   sb::add_merge_command(app);
   sb::add_export_command(app);
   sb::add_history_commands(app);
+  sb::add_check_command(app);
   sb::add_simulate_command(app);
 #ifdef SCANBENCH_WITH_BENCH
   sb::add_bench_command(app);

@@ -2,7 +2,9 @@
 
 #include <chrono>
 #include <nlohmann/json.hpp>
+#include <set>
 
+#include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "modeling/settings_json.hpp"
 
@@ -16,8 +18,25 @@ std::string settings_json(std::span<const std::filesystem::path> files,
   nlohmann::json names = nlohmann::json::array();
   for (const std::filesystem::path& file : files) names.push_back(file.string());
   const nlohmann::json document = {
-      {"files", names}, {"readers", nlohmann::json::parse(settings_to_json(settings.readers))}};
+      {"files", names},
+      {"readers", nlohmann::json::parse(settings_to_json(settings.readers))},
+      {"allow_duplicates", settings.allow_duplicates}};
   return document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// Refuses a scan whose data the project, or this import, already holds.
+void refuse_duplicate(const Project& project, const EncodedScan& scan,
+                      const std::filesystem::path& file, std::set<std::int64_t>& digests) {
+  const auto twin = project.scan_with_content(scan.content_digest);
+  const bool repeated = !digests.insert(scan.content_digest).second;
+  if (!twin && !repeated) return;
+  core::FilePosition position;
+  position.detail = "scan \"" + scan.metadata.name + "\"";
+  throw core::InputError(
+      file.string(), position,
+      (twin ? "is already in the project as scan " + std::to_string(*twin)
+            : std::string("appears twice in this import")) +
+          "; importing it again would add a twin (--allow-duplicate imports it anyway)");
 }
 
 // True when the project holds no command at all (not even a pending one).
@@ -40,10 +59,12 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
   // (compression, most of the work, happens before).
   Project::LongCommand command = project.begin_long_command(kStage, settings_json(files, settings));
   result.command_id = command.command_id();
+  std::set<std::int64_t> digests;  // of the scans of this import
   for (std::size_t f = 0; f < files.size(); ++f) {
     progress.throw_if_cancelled(kStage);
     acquisition::read_scan_file(files[f], settings.readers, [&](acquisition::Scan&& scan) {
       const EncodedScan encoded = encode_scan(scan);
+      if (!settings.allow_duplicates) refuse_duplicate(project, encoded, files[f], digests);
       progress.throw_if_cancelled(kStage);
       Project::Edit part = command.part();
       result.scan_ids.push_back(project.insert_scan(part, encoded));

@@ -15,6 +15,10 @@ namespace scanbench::modeling {
 
 struct ImportSettings {
   acquisition::ScanFileSettings readers;
+  // A scan whose data (range and validity) is already in the project, or
+  // earlier in the same import, is refused unless this is set: importing a
+  // file twice by mistake would add a silent twin.
+  bool allow_duplicates = false;
 };
 
 struct ImportResult {
@@ -28,8 +32,9 @@ struct ImportResult {
 // file), written scan by scan (Project::LongCommand), so memory holds one
 // scan at a time. The merge's keep masks of the scans already there are
 // removed with it: new scans may sample their surfaces more finely. On any
-// error (core::InputError from a reader, a write failure) or cancellation
-// nothing becomes visible, and what was written is removed.
+// error (core::InputError from a reader or for a duplicate, a write
+// failure) or cancellation nothing becomes visible, and what was written is
+// removed.
 ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
                           const ImportSettings& settings, core::Progress& progress);
 

@@ -11,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
+#include "modeling/records.hpp"
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling {
@@ -20,12 +21,33 @@ constexpr const char* kBumpRevision =
     "UPDATE meta SET value = CAST(value AS INTEGER) + 1 WHERE key = 'revision'";
 
 constexpr const char* kSelectCommands =
-    "SELECT id, name, settings, result, state, undoable, created_at FROM commands";
+    "SELECT id, name, settings, result, state, undoable, created_at, checksum FROM commands";
 
 // The next place in the journal.
 constexpr const char* kNextSeq = "(SELECT coalesce(max(seq), 0) + 1 FROM commands)";
 
-CommandRecord read_command(const sqlite::Statement& row) {
+// Stores the checksum of command `id` as it now stands.
+void update_checksum(sqlite3* db, const std::string& file, std::int64_t id) {
+  sqlite::Statement select(
+      db, "SELECT name, settings, result, undoable FROM commands WHERE id = ?1", file);
+  select.bind_int(1, id);
+  if (!select.step()) return;
+  const CommandFields fields{id, select.column_text(0), select.column_text(1),
+                             select.column_text(2), select.column_int(3)};
+  sqlite::Statement update(db, "UPDATE commands SET checksum = ?2 WHERE id = ?1", file);
+  update.bind_int(1, id).bind_int(2, checksum(fields)).run();
+}
+
+CommandRecord read_command(const sqlite::Statement& row, const std::string& file) {
+  const CommandFields fields{row.column_int(0), row.column_text(1), row.column_text(2),
+                             row.column_text(3), row.column_int(5)};
+  if (checksum(fields) != row.column_int(7)) {
+    core::FilePosition position;
+    position.detail = "command " + std::to_string(fields.id);
+    throw core::InputError(file, position,
+                           "project is damaged: the journal entry fails its checksum "
+                           "(changed outside scanbench?)");
+  }
   CommandRecord record;
   record.id = row.column_int(0);
   record.name = row.column_text(1);
@@ -44,7 +66,7 @@ std::optional<CommandRecord> select_one(sqlite3* db, const std::string& file, co
   const std::string sql = std::string(kSelectCommands) + " " + where;
   sqlite::Statement select(db, sql.c_str(), file);
   if (!select.step()) return std::nullopt;
-  return read_command(select);
+  return read_command(select, file);
 }
 
 std::int64_t read_revision(sqlite3* db, const std::string& file) {
@@ -122,6 +144,7 @@ Project::Edit Project::begin_command(std::string_view name, const std::string& s
   sqlite::Statement insert(db(), sql.c_str(), file_name());
   insert.bind_text(1, name).bind_text(2, settings_json).run();
   edit.command_id_ = sqlite3_last_insert_rowid(db());
+  update_checksum(db(), file_name(), edit.command_id_);
   return edit;
 }
 
@@ -140,6 +163,7 @@ Project::LongCommand Project::begin_long_command(std::string_view name,
   insert.bind_text(1, name).bind_text(2, settings_json).bind_text(3, host_name());
   insert.bind_int(4, ::getpid()).run();
   const std::int64_t id = sqlite3_last_insert_rowid(db());
+  update_checksum(db(), file_name(), id);
   edit.commit_part();
   return LongCommand(db(), file_name(), id, std::string(name), based_on_revision);
 }
@@ -194,6 +218,7 @@ void Project::Edit::commit(const std::string& result_json) {
                           kNextSeq + "), owner_host = NULL, owner_pid = NULL WHERE id = ?1";
   sqlite::Statement update(db_, sql.c_str(), file_);
   update.bind_int(1, command_id_).bind_text(2, result_json).run();
+  update_checksum(db_, file_, command_id_);
   finish_transaction();
 }
 
@@ -212,7 +237,7 @@ std::vector<CommandRecord> Project::history() const {
   const std::string sql = std::string(kSelectCommands) + " ORDER BY seq IS NULL, seq, id";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   std::vector<CommandRecord> records;
-  while (select.step()) records.push_back(read_command(select));
+  while (select.step()) records.push_back(read_command(select, file_name()));
   return records;
 }
 

@@ -87,6 +87,9 @@ struct EncodedScan {
   acquisition::Scan metadata;  // channels left empty; pose, angles, names as the scan's
   acquisition::ScanSummary summary;
   std::vector<EncodedLayer> layers;
+  // Identifies the scan's data (its range and validity), whatever its name
+  // or pose: the same scan imported twice has the same digest.
+  std::int64_t content_digest = 0;
 };
 
 // Encodes every channel of `scan`. Asserts the scan is consistent
@@ -163,6 +166,10 @@ class Project {
   // Stores a new scan (metadata, pose, summary, channel layers) as part of
   // `edit` and returns its id, which no other scan of the project ever gets.
   std::int64_t insert_scan(Edit& edit, const EncodedScan& scan);
+
+  // The live scan whose data (range and validity) has `digest`
+  // (EncodedScan::content_digest), or none.
+  std::optional<std::int64_t> scan_with_content(std::int64_t digest) const;
 
   // Moves scan `id` to scan.T_world_scan as part of `edit`: a new pose
   // version with the world bounds of `scan`, which must be the stored scan
@@ -242,6 +249,22 @@ class Project {
 
   // The result of the newest done command called `name`, or none.
   std::optional<std::string> latest_result(std::string_view name) const;
+
+  // ---- Integrity ---------------------------------------------------------
+
+  // Checks the whole file (`scanbench check`): SQLite's integrity and
+  // foreign-key checks, the checksum of every record (scans, poses, journal
+  // entries, undone ones included), and every layer decoded in full against
+  // its zstd checksum and its element count. Reading verifies the records
+  // it touches anyway; this reads everything. Damage is listed in the
+  // report; only a file too damaged for SQLite to read its tables at all
+  // throws core::InputError.
+  struct CheckReport {
+    std::vector<std::string> damage;  // one line each: what is damaged and how
+    std::size_t records = 0;          // scans, poses and journal entries checked
+    std::size_t layers = 0;           // layer versions decoded
+  };
+  CheckReport check() const;
 
  private:
   struct CloseConnection {

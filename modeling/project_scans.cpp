@@ -1,5 +1,6 @@
 // The scans and scan_poses tables: encode_scan, Project::insert_scan,
-// set_pose, scans, load_scan.
+// set_pose, scans, load_scan. Every record is checksummed when written and
+// verified when read (records.hpp).
 #include <sqlite3.h>
 
 #include <array>
@@ -11,6 +12,8 @@
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
+#include "modeling/records.hpp"
+#include "modeling/row_checksum.hpp"
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling {
@@ -20,42 +23,13 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "poses are stored as little-endian doubles");
 
-// Column order of kSelectScans.
-enum Column : int {
-  kId = 0,
-  kName,
-  kRows,
-  kColumns,
-  kAngleModel,
-  kAzimuthStart,
-  kAzimuthStep,
-  kElevationStart,
-  kElevationStep,
-  kScannerName,
-  kSourceFile,
-  kValidPoints,
-  kHasColor,
-  kHasIntensity,
-  kPose,
-  kScannerX,
-  kScannerY,
-  kScannerZ,
-  kBboxMinX,
-  kBboxMinY,
-  kBboxMinZ,
-  kBboxMaxX,
-  kBboxMaxY,
-  kBboxMaxZ,
-};
+constexpr int kFirstScanColumn = 1;  // after s.id
+constexpr int kFirstPoseColumn = kFirstScanColumn + kScanRecordColumnCount;
 
 // Every live scan (its import done) with its current pose: the pose row of
 // the newest done command, in journal order.
-constexpr const char* kSelectScans = R"sql(
-SELECT s.id, s.name, s.rows, s.columns, s.angle_model,
-       s.azimuth_start_rad, s.azimuth_step_rad, s.elevation_start_rad, s.elevation_step_rad,
-       s.scanner_name, s.source_file, s.valid_points, s.has_color, s.has_intensity,
-       p.T_world_scan, p.scanner_x, p.scanner_y, p.scanner_z,
-       p.bbox_min_x, p.bbox_min_y, p.bbox_min_z, p.bbox_max_x, p.bbox_max_y, p.bbox_max_z
+const std::string kSelectScans =
+    std::string("SELECT s.id, ") + kScanRecordColumns + ", " + kPoseRecordColumns + R"sql(
 FROM scans s JOIN scan_poses p ON p.scan_id = s.id
 WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
   AND p.command_id = (SELECT q.command_id FROM scan_poses q JOIN commands c ON c.id = q.command_id
@@ -65,14 +39,14 @@ WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
 constexpr const char* kInsertScan = R"sql(
 INSERT INTO scans (created_by, name, rows, columns, angle_model, azimuth_start_rad,
                    azimuth_step_rad, elevation_start_rad, elevation_step_rad, scanner_name,
-                   source_file, valid_points, has_color, has_intensity)
-VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14))sql";
+                   source_file, valid_points, has_color, has_intensity, content_digest, checksum)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16))sql";
 
 constexpr const char* kInsertPose = R"sql(
 INSERT OR REPLACE INTO scan_poses (scan_id, command_id, T_world_scan, scanner_x, scanner_y,
                                    scanner_z, bbox_min_x, bbox_min_y, bbox_min_z, bbox_max_x,
-                                   bbox_max_y, bbox_max_z)
-VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12))sql";
+                                   bbox_max_y, bbox_max_z, checksum)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13))sql";
 
 constexpr std::size_t kPoseBytes = 16 * sizeof(double);
 
@@ -83,9 +57,9 @@ constexpr std::size_t kPoseBytes = 16 * sizeof(double);
 }
 
 // Row-major 4x4, raw doubles: bit-exact, including -0.0.
-std::array<std::uint8_t, kPoseBytes> encode_pose(const Eigen::Isometry3d& pose) {
+std::vector<std::uint8_t> encode_pose(const Eigen::Isometry3d& pose) {
   const std::array<double, 16> values = acquisition::row_major(pose);
-  std::array<std::uint8_t, kPoseBytes> bytes{};
+  std::vector<std::uint8_t> bytes(kPoseBytes);
   std::memcpy(bytes.data(), values.data(), kPoseBytes);
   return bytes;
 }
@@ -100,83 +74,109 @@ Eigen::Isometry3d decode_pose(std::span<const std::uint8_t> bytes, const std::st
   return pose;
 }
 
-void bind_scan_row(sqlite::Statement& insert, std::int64_t command_id, const EncodedScan& encoded) {
+ScanRecord scan_record(std::int64_t command_id, const EncodedScan& encoded) {
   const acquisition::Scan& scan = encoded.metadata;
-  const acquisition::ScanSummary& summary = encoded.summary;
-  insert.bind_int(1, command_id).bind_text(2, scan.name);
-  insert.bind_int(3, scan.rows).bind_int(4, scan.columns);
-  insert.bind_text(5, acquisition::angle_model_name(scan.is_spherical()));
-  const auto* angles = std::get_if<acquisition::SphericalAngles>(&scan.angles);
-  const auto angle = [&](double acquisition::SphericalAngles::*field) {
-    return angles != nullptr ? std::optional<double>(angles->*field) : std::nullopt;
-  };
-  insert.bind_optional_double(6, angle(&acquisition::SphericalAngles::azimuth_start_rad))
-      .bind_optional_double(7, angle(&acquisition::SphericalAngles::azimuth_step_rad))
-      .bind_optional_double(8, angle(&acquisition::SphericalAngles::elevation_start_rad))
-      .bind_optional_double(9, angle(&acquisition::SphericalAngles::elevation_step_rad));
-  insert.bind_text(10, scan.scanner.name).bind_text(11, scan.scanner.source_file);
-  insert.bind_int(12, static_cast<std::int64_t>(summary.valid_points))
-      .bind_int(13, summary.has_color)
-      .bind_int(14, summary.has_intensity);
+  ScanRecord r;
+  r.created_by = command_id;
+  r.name = scan.name;
+  r.rows = scan.rows;
+  r.columns = scan.columns;
+  r.angle_model = acquisition::angle_model_name(scan.is_spherical());
+  if (const auto* a = std::get_if<acquisition::SphericalAngles>(&scan.angles)) {
+    r.angles = {a->azimuth_start_rad, a->azimuth_step_rad, a->elevation_start_rad,
+                a->elevation_step_rad};
+  }
+  r.scanner_name = scan.scanner.name;
+  r.source_file = scan.scanner.source_file;
+  r.valid_points = static_cast<std::int64_t>(encoded.summary.valid_points);
+  r.has_color = encoded.summary.has_color;
+  r.has_intensity = encoded.summary.has_intensity;
+  r.content_digest = encoded.content_digest;
+  return r;
+}
+
+void bind_scan_record(sqlite::Statement& insert, const ScanRecord& r) {
+  insert.bind_int(1, r.created_by).bind_text(2, r.name).bind_int(3, r.rows).bind_int(4, r.columns);
+  insert.bind_text(5, r.angle_model);
+  for (int k = 0; k < 4; ++k)
+    insert.bind_optional_double(6 + k, r.angles[static_cast<std::size_t>(k)]);
+  insert.bind_text(10, r.scanner_name).bind_text(11, r.source_file);
+  insert.bind_int(12, r.valid_points).bind_int(13, r.has_color).bind_int(14, r.has_intensity);
+  insert.bind_int(15, r.content_digest).bind_int(16, checksum(r));
 }
 
 void insert_pose(sqlite3* db, const std::string& file, std::int64_t id, std::int64_t command_id,
                  const Eigen::Isometry3d& T_world_scan, const Eigen::Vector3d& scanner_world,
                  const std::optional<Eigen::AlignedBox3d>& box) {
-  const auto pose_bytes = encode_pose(T_world_scan);
-  sqlite::Statement insert(db, kInsertPose, file);
-  insert.bind_int(1, id).bind_int(2, command_id).bind_blob(3, pose_bytes);
-  for (int axis = 0; axis < 3; ++axis) insert.bind_double(4 + axis, scanner_world[axis]);
+  PoseRecord r;
+  r.scan_id = id;
+  r.command_id = command_id;
+  r.pose = encode_pose(T_world_scan);
+  r.scanner = {scanner_world.x(), scanner_world.y(), scanner_world.z()};
   for (int axis = 0; axis < 3; ++axis) {
-    insert.bind_optional_double(7 + axis, box ? std::optional(box->min()[axis]) : std::nullopt)
-        .bind_optional_double(10 + axis, box ? std::optional(box->max()[axis]) : std::nullopt);
+    r.bbox[static_cast<std::size_t>(axis)] = box ? std::optional(box->min()[axis]) : std::nullopt;
+    r.bbox[static_cast<std::size_t>(3 + axis)] =
+        box ? std::optional(box->max()[axis]) : std::nullopt;
   }
-  insert.run();
+  sqlite::Statement insert(db, kInsertPose, file);
+  insert.bind_int(1, r.scan_id).bind_int(2, r.command_id).bind_blob(3, r.pose);
+  for (int k = 0; k < 3; ++k) insert.bind_double(4 + k, r.scanner[static_cast<std::size_t>(k)]);
+  for (int k = 0; k < 6; ++k)
+    insert.bind_optional_double(7 + k, r.bbox[static_cast<std::size_t>(k)]);
+  insert.bind_int(13, checksum(r)).run();
 }
 
-int read_dimension(const sqlite::Statement& row, int column, const std::string& file,
-                   std::int64_t id) {
-  const std::int64_t value = row.column_int(column);
+int dimension(std::int64_t value, const std::string& file, std::int64_t id) {
   if (value < 0 || value > INT_MAX) damaged(file, id, "impossible grid size");
   return static_cast<int>(value);
 }
 
-std::optional<Eigen::AlignedBox3d> read_bbox(const sqlite::Statement& row) {
-  if (row.is_null(kBboxMinX)) return std::nullopt;
-  const Eigen::Vector3d min(row.column_double(kBboxMinX), row.column_double(kBboxMinY),
-                            row.column_double(kBboxMinZ));
-  const Eigen::Vector3d max(row.column_double(kBboxMaxX), row.column_double(kBboxMaxY),
-                            row.column_double(kBboxMaxZ));
-  return Eigen::AlignedBox3d(min, max);
+// The scan and pose records of a kSelectScans row, verified.
+std::pair<ScanRecord, PoseRecord> verified_records(const sqlite::Statement& row,
+                                                   const std::string& file, std::int64_t id) {
+  auto [scan, scan_sum] = read_scan_record(row, kFirstScanColumn);
+  if (checksum(scan) != scan_sum) {
+    damaged(file, id, "the scan's record fails its checksum (changed outside scanbench?)");
+  }
+  auto [pose, pose_sum] = read_pose_record(row, kFirstPoseColumn);
+  if (checksum(pose) != pose_sum) {
+    damaged(file, id, "the scan's pose fails its checksum (changed outside scanbench?)");
+  }
+  return {std::move(scan), std::move(pose)};
 }
 
 StoredScanSummary read_summary(const sqlite::Statement& row, const std::string& file) {
   StoredScanSummary stored;
-  stored.id = row.column_int(kId);
+  stored.id = row.column_int(0);
+  const auto [scan, pose] = verified_records(row, file, stored.id);
   auto& summary = stored.summary;
-  summary.name = row.column_text(kName);
-  summary.rows = read_dimension(row, kRows, file, stored.id);
-  summary.columns = read_dimension(row, kColumns, file, stored.id);
-  const std::string model = row.column_text(kAngleModel);
-  if (model != "spherical" && model != "per_pixel") damaged(file, stored.id, "unknown angle model");
-  summary.spherical = model == "spherical";
-  summary.T_world_scan = decode_pose(row.column_blob(kPose), file, stored.id);
-  summary.scanner.name = row.column_text(kScannerName);
-  summary.scanner.source_file = row.column_text(kSourceFile);
-  summary.scanner.position_world = {row.column_double(kScannerX), row.column_double(kScannerY),
-                                    row.column_double(kScannerZ)};
-  summary.valid_points = static_cast<std::size_t>(row.column_int(kValidPoints));
-  summary.has_color = row.column_int(kHasColor) != 0;
-  summary.has_intensity = row.column_int(kHasIntensity) != 0;
-  summary.bbox_world = read_bbox(row);
+  summary.name = scan.name;
+  summary.rows = dimension(scan.rows, file, stored.id);
+  summary.columns = dimension(scan.columns, file, stored.id);
+  if (scan.angle_model != "spherical" && scan.angle_model != "per_pixel") {
+    damaged(file, stored.id, "unknown angle model");
+  }
+  summary.spherical = scan.angle_model == "spherical";
+  summary.T_world_scan = decode_pose(pose.pose, file, stored.id);
+  summary.scanner.name = scan.scanner_name;
+  summary.scanner.source_file = scan.source_file;
+  summary.scanner.position_world = {pose.scanner[0], pose.scanner[1], pose.scanner[2]};
+  summary.valid_points = static_cast<std::size_t>(scan.valid_points);
+  summary.has_color = scan.has_color != 0;
+  summary.has_intensity = scan.has_intensity != 0;
+  if (pose.bbox[0]) {
+    summary.bbox_world =
+        Eigen::AlignedBox3d(Eigen::Vector3d(*pose.bbox[0], *pose.bbox[1], *pose.bbox[2]),
+                            Eigen::Vector3d(*pose.bbox[3], *pose.bbox[4], *pose.bbox[5]));
+  }
   return stored;
 }
 
 acquisition::AngleModel read_angles(const sqlite::Statement& row, bool spherical) {
   if (!spherical) return acquisition::PerPixelDirections{};
-  return acquisition::SphericalAngles{
-      row.column_double(kAzimuthStart), row.column_double(kAzimuthStep),
-      row.column_double(kElevationStart), row.column_double(kElevationStep)};
+  const ScanRecord scan = read_scan_record(row, kFirstScanColumn).first;
+  return acquisition::SphericalAngles{*scan.angles[0], *scan.angles[1], *scan.angles[2],
+                                      *scan.angles[3]};
 }
 
 // Loads a channel layer that must be there.
@@ -203,6 +203,11 @@ EncodedScan encode_scan(const acquisition::Scan& scan) {
   auto& layers = encoded.layers;
   layers.push_back(encode_layer<float>(layer::kRange, ElementType::kF32, scan.range_m));
   layers.push_back(encode_layer<std::uint8_t>(layer::kValid, ElementType::kU8, scan.valid));
+  // The digest that finds the same scan imported twice: the stored range and
+  // validity, in layer-name order (as the migration computes it).
+  encoded.content_digest = crc32_of(std::as_bytes(std::span(layers[0].blob)));
+  encoded.content_digest = crc32_of(std::as_bytes(std::span(layers[1].blob)),
+                                    static_cast<std::uint32_t>(encoded.content_digest));
   if (scan.has_intensity()) {
     layers.push_back(encode_layer<float>(layer::kIntensity, ElementType::kF32, scan.intensity));
   }
@@ -234,7 +239,7 @@ WHERE id = ?1 AND (created_by = ?2 OR created_by IN (SELECT id FROM commands WHE
 std::int64_t Project::insert_scan(Edit& edit, const EncodedScan& scan) {
   check_edit(edit);
   sqlite::Statement insert(db(), kInsertScan, file_name());
-  bind_scan_row(insert, edit.command_id(), scan);
+  bind_scan_record(insert, scan_record(edit.command_id(), scan));
   insert.run();
   const std::int64_t id = sqlite3_last_insert_rowid(db());
   insert_pose(db(), file_name(), id, edit.command_id(), scan.metadata.T_world_scan,
@@ -257,7 +262,7 @@ void Project::set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& sca
 }
 
 StoredScanSummary Project::current_summary(std::int64_t id) const {
-  const std::string sql = std::string(kSelectScans) + " AND s.id = ?1";
+  const std::string sql = kSelectScans + " AND s.id = ?1";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
   if (!select.step()) {
@@ -267,15 +272,26 @@ StoredScanSummary Project::current_summary(std::int64_t id) const {
 }
 
 std::vector<StoredScanSummary> Project::scans() const {
-  const std::string sql = std::string(kSelectScans) + " ORDER BY s.id";
+  const std::string sql = kSelectScans + " ORDER BY s.id";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   std::vector<StoredScanSummary> result;
   while (select.step()) result.push_back(read_summary(select, file_name()));
   return result;
 }
 
+std::optional<std::int64_t> Project::scan_with_content(std::int64_t digest) const {
+  sqlite::Statement select(db(), R"sql(
+SELECT id FROM scans
+WHERE content_digest = ?1 AND created_by IN (SELECT id FROM commands WHERE state = 'done')
+ORDER BY id LIMIT 1)sql",
+                           file_name());
+  select.bind_int(1, digest);
+  if (!select.step()) return std::nullopt;
+  return select.column_int(0);
+}
+
 acquisition::Scan Project::load_scan(std::int64_t id) const {
-  const std::string sql = std::string(kSelectScans) + " AND s.id = ?1";
+  const std::string sql = kSelectScans + " AND s.id = ?1";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
   if (!select.step()) {

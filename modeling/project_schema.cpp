@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
+#include "modeling/records.hpp"
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling::schema {
@@ -182,6 +183,7 @@ CREATE TABLE commands (
   undoable INTEGER NOT NULL CHECK (undoable IN (0, 1)),
   owner_host TEXT,     -- pending: the host and process writing it
   owner_pid INTEGER,
+  checksum INTEGER NOT NULL DEFAULT 0,   -- of id, name, settings, result, undoable
   created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
   CHECK ((state = 'pending') = (seq IS NULL))
 );
@@ -224,6 +226,8 @@ CREATE TABLE scans (
   valid_points INTEGER NOT NULL CHECK (valid_points >= 0),
   has_color INTEGER NOT NULL CHECK (has_color IN (0, 1)),
   has_intensity INTEGER NOT NULL CHECK (has_intensity IN (0, 1)),
+  content_digest INTEGER NOT NULL DEFAULT 0,  -- CRC of the range and valid layers: finds twins
+  checksum INTEGER NOT NULL DEFAULT 0,        -- of every column above but the id
   created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
   CHECK ((angle_model = 'spherical') =
          (azimuth_start_rad IS NOT NULL AND azimuth_step_rad IS NOT NULL AND
@@ -243,6 +247,7 @@ CREATE TABLE scan_poses (
   bbox_max_x CHECK (typeof(bbox_max_x) IN ('real', 'null')),
   bbox_max_y CHECK (typeof(bbox_max_y) IN ('real', 'null')),
   bbox_max_z CHECK (typeof(bbox_max_z) IN ('real', 'null')),
+  checksum INTEGER NOT NULL DEFAULT 0,  -- of every column above
   CHECK ((bbox_min_x IS NULL) = (bbox_max_z IS NULL)),
   PRIMARY KEY (scan_id, command_id)
 );
@@ -266,7 +271,8 @@ INSERT INTO scans (id, created_by, name, rows, columns, angle_model, azimuth_sta
          elevation_start_rad, elevation_step_rad, scanner_name, source_file, valid_points,
          has_color, has_intensity, created_at
   FROM scans_v3;
-INSERT INTO scan_poses
+INSERT INTO scan_poses (scan_id, command_id, T_world_scan, scanner_x, scanner_y, scanner_z,
+                        bbox_min_x, bbox_min_y, bbox_min_z, bbox_max_x, bbox_max_y, bbox_max_z)
   SELECT id, 1, T_world_scan, scanner_x, scanner_y, scanner_z, bbox_min_x, bbox_min_y,
          bbox_min_z, bbox_max_x, bbox_max_y, bbox_max_z
   FROM scans_v3;
@@ -312,6 +318,7 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
       return;
     case 3:
       sqlite::execute_with_int(db, kMigrate3To4, original_version, file);
+      fill_migrated_checksums(db, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

@@ -32,7 +32,7 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
   for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry",
-                              "register", "merge", "history", "undo", "redo"}) {
+                              "register", "merge", "history", "undo", "redo", "check"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;

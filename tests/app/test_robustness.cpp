@@ -190,17 +190,47 @@ TEST(Robustness, AReadOnlyProjectCanBeDescribedAndExported) {
   EXPECT_EQ(run_cli(dir, {"info", project.string(), "--json"}).out, before);
 }
 
+TEST(Robustness, CheckNamesDamageAndTheSameFileTwiceIsRefused) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  const std::string before = make_project(dir, project);
+  const CliResult sound = run_cli(dir, {"check", project.string()});
+  EXPECT_EQ(sound.exit_code, 0) << sound.err;
+  EXPECT_NE(sound.out.find(": ok ("), std::string::npos) << sound.out;
+  expect_one_line_error(
+      run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()}), 2,
+      "already in the project as scan 1");
+  EXPECT_EQ(run_cli(dir, {"info", project.string(), "--json"}).out, before);
+  EXPECT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string(),
+                          "--allow-duplicate"})
+                .exit_code,
+            0);
+  // A damaged journal entry: named on stdout, exit 2.
+  ASSERT_EQ(run_shell(dir, "true").exit_code, 0);
+  {
+    std::string bytes = test::read_file_bytes(project);
+    const std::size_t at = bytes.find("tiny_color.ptx");
+    ASSERT_NE(at, std::string::npos);
+    bytes[at] = 'T';
+    std::ofstream(project, std::ios::binary | std::ios::trunc) << bytes;
+  }
+  const CliResult damaged = run_cli(dir, {"check", project.string()});
+  expect_one_line_error(damaged, 2, "project is damaged");
+  EXPECT_NE(damaged.out.find("damaged: "), std::string::npos) << damaged.out;
+}
+
 TEST(Robustness, TwoImportsCreatingOneProjectAtOnceBothLand) {
   ScratchDir dir;
   const std::string project = shell_quote((dir / "new.sbproj").string());
-  const std::string scan = shell_quote(fixture("good/ptx/tiny_color.ptx").string());
-  const CliResult both =
-      run_shell(dir, "\"$SCANBENCH\" import " + project + " " + scan + " & \"$SCANBENCH\" import " +
-                         project + " " + scan + " & wait %1 && wait %2");
+  const std::string first = shell_quote(fixture("good/ptx/tiny_color.ptx").string());
+  const std::string second = shell_quote(fixture("good/ptx/two_scans.ptx").string());
+  const CliResult both = run_shell(dir, "\"$SCANBENCH\" import " + project + " " + first +
+                                            " & \"$SCANBENCH\" import " + project + " " + second +
+                                            " & wait %1 && wait %2");
   ASSERT_EQ(both.exit_code, 0) << both.err;
   const CliResult info = run_cli(dir, {"info", (dir / "new.sbproj").string(), "--json"});
   ASSERT_EQ(info.exit_code, 0) << info.err;
-  EXPECT_EQ(nlohmann::json::parse(info.out)["scans"].size(), 2u);
+  EXPECT_EQ(nlohmann::json::parse(info.out)["scans"].size(), 3u);
 }
 
 }  // namespace

@@ -104,7 +104,7 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
   EXPECT_EQ(raw_count(), "3");
   EXPECT_EQ(Project::open(project).history().back().state, CommandState::kPending);
   // ... until the next writer removes them.
-  import_files(project, {fixture("good/ptx/tiny_color.ptx")});
+  import_files(project, {fixture("good/ptx/irregular.ptx")});
   EXPECT_EQ(raw_count(), "2");
   for (const CommandRecord& c : Project::open(project).history()) {
     EXPECT_EQ(c.state, CommandState::kDone) << c.id;

@@ -1,0 +1,108 @@
+// Project::check: everything `scanbench check` verifies.
+#include <sqlite3.h>
+
+#include <vector>
+
+#include "core/errors.hpp"
+#include "modeling/blob_codec.hpp"
+#include "modeling/project.hpp"
+#include "modeling/records.hpp"
+#include "modeling/sqlite_statement.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+void sqlite_checks(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
+  for (sqlite::Statement integrity(db, "PRAGMA integrity_check", file); integrity.step();) {
+    const std::string line = integrity.column_text(0);
+    if (line != "ok") damage.push_back("database: " + line);
+  }
+  for (sqlite::Statement keys(db, "PRAGMA foreign_key_check", file); keys.step();) {
+    damage.push_back("database: a row of " + keys.column_text(0) + " points to a missing " +
+                     keys.column_text(2));
+  }
+}
+
+std::size_t check_scan_records(sqlite3* db, const std::string& file,
+                               std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  const std::string sql = std::string("SELECT s.id, ") + kScanRecordColumns + " FROM scans s";
+  for (sqlite::Statement scans(db, sql.c_str(), file); scans.step(); ++checked) {
+    const auto [record, stored] = read_scan_record(scans, 1);
+    if (checksum(record) != stored) {
+      damage.push_back("scan " + std::to_string(scans.column_int(0)) +
+                       ": its record (name, grid, angle model, summary) fails its checksum");
+    }
+  }
+  const std::string poses_sql = std::string("SELECT ") + kPoseRecordColumns + " FROM scan_poses p";
+  for (sqlite::Statement poses(db, poses_sql.c_str(), file); poses.step(); ++checked) {
+    const auto [record, stored] = read_pose_record(poses, 0);
+    if (checksum(record) != stored || record.pose.size() != 16 * sizeof(double)) {
+      damage.push_back("scan " + std::to_string(record.scan_id) + ": the pose of command " +
+                       std::to_string(record.command_id) + " fails its checksum");
+    }
+  }
+  return checked;
+}
+
+std::size_t check_commands(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  for (sqlite::Statement commands(
+           db, "SELECT id, name, settings, result, undoable, checksum FROM commands", file);
+       commands.step(); ++checked) {
+    const CommandFields fields{commands.column_int(0), commands.column_text(1),
+                               commands.column_text(2), commands.column_text(3),
+                               commands.column_int(4)};
+    if (checksum(fields) != commands.column_int(5)) {
+      damage.push_back("command " + std::to_string(fields.id) + " (" + fields.name +
+                       "): its journal entry (settings, result) fails its checksum");
+    }
+  }
+  return checked;
+}
+
+std::size_t check_layers(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  for (sqlite::Statement layers(db, R"sql(
+SELECT l.scan_id, l.name, l.command_id, l.element_type, l.element_count, l.data,
+       s.rows * s.columns
+FROM scan_layers l JOIN scans s ON s.id = l.scan_id WHERE l.codec = 'zstd')sql",
+                                file);
+       layers.step(); ++checked) {
+    const std::string where = "scan " + std::to_string(layers.column_int(0)) + ", layer " +
+                              layers.column_text(1) + " of command " +
+                              std::to_string(layers.column_int(2));
+    const std::optional<ElementType> type = element_type_from_name(layers.column_text(3));
+    if (!type) {
+      damage.push_back(where + ": unknown element type");
+      continue;
+    }
+    if (layers.column_int(4) != layers.column_int(6)) {
+      damage.push_back(where + ": holds " + std::to_string(layers.column_int(4)) +
+                       " elements, the scan has " + std::to_string(layers.column_int(6)) +
+                       " pixels");
+      continue;
+    }
+    try {
+      decompress(layers.column_blob(5),
+                 static_cast<std::size_t>(layers.column_int(4)) * element_size(*type),
+                 BlobContext{file, where});
+    } catch (const core::InputError& error) {
+      damage.push_back(where + ": " + error.problem());
+    }
+  }
+  return checked;
+}
+
+}  // namespace
+
+Project::CheckReport Project::check() const {
+  CheckReport report;
+  sqlite_checks(db(), file_name(), report.damage);
+  report.records += check_scan_records(db(), file_name(), report.damage);
+  report.records += check_commands(db(), file_name(), report.damage);
+  report.layers = check_layers(db(), file_name(), report.damage);
+  return report;
+}
+
+}  // namespace scanbench::modeling

@@ -1,0 +1,135 @@
+// Checksummed records and `Project::check`: a flipped byte anywhere that
+// matters is found and named; a sound project, migrated ones included,
+// passes; the same data imported twice is refused unless asked for.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "modeling/import_scans.hpp"
+#include "modeling/project.hpp"
+#include "modeling/project_test_support.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::fixture;
+using test::RawDatabase;
+using test::ScratchDir;
+using ::testing::HasSubstr;
+
+// A project with one imported scan, closed.
+std::filesystem::path sound_project(const ScratchDir& dir) {
+  const auto file = dir / "p.sbproj";
+  Project project = Project::create(file);
+  core::Progress quiet;
+  import_scans(project, std::vector<std::filesystem::path>{fixture("good/ptx/tiny_color.ptx")}, {},
+               quiet);
+  return file;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string all;
+  for (const std::string& line : lines) all += line + "\n";
+  return all;
+}
+
+TEST(Integrity, ASoundProjectPassesTheCheck) {
+  const ScratchDir dir;
+  const Project project = Project::open(sound_project(dir));
+  const Project::CheckReport report = project.check();
+  EXPECT_TRUE(report.damage.empty()) << joined(report.damage);
+  EXPECT_EQ(report.records, 3u);  // the scan, its pose, the import
+  EXPECT_EQ(report.layers, 4u);   // range, valid, intensity, rgb
+}
+
+TEST(Integrity, MigratedProjectsPassTheCheck) {
+  const ScratchDir dir;
+  for (int version : {1, 2, 3}) {
+    const auto file = dir / ("v" + std::to_string(version) + ".sbproj");
+    std::filesystem::copy_file(fixture("projects/version" + std::to_string(version) + ".sbproj"),
+                               file);
+    const Project::CheckReport report = Project::open(file).check();
+    EXPECT_TRUE(report.damage.empty()) << version << ":\n" << joined(report.damage);
+    EXPECT_GT(report.layers, 0u);
+  }
+}
+
+TEST(Integrity, AFlippedByteInAPoseIsFoundOnReadingAndByTheCheck) {
+  const ScratchDir dir;
+  const auto file = sound_project(dir);
+  // Flip one byte of the stored pose on disk, as a failing medium would:
+  // the translation's x (row-major element 3), a byte of its mantissa.
+  // tiny_color's pose is the identity.
+  std::string bytes = test::read_file_bytes(file);
+  const Eigen::Matrix4d m = Eigen::Isometry3d::Identity().matrix();
+  std::string stored(128, '\0');
+  for (int k = 0; k < 16; ++k) {
+    const double value = m(k / 4, k % 4);
+    std::memcpy(&stored[static_cast<std::size_t>(k) * 8], &value, 8);
+  }
+  const std::size_t at = bytes.find(stored);
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 3 * 8 + 6] ^= 0x10;  // 0.0 becomes a tiny non-zero x
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+  const Project project = Project::open(file);
+  try {
+    project.scans();
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.problem(), HasSubstr("pose fails its checksum"));
+  }
+  EXPECT_THAT(joined(project.check().damage), HasSubstr("scan 1: the pose of command 1"));
+}
+
+TEST(Integrity, ChangedSettingsInTheJournalAreFound) {
+  const ScratchDir dir;
+  const auto file = sound_project(dir);
+  RawDatabase(file).execute("UPDATE commands SET settings = replace(settings, 'tiny', 'tidy')");
+  const Project project = Project::open(file);
+  EXPECT_THROW(project.history(), core::InputError);
+  EXPECT_THAT(joined(project.check().damage), HasSubstr("command 1 (import)"));
+}
+
+TEST(Integrity, ADamagedLayerIsNamedByTheCheck) {
+  const ScratchDir dir;
+  const auto file = sound_project(dir);
+  RawDatabase(file).execute(
+      "UPDATE scan_layers SET data = substr(data, 1, 12) || x'00' || substr(data, 14) "
+      "WHERE name = 'intensity'");
+  const Project::CheckReport report = Project::open(file).check();
+  ASSERT_EQ(report.damage.size(), 1u) << joined(report.damage);
+  EXPECT_THAT(report.damage[0], HasSubstr("scan 1, layer intensity of command 1"));
+}
+
+TEST(Integrity, TheSameScanImportedTwiceIsRefusedUnlessAllowed) {
+  const ScratchDir dir;
+  Project project = Project::open(sound_project(dir));
+  core::Progress quiet;
+  const std::vector<std::filesystem::path> again{fixture("good/ptx/tiny_color.ptx")};
+  try {
+    import_scans(project, again, {}, quiet);
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.problem(), HasSubstr("already in the project as scan 1"));
+  }
+  EXPECT_EQ(project.scans().size(), 1u);
+  // The same file twice in one call is a twin too.
+  const auto copy = dir / "copy.ptx";
+  std::filesystem::copy_file(fixture("good/ptx/two_scans.ptx"), copy);
+  const std::vector<std::filesystem::path> twice{fixture("good/ptx/two_scans.ptx"), copy};
+  EXPECT_THROW(import_scans(project, twice, {}, quiet), core::InputError);
+  EXPECT_EQ(project.scans().size(), 1u);
+  ImportSettings allow;
+  allow.allow_duplicates = true;
+  import_scans(project, again, allow, quiet);
+  EXPECT_EQ(project.scans().size(), 2u);
+}
+
+}  // namespace
+}  // namespace scanbench::modeling
