@@ -1,5 +1,6 @@
 #include "acquisition/text_lines.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -32,7 +33,10 @@ TextLineReader::TextLineReader(const std::filesystem::path& path) : file_name_(p
     throw core::InputError(file_name_, {}, std::string("cannot open: ") + std::strerror(errno));
   }
   file_size_ = std::filesystem::file_size(path, error);
-  buffer_.resize(kChunkBytes);
+  // A small file gets a buffer its size, not 4 MB (opening many small files,
+  // as the fuzzer does, then costs little).
+  buffer_.resize(std::clamp<std::size_t>(static_cast<std::size_t>(file_size_) + 1, 4096,
+                                         kChunkBytes));
 }
 
 TextLineReader::~TextLineReader() {

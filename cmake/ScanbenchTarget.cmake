@@ -8,6 +8,11 @@ function(scanbench_target_settings target)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
     target_compile_options(${target} PRIVATE -Wno-error=restrict)
   endif()
+  # The branch-free kernels (acquisition/branch_free.hpp, mixed_pixels.cpp)
+  # combine booleans with & and | on purpose: no short-circuit branches.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    target_compile_options(${target} PRIVATE -Wno-bitwise-instead-of-logical)
+  endif()
   if(SCANBENCH_SANITIZE)
     # -UNDEBUG: the sanitizer pass also checks every programmer-error assert,
     # at optimised speed (RelWithDebInfo would otherwise define NDEBUG).
@@ -23,6 +28,11 @@ function(scanbench_target_settings target)
     # No AVX2 clones (acquisition/branch_free.hpp): their ifunc resolvers run
     # during relocation, before the sanitizer runtime is initialised.
     target_compile_definitions(${target} PRIVATE SCANBENCH_VECTOR_CLONES=)
+  endif()
+  if(SCANBENCH_FUZZ)
+    # Coverage for libFuzzer in every library it drives (fuzz/CMakeLists.txt
+    # links the fuzzer's own main into the targets).
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
   endif()
 endfunction()
 

@@ -57,6 +57,11 @@ std::vector<T> decompress_typed(std::span<const std::uint8_t> blob, std::size_t 
 
 }  // namespace
 
+void check_blob_size(std::span<const std::uint8_t> blob, std::size_t expected_bytes,
+                     const BlobContext& context) {
+  check_recorded_size(blob, expected_bytes, context);
+}
+
 std::vector<std::uint8_t> compress(std::span<const std::byte> raw, int level) {
   const std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> context(ZSTD_createCCtx(),
                                                                      &ZSTD_freeCCtx);

@@ -42,6 +42,12 @@ std::vector<std::uint8_t> compress(std::span<const std::byte> raw,
 void decompress_into(std::span<const std::uint8_t> blob, std::span<std::byte> out,
                      const BlobContext& context);
 
+// Throws core::InputError naming `context` unless `blob` is one zstd frame
+// that records exactly `expected_bytes` of content: checked before any
+// buffer for it is allocated.
+void check_blob_size(std::span<const std::uint8_t> blob, std::size_t expected_bytes,
+                     const BlobContext& context);
+
 // As decompress_into, returning a new buffer of `expected_bytes` bytes.
 std::vector<std::byte> decompress(std::span<const std::uint8_t> blob, std::size_t expected_bytes,
                                   const BlobContext& context);

@@ -8,6 +8,7 @@
 #include <cassert>
 
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 #include "modeling/blob_codec.hpp"
 #include "modeling/project.hpp"
 #include "modeling/sqlite_statement.hpp"
@@ -153,6 +154,9 @@ bool Project::read_layer(
   }
   const BlobContext context{file_name(),
                             "scan " + std::to_string(id) + ", layer " + std::string(name)};
+  // The frame must hold what the grid needs before a buffer is made for it.
+  check_blob_size(select.column_blob(3), n * element_size(type), context);
+  core::check_memory(n * element_size(type), file_name());
   decompress_into(select.column_blob(3), allocate(n * element_size(type)), context);
   return true;
 }

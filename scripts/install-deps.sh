@@ -10,7 +10,7 @@ packages=(
   libsqlite3-dev libzstd-dev nlohmann-json3-dev libcli11-dev
   libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev libglfw3-dev libepoxy-dev libegl-dev libegl1-mesa-dev
-  libgl1-mesa-dri xvfb xauth
+  libgl1-mesa-dri xvfb xauth clang libclang-rt-14-dev
 )
 
 missing=()

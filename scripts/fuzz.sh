@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, with AddressSanitizer and
+# UndefinedBehaviorSanitizer) and runs each for a while on its seed corpus.
+#   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 60 s, all targets)
+# Corpora grow in build-fuzz/corpus/<target> across runs; a finding leaves its
+# input in build-fuzz/findings/ and makes the script fail. Each target's line
+# "fuzz: <target>: N executions in S s, no finding" is what docs/reliability.md
+# records.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+seconds=${1:-60}
+shift || true
+targets=("$@")
+[ ${#targets[@]} -eq 0 ] && targets=(fuzz_ptx fuzz_pcd fuzz_triplet fuzz_project)
+build=${FUZZ_BUILD_DIR:-$root/build-fuzz}
+
+"$root/scripts/install-deps.sh"
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DSCANBENCH_FUZZ=ON -DSCANBENCH_TESTS=OFF \
+  -DSCANBENCH_BENCH=OFF >/dev/null
+cmake --build "$build" --target fuzz_targets --parallel "$(nproc)"
+
+seed() {  # target -> the fixtures its corpus starts from
+  case $1 in
+    fuzz_ptx) ls "$root"/fixtures/good/ptx/*.ptx "$root"/fixtures/bad/ptx_*.ptx ;;
+    fuzz_pcd) ls "$root"/fixtures/good/pcd/*.pcd "$root"/fixtures/bad/pcd_*.pcd ;;
+    fuzz_triplet) ls "$root"/fixtures/good/triplet/*.json "$root"/fixtures/bad/triplet_*.json ;;
+    fuzz_project) ls "$root"/fixtures/projects/*.sbproj "$root"/fixtures/bad/project_*.sbproj ;;
+  esac
+}
+dictionary() {
+  case $1 in
+    fuzz_ptx) echo ptx ;; fuzz_pcd) echo pcd ;; fuzz_triplet) echo triplet ;; fuzz_project) echo project ;;
+  esac
+}
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+mkdir -p "$build/findings"
+status=0
+for target in "${targets[@]}"; do
+  corpus=$build/corpus/$target
+  mkdir -p "$corpus"
+  seed "$target" | while read -r file; do cp -n "$file" "$corpus/" 2>/dev/null || true; done
+  log=$build/$target.log
+  set +e
+  "$build/bin/$target" "$corpus" -dict="$root/fuzz/dict/$(dictionary "$target").dict" \
+    -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=4096 \
+    -artifact_prefix="$build/findings/$target-" -print_final_stats=1 >"$log" 2>&1
+  code=$?
+  set -e
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  if [ $code -eq 0 ]; then
+    echo "fuzz: $target: $runs executions in $seconds s, no finding"
+  else
+    echo "fuzz: $target: FINDING after $runs executions (exit $code); see $log and $build/findings/"
+    tail -30 "$log"
+    status=1
+  fi
+done
+exit $status
