@@ -1,18 +1,46 @@
 #include "acquisition/output_file.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <charconv>
 #include <cstring>
-#include <stdexcept>
 
 #include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 namespace {
+
 constexpr std::size_t kFlushBytes = 4u << 20;
+constexpr std::string_view kPartial = ".partial-";
+
+// Removes "<target>.partial-<pid>" regular files whose process is gone:
+// what a killed run of an export to the same target left.
+void remove_abandoned_partials(const std::filesystem::path& target) {
+  const std::filesystem::path folder =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  const std::string prefix = target.filename().string() + std::string(kPartial);
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    pid_t pid = 0;
+    const char* digits = name.data() + prefix.size();
+    const auto [end, parsed] = std::from_chars(digits, name.data() + name.size(), pid);
+    if (parsed != std::errc() || end != name.data() + name.size() || pid <= 0) continue;
+    if (!entry.is_regular_file(error) || entry.is_symlink(error)) continue;
+    if (::kill(pid, 0) != 0 && errno == ESRCH) std::filesystem::remove(entry.path(), error);
+  }
 }
 
+}  // namespace
+
 OutputFile::OutputFile(std::filesystem::path target)
-    : target_(std::move(target)), partial_(target_.string() + ".partial") {
+    : target_(std::move(target)),
+      partial_(target_.string() + std::string(kPartial) + std::to_string(::getpid())) {
   if (target_.empty()) throw core::InputError("", {}, "no output file given");
   std::error_code error;
   const auto status = std::filesystem::status(target_, error);
@@ -23,8 +51,24 @@ OutputFile::OutputFile(std::filesystem::path target)
     throw core::InputError(target_.string(), {},
                            "is not a regular file (a device or a pipe); exports write files");
   }
-  file_ = std::fopen(partial_.c_str(), "wb");
-  if (file_ == nullptr) fail("cannot create");
+  remove_abandoned_partials(target_);
+  ::unlink(partial_.c_str());  // an earlier process of our pid, long gone
+  const int fd =
+      ::open(partial_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    const int code = errno;
+    const std::string problem = std::string("cannot create the output: ") + std::strerror(code);
+    if (code == ENOENT || code == ENOTDIR || code == ENAMETOOLONG) {
+      throw core::InputError(target_.string(), {}, problem);  // the path is the user's
+    }
+    throw core::RuntimeFailure(target_.string(), {}, problem);
+  }
+  file_ = ::fdopen(fd, "wb");
+  if (file_ == nullptr) {
+    ::close(fd);
+    ::unlink(partial_.c_str());
+    fail("cannot create");
+  }
   buffer_.reserve(kFlushBytes + 4096);
 }
 
@@ -55,10 +99,15 @@ void OutputFile::flush() {
 void OutputFile::close() {
   if (file_ == nullptr) return;
   flush();
+  // On the disk before it replaces the target: a power cut after the rename
+  // must not leave an empty file where the old one was.
+  const bool synced = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
+  const int saved = errno;
   const int closed = std::fclose(file_);
   file_ = nullptr;
   closed_ = true;
-  if (closed != 0) fail("cannot write");
+  if (!synced) errno = saved;
+  if (!synced || closed != 0) fail("cannot write");
 }
 
 void OutputFile::commit() {
@@ -66,14 +115,13 @@ void OutputFile::commit() {
   std::error_code error;
   std::filesystem::rename(partial_, target_, error);
   if (error) {
-    const std::string problem = error.message();
-    throw std::runtime_error(target_.string() + ": cannot replace: " + problem);
+    throw core::RuntimeFailure(target_.string(), {}, "cannot replace: " + error.message());
   }
   closed_ = false;  // renamed: nothing left to remove
 }
 
 void OutputFile::fail(const std::string& what) const {
-  throw std::runtime_error(target_.string() + ": " + what + ": " + std::strerror(errno));
+  throw core::RuntimeFailure(target_.string(), {}, what + ": " + std::strerror(errno));
 }
 
 }  // namespace scanbench::acquisition

@@ -12,23 +12,28 @@ namespace scanbench::acquisition {
 
 class OutputFile {
  public:
-  // Creates "<target>.partial" (replacing what a killed run of the same
-  // export left under that name). Throws core::InputError when `target` is
-  // empty, a directory or an existing file that is not a regular file, and
-  // std::runtime_error naming the file when it cannot be created.
+  // Creates "<target>.partial-<pid>", a new file of its own (never through a
+  // symlink, never shared with another export to the same target), after
+  // removing what killed runs of this export left beside the target (their
+  // processes are gone). Throws core::InputError when `target` is empty, a
+  // directory, an existing file that is not a regular file, or in a folder
+  // that does not exist; core::RuntimeFailure naming the file when it cannot
+  // be created otherwise.
   explicit OutputFile(std::filesystem::path target);
   // Removes the temporary file unless commit() succeeded.
   ~OutputFile();
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
 
-  // Buffered; throws std::runtime_error on a write error (disk full).
+  // Buffered; throws core::RuntimeFailure on a write error (disk full).
   void write(std::string_view bytes);
-  // Flushes and closes the temporary file; throws std::runtime_error on a
-  // write error. Outputs that belong together (a triplet) close all before
-  // any replaces its target, so a full disk leaves none of them behind.
+  // Flushes the temporary file to the disk (fsync) and closes it; throws
+  // core::RuntimeFailure on a write error. Outputs that belong together (a
+  // triplet) close all before any replaces its target, so a full disk leaves
+  // none of them behind.
   void close();
-  // close() when still open, then renames onto the target.
+  // close() when still open, then renames onto the target; throws
+  // core::RuntimeFailure when the rename fails.
   void commit();
 
   // Appends to an internal buffer that is flushed in large blocks: the text

@@ -69,6 +69,16 @@ void refuse_to_replace_projects(const Project& project,
                                 std::span<const std::filesystem::path> outputs) {
   for (const std::filesystem::path& output : outputs) {
     std::error_code error;
+    // SQLite's companion files hold the project's latest changes.
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(output, error);
+    const std::string project_path = std::filesystem::weakly_canonical(project.path(), error);
+    for (const char* suffix : {"-wal", "-shm", "-journal"}) {
+      if (canonical == project_path + suffix) {
+        throw core::InputError(output.string(), {},
+                               "is a file of the project being exported; an export never "
+                               "replaces its input");
+      }
+    }
     if (!std::filesystem::exists(output, error)) continue;
     if (std::filesystem::equivalent(output, project.path(), error)) {
       throw core::InputError(output.string(), {},

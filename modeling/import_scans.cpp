@@ -39,15 +39,6 @@ void refuse_duplicate(const Project& project, const EncodedScan& scan,
           "; importing it again would add a twin (--allow-duplicate imports it anyway)");
 }
 
-// True when the project holds no command at all (not even a pending one).
-bool still_empty(const std::filesystem::path& project_path) noexcept {
-  try {
-    return Project::open(project_path).history().empty();
-  } catch (...) {
-    return false;
-  }
-}
-
 }  // namespace
 
 ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
@@ -87,19 +78,21 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
 ImportResult import_scan_files(const std::filesystem::path& project_path,
                                std::span<const std::filesystem::path> files,
                                const ImportSettings& settings, core::Progress& progress) {
-  // Only a project this call created, and nobody has written to since, is
-  // removed on failure: when another process creates the file first, this
-  // import goes into that one.
-  bool created = false;
-  try {
-    Project project = Project::open_or_create(project_path, &created);
-    ImportResult result = import_scans(project, files, settings, progress);
-    result.created_project = created;
-    return result;
-  } catch (...) {
-    if (created && still_empty(project_path)) remove_project_files(project_path);
-    throw;
+  std::error_code error;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(project_path, error))) {
+    // A new project is filled as a draft and appears only once the import is
+    // done: a refused import leaves nothing, and no other process ever sees
+    // it half made.
+    Project::Draft draft = Project::create_draft(project_path);
+    ImportResult result = import_scans(draft.project(), files, settings, progress);
+    if (draft.publish()) {
+      result.created_project = true;
+      return result;
+    }
+    // Another process created the project meanwhile: import into that one.
   }
+  Project project = Project::open(project_path);
+  return import_scans(project, files, settings, progress);
 }
 
 }  // namespace scanbench::modeling

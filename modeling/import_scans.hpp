@@ -38,9 +38,11 @@ struct ImportResult {
 ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
                           const ImportSettings& settings, core::Progress& progress);
 
-// import_scans into the project at `project_path`, which is created when it
-// does not exist; a project this call created is removed again when the
-// import fails.
+// import_scans into the project at `project_path`. When it does not exist,
+// the import fills a new project under a temporary name, which takes the
+// name only when the import is done (Project::Draft): a failed import leaves
+// no file, and when another process creates the project meanwhile, the scans
+// go into that one.
 ImportResult import_scan_files(const std::filesystem::path& project_path,
                                std::span<const std::filesystem::path> files,
                                const ImportSettings& settings, core::Progress& progress);

@@ -8,6 +8,7 @@
 #include <cassert>
 #include <cerrno>
 #include <cstring>
+#include <random>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -65,21 +66,36 @@ bool writable(const std::filesystem::path& file) {
 // that is one step; elsewhere a hard link does the same.
 bool place_without_replacing(const std::filesystem::path& temporary,
                              const std::filesystem::path& file) {
+  const auto refuse = [&](int code) {
+    throw core::RuntimeFailure(file.string(), {},
+                               std::string("cannot create the project: ") + std::strerror(code));
+  };
   if (::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, file.c_str(), RENAME_NOREPLACE) == 0) {
     return true;
   }
   if (errno == EEXIST) return false;
-  if (errno != EINVAL && errno != ENOSYS) {
-    throw core::RuntimeFailure(file.string(), {},
-                               std::string("cannot create the project: ") + std::strerror(errno));
+  if (errno != EINVAL && errno != ENOSYS) refuse(errno);
+  if (::link(temporary.c_str(), file.c_str()) == 0) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    return true;
   }
-  if (::link(temporary.c_str(), file.c_str()) != 0) {
+  if (errno == EEXIST) return false;
+  if (errno != EPERM && errno != EOPNOTSUPP) refuse(errno);
+  // A file system with neither (FAT, some FUSE mounts): claim the name with
+  // an empty file first, then replace that one. Another process may see it
+  // empty for a moment and refuse it as not a project; none overwrites one.
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
     if (errno == EEXIST) return false;
-    throw core::RuntimeFailure(file.string(), {},
-                               std::string("cannot create the project: ") + std::strerror(errno));
+    refuse(errno);
   }
-  std::error_code ignored;
-  std::filesystem::remove(temporary, ignored);
+  ::close(fd);
+  if (::rename(temporary.c_str(), file.c_str()) != 0) {
+    const int code = errno;
+    ::unlink(file.c_str());
+    refuse(code);
+  }
   return true;
 }
 
@@ -101,8 +117,10 @@ void check_folder(const std::filesystem::path& file) {
 // Builds a new, empty project at a temporary name beside `file` and closes
 // it (its write-ahead log checkpointed away). Returns the temporary path.
 std::filesystem::path build_empty_project(const std::filesystem::path& file) {
-  const std::filesystem::path temporary = file.string() + ".creating-" + std::to_string(::getpid());
-  remove_project_files(temporary);  // what a killed earlier attempt of ours left
+  // Unique across processes and hosts sharing the folder.
+  const std::filesystem::path temporary = file.string() + ".creating-" +
+                                          std::to_string(::getpid()) + "-" +
+                                          std::to_string(std::random_device{}());
   try {
     sqlite3* raw = connect(temporary, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
     const std::unique_ptr<sqlite3, decltype(&sqlite3_close)> db(raw, &sqlite3_close);
@@ -153,39 +171,55 @@ Project Project::open(const std::filesystem::path& file) {
   return project;
 }
 
-Project Project::create(const std::filesystem::path& file) {
+Project::Draft Project::create_draft(const std::filesystem::path& file) {
   std::error_code error;
   if (std::filesystem::exists(std::filesystem::symlink_status(file, error))) refuse_existing(file);
   check_folder(file);
   const std::filesystem::path temporary = build_empty_project(file);
-  bool placed = false;
   try {
-    placed = place_without_replacing(temporary, file);
+    Project project(file, Connection(connect(temporary)));
+    schema::configure_connection(project.db(), project.file_name());
+    return Draft(std::move(project), temporary);
   } catch (...) {
     remove_project_files(temporary);
     throw;
   }
-  if (!placed) {
-    remove_project_files(temporary);
-    refuse_existing(file);
+}
+
+Project::Draft::~Draft() {
+  if (!temporary_.empty()) {
+    project_.reset();
+    remove_project_files(temporary_);
   }
+}
+
+bool Project::Draft::publish() {
+  assert(project_ && "publish of a published or moved-from draft");
+  const std::filesystem::path file = project_->path();
+  project_.reset();  // closed: its write-ahead log is checkpointed into the file
+  bool placed = false;
+  try {
+    placed = place_without_replacing(temporary_, file);
+  } catch (...) {
+    remove_project_files(temporary_);
+    temporary_.clear();
+    throw;
+  }
+  if (!placed) remove_project_files(temporary_);
+  temporary_.clear();
+  return placed;
+}
+
+Project Project::create(const std::filesystem::path& file) {
+  Draft draft = create_draft(file);
+  if (!draft.publish()) refuse_existing(file);
   return open(file);
 }
 
 Project Project::open_or_create(const std::filesystem::path& file, bool* created) {
   std::error_code error;
-  if (created != nullptr) *created = false;
-  if (std::filesystem::exists(std::filesystem::symlink_status(file, error))) return open(file);
-  check_folder(file);
-  const std::filesystem::path temporary = build_empty_project(file);
-  bool placed = false;
-  try {
-    placed = place_without_replacing(temporary, file);
-  } catch (...) {
-    remove_project_files(temporary);
-    throw;
-  }
-  if (!placed) remove_project_files(temporary);  // another process made it first
+  const bool exists = std::filesystem::exists(std::filesystem::symlink_status(file, error));
+  const bool placed = !exists && create_draft(file).publish();
   if (created != nullptr) *created = placed;
   return open(file);
 }

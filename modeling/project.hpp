@@ -106,6 +106,7 @@ class Project {
   class Edit;
   class LongCommand;
   class ReadSnapshot;
+  class Draft;
 
   // Opens an existing project for reading and writing. Never creates or
   // recreates the file. Throws core::InputError, leaving the file untouched,
@@ -131,6 +132,12 @@ class Project {
   // or its folder does not exist, core::RuntimeFailure when it cannot be
   // written; nothing is left behind.
   static Project create(const std::filesystem::path& file);
+
+  // A new project that nobody sees until it is published: built and filled
+  // under a temporary name beside `file` (an import into a new project
+  // writes its scans into the draft), then moved into place whole. Throws as
+  // create(); the draft's temporary file is removed unless published.
+  static Draft create_draft(const std::filesystem::path& file);
 
   // open() when `file` exists, else create(); when another process creates
   // it first, opens that one. `created` (when given) tells which happened.
@@ -386,6 +393,31 @@ class Project::ReadSnapshot {
   friend class Project;
   explicit ReadSnapshot(sqlite3* db) : db_(db) {}
   sqlite3* db_ = nullptr;
+};
+
+// A project being built under a temporary name (Project::create_draft).
+// Its path() is the name it will have, and messages name that. Removed on
+// destruction unless published.
+class Project::Draft {
+ public:
+  Draft(Draft&&) noexcept = default;
+  Draft& operator=(Draft&&) = delete;
+  ~Draft();
+
+  Project& project() { return *project_; }
+
+  // Closes the draft and moves it to its name unless a file of that name
+  // appeared meanwhile (another process created it): then the draft is
+  // removed and false returned. Throws core::RuntimeFailure when the file
+  // system refuses the move; the draft is removed.
+  bool publish();
+
+ private:
+  friend class Project;
+  Draft(Project project, std::filesystem::path temporary)
+      : project_(std::make_unique<Project>(std::move(project))), temporary_(std::move(temporary)) {}
+  std::unique_ptr<Project> project_;
+  std::filesystem::path temporary_;
 };
 
 }  // namespace scanbench::modeling

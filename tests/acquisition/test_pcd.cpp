@@ -8,6 +8,7 @@
 
 #include "acquisition/pcd_reader.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
@@ -180,6 +181,30 @@ TEST(PcdReader, WorldCoordinatesKeepATenthOfAMillimetre) {
   }
   EXPECT_LT(worst, 1e-4);
   EXPECT_GT(scan.T_world_scan.translation().norm(), 8e6);  // the offset is in the pose
+}
+
+// A sparse file whose header declares 2147 x 1,000,000 binary points (25.8
+// GB of body) passes the size checks; it must be refused for the memory it
+// needs (129 GB with the scan), not die in std::bad_alloc.
+TEST(PcdReader, AHeaderAskingForMoreMemoryThanThereIsIsRefused) {
+  const ScratchDir dir;
+  const auto path = dir / "sparse.pcd";
+  const std::string header =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1000000\n"
+      "HEIGHT 2147\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2147000000\nDATA binary\n";
+  { std::ofstream(path, std::ios::binary) << header; }
+  std::error_code error;
+  std::filesystem::resize_file(path, header.size() + std::uint64_t{2147000000} * 12, error);
+  const std::optional<std::uint64_t> available = core::available_memory_bytes();
+  if (error || !available || *available > std::uint64_t{129} << 30) {
+    GTEST_SKIP() << "needs a sparse file and less than 129 GB of free memory";
+  }
+  try {
+    read_organized_pcd(path);
+    FAIL() << "expected core::RuntimeFailure";
+  } catch (const core::RuntimeFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("GB of memory"), std::string::npos) << e.what();
+  }
 }
 
 struct BadPcd {

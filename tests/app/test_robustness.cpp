@@ -4,6 +4,7 @@
 // Each runs the scanbench executable as a user would.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -157,11 +158,17 @@ TEST(Robustness, TheNextRunOfAnExportRemovesWhatAKilledOneLeft) {
   const std::filesystem::path project = dir / "p.sbproj";
   make_project(dir, project);
   const std::filesystem::path csv = dir / "points.csv";
-  { std::ofstream(csv.string() + ".partial") << "half of an earlier, killed export"; }
+  // A process that is gone: its pid names what its killed export left.
+  const pid_t gone = ::fork();
+  if (gone == 0) ::_exit(0);
+  ASSERT_GT(gone, 0);
+  ::waitpid(gone, nullptr, 0);
+  const std::string left = csv.string() + ".partial-" + std::to_string(gone);
+  { std::ofstream(left) << "half of an earlier, killed export"; }
   ASSERT_EQ(
       run_cli(dir, {"export", project.string(), "--format", "csv", "-o", csv.string()}).exit_code,
       0);
-  EXPECT_FALSE(std::filesystem::exists(csv.string() + ".partial"));
+  EXPECT_FALSE(std::filesystem::exists(left));
   EXPECT_TRUE(std::filesystem::exists(csv));
 }
 
