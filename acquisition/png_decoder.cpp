@@ -60,8 +60,8 @@ bool read_rows(png_structp png, png_infop info, png_bytepp rows) {
 
 }  // namespace
 
-PngDecodeResult decode_png(const std::filesystem::path& path, int rows, int columns) {
-  PngDecodeResult result;
+DecodedImage decode_png(const std::filesystem::path& path, int rows, int columns) {
+  DecodedImage result;
   const std::unique_ptr<std::FILE, decltype(&std::fclose)> file(std::fopen(path.c_str(), "rb"),
                                                                 &std::fclose);
   if (!file) return {{}, "cannot open the file"};
@@ -77,15 +77,12 @@ PngDecodeResult decode_png(const std::filesystem::path& path, int rows, int colu
   Header header;
   if (!read_header(png, info, header)) {
     destroy();
-    return {{}, std::string("image is unreadable or corrupt (libpng: ") + report.error + ")"};
+    return {{}, unreadable(std::string("libpng: ") + report.error)};
   }
   if (header.height != static_cast<png_uint_32>(rows) ||
       header.width != static_cast<png_uint_32>(columns)) {
     destroy();
-    return {{},
-            "image size " + std::to_string(header.height) + " x " + std::to_string(header.width) +
-                " differs from the sidecar's " + std::to_string(rows) + " x " +
-                std::to_string(columns)};
+    return {{}, size_differs(header.height, header.width, rows, columns)};
   }
   result.pixels.create(rows, columns,
                        CV_MAKETYPE(header.depth == 16 ? CV_16U : CV_8U, header.channels));
@@ -94,8 +91,7 @@ PngDecodeResult decode_png(const std::filesystem::path& path, int rows, int colu
     row_pointers[static_cast<std::size_t>(row)] = result.pixels.ptr(row);
   const bool read = read_rows(png, info, row_pointers.data());
   destroy();
-  if (!read)
-    return {{}, std::string("image is unreadable or corrupt (libpng: ") + report.error + ")"};
+  if (!read) return {{}, unreadable(std::string("libpng: ") + report.error)};
   return result;
 }
 

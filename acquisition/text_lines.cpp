@@ -35,8 +35,8 @@ TextLineReader::TextLineReader(const std::filesystem::path& path) : file_name_(p
   file_size_ = std::filesystem::file_size(path, error);
   // A small file gets a buffer its size, not 4 MB (opening many small files,
   // as the fuzzer does, then costs little).
-  buffer_.resize(std::clamp<std::size_t>(static_cast<std::size_t>(file_size_) + 1, 4096,
-                                         kChunkBytes));
+  buffer_.resize(
+      std::clamp<std::size_t>(static_cast<std::size_t>(file_size_) + 1, 4096, kChunkBytes));
 }
 
 TextLineReader::~TextLineReader() {

@@ -10,12 +10,11 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <string>
 #include <utility>
 
-#include "acquisition/png_decoder.hpp"
+#include "acquisition/image_decoder.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
@@ -270,31 +269,9 @@ Image load_image(const Sidecar& s, const std::string& name, const std::string& k
                            fs::is_directory(status) ? "is a directory, not an image file"
                                                     : "is not a regular file (a pipe or a device)");
   }
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension == ".png") {
-    // libpng through our handlers: its reason goes into our message.
-    PngDecodeResult png = decode_png(path, grid.rows, grid.columns);
-    if (png.pixels.empty()) throw core::InputError(image.file, where, png.problem);
-    image.pixels = std::move(png.pixels);
-    return image;
-  }
-  try {
-    image.pixels = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    image.pixels.release();  // a decoder that throws is the same as a corrupt file
-  }
-  if (image.pixels.empty())
-    throw core::InputError(image.file, where, "image is unreadable or corrupt");
-  auto size = [](int rows, int cols) {
-    return std::to_string(rows) + " x " + std::to_string(cols);
-  };
-  if (image.pixels.rows != grid.rows || image.pixels.cols != grid.columns) {
-    throw core::InputError(image.file, where,
-                           "image size " + size(image.pixels.rows, image.pixels.cols) +
-                               " differs from the sidecar's " + size(grid.rows, grid.columns));
-  }
+  DecodedImage decoded = decode_image(path, grid.rows, grid.columns);
+  if (decoded.pixels.empty()) throw core::InputError(image.file, where, decoded.problem);
+  image.pixels = std::move(decoded.pixels);
   return image;
 }
 

@@ -14,6 +14,7 @@
 
 #include "acquisition/output_file.hpp"
 #include "acquisition/rigid_transform.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -126,9 +127,10 @@ std::string encode_image(const fs::path& path, const cv::Mat& image) {
   try {
     ok = cv::imencode(path.extension().string(), image, bytes);
   } catch (const cv::Exception& e) {
-    throw std::runtime_error(utf8(path) + ": could not encode image (" + e.what() + ")");
+    throw core::RuntimeFailure(utf8(path), {},
+                               std::string("could not encode image (") + e.what() + ")");
   }
-  if (!ok) throw std::runtime_error(utf8(path) + ": could not encode image");
+  if (!ok) throw core::RuntimeFailure(utf8(path), {}, "could not encode image");
   return std::string(bytes.begin(), bytes.end());
 }
 
@@ -179,7 +181,11 @@ void write_triplet(const Scan& scan, const std::filesystem::path& sidecar_json,
   add_image(range);
   if (scan.has_intensity()) add_image(encode_intensity(scan));
   if (scan.has_color()) add_image(encode_color(scan));
-  files.emplace_back(sidecar_json, make_sidecar(scan, stem, settings).dump(2) + "\n");
+  // Names and paths that are not UTF-8 are written with U+FFFD in their place.
+  files.emplace_back(sidecar_json,
+                     make_sidecar(scan, stem, settings)
+                             .dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
+                         "\n");
   // Every file is written in full beside its target before any replaces it,
   // the sidecar last: a failure leaves the old triplet (or nothing) behind.
   std::vector<std::unique_ptr<OutputFile>> outputs;

@@ -15,8 +15,10 @@
 
 namespace {
 
+// Every failure is one line: whatever a library's text holds (newlines, a
+// 5,000-character path) is cut to fit.
 int report_error(const char* kind, const std::string& message, int exit_code) {
-  fmt::print(stderr, "scanbench: {}: {}\n", kind, message);
+  fmt::print(stderr, "scanbench: {}: {}\n", kind, scanbench::core::one_line(message, 1000));
   return exit_code;
 }
 

@@ -5,10 +5,11 @@
 namespace scanbench::core {
 
 namespace {
+constexpr std::size_t kMaxPartChars = 240;
+}  // namespace
 
-// A part of a message cut to `limit` characters around its middle: a
-// 5,000-character file name or a 200 KB token must not flood the terminal.
-std::string shortened(std::string text, std::size_t limit) {
+// A 5,000-character file name or a 200 KB token must not flood the terminal.
+std::string one_line(std::string text, std::size_t limit) {
   for (char& c : text) {
     if (static_cast<unsigned char>(c) < 0x20) c = '?';  // one line, whatever a name holds
   }
@@ -21,14 +22,10 @@ std::string shortened(std::string text, std::size_t limit) {
   return text.substr(0, head) + "…" + text.substr(tail);
 }
 
-constexpr std::size_t kMaxPartChars = 240;
-
-}  // namespace
-
 std::string format_input_error(const std::string& file_name, const FilePosition& position,
                                const std::string& problem_text) {
-  const std::string file = shortened(file_name, kMaxPartChars);
-  const std::string problem = shortened(problem_text, kMaxPartChars);
+  const std::string file = one_line(file_name, kMaxPartChars);
+  const std::string problem = one_line(problem_text, kMaxPartChars);
   std::ostringstream out;
   out << file;
   std::string where;
@@ -39,7 +36,7 @@ std::string format_input_error(const std::string& file_name, const FilePosition&
   }
   if (!position.detail.empty()) {
     where += where.empty() ? "" : ", ";
-    where += shortened(position.detail, kMaxPartChars);
+    where += one_line(position.detail, kMaxPartChars);
   }
   if (!where.empty()) out << (file.empty() ? "" : ": ") << where;
   out << (file.empty() && where.empty() ? "" : ": ") << problem;

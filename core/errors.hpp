@@ -69,4 +69,8 @@ class Cancelled : public std::runtime_error {
 std::string format_input_error(const std::string& file, const FilePosition& position,
                                const std::string& problem);
 
+// `text` as one line for a message: control characters become '?', and it
+// is cut in the middle (between UTF-8 characters) to at most `limit` bytes.
+std::string one_line(std::string text, std::size_t limit);
+
 }  // namespace scanbench::core

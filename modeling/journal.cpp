@@ -20,28 +20,25 @@ namespace {
 constexpr const char* kBumpRevision =
     "UPDATE meta SET value = CAST(value AS INTEGER) + 1 WHERE key = 'revision'";
 
-constexpr const char* kSelectCommands =
-    "SELECT id, name, settings, result, state, undoable, created_at, checksum FROM commands";
+const std::string kSelectCommands = sql_of({"SELECT ", kCommandColumns, " FROM commands"});
 
 // The next place in the journal.
 constexpr const char* kNextSeq = "(SELECT coalesce(max(seq), 0) + 1 FROM commands)";
 
 // Stores the checksum of command `id` as it now stands.
 void update_checksum(sqlite3* db, const std::string& file, std::int64_t id) {
-  sqlite::Statement select(
-      db, "SELECT name, settings, result, undoable FROM commands WHERE id = ?1", file);
+  const std::string sql = kSelectCommands + " WHERE id = ?1";
+  sqlite::Statement select(db, sql.c_str(), file);
   select.bind_int(1, id);
   if (!select.step()) return;
-  const CommandFields fields{id, select.column_text(0), select.column_text(1),
-                             select.column_text(2), select.column_int(3)};
+  const CommandFields fields = read_command_fields(select).first;
   sqlite::Statement update(db, "UPDATE commands SET checksum = ?2 WHERE id = ?1", file);
   update.bind_int(1, id).bind_int(2, checksum(fields)).run();
 }
 
 CommandRecord read_command(const sqlite::Statement& row, const std::string& file) {
-  const CommandFields fields{row.column_int(0), row.column_text(1), row.column_text(2),
-                             row.column_text(3), row.column_int(5)};
-  if (checksum(fields) != row.column_int(7)) {
+  const auto [fields, stored] = read_command_fields(row);
+  if (checksum(fields) != stored) {
     core::FilePosition position;
     position.detail = "command " + std::to_string(fields.id);
     throw core::InputError(file, position,
@@ -49,21 +46,20 @@ CommandRecord read_command(const sqlite::Statement& row, const std::string& file
                            "(changed outside scanbench?)");
   }
   CommandRecord record;
-  record.id = row.column_int(0);
-  record.name = row.column_text(1);
-  record.settings = row.column_text(2);
-  record.result = row.column_text(3);
-  const std::string state = row.column_text(4);
-  record.state = state == "done"     ? CommandState::kDone
-                 : state == "undone" ? CommandState::kUndone
-                                     : CommandState::kPending;
-  record.undoable = row.column_int(5) != 0;
-  record.created_at = row.column_text(6);
+  record.id = fields.id;
+  record.name = fields.name;
+  record.settings = fields.settings;
+  record.result = fields.result;
+  record.state = fields.state == "done"     ? CommandState::kDone
+                 : fields.state == "undone" ? CommandState::kUndone
+                                            : CommandState::kPending;
+  record.undoable = fields.undoable != 0;
+  record.created_at = row.column_text(7);
   return record;
 }
 
 std::optional<CommandRecord> select_one(sqlite3* db, const std::string& file, const char* where) {
-  const std::string sql = std::string(kSelectCommands) + " " + where;
+  const std::string sql = kSelectCommands + " " + where;
   sqlite::Statement select(db, sql.c_str(), file);
   if (!select.step()) return std::nullopt;
   return read_command(select, file);
@@ -121,6 +117,7 @@ void end_redo_branch(sqlite3* db, const std::string& file) {
 void set_state(sqlite3* db, const std::string& file, std::int64_t id, const char* state) {
   sqlite::Statement update(db, "UPDATE commands SET state = ?2 WHERE id = ?1", file);
   update.bind_int(1, id).bind_text(2, state).run();
+  update_checksum(db, file, id);
 }
 
 }  // namespace
@@ -234,7 +231,7 @@ void Project::Edit::finish_transaction() {
 }
 
 std::vector<CommandRecord> Project::history() const {
-  const std::string sql = std::string(kSelectCommands) + " ORDER BY seq IS NULL, seq, id";
+  const std::string sql = kSelectCommands + " ORDER BY seq IS NULL, seq, id";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   std::vector<CommandRecord> records;
   while (select.step()) records.push_back(read_command(select, file_name()));
@@ -268,13 +265,12 @@ std::optional<CommandRecord> Project::redo() {
 }
 
 std::optional<std::string> Project::latest_result(std::string_view name) const {
-  sqlite::Statement select(db(),
-                           "SELECT result FROM commands WHERE name = ?1 AND state = 'done' "
-                           "ORDER BY seq DESC LIMIT 1",
-                           file_name());
+  const std::string sql =
+      kSelectCommands + " WHERE name = ?1 AND state = 'done' ORDER BY seq DESC LIMIT 1";
+  sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_text(1, name);
   if (!select.step()) return std::nullopt;
-  return select.column_text(0);
+  return read_command(select, file_name()).result;  // verified
 }
 
 Project::ReadSnapshot Project::read_snapshot() const {

@@ -11,6 +11,7 @@
 #include "core/memory.hpp"
 #include "modeling/blob_codec.hpp"
 #include "modeling/project.hpp"
+#include "modeling/records.hpp"
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling {
@@ -38,11 +39,10 @@ const TypeInfo& info(ElementType type) {
 
 // The current version of layer (scan, name): the row of the newest done
 // command, in journal order.
-constexpr const char* kSelectCurrent = R"sql(
-SELECT l.element_type, l.element_count, l.codec, l.data
+const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data
 FROM scan_layers l JOIN commands c ON c.id = l.command_id
 WHERE l.scan_id = ?1 AND l.name = ?2 AND c.state = 'done'
-ORDER BY c.seq DESC LIMIT 1)sql";
+ORDER BY c.seq DESC LIMIT 1)sql"});
 
 // The layers whose name fixes their type (layers.hpp).
 struct KnownLayer {
@@ -102,23 +102,49 @@ EncodedLayer encode_layer_bytes(std::string name, ElementType type,
   return layer;
 }
 
+namespace {
+
+// Writes (or replaces, within one command) the row of a layer version, with
+// its checksum; `blob` empty for a removal.
+void write_layer_row(sqlite3* db, const std::string& file, const LayerFields& fields,
+                     std::span<const std::uint8_t> blob) {
+  sqlite::Statement insert(db, R"sql(
+INSERT OR REPLACE INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec,
+                                    data, checksum)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8))sql",
+                           file);
+  insert.bind_int(1, fields.scan_id).bind_text(2, fields.name).bind_int(3, fields.command_id);
+  insert.bind_text(4, fields.element_type).bind_int(5, fields.element_count);
+  insert.bind_text(6, fields.codec);
+  if (fields.codec == "removed") {
+    insert.bind_null(7);
+  } else {
+    insert.bind_blob(7, blob);
+  }
+  insert.bind_int(8, checksum(fields)).run();
+}
+
+// A layer row read back, refused unless it passes its checksum.
+LayerFields verified(const sqlite::Statement& row, const std::string& file) {
+  auto [fields, stored] = read_layer_fields(row, 0);
+  if (checksum(fields) != stored) {
+    damaged(file, fields.scan_id, fields.name,
+            "the layer's row fails its checksum (changed outside scanbench?)");
+  }
+  return std::move(fields);
+}
+
+}  // namespace
+
 void Project::put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer) {
   check_edit(edit);
   [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);
   assert(layer.element_count == n && "a layer holds one element per pixel");
   assert(has_its_type(layer) && "a layer named in layers.hpp has the type listed there");
-  sqlite::Statement insert(db(), R"sql(
-INSERT INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec, data)
-VALUES (?1, ?2, ?3, ?4, ?5, 'zstd', ?6)
-ON CONFLICT (scan_id, name, command_id) DO UPDATE SET
-  element_type = excluded.element_type, element_count = excluded.element_count,
-  codec = excluded.codec, data = excluded.data)sql",
-                           file_name());
-  insert.bind_int(1, id).bind_text(2, layer.name).bind_int(3, edit.command_id());
-  insert.bind_text(4, element_type_name(layer.type))
-      .bind_int(5, static_cast<std::int64_t>(layer.element_count))
-      .bind_blob(6, layer.blob)
-      .run();
+  write_layer_row(db(), file_name(),
+                  {id, layer.name, edit.command_id(), element_type_name(layer.type),
+                   static_cast<std::int64_t>(layer.element_count), "zstd"},
+                  layer.blob);
 }
 
 void Project::remove_layer(Edit& edit, std::int64_t id, std::string_view name) {
@@ -126,53 +152,54 @@ void Project::remove_layer(Edit& edit, std::int64_t id, std::string_view name) {
   static_cast<void>(stored_pixel_count(id, &edit));  // no such scan: InputError
   const std::vector<std::string> present = layer_names(id);
   if (std::find(present.begin(), present.end(), name) == present.end()) return;
-  sqlite::Statement insert(db(), R"sql(
-INSERT OR REPLACE INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec,
-                                    data)
-VALUES (?1, ?2, ?3, 'u8', 0, 'removed', NULL))sql",
-                           file_name());
-  insert.bind_int(1, id).bind_text(2, name).bind_int(3, edit.command_id()).run();
+  write_layer_row(db(), file_name(), {id, std::string(name), edit.command_id(), "u8", 0, "removed"},
+                  {});
 }
 
 bool Project::read_layer(
     std::int64_t id, std::string_view name, ElementType type,
     const std::function<std::span<std::byte>(std::size_t bytes)>& allocate) const {
   const std::size_t n = stored_pixel_count(id);
-  sqlite::Statement select(db(), kSelectCurrent, file_name());
+  sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
   select.bind_int(1, id).bind_text(2, name);
-  if (!select.step() || select.column_text(2) == "removed") return false;
-  if (select.column_text(2) != "zstd") damaged(file_name(), id, name, "unknown codec");
-  const std::string stored_type = select.column_text(0);
-  if (stored_type != element_type_name(type)) {
+  if (!select.step()) return false;
+  const LayerFields fields = verified(select, file_name());
+  if (fields.codec == "removed") return false;
+  if (fields.codec != "zstd") damaged(file_name(), id, name, "unknown codec");
+  if (fields.element_type != element_type_name(type)) {
     damaged(file_name(), id, name,
-            "holds " + stored_type + " elements, expected " + element_type_name(type));
+            "holds " + fields.element_type + " elements, expected " + element_type_name(type));
   }
-  if (select.column_int(1) != static_cast<std::int64_t>(n)) {
+  if (fields.element_count != static_cast<std::int64_t>(n)) {
     damaged(file_name(), id, name,
-            "has " + std::to_string(select.column_int(1)) + " elements, expected " +
+            "has " + std::to_string(fields.element_count) + " elements, expected " +
                 std::to_string(n) + " (one per pixel)");
   }
   const BlobContext context{file_name(),
                             "scan " + std::to_string(id) + ", layer " + std::string(name)};
   // The frame must hold what the grid needs before a buffer is made for it.
-  check_blob_size(select.column_blob(3), n * element_size(type), context);
+  const std::span<const std::uint8_t> blob = select.column_blob(7);
+  check_blob_size(blob, n * element_size(type), context);
   core::check_memory(n * element_size(type), file_name());
-  decompress_into(select.column_blob(3), allocate(n * element_size(type)), context);
+  decompress_into(blob, allocate(n * element_size(type)), context);
   return true;
 }
 
 std::vector<std::string> Project::layer_names(std::int64_t id) const {
-  sqlite::Statement select(db(), R"sql(
-SELECT name FROM (
-  SELECT l.name, l.codec, row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
+  const std::string sql = sql_of({R"sql(
+SELECT )sql", kLayerColumns, R"sql( FROM (
+  SELECT l.*, row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
   FROM scan_layers l JOIN commands c ON c.id = l.command_id
-  WHERE l.scan_id = ?1 AND c.state = 'done')
-WHERE newest = 1 AND codec != 'removed'
-ORDER BY name)sql",
-                           file_name());
+  WHERE l.scan_id = ?1 AND c.state = 'done') l
+WHERE newest = 1
+ORDER BY name)sql"});
+  sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
   std::vector<std::string> names;
-  while (select.step()) names.push_back(select.column_text(0));
+  while (select.step()) {
+    const LayerFields fields = verified(select, file_name());
+    if (fields.codec != "removed") names.push_back(fields.name);
+  }
   return names;
 }
 

@@ -228,14 +228,23 @@ Project Project::open_for_reading(const std::filesystem::path& file) {
   if (writable(file)) return open(file);
   schema::check_file_header(file);
   // Read-only: SQLite still needs the shared-memory file of the write-ahead
-  // log; where it cannot make one, the file is read as immutable.
+  // log. Where it cannot make one (a write-protected medium) and the log is
+  // empty, the file holds every change and is read as immutable; a log with
+  // changes in it cannot be read safely without that file.
   Connection db(connect(file, SQLITE_OPEN_READONLY));
-  try {
-    schema::check_readable(db.get(), file.string());
-  } catch (const core::RuntimeFailure&) {
+  const int probe = sqlite3_exec(db.get(), "PRAGMA user_version", nullptr, nullptr, nullptr);
+  if ((probe & 0xff) == SQLITE_CANTOPEN || (probe & 0xff) == SQLITE_READONLY) {
+    std::error_code error;
+    const auto log_size = std::filesystem::file_size(file.string() + "-wal", error);
+    if (!error && log_size > 0) {
+      throw core::RuntimeFailure(file.string(), {},
+                                 "cannot read the project here: its write-ahead log holds "
+                                 "changes and the folder is read-only; copy the project, with "
+                                 "its -wal file, to writable storage");
+    }
     db = Connection(connect(immutable_uri(file), SQLITE_OPEN_READONLY | SQLITE_OPEN_URI));
-    schema::check_readable(db.get(), file.string());
   }
+  schema::check_readable(db.get(), file.string());
   return Project(file, std::move(db));
 }
 

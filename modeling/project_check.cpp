@@ -26,7 +26,7 @@ void sqlite_checks(sqlite3* db, const std::string& file, std::vector<std::string
 std::size_t check_scan_records(sqlite3* db, const std::string& file,
                                std::vector<std::string>& damage) {
   std::size_t checked = 0;
-  const std::string sql = std::string("SELECT s.id, ") + kScanRecordColumns + " FROM scans s";
+  const std::string sql = sql_of({"SELECT s.id, ", kScanRecordColumns, " FROM scans s"});
   for (sqlite::Statement scans(db, sql.c_str(), file); scans.step(); ++checked) {
     const auto [record, stored] = read_scan_record(scans, 1);
     if (checksum(record) != stored) {
@@ -34,7 +34,7 @@ std::size_t check_scan_records(sqlite3* db, const std::string& file,
                        ": its record (name, grid, angle model, summary) fails its checksum");
     }
   }
-  const std::string poses_sql = std::string("SELECT ") + kPoseRecordColumns + " FROM scan_poses p";
+  const std::string poses_sql = sql_of({"SELECT ", kPoseRecordColumns, " FROM scan_poses p"});
   for (sqlite::Statement poses(db, poses_sql.c_str(), file); poses.step(); ++checked) {
     const auto [record, stored] = read_pose_record(poses, 0);
     if (checksum(record) != stored || record.pose.size() != 16 * sizeof(double)) {
@@ -45,17 +45,15 @@ std::size_t check_scan_records(sqlite3* db, const std::string& file,
   return checked;
 }
 
-std::size_t check_commands(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
+std::size_t check_commands(sqlite3* db, const std::string& file,
+                           std::vector<std::string>& damage) {
   std::size_t checked = 0;
-  for (sqlite::Statement commands(
-           db, "SELECT id, name, settings, result, undoable, checksum FROM commands", file);
-       commands.step(); ++checked) {
-    const CommandFields fields{commands.column_int(0), commands.column_text(1),
-                               commands.column_text(2), commands.column_text(3),
-                               commands.column_int(4)};
-    if (checksum(fields) != commands.column_int(5)) {
+  const std::string sql = sql_of({"SELECT ", kCommandColumns, " FROM commands"});
+  for (sqlite::Statement commands(db, sql.c_str(), file); commands.step(); ++checked) {
+    const auto [fields, stored] = read_command_fields(commands);
+    if (checksum(fields) != stored) {
       damage.push_back("command " + std::to_string(fields.id) + " (" + fields.name +
-                       "): its journal entry (settings, result) fails its checksum");
+                       "): its journal entry (settings, result, state) fails its checksum");
     }
   }
   return checked;
@@ -63,29 +61,33 @@ std::size_t check_commands(sqlite3* db, const std::string& file, std::vector<std
 
 std::size_t check_layers(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
   std::size_t checked = 0;
-  for (sqlite::Statement layers(db, R"sql(
-SELECT l.scan_id, l.name, l.command_id, l.element_type, l.element_count, l.data,
-       s.rows * s.columns
-FROM scan_layers l JOIN scans s ON s.id = l.scan_id WHERE l.codec = 'zstd')sql",
-                                file);
-       layers.step(); ++checked) {
-    const std::string where = "scan " + std::to_string(layers.column_int(0)) + ", layer " +
-                              layers.column_text(1) + " of command " +
-                              std::to_string(layers.column_int(2));
-    const std::optional<ElementType> type = element_type_from_name(layers.column_text(3));
+  const std::string sql = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data, s.rows * s.columns
+FROM scan_layers l JOIN scans s ON s.id = l.scan_id)sql"});
+  for (sqlite::Statement layers(db, sql.c_str(), file); layers.step(); ++checked) {
+    const auto [fields, stored] = read_layer_fields(layers, 0);
+    if (checksum(fields) != stored) {
+      damage.push_back("scan " + std::to_string(fields.scan_id) + ", layer " + fields.name +
+                       " of command " + std::to_string(fields.command_id) +
+                       ": its row (name, type, size, command) fails its checksum");
+      continue;
+    }
+    if (fields.codec != "zstd") continue;  // a removal: no data
+    const std::string where = "scan " + std::to_string(fields.scan_id) + ", layer " + fields.name +
+                              " of command " + std::to_string(fields.command_id);
+    const std::optional<ElementType> type = element_type_from_name(fields.element_type);
     if (!type) {
       damage.push_back(where + ": unknown element type");
       continue;
     }
-    if (layers.column_int(4) != layers.column_int(6)) {
-      damage.push_back(where + ": holds " + std::to_string(layers.column_int(4)) +
-                       " elements, the scan has " + std::to_string(layers.column_int(6)) +
+    if (fields.element_count != layers.column_int(8)) {
+      damage.push_back(where + ": holds " + std::to_string(fields.element_count) +
+                       " elements, the scan has " + std::to_string(layers.column_int(8)) +
                        " pixels");
       continue;
     }
     try {
-      decompress(layers.column_blob(5),
-                 static_cast<std::size_t>(layers.column_int(4)) * element_size(*type),
+      decompress(layers.column_blob(7),
+                 static_cast<std::size_t>(fields.element_count) * element_size(*type),
                  BlobContext{file, where});
     } catch (const core::InputError& error) {
       damage.push_back(where + ": " + error.problem());

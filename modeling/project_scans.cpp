@@ -28,13 +28,13 @@ constexpr int kFirstPoseColumn = kFirstScanColumn + kScanRecordColumnCount;
 
 // Every live scan (its import done) with its current pose: the pose row of
 // the newest done command, in journal order.
-const std::string kSelectScans =
-    std::string("SELECT s.id, ") + kScanRecordColumns + ", " + kPoseRecordColumns + R"sql(
+const std::string kSelectScans = sql_of({"SELECT s.id, ", kScanRecordColumns, ", ",
+                                         kPoseRecordColumns, R"sql(
 FROM scans s JOIN scan_poses p ON p.scan_id = s.id
 WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
   AND p.command_id = (SELECT q.command_id FROM scan_poses q JOIN commands c ON c.id = q.command_id
                       WHERE q.scan_id = s.id AND c.state = 'done'
-                      ORDER BY c.seq DESC LIMIT 1))sql";
+                      ORDER BY c.seq DESC LIMIT 1))sql"});
 
 constexpr const char* kInsertScan = R"sql(
 INSERT INTO scans (created_by, name, rows, columns, angle_model, azimuth_start_rad,
@@ -203,11 +203,9 @@ EncodedScan encode_scan(const acquisition::Scan& scan) {
   auto& layers = encoded.layers;
   layers.push_back(encode_layer<float>(layer::kRange, ElementType::kF32, scan.range_m));
   layers.push_back(encode_layer<std::uint8_t>(layer::kValid, ElementType::kU8, scan.valid));
-  // The digest that finds the same scan imported twice: the stored range and
-  // validity, in layer-name order (as the migration computes it).
-  encoded.content_digest = crc32_of(std::as_bytes(std::span(layers[0].blob)));
-  encoded.content_digest = crc32_of(std::as_bytes(std::span(layers[1].blob)),
-                                    static_cast<std::uint32_t>(encoded.content_digest));
+  encoded.content_digest = content_digest(
+      scan.rows, scan.columns, acquisition::angle_model_name(scan.is_spherical()),
+      std::as_bytes(std::span(scan.range_m)), std::as_bytes(std::span(scan.valid)));
   if (scan.has_intensity()) {
     layers.push_back(encode_layer<float>(layer::kIntensity, ElementType::kF32, scan.intensity));
   }

@@ -183,7 +183,7 @@ CREATE TABLE commands (
   undoable INTEGER NOT NULL CHECK (undoable IN (0, 1)),
   owner_host TEXT,     -- pending: the host and process writing it
   owner_pid INTEGER,
-  checksum INTEGER NOT NULL DEFAULT 0,   -- of id, name, settings, result, undoable
+  checksum INTEGER NOT NULL DEFAULT 0,   -- of id, seq, name, settings, result, state, undoable
   created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
   CHECK ((state = 'pending') = (seq IS NULL))
 );
@@ -259,7 +259,8 @@ CREATE TABLE scan_layers (
   element_type TEXT NOT NULL CHECK (element_type IN ('u8', 'u8x3', 'u32', 'f32', 'f32x3')),
   element_count INTEGER NOT NULL CHECK (element_count >= 0),
   codec TEXT NOT NULL CHECK (codec IN ('zstd', 'removed')),
-  data BLOB CHECK ((codec = 'removed') = (data IS NULL)),
+  data BLOB CHECK ((codec = 'removed') = (data IS NULL)),  -- zstd frames check their own content
+  checksum INTEGER NOT NULL DEFAULT 0,  -- of every column above but data
   PRIMARY KEY (scan_id, name, command_id)
 );
 CREATE INDEX scan_layers_by_command ON scan_layers (command_id);
@@ -276,13 +277,13 @@ INSERT INTO scan_poses (scan_id, command_id, T_world_scan, scanner_x, scanner_y,
   SELECT id, 1, T_world_scan, scanner_x, scanner_y, scanner_z, bbox_min_x, bbox_min_y,
          bbox_min_z, bbox_max_x, bbox_max_y, bbox_max_z
   FROM scans_v3;
-INSERT INTO scan_layers
+INSERT INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec, data)
   SELECT scan_id, channel, 1,
          CASE channel WHEN 'valid' THEN 'u8' WHEN 'rgb' THEN 'u8x3'
                       WHEN 'directions' THEN 'f32x3' ELSE 'f32' END,
          CASE channel WHEN 'rgb' THEN element_count / 3 ELSE element_count END, codec, data
   FROM scan_channels;
-INSERT INTO scan_layers
+INSERT INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec, data)
   SELECT g.scan_id, 'footprint_m', 2, 'f32', s.rows * s.columns, 'zstd', g.footprint_m
   FROM scan_geometry g JOIN scans s ON s.id = g.scan_id
   UNION ALL
@@ -443,10 +444,12 @@ void check_readable(sqlite3* db, const std::string& file) {
   const int version = read_schema_version(db, file);
   check_identity(application_id, version, file);
   if (version < kProjectSchemaVersion) {
-    refuse(file, "project of schema version " + std::to_string(version) +
-                     " on read-only storage: open it once where it can be written to bring it "
-                     "to version " +
-                     std::to_string(kProjectSchemaVersion));
+    throw core::RuntimeFailure(
+        file, {},
+        "project of schema version " + std::to_string(version) +
+            " on read-only storage: open it once where it can be written to bring it to "
+            "version " +
+            std::to_string(kProjectSchemaVersion));
   }
   check_tables(db, file, kCurrentTables);
 }

@@ -54,9 +54,8 @@ void create_schema(sqlite3* db, const std::string& file);
 void check_and_migrate(sqlite3* db, const std::string& file);
 
 // For a project opened read-only: the identity checks of check_and_migrate,
-// with an older schema refused (core::InputError: it cannot be migrated
-// without writing) rather than migrated. core::RuntimeFailure when SQLite
-// cannot read it as it is (no shared-memory file can be made).
+// with an older schema refused (core::RuntimeFailure: it cannot be migrated
+// without writing) rather than migrated.
 void check_readable(sqlite3* db, const std::string& file);
 
 // PRAGMA user_version.

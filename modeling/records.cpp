@@ -1,5 +1,6 @@
 #include "modeling/records.hpp"
 
+#include "modeling/blob_codec.hpp"
 #include "modeling/row_checksum.hpp"
 
 namespace scanbench::modeling {
@@ -11,6 +12,12 @@ std::optional<double> optional_double(const sqlite::Statement& row, int column) 
 }
 
 }  // namespace
+
+std::string sql_of(std::initializer_list<std::string_view> parts) {
+  std::string sql;
+  for (const std::string_view part : parts) sql += part;
+  return sql;
+}
 
 std::int64_t checksum(const ScanRecord& r) {
   RowChecksum sum;
@@ -29,8 +36,53 @@ std::int64_t checksum(const PoseRecord& r) {
   return sum.value();
 }
 
+std::int64_t content_digest(std::int64_t rows, std::int64_t columns, std::string_view angle_model,
+                            std::span<const std::byte> range, std::span<const std::byte> valid) {
+  RowChecksum sum;
+  sum.add(rows).add(columns).add(angle_model);
+  return crc32_of(valid, crc32_of(range, static_cast<std::uint32_t>(sum.value())));
+}
+
 std::int64_t checksum(const CommandFields& r) {
-  return RowChecksum().add(r.id).add(r.name).add(r.settings).add(r.result).add(r.undoable).value();
+  RowChecksum sum;
+  sum.add(r.id);
+  sum.add(r.seq ? std::optional<double>(static_cast<double>(*r.seq)) : std::nullopt);
+  sum.add(r.name).add(r.settings).add(r.result).add(r.state).add(r.undoable);
+  return sum.value();
+}
+
+std::int64_t checksum(const LayerFields& r) {
+  return RowChecksum()
+      .add(r.scan_id)
+      .add(r.name)
+      .add(r.command_id)
+      .add(r.element_type)
+      .add(r.element_count)
+      .add(r.codec)
+      .value();
+}
+
+std::pair<CommandFields, std::int64_t> read_command_fields(const sqlite::Statement& row) {
+  CommandFields r;
+  r.id = row.column_int(0);
+  if (!row.is_null(1)) r.seq = row.column_int(1);
+  r.name = row.column_text(2);
+  r.settings = row.column_text(3);
+  r.result = row.column_text(4);
+  r.state = row.column_text(5);
+  r.undoable = row.column_int(6);
+  return {std::move(r), row.column_int(8)};
+}
+
+std::pair<LayerFields, std::int64_t> read_layer_fields(const sqlite::Statement& row, int c) {
+  LayerFields r;
+  r.scan_id = row.column_int(c);
+  r.name = row.column_text(c + 1);
+  r.command_id = row.column_int(c + 2);
+  r.element_type = row.column_text(c + 3);
+  r.element_count = row.column_int(c + 4);
+  r.codec = row.column_text(c + 5);
+  return {std::move(r), row.column_int(c + 6)};
 }
 
 std::pair<ScanRecord, std::int64_t> read_scan_record(const sqlite::Statement& row, int c) {
@@ -63,18 +115,22 @@ std::pair<PoseRecord, std::int64_t> read_pose_record(const sqlite::Statement& ro
 }
 
 void fill_migrated_checksums(sqlite3* db, const std::string& file) {
-  // Content digests: the CRC of the stored range and valid layers, as
-  // content_digest() computes it for new scans.
-  std::vector<std::pair<std::int64_t, std::uint32_t>> digests;
-  for (sqlite::Statement select(db,
-                                "SELECT scan_id, data FROM scan_layers WHERE name IN "
-                                "('range_m', 'valid') ORDER BY scan_id, name",
+  // Content digests, from the decoded range and validity (what
+  // content_digest() takes for new scans).
+  std::vector<std::pair<std::int64_t, std::int64_t>> digests;
+  for (sqlite::Statement select(db, R"sql(
+SELECT s.id, s.rows, s.columns, s.angle_model, r.data, v.data
+FROM scans s JOIN scan_layers r ON r.scan_id = s.id AND r.name = 'range_m'
+             JOIN scan_layers v ON v.scan_id = s.id AND v.name = 'valid')sql",
                                 file);
        select.step();) {
-    if (digests.empty() || digests.back().first != select.column_int(0)) {
-      digests.emplace_back(select.column_int(0), 0);
-    }
-    digests.back().second = crc32_of(std::as_bytes(select.column_blob(1)), digests.back().second);
+    const auto n = static_cast<std::size_t>(select.column_int(1) * select.column_int(2));
+    const BlobContext context{file, "scan " + std::to_string(select.column_int(0))};
+    const std::vector<std::byte> range = decompress(select.column_blob(4), 4 * n, context);
+    const std::vector<std::byte> valid = decompress(select.column_blob(5), n, context);
+    digests.emplace_back(select.column_int(0),
+                         content_digest(select.column_int(1), select.column_int(2),
+                                        select.column_text(3), range, valid));
   }
   for (const auto& [id, digest] : digests) {
     sqlite::Statement update(db, "UPDATE scans SET content_digest = ?2 WHERE id = ?1", file);
@@ -83,7 +139,7 @@ void fill_migrated_checksums(sqlite3* db, const std::string& file) {
   // Each table read whole first, then updated: no row changes under a
   // statement that is still reading it.
   std::vector<std::pair<std::int64_t, std::int64_t>> sums;  // (key, checksum)
-  const std::string scans_sql = std::string("SELECT s.id, ") + kScanRecordColumns + " FROM scans s";
+  const std::string scans_sql = sql_of({"SELECT s.id, ", kScanRecordColumns, " FROM scans s"});
   for (sqlite::Statement scans(db, scans_sql.c_str(), file); scans.step();) {
     sums.emplace_back(scans.column_int(0), checksum(read_scan_record(scans, 1).first));
   }
@@ -92,7 +148,7 @@ void fill_migrated_checksums(sqlite3* db, const std::string& file) {
     update.bind_int(1, id).bind_int(2, sum).run();
   }
   std::vector<PoseRecord> poses;
-  const std::string poses_sql = std::string("SELECT ") + kPoseRecordColumns + " FROM scan_poses p";
+  const std::string poses_sql = sql_of({"SELECT ", kPoseRecordColumns, " FROM scan_poses p"});
   for (sqlite::Statement select(db, poses_sql.c_str(), file); select.step();) {
     poses.push_back(read_pose_record(select, 0).first);
   }
@@ -103,17 +159,27 @@ void fill_migrated_checksums(sqlite3* db, const std::string& file) {
     update.bind_int(3, checksum(record)).run();
   }
   sums.clear();
-  for (sqlite::Statement commands(db, "SELECT id, name, settings, result, undoable FROM commands",
-                                  file);
-       commands.step();) {
-    const CommandFields record{commands.column_int(0), commands.column_text(1),
-                               commands.column_text(2), commands.column_text(3),
-                               commands.column_int(4)};
+  const std::string commands_sql = sql_of({"SELECT ", kCommandColumns, " FROM commands"});
+  for (sqlite::Statement commands(db, commands_sql.c_str(), file); commands.step();) {
+    const CommandFields record = read_command_fields(commands).first;
     sums.emplace_back(record.id, checksum(record));
   }
   for (const auto& [id, sum] : sums) {
     sqlite::Statement update(db, "UPDATE commands SET checksum = ?2 WHERE id = ?1", file);
     update.bind_int(1, id).bind_int(2, sum).run();
+  }
+  std::vector<std::pair<LayerFields, std::int64_t>> layers;
+  const std::string layers_sql = sql_of({"SELECT ", kLayerColumns, " FROM scan_layers l"});
+  for (sqlite::Statement select(db, layers_sql.c_str(), file); select.step();) {
+    const LayerFields record = read_layer_fields(select, 0).first;
+    layers.emplace_back(record, checksum(record));
+  }
+  for (const auto& [record, sum] : layers) {
+    sqlite::Statement update(
+        db, "UPDATE scan_layers SET checksum = ?4 WHERE scan_id = ?1 AND name = ?2 AND command_id = ?3",
+        file);
+    update.bind_int(1, record.scan_id).bind_text(2, record.name).bind_int(3, record.command_id);
+    update.bind_int(4, sum).run();
   }
 }
 

@@ -9,9 +9,11 @@
 
 #include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "modeling/sqlite_statement.hpp"
@@ -43,15 +45,36 @@ struct PoseRecord {
 
 struct CommandFields {
   std::int64_t id = 0;
+  std::optional<std::int64_t> seq;  // none while pending
   std::string name;
   std::string settings;
   std::string result;
+  std::string state;
   std::int64_t undoable = 1;
 };
 
+// A layer version's row without its data (whose zstd frame checks itself).
+struct LayerFields {
+  std::int64_t scan_id = 0;
+  std::string name;
+  std::int64_t command_id = 0;
+  std::string element_type;
+  std::int64_t element_count = 0;
+  std::string codec;
+};
+
+// The CRC-32 of a record's fields (RowChecksum), what its `checksum` column
+// holds. Every field counts, NULLs and the bits of -0.0 included.
 std::int64_t checksum(const ScanRecord& record);
 std::int64_t checksum(const PoseRecord& record);
 std::int64_t checksum(const CommandFields& record);
+std::int64_t checksum(const LayerFields& record);
+
+// What identifies a scan's data whatever its name or pose (the same file
+// imported twice has the same): CRC-32 of its grid size, angle model and
+// raw range and validity bytes. Independent of how layers are compressed.
+std::int64_t content_digest(std::int64_t rows, std::int64_t columns, std::string_view angle_model,
+                            std::span<const std::byte> range, std::span<const std::byte> valid);
 
 // The columns of each record, in the order the readers below expect, for
 // SELECT lists ("s." / "p." prefixed for the scans-poses join).
@@ -65,11 +88,24 @@ inline constexpr const char* kPoseRecordColumns =
     "p.bbox_min_x, p.bbox_min_y, p.bbox_min_z, p.bbox_max_x, p.bbox_max_y, p.bbox_max_z, "
     "p.checksum";
 inline constexpr int kPoseRecordColumnCount = 13;
+inline constexpr const char* kCommandColumns =
+    "id, seq, name, settings, result, state, undoable, created_at, checksum";
+inline constexpr const char* kLayerColumns =
+    "l.scan_id, l.name, l.command_id, l.element_type, l.element_count, l.codec, l.checksum";
 
-// Reads a record from `row` starting at column `first`, with the checksum
-// stored beside it.
+// The parts of an SQL statement put together (plain appends: GCC 12 warns
+// falsely on chains of std::string operator+ at -O3).
+std::string sql_of(std::initializer_list<std::string_view> parts);
+
+// Reads a record from `row` (a statement selecting kScanRecordColumns or
+// kPoseRecordColumns) starting at column `first`, with the checksum stored
+// beside it; the caller compares.
 std::pair<ScanRecord, std::int64_t> read_scan_record(const sqlite::Statement& row, int first);
 std::pair<PoseRecord, std::int64_t> read_pose_record(const sqlite::Statement& row, int first);
+// A statement selecting kCommandColumns, from column 0.
+std::pair<CommandFields, std::int64_t> read_command_fields(const sqlite::Statement& row);
+// A statement selecting kLayerColumns, from column `first`.
+std::pair<LayerFields, std::int64_t> read_layer_fields(const sqlite::Statement& row, int first);
 
 // Computes and stores the checksums (and scans' content digests) of every
 // row the migration from an older version copied; inside its transaction.

@@ -67,7 +67,7 @@ void throw_error(sqlite3* db, int code, const std::string& file, const std::stri
   if (primary == SQLITE_FULL || primary == SQLITE_IOERR) {
     // Say what it means for the user; SQLite's words stay in brackets.
     throw core::RuntimeFailure(
-        file, {}, "cannot write the project: the disk is full or failing (" + message + ")");
+        file, {}, "the disk is full or failing (" + message + ")");
   }
   if (primary == SQLITE_READONLY) {
     throw core::RuntimeFailure(file, {}, "cannot write the project: it is read-only here");
@@ -126,6 +126,12 @@ Statement& Statement::bind_int(int index, std::int64_t value) {
 
 Statement& Statement::bind_double(int index, double value) {
   [[maybe_unused]] const int code = sqlite3_bind_double(statement_, index, value);
+  assert(code == SQLITE_OK && "sqlite bind failed");
+  return *this;
+}
+
+Statement& Statement::bind_null(int index) {
+  [[maybe_unused]] const int code = sqlite3_bind_null(statement_, index);
   assert(code == SQLITE_OK && "sqlite bind failed");
   return *this;
 }

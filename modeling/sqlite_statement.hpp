@@ -48,6 +48,7 @@ class Statement {
   Statement& bind_int(int index, std::int64_t value);
   Statement& bind_double(int index, double value);
   Statement& bind_optional_double(int index, std::optional<double> value);  // NULL when empty
+  Statement& bind_null(int index);
   Statement& bind_text(int index, std::string_view value);                  // copied by SQLite
   // Not copied: `value` must outlive the next step().
   Statement& bind_blob(int index, std::span<const std::uint8_t> value);

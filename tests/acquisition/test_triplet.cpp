@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "acquisition/triplet_reader.hpp"
@@ -313,6 +316,106 @@ TEST(TripletReader, NotJsonReportsTheParserByteOffset) {
 TEST(TripletReader, MissingSidecarIsAnInputError) {
   const ScratchDir dir;
   EXPECT_THROW(read_triplet(dir / "nothing here.json"), core::InputError);
+}
+
+// A little-endian, uncompressed TIFF of grey 32-bit float samples that
+// declares `rows` × `cols`; `samples` (row by row) are stored in one strip,
+// or in one 16 × 16 tile when `tiled`. With no samples, only the header.
+std::string float_tiff(std::uint32_t rows, std::uint32_t cols, const std::vector<float>& samples,
+                       bool tiled = false) {
+  std::vector<float> data = samples;
+  if (tiled && !samples.empty()) {
+    data.assign(16 * 16, 0.0f);
+    for (std::uint32_t r = 0; r < rows; ++r)
+      for (std::uint32_t c = 0; c < cols; ++c) data[r * 16 + c] = samples[r * cols + c];
+  }
+  const std::uint16_t entries = tiled ? 11 : 10;
+  const std::uint32_t data_offset = 8 + 2 + 12u * entries + 4;
+  const auto data_bytes = static_cast<std::uint32_t>(data.size() * sizeof(float));
+  std::string out = {'I', 'I', 42, 0, 8, 0, 0, 0};
+  auto put16 = [&out](std::uint16_t v) { out.append(reinterpret_cast<const char*>(&v), 2); };
+  auto put32 = [&out](std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  auto entry = [&](std::uint16_t tag, std::uint16_t type, std::uint32_t value) {
+    put16(tag);
+    put16(type);
+    put32(1);
+    type == 3 ? (put16(static_cast<std::uint16_t>(value)), put16(0)) : put32(value);
+  };
+  put16(entries);  // tags in ascending order; type 3 SHORT, 4 LONG
+  entry(256, 4, cols);
+  entry(257, 4, rows);
+  entry(258, 3, 32);  // bits per sample
+  entry(259, 3, 1);   // no compression
+  entry(262, 3, 1);   // grey, black is zero
+  if (!tiled) entry(273, 4, data_offset);
+  entry(277, 3, 1);  // samples per pixel
+  if (!tiled) {
+    entry(278, 4, rows);  // rows per strip
+    entry(279, 4, data_bytes);
+  } else {
+    entry(322, 3, 16);
+    entry(323, 3, 16);
+    entry(324, 4, data_offset);
+    entry(325, 4, data_bytes);
+  }
+  entry(339, 3, 3);  // IEEE float samples
+  put32(0);          // no further image
+  out.append(reinterpret_cast<const char*>(data.data()), data_bytes);
+  return out;
+}
+
+TEST(TripletReader, ReadsFloatTiffsInStripsAndTilesAndPfmFromTheBottomUp) {
+  const std::vector<float> values = {1.5f, 2.5f, 3.5f, 4.5f, 5.5f, 6.5f};
+  // PFM stores the bottom row first.
+  const std::vector<float> bottom_up = {4.5f, 5.5f, 6.5f, 1.5f, 2.5f, 3.5f};
+  for (const auto& [file, bytes] :
+       {std::pair<std::string, std::string>{"r.tif", float_tiff(2, 3, values)},
+        {"r.tif", float_tiff(2, 3, values, true)},
+        {"r.pfm", pfm("Pf", 2, 3, bottom_up)}}) {
+    const ScratchDir dir;
+    const auto sidecar = triplet_with_image(dir, "range", file, bytes);
+    nlohmann::json j = read_json(sidecar);
+    j["range"]["encoding"] = "float32";
+    write_json(sidecar, j);
+    EXPECT_EQ(read_triplet(sidecar).range_m, values) << file;
+  }
+}
+
+TEST(TripletReader, ImageSizeIsCheckedFromTheHeaderBeforeDecoding) {
+  // 30000 × 30000 floats would be 3.6 GB; a 90-byte file must not get them.
+  for (const auto& [file, bytes] :
+       {std::pair<std::string, std::string>{"r.tif", float_tiff(30000, 30000, {})},
+        {"r.pfm", "Pf\n30000 30000\n-1.0\n"}}) {
+    const ScratchDir dir;
+    const auto sidecar = triplet_with_image(dir, "range", file, bytes);
+    try {
+      read_triplet(sidecar);
+      FAIL() << "expected core::InputError for " << file;
+    } catch (const core::InputError& e) {
+      EXPECT_NE(e.file().find(file), std::string::npos) << e.what();
+      EXPECT_NE(e.problem().find("image size 30000 x 30000 differs from the sidecar's 2 x 3"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(TripletReader, TruncatedTiffAndUnknownFormatsAreUnreadable) {
+  const std::string tiff = float_tiff(2, 3, {});
+  for (const auto& [file, bytes, reason] :
+       {std::tuple<std::string, std::string, std::string>{"r.tif", tiff.substr(0, 20), "TIFF"},
+        {"r.tif", tiff, "libtiff"},  // the strip lies past the end of the file
+        {"r.jpg", "\xff\xd8\xff\xe0 not really a JPEG", "not a PNG, TIFF or PNM image"}}) {
+    const ScratchDir dir;
+    const auto sidecar = triplet_with_image(dir, "range", file, bytes);
+    try {
+      read_triplet(sidecar);
+      FAIL() << "expected core::InputError for " << file;
+    } catch (const core::InputError& e) {
+      EXPECT_NE(e.problem().find("unreadable"), std::string::npos) << e.what();
+      EXPECT_NE(e.problem().find(reason), std::string::npos) << e.what();
+    }
+  }
 }
 
 // ---- malformed images: one fixture folder each -------------------------
