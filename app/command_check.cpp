@@ -18,7 +18,8 @@ struct CheckOptions {
 };
 
 void run_check(const CheckOptions& options) {
-  const modeling::Project project = modeling::Project::open_for_reading(options.project);
+  // A diagnosis never changes what it diagnoses: no migration, no recovery.
+  const modeling::Project project = modeling::Project::open_read_only(options.project);
   const modeling::Project::CheckReport report = project.check();
   if (options.json) {
     fmt::print("{}\n", nlohmann::json{{"damage", report.damage},

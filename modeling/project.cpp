@@ -225,7 +225,10 @@ Project Project::open_or_create(const std::filesystem::path& file, bool* created
 }
 
 Project Project::open_for_reading(const std::filesystem::path& file) {
-  if (writable(file)) return open(file);
+  return writable(file) ? open(file) : open_read_only(file);
+}
+
+Project Project::open_read_only(const std::filesystem::path& file) {
   schema::check_file_header(file);
   // Read-only: SQLite still needs the shared-memory file of the write-ahead
   // log. Where it cannot make one (a write-protected medium) and the log is

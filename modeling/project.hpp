@@ -118,12 +118,17 @@ class Project {
   static Project open(const std::filesystem::path& file);
 
   // Opens a project for reading only (info, export, history): as open()
-  // where the file and its folder are writable; otherwise read-only, which
-  // also works on write-protected media (as SQLite's "immutable" file when
-  // not even its shared-memory file can be made). A read-only project of an
-  // older schema version cannot be migrated: core::InputError saying so.
-  // Writing through it throws core::RuntimeFailure.
+  // where the file and its folder are writable (an older schema is
+  // migrated), otherwise as open_read_only().
   static Project open_for_reading(const std::filesystem::path& file);
+
+  // Opens a project without ever changing its file (check): read-only, which
+  // also works on write-protected media (as SQLite's "immutable" file when
+  // not even its shared-memory file can be made and the write-ahead log is
+  // empty). A project of an older schema version is not migrated:
+  // core::RuntimeFailure saying how to upgrade it. Writing through it throws
+  // core::RuntimeFailure.
+  static Project open_read_only(const std::filesystem::path& file);
 
   // Creates a new, empty project. The file appears complete or not at all
   // (built under a temporary name, then moved into place without replacing

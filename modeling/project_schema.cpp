@@ -447,9 +447,9 @@ void check_readable(sqlite3* db, const std::string& file) {
     throw core::RuntimeFailure(
         file, {},
         "project of schema version " + std::to_string(version) +
-            " on read-only storage: open it once where it can be written to bring it to "
-            "version " +
-            std::to_string(kProjectSchemaVersion));
+            ", read here without changes: any other command run where it can be written "
+            "(scanbench info, for one) upgrades it to version " +
+            std::to_string(kProjectSchemaVersion) + " first");
   }
   check_tables(db, file, kCurrentTables);
 }

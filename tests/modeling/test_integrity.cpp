@@ -107,6 +107,34 @@ TEST(Integrity, ADamagedLayerIsNamedByTheCheck) {
   EXPECT_THAT(report.damage[0], HasSubstr("scan 1, layer intensity of command 1"));
 }
 
+TEST(Integrity, AChangedLayerRowIsFoundOnReadingAndByTheCheck) {
+  const ScratchDir dir;
+  const auto file = sound_project(dir);
+  // The data still decodes; the row now claims another layer's name.
+  RawDatabase(file).execute("UPDATE scan_layers SET name = 'intensitx' WHERE name = 'intensity'");
+  const Project project = Project::open(file);
+  EXPECT_THROW(project.load_scan(1), core::InputError);
+  const Project::CheckReport report = project.check();
+  ASSERT_EQ(report.damage.size(), 1u) << joined(report.damage);
+  EXPECT_THAT(report.damage[0], HasSubstr("layer intensitx of command 1: its row"));
+}
+
+TEST(Integrity, TheCheckNeverChangesTheFileItChecks) {
+  const ScratchDir dir;
+  const auto old = dir / "v2.sbproj";
+  std::filesystem::copy_file(fixture("projects/version2.sbproj"), old);
+  const std::string before = test::read_file_bytes(old);
+  try {
+    Project::open_read_only(old);
+    FAIL() << "expected core::RuntimeFailure";
+  } catch (const core::RuntimeFailure& error) {
+    EXPECT_THAT(error.problem(), HasSubstr("schema version 2, read here without changes"));
+  }
+  EXPECT_EQ(test::read_file_bytes(old), before);
+  const Project project = Project::open_read_only(sound_project(dir));
+  EXPECT_TRUE(project.check().damage.empty());
+}
+
 TEST(Integrity, TheSameScanImportedTwiceIsRefusedUnlessAllowed) {
   const ScratchDir dir;
   Project project = Project::open(sound_project(dir));
