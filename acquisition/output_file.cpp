@@ -58,9 +58,14 @@ OutputFile::OutputFile(std::filesystem::path target)
   if (fd < 0) {
     const int code = errno;
     const std::string problem = std::string("cannot create the output: ") + std::strerror(code);
-    if (code == ENOENT || code == ENOTDIR || code == ENAMETOOLONG) {
-      throw core::InputError(target_.string(), {}, problem);  // the path is the user's
+    if (code == ENOENT || code == ENOTDIR) {  // the path is the user's
+      const std::filesystem::path folder = target_.parent_path();
+      throw core::InputError(target_.string(), {},
+                             "cannot create the output: its folder " +
+                                 (folder.empty() ? std::string(".") : folder.string()) +
+                                 " is not an existing folder");
     }
+    if (code == ENAMETOOLONG) throw core::InputError(target_.string(), {}, problem);
     throw core::RuntimeFailure(target_.string(), {}, problem);
   }
   file_ = ::fdopen(fd, "wb");

@@ -237,6 +237,8 @@ INSTANTIATE_TEST_SUITE_P(
                     BadPcd{"pcd_truncated_compressed", "truncated compressed body"},
                     BadPcd{"pcd_non_numeric", "'abc' is not a number"},
                     BadPcd{"pcd_value_out_of_type", "'70000' is not a number of the field's type"},
+                    BadPcd{"pcd_coordinate_beyond_range",
+                           "point 3 (row 0, col 3): coordinate beyond 10^8 m"},
                     BadPcd{"pcd_wrong_value_count", "4 values, the header says 5"},
                     BadPcd{"pcd_extra_points", "more points"},
                     BadPcd{"pcd_points_mismatch", "disagrees with POINTS"},

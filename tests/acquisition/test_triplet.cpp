@@ -293,6 +293,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadSidecar{"triplet_nonfinite_angle", "triplet_nonfinite_angle.json", "not finite"},
         BadSidecar{"triplet_zero_step", "key \"angles.elevation_step_rad\"", "zero"},
         BadSidecar{"triplet_huge_step", "key \"angles.azimuth_step_rad\"", "full turn"},
+        BadSidecar{"triplet_start_beyond_two_turns", "key \"angles.elevation_start_rad\"",
+                   "more than two turns"},
         BadSidecar{"triplet_long_image_name", "key \"range.file\"", "file name"},
         BadSidecar{"triplet_zero_scale", "key \"range.scale_m\"", "positive"},
         BadSidecar{"triplet_negative_scale", "key \"range.scale_m\"", "positive"},

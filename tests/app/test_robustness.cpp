@@ -75,7 +75,7 @@ TEST(Robustness, AnExportNeverReplacesItsProjectOrAnyProject) {
   EXPECT_EQ(run_cli(dir, {"info", other.string(), "--json"}).exit_code, 0);
 }
 
-TEST(Robustness, AnExportToAFolderOrToNothingIsBadInput) {
+TEST(Robustness, AnExportToAFolderToNothingOrIntoNoFolderIsBadInput) {
   ScratchDir dir;
   const std::filesystem::path project = dir / "p.sbproj";
   make_project(dir, project);
@@ -85,6 +85,10 @@ TEST(Robustness, AnExportToAFolderOrToNothingIsBadInput) {
                         2, "is a directory");
   expect_one_line_error(run_cli(dir, {"export", project.string(), "--format", "ply", "-o", ""}), 2,
                         "no output file given");
+  expect_one_line_error(run_cli(dir, {"export", project.string(), "--format", "ply", "-o",
+                                      (dir / "missing/p.ply").string()}),
+                        2,
+                        "its folder " + (dir / "missing").string() + " is not an existing folder");
 }
 
 TEST(Robustness, NamesThatAreNotUtf8KeepEveryJsonReportValid) {
