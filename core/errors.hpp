@@ -58,6 +58,13 @@ class RuntimeFailure : public std::runtime_error {
   std::string problem_;
 };
 
+// Work refused because it cannot fit in the memory this process may use
+// (core::check_memory): a runtime failure of this machine, not of the data.
+class MemoryShortage : public RuntimeFailure {
+ public:
+  using RuntimeFailure::RuntimeFailure;
+};
+
 class Cancelled : public std::runtime_error {
  public:
   // `stage` names what was stopped ("geometry", "merge").

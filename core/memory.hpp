@@ -9,11 +9,14 @@
 
 namespace scanbench::core {
 
-// The memory the system can give this process now [bytes] (Linux:
-// MemAvailable of /proc/meminfo); none where it cannot be told.
+// The memory this process can still be given [bytes]: the least of the
+// system's (MemAvailable of /proc/meminfo), what the memory cgroups of the
+// process and their ancestors still allow (v1 or v2: limit less usage,
+// reclaimable file cache not counted as used), and what RLIMIT_AS leaves of
+// the address space. None where none of them can be told.
 std::optional<std::uint64_t> available_memory_bytes();
 
-// Throws RuntimeFailure naming `file` and saying "reading it needs N GB of
+// Throws MemoryShortage naming `file` and saying "reading it needs N GB of
 // memory, M GB are available" when `bytes` exceeds what is available.
 // Nothing happens where the available memory cannot be told.
 void check_memory(std::uint64_t bytes, const std::string& file);

@@ -40,14 +40,18 @@ inline std::filesystem::path write_input(const std::uint8_t* data, std::size_t s
   return path;
 }
 
-// Runs `read`; the two refusals scanbench promises are fine, anything else
-// (another exception type) is a finding.
+// Runs `read`. Bad input must be refused as such (core::InputError), and
+// so may work that does not fit in memory (core::MemoryShortage); any other
+// failure reading a file from RAM, a RuntimeFailure included, is a finding.
 template <typename Read>
 void expect_refusal_or_success(Read&& read) {
   try {
     read();
   } catch (const core::InputError&) {
-  } catch (const core::RuntimeFailure&) {
+  } catch (const core::MemoryShortage&) {
+  } catch (const core::RuntimeFailure& failure) {
+    std::fprintf(stderr, "finding: a runtime failure for bad input: %s\n", failure.what());
+    std::abort();
   }
 }
 

@@ -48,9 +48,9 @@ TEST(Integrity, ASoundProjectPassesTheCheck) {
   EXPECT_EQ(report.layers, 4u);   // range, valid, intensity, rgb
 }
 
-TEST(Integrity, MigratedProjectsPassTheCheck) {
+TEST(Integrity, ProjectsOfEveryVersionPassTheCheck) {
   const ScratchDir dir;
-  for (int version : {1, 2, 3}) {
+  for (int version : {1, 2, 3, 4}) {
     const auto file = dir / ("v" + std::to_string(version) + ".sbproj");
     std::filesystem::copy_file(fixture("projects/version" + std::to_string(version) + ".sbproj"),
                                file);

@@ -36,6 +36,30 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
+// fixtures/projects/version4.sbproj: two_scans.ptx and tiny_color.ptx
+// imported, then geometry computed and undone.
+TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournal) {
+  static_assert(kProjectSchemaVersion == 4, "add fixtures/projects/version5.sbproj");
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 4);
+  const std::string before = test::read_file_bytes(file);
+  {
+    Project project = Project::open(file);
+    EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
+    const std::vector<CommandRecord> history = project.history();
+    ASSERT_EQ(history.size(), 2u);
+    EXPECT_EQ(history[1].name, "geometry");
+    EXPECT_EQ(history[1].state, CommandState::kUndone);
+  }
+  EXPECT_EQ(test::read_file_bytes(file), before);
+  Project project = Project::open(file);
+  EXPECT_FALSE(load_geometry(project, 3).has_value());
+  ASSERT_TRUE(project.redo().has_value());
+  const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, 3);
+  ASSERT_TRUE(geometry.has_value());
+  EXPECT_EQ(geometry->footprint_m.size(), 6u);  // tiny_color is 2 × 3
+}
+
 class Migration : public ::testing::TestWithParam<int> {};
 
 TEST_P(Migration, OpensAtTheCurrentVersionWithEveryScanLoadable) {
