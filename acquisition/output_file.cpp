@@ -8,8 +8,10 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <memory>
 
 #include "core/errors.hpp"
+#include "core/project_file.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -50,6 +52,10 @@ OutputFile::OutputFile(std::filesystem::path target)
   if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
     throw core::InputError(target_.string(), {},
                            "is not a regular file (a device or a pipe); exports write files");
+  }
+  if (core::is_project_file(target_)) {
+    throw core::InputError(target_.string(), {},
+                           "is a scanbench project; scanbench never writes over a project");
   }
   remove_abandoned_partials(target_);
   ::unlink(partial_.c_str());  // an earlier process of our pid, long gone
@@ -127,6 +133,16 @@ void OutputFile::commit() {
 
 void OutputFile::fail(const std::string& what) const {
   throw core::RuntimeFailure(target_.string(), {}, what + ": " + std::strerror(errno));
+}
+
+void write_files_together(const std::vector<std::pair<std::filesystem::path, std::string>>& files) {
+  std::vector<std::unique_ptr<OutputFile>> outputs;
+  for (const auto& [path, bytes] : files) {
+    outputs.push_back(std::make_unique<OutputFile>(path));
+    outputs.back()->write(bytes);
+  }
+  for (auto& output : outputs) output->close();
+  for (auto& output : outputs) output->commit();
 }
 
 }  // namespace scanbench::acquisition

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace scanbench::acquisition {
 
@@ -16,9 +18,9 @@ class OutputFile {
   // symlink, never shared with another export to the same target), after
   // removing what killed runs of this export left beside the target (their
   // processes are gone). Throws core::InputError when `target` is empty, a
-  // directory, an existing file that is not a regular file, or in a folder
-  // that does not exist; core::RuntimeFailure naming the file when it cannot
-  // be created otherwise.
+  // directory, an existing file that is not a regular file, a scanbench
+  // project (of any name), or in a folder that does not exist; core::RuntimeFailure naming the file
+  // when it cannot be created otherwise.
   explicit OutputFile(std::filesystem::path target);
   // Removes the temporary file unless commit() succeeded.
   ~OutputFile();
@@ -51,5 +53,12 @@ class OutputFile {
   bool closed_ = false;  // closed, not yet renamed: the partial file is still there
   std::string buffer_;
 };
+
+// Writes files that belong together (a triplet, a picture and its object
+// ids), each through an OutputFile: all are on the disk beside their
+// targets before any replaces its target, in the order given (a sidecar
+// last). A failure leaves the old files (or none) behind. Throws as
+// OutputFile.
+void write_files_together(const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 
 }  // namespace scanbench::acquisition

@@ -3,15 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "acquisition/image_file.hpp"
 #include "acquisition/output_file.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
@@ -120,20 +119,6 @@ cv::Mat encode_color(const Scan& scan) {
   return image;
 }
 
-// The file bytes of `image` in the format its extension names.
-std::string encode_image(const fs::path& path, const cv::Mat& image) {
-  std::vector<std::uint8_t> bytes;
-  bool ok = false;
-  try {
-    ok = cv::imencode(path.extension().string(), image, bytes);
-  } catch (const cv::Exception& e) {
-    throw core::RuntimeFailure(utf8(path), {},
-                               std::string("could not encode image (") + e.what() + ")");
-  }
-  if (!ok) throw core::RuntimeFailure(utf8(path), {}, "could not encode image");
-  return std::string(bytes.begin(), bytes.end());
-}
-
 Json range_entry(const std::string& file, const TripletWriteSettings& settings) {
   if (settings.range_encoding == Encoding::kFloat32) {
     return Json{{"file", file}, {"encoding", "float32"}};
@@ -186,15 +171,8 @@ void write_triplet(const Scan& scan, const std::filesystem::path& sidecar_json,
                      make_sidecar(scan, stem, settings)
                              .dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
                          "\n");
-  // Every file is written in full beside its target before any replaces it,
-  // the sidecar last: a failure leaves the old triplet (or nothing) behind.
-  std::vector<std::unique_ptr<OutputFile>> outputs;
-  for (const auto& [path, bytes] : files) {
-    outputs.push_back(std::make_unique<OutputFile>(path));
-    outputs.back()->write(bytes);
-  }
-  for (auto& output : outputs) output->close();  // all on disk before any replaces its target
-  for (auto& output : outputs) output->commit();
+  // The sidecar last: a failure leaves the old triplet (or nothing) behind.
+  write_files_together(files);
 }
 
 std::vector<std::filesystem::path> triplet_files(const Scan& scan,

@@ -43,6 +43,8 @@ void run_campaign(SimulateOptions& options) {
 void run_render_view(const SimulateOptions& options) {
   if (options.output_png.empty())
     throw CLI::ValidationError("-o", "is required with --render-view");
+  if (std::filesystem::path(options.output_png).extension() != ".png")
+    throw CLI::ValidationError("-o", "must name a .png file (the truth picture is a PNG)");
   const sim::CameraView view = sim::read_camera_view(options.render_view);
   const sim::Site site = sim::make_site(options.campaign.site, options.campaign.seed, 1);
   const sim::TruthImage image =

@@ -7,7 +7,6 @@
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/triplet_writer.hpp"
 #include "core/errors.hpp"
-#include "modeling/project_schema.hpp"
 #include "modeling/scan_layers.hpp"
 
 namespace scanbench::modeling {
@@ -63,10 +62,10 @@ void write_triplet(const Project& project, const std::vector<acquisition::Scan>&
 }
 
 // Refuses (core::InputError, nothing written) an output that would replace
-// the project being exported, by any path (a symlink, a hard link, "./"), or
-// any other scanbench project.
-void refuse_to_replace_projects(const Project& project,
-                                std::span<const std::filesystem::path> outputs) {
+// the project being exported or one of its files, by any path (a symlink, a
+// hard link, "./"). Any other project is refused by the output file itself.
+void refuse_to_replace_the_project(const Project& project,
+                                   std::span<const std::filesystem::path> outputs) {
   for (const std::filesystem::path& output : outputs) {
     std::error_code error;
     // SQLite's companion files hold the project's latest changes.
@@ -83,10 +82,6 @@ void refuse_to_replace_projects(const Project& project,
     if (std::filesystem::equivalent(output, project.path(), error)) {
       throw core::InputError(output.string(), {},
                              "is the project being exported; an export never replaces its input");
-    }
-    if (schema::has_project_header(output)) {
-      throw core::InputError(output.string(), {},
-                             "is a scanbench project; an export never replaces a project");
     }
   }
 }
@@ -118,7 +113,7 @@ ExportResult export_project(const Project& project, const ExportSettings& settin
       settings.format == ExportFormat::kTriplet && scans.size() == 1
           ? acquisition::triplet_files(scans.front(), settings.output)
           : std::vector<std::filesystem::path>{settings.output};
-  refuse_to_replace_projects(project, outputs);
+  refuse_to_replace_the_project(project, outputs);
   std::vector<const acquisition::ScanGeometry*> geometry_of;
   for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
   std::vector<const std::vector<std::uint8_t>*> keep_of;

@@ -43,6 +43,7 @@
 
 #include "acquisition/scan.hpp"
 #include "acquisition/scan_summary.hpp"
+#include "core/project_file.hpp"
 #include "modeling/layers.hpp"
 
 struct sqlite3;
@@ -51,7 +52,7 @@ namespace scanbench::modeling {
 
 // PRAGMA application_id of every scanbench project: "SBNC" in ASCII. Files
 // with another id are other applications' databases and are never touched.
-inline constexpr std::uint32_t kProjectApplicationId = 0x53424E43;
+inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplicationId;
 
 // PRAGMA user_version written by this build. Older projects are migrated on
 // open; newer ones are refused.

@@ -366,18 +366,6 @@ void enable_wal(sqlite3* db, const std::string& file) {
 
 }  // namespace
 
-bool has_project_header(const std::filesystem::path& file) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(file, error)) return false;
-  std::array<char, 100> header{};
-  std::ifstream in(file, std::ios::binary);
-  in.read(header.data(), header.size());
-  constexpr char kMagic[16] = "SQLite format 3";
-  return in.gcount() == static_cast<std::streamsize>(header.size()) &&
-         std::equal(kMagic, kMagic + 16, header.begin()) &&
-         big_endian_u32(header.data() + 68) == kProjectApplicationId;
-}
-
 void check_file_header(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code error;

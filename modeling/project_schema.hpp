@@ -27,10 +27,6 @@ namespace scanbench::modeling::schema {
 // project of a schema version newer than kProjectSchemaVersion or below 1.
 void check_file_header(const std::filesystem::path& file);
 
-// True when `file` is a regular file that starts like a scanbench project
-// (SQLite header with our application id), of whatever version.
-bool has_project_header(const std::filesystem::path& file);
-
 // Sets the per-connection settings every project connection needs: foreign
 // keys on, synchronous=FULL, busy timeout. Throws as sqlite::throw_error.
 void configure_connection(sqlite3* db, const std::string& file);

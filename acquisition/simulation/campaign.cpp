@@ -2,10 +2,9 @@
 
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
 
+#include "acquisition/output_file.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/simulation/pose_error.hpp"
@@ -109,9 +108,9 @@ json write_scan(const SimulatedScan& sim, const Eigen::Isometry3d& true_pose,
 }
 
 void write_json(const fs::path& path, const json& value) {
-  std::ofstream out(path, std::ios::binary);
-  out << value.dump(2) << '\n';
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+  OutputFile out(path);
+  out.write(value.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
+  out.commit();
 }
 
 std::string scan_name(const std::string& site, int k) {

@@ -3,22 +3,12 @@
 #include <cassert>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <stdexcept>
 
+#include "acquisition/image_file.hpp"
 #include "core/errors.hpp"
 
 namespace scanbench::acquisition::sim {
 namespace {
-
-void write_image(const std::filesystem::path& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path.string(), image);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path.string() + ": cannot write image: " + e.what());
-  }
-  if (!ok) throw std::runtime_error(path.string() + ": cannot write image");
-}
 
 cv::Mat read_image(const std::filesystem::path& path, int type, int rows, int columns) {
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
@@ -50,10 +40,10 @@ void write_truth_images(const ScanTruth& truth, int rows, int columns, const Tru
       mixed.at<std::uint8_t>(row, col) = truth.mixed[i] ? 255 : 0;
     }
   }
-  write_image(files.object_id, ids);
-  write_image(files.normal, normals);
-  write_image(files.range, range);
-  write_image(files.mixed, mixed);
+  write_image_file(files.object_id, ids);
+  write_image_file(files.normal, normals);
+  write_image_file(files.range, range);
+  write_image_file(files.mixed, mixed);
 }
 
 ScanTruth read_truth_images(const TruthFiles& files, int rows, int columns) {

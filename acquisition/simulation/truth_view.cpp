@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <stdexcept>
 
+#include "acquisition/image_file.hpp"
+#include "acquisition/output_file.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
@@ -144,10 +144,7 @@ void write_truth_image(const TruthImage& image, const fs::path& png) {
     }
   }
   const fs::path id_png = png.parent_path() / (png.stem().string() + "_object_id.png");
-  for (const auto& [path, mat] : {std::pair{png, bgr}, std::pair{id_png, ids}}) {
-    if (!cv::imwrite(path.string(), mat))
-      throw std::runtime_error(path.string() + ": cannot write image");
-  }
+  write_files_together({{png, encode_image(png, bgr)}, {id_png, encode_image(id_png, ids)}});
 }
 
 }  // namespace scanbench::acquisition::sim

@@ -38,8 +38,10 @@ struct TruthImage {
 TruthImage render_truth_view(const Scene& scene, const CameraView& view,
                              const SimulationSettings& settings = {});
 
-// Writes the colour image to `png` and the 16-bit id image beside it as
-// "<stem>_object_id.png". Throws std::runtime_error naming the file on failure.
+// Writes the colour image to `png` and the 16-bit object ids beside it as
+// "<stem>_object_id.png", both or neither (as acquisition::write_files_together). Throws
+// core::InputError for an output that cannot be one (a folder, a project),
+// core::RuntimeFailure naming the file when it cannot be written.
 void write_truth_image(const TruthImage& image, const std::filesystem::path& png);
 
 }  // namespace scanbench::acquisition::sim

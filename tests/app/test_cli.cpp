@@ -364,10 +364,10 @@ TEST(Cli, UndoRedoAndHistoryWorkAcrossProcesses) {
 TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {
   ScratchDir dir;
   const std::filesystem::path view = dir / "view.json", png = dir / "truth.png";
+  const char* const good_view = R"({"position": [0, -30, 2], "look_at": [0, 0, 5],
+                                    "vertical_fov_deg": 50, "width": 64, "height": 48})";
   std::FILE* f = std::fopen(view.c_str(), "w");
-  std::fputs(R"({"position": [0, -30, 2], "look_at": [0, 0, 5], "vertical_fov_deg": 50,
-                 "width": 64, "height": 48})",
-             f);
+  std::fputs(good_view, f);
   std::fclose(f);
   const CliResult ok = run_cli(
       dir, {"simulate", "--site", "street", "--render-view", view.string(), "-o", png.string()});
@@ -383,6 +383,27 @@ TEST(Cli, SimulateRendersATruthViewAndRefusesABadViewFile) {
       dir, {"simulate", "--site", "street", "--render-view", view.string(), "-o", png.string()});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("look_at"), std::string::npos) << bad.err;
+  // The picture is a PNG: it never replaces the view it reads, nor a project.
+  const std::string view_before = test::read_file_bytes(view);
+  const CliResult over_view = run_cli(
+      dir, {"simulate", "--site", "street", "--render-view", view.string(), "-o", view.string()});
+  EXPECT_EQ(over_view.exit_code, 2);
+  EXPECT_NE(over_view.err.find("must name a .png file"), std::string::npos) << over_view.err;
+  EXPECT_EQ(test::read_file_bytes(view), view_before);
+  f = std::fopen(view.c_str(), "w");
+  std::fputs(good_view, f);
+  std::fclose(f);
+  const std::filesystem::path project = dir / "project.png";  // a project of any name
+  ASSERT_EQ(
+      run_cli(dir, {"import", project.string(), test::fixture("good/ptx/tiny_color.ptx").string()})
+          .exit_code,
+      0);
+  const CliResult over_project = run_cli(dir, {"simulate", "--site", "street", "--render-view",
+                                               view.string(), "-o", project.string()});
+  EXPECT_EQ(over_project.exit_code, 2);
+  EXPECT_NE(over_project.err.find("never writes over a project"), std::string::npos)
+      << over_project.err;
+  EXPECT_EQ(run_cli(dir, {"check", project.string()}).exit_code, 0);
 }
 
 TEST(Cli, SimulateWithoutAnOutputFolderIsAUsageError) {

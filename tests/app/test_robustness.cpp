@@ -70,7 +70,7 @@ TEST(Robustness, AnExportNeverReplacesItsProjectOrAnyProject) {
   }
   expect_one_line_error(
       run_cli(dir, {"export", project.string(), "--format", "csv", "-o", other.string()}), 2,
-      "never replaces a project");
+      "scanbench never writes over a project");
   EXPECT_EQ(run_cli(dir, {"info", project.string(), "--json"}).out, before);
   EXPECT_EQ(run_cli(dir, {"info", other.string(), "--json"}).exit_code, 0);
 }
