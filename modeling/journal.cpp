@@ -1,15 +1,14 @@
 // The commands table: Project::begin_command, begin_long_command, the
 // Edit's commits, history, undo, redo and latest_result, and the revision
 // every commit advances.
-#include <signal.h>
 #include <sqlite3.h>
-#include <unistd.h>
 
-#include <array>
 #include <cassert>
-#include <cerrno>
+#include <string>
+#include <vector>
 
 #include "core/errors.hpp"
+#include "core/process.hpp"
 #include "modeling/project.hpp"
 #include "modeling/records.hpp"
 #include "modeling/sqlite_statement.hpp"
@@ -84,23 +83,20 @@ void check_revision(sqlite3* db, const std::string& file, std::string_view name,
   }
 }
 
-std::string host_name() {
-  std::array<char, 256> name{};
-  if (::gethostname(name.data(), name.size() - 1) != 0) return "";
-  return name.data();
-}
-
-// Removes pending commands (with their rows) whose process on this host is
-// gone: what a killed long command left. Commands of other hosts are left
-// alone (a live process there cannot be told from a dead one).
+// Removes pending commands (with their rows) whose process is gone: what a
+// killed long command left. Only processes of this machine (host, boot,
+// pid namespace) can be judged; other machines' commands are left alone.
 void remove_abandoned(sqlite3* db, const std::string& file) {
-  sqlite::Statement select(
-      db, "SELECT id, owner_pid FROM commands WHERE state = 'pending' AND owner_host = ?1", file);
-  select.bind_text(1, host_name());
+  sqlite::Statement select(db,
+                           "SELECT id, owner_pid, owner_start FROM commands "
+                           "WHERE state = 'pending' AND owner_machine = ?1",
+                           file);
+  const std::string machine = core::this_process().machine;
+  select.bind_text(1, machine);
   std::vector<std::int64_t> abandoned;
   while (select.step()) {
-    const auto pid = static_cast<pid_t>(select.column_int(1));
-    if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) abandoned.push_back(select.column_int(0));
+    if (!core::is_running({machine, select.column_int(1), select.column_int(2)}))
+      abandoned.push_back(select.column_int(0));
   }
   for (const std::int64_t id : abandoned) {
     sqlite::Statement remove(db, "DELETE FROM commands WHERE id = ?1", file);
@@ -154,11 +150,12 @@ Project::LongCommand Project::begin_long_command(std::string_view name,
   check_revision(db(), file_name(), name, based_on_revision);
   remove_abandoned(db(), file_name());
   sqlite::Statement insert(db(),
-                           "INSERT INTO commands (name, settings, state, undoable, owner_host, "
-                           "owner_pid) VALUES (?1, ?2, 'pending', 1, ?3, ?4)",
+                           "INSERT INTO commands (name, settings, state, undoable, owner_machine, "
+                           "owner_pid, owner_start) VALUES (?1, ?2, 'pending', 1, ?3, ?4, ?5)",
                            file_name());
-  insert.bind_text(1, name).bind_text(2, settings_json).bind_text(3, host_name());
-  insert.bind_int(4, ::getpid()).run();
+  const core::ProcessIdentity self = core::this_process();
+  insert.bind_text(1, name).bind_text(2, settings_json).bind_text(3, self.machine);
+  insert.bind_int(4, self.pid).bind_int(5, self.start_ticks).run();
   const std::int64_t id = sqlite3_last_insert_rowid(db());
   update_checksum(db(), file_name(), id);
   edit.commit_part();
@@ -209,10 +206,11 @@ Project::Edit Project::LongCommand::finish() {
 void Project::Edit::commit(const std::string& result_json) {
   assert(active() && (kind_ == Kind::kCommand || kind_ == Kind::kFinal) &&
          "commit on a committed, moved-from or part Edit");
-  const std::string sql = std::string(
-                              "UPDATE commands SET result = ?2, state = 'done', seq = "
-                              "coalesce(seq, ") +
-                          kNextSeq + "), owner_host = NULL, owner_pid = NULL WHERE id = ?1";
+  const std::string sql =
+      std::string(
+          "UPDATE commands SET result = ?2, state = 'done', seq = "
+          "coalesce(seq, ") +
+      kNextSeq + "), owner_machine = NULL, owner_pid = NULL, owner_start = NULL WHERE id = ?1";
   sqlite::Statement update(db_, sql.c_str(), file_);
   update.bind_int(1, command_id_).bind_text(2, result_json).run();
   update_checksum(db_, file_, command_id_);

@@ -181,8 +181,9 @@ CREATE TABLE commands (
   result TEXT NOT NULL DEFAULT '{}',
   state TEXT NOT NULL CHECK (state IN ('pending', 'done', 'undone')),
   undoable INTEGER NOT NULL CHECK (undoable IN (0, 1)),
-  owner_host TEXT,     -- pending: the host and process writing it
+  owner_machine TEXT,  -- pending: the process writing it (core::ProcessIdentity)
   owner_pid INTEGER,
+  owner_start INTEGER,
   checksum INTEGER NOT NULL DEFAULT 0,   -- of id, seq, name, settings, result, state, undoable
   created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
   CHECK ((state = 'pending') = (seq IS NULL))

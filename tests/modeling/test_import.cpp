@@ -4,9 +4,11 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/process.hpp"
 #include "modeling/import_scans.hpp"
 #include "modeling/project.hpp"
 #include "modeling/project_test_support.hpp"
@@ -109,6 +111,31 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
   for (const CommandRecord& c : Project::open(project).history()) {
     EXPECT_EQ(c.state, CommandState::kDone) << c.id;
   }
+}
+
+// Pending commands another process left: removed when that process is
+// gone on this machine (its pid now names a process started at another
+// time), kept when it runs on another machine, where nothing can tell.
+TEST(ImportScans, OnlyPendingCommandsOfGoneProcessesOfThisMachineAreRemoved) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  import_files(project, {fixture("good/ptx/tiny_color.ptx")});
+  const core::ProcessIdentity self = core::this_process();
+  {
+    test::RawDatabase raw(project);
+    const auto pending = [&](const std::string& machine, std::int64_t start) {
+      raw.execute(
+          "INSERT INTO commands (name, settings, state, undoable, owner_machine, "
+          "owner_pid, owner_start) VALUES ('import', '{}', 'pending', 1, '" +
+          machine + "', " + std::to_string(self.pid) + ", " + std::to_string(start) + ")");
+    };
+    pending(self.machine, self.start_ticks + 1);                            // a reused pid: gone
+    pending("survey-laptop boot 1234 pid:[4026531836]", self.start_ticks);  // elsewhere
+  }
+  import_files(project, {fixture("good/ptx/irregular.ptx")});
+  EXPECT_EQ(test::RawDatabase(project).text(
+                "SELECT group_concat(owner_machine) FROM commands WHERE state = 'pending'"),
+            "survey-laptop boot 1234 pid:[4026531836]");
 }
 
 }  // namespace
