@@ -1,6 +1,7 @@
 // The checksummed records of the project: a scan's metadata (scans), a
-// pose (scan_poses) and a journal entry (commands), with the checksum of
-// each as RowChecksum computes it. One definition of each record's fields
+// pose (scan_poses), a journal entry (commands) and a layer's row
+// (scan_layers; its data is checked by its own zstd frame), with the
+// checksum of each as RowChecksum computes it. One definition of each record's fields
 // serves the writers, the readers that verify on the way, the migration
 // that fills checksums in, and `scanbench check`. Internal to modeling/.
 #pragma once
@@ -20,8 +21,10 @@
 
 namespace scanbench::modeling {
 
+// The columns of one row of each table, as stored; the structs hold no
+// meaning beyond that (the Project turns them into summaries and poses).
 struct ScanRecord {
-  std::int64_t created_by = 0;
+  std::int64_t created_by = 0;  // the command that imported it
   std::string name;
   std::int64_t rows = 0;
   std::int64_t columns = 0;

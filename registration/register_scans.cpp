@@ -305,6 +305,87 @@ void report_edges(std::span<const PreparedScan> scans, const std::vector<SampleC
   if (sample_count > 0) result.overlap = static_cast<double>(result.correspondences) / sample_count;
 }
 
+// register_scans' progress: one unit per scan made ready, per pair, and
+// the global refinement; cancellation is checked after each.
+class StageProgress {
+ public:
+  StageProgress(core::Progress* progress, std::size_t units) : progress_(progress), units_(units) {}
+
+  void step(const std::string& note) {
+    if (progress_ == nullptr) return;
+    progress_->update({"register", ++done_, units_, note});
+    progress_->throw_if_cancelled("register");
+  }
+
+ private:
+  core::Progress* progress_;
+  std::size_t units_;
+  std::size_t done_ = 0;
+};
+
+// Every scan's ICP samples, and its features when the coarse step uses them.
+struct Clouds {
+  std::vector<SampleCloud> samples;
+  std::vector<FeatureCloud> features;
+};
+
+Clouds prepare_clouds(std::span<const PreparedScan> scans, const RegistrationSettings& settings,
+                      StageProgress& steps) {
+  Clouds clouds;
+  for (const PreparedScan& scan : scans) {
+    clouds.samples.push_back(sample_scan(scan, settings.icp_sample));
+    if (settings.coarse == CoarseMethod::kFeatures) {
+      clouds.features.emplace_back(sample_scan(scan, settings.features.sample), settings.features);
+    }
+    steps.step("features of " + scan.scan->name);
+  }
+  return clouds;
+}
+
+// Every scan's pose in the first scan's frame, and whether it registered
+// (with the whole chain to the first scan).
+struct Chain {
+  std::vector<Eigen::Isometry3d> T_first_scan;
+  std::vector<bool> registered;
+};
+
+// Registers each scan after the first against its target (the previous
+// scan, or the one its picked point pairs name), chaining the poses; adds
+// each pair's report, iterations and times to `result`.
+Chain register_chain(std::span<const PreparedScan> scans,
+                     std::span<const Eigen::Isometry3d> initial_T_world_scan, const Clouds& clouds,
+                     const RegistrationSettings& settings, StageProgress& steps,
+                     RegistrationResult& result) {
+  const std::size_t n = scans.size();
+  Chain chain{std::vector<Eigen::Isometry3d>(n, Eigen::Isometry3d::Identity()),
+              std::vector<bool>(n, true)};
+  for (std::size_t k = 1; k < n; ++k) {
+    const int source = static_cast<int>(k);
+    int target = source - 1;
+    const PickedPairs* picks =
+        settings.coarse == CoarseMethod::kPointPairs ? picks_for(settings, source) : nullptr;
+    if (picks != nullptr) target = picks->target;
+    const auto t = static_cast<std::size_t>(target);
+    // The start: the source's initial pose against the target where the
+    // target registered, so that one scan's initial error does not add to
+    // the next one's (with a lever arm as long as the distance between them).
+    const Eigen::Isometry3d initial_T_first_source =
+        initial_T_world_scan[0].inverse() * initial_T_world_scan[k];
+    const Eigen::Isometry3d initial = chain.T_first_scan[t].inverse() * initial_T_first_source;
+    PairReport pair =
+        register_pair(source, target, initial, scans, clouds.samples, clouds.features, settings);
+    chain.T_first_scan[k] =
+        pair.registered ? chain.T_first_scan[t] * pair.icp.T_target_source : initial_T_first_source;
+    chain.registered[k] = pair.registered && chain.registered[t];
+    result.iterations += pair.icp.iterations;
+    result.coarse_seconds += pair.coarse.seconds;
+    result.fine_seconds += pair.seconds - pair.coarse.seconds;
+    result.pairs.push_back(std::move(pair));
+    steps.step("registered " + scans[k].scan->name);
+  }
+  return chain;
+}
+
 }  // namespace
 
 const char* coarse_method_name(CoarseMethod method) {
@@ -338,66 +419,30 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
   assert(scans.size() == initial_T_world_scan.size() && !scans.empty());
   const Clock::time_point start = Clock::now();
   const std::size_t n = scans.size();
-  std::size_t done = 0;
-  const std::size_t units = 2 * n;  // scans made ready, pairs, the global refinement
-  const auto step = [&](const std::string& note) {
-    if (progress == nullptr) return;
-    progress->update({"register", ++done, units, note});
-    progress->throw_if_cancelled("register");
-  };
-  std::vector<SampleCloud> samples;
-  std::vector<FeatureCloud> features;
-  for (const PreparedScan& scan : scans) {
-    samples.push_back(sample_scan(scan, settings.icp_sample));
-    if (settings.coarse == CoarseMethod::kFeatures) {
-      features.emplace_back(sample_scan(scan, settings.features.sample), settings.features);
-    }
-    step("features of " + scan.scan->name);
-  }
+  StageProgress steps(progress, 2 * n);  // scans made ready, pairs, the global refinement
+  const Clouds clouds = prepare_clouds(scans, settings, steps);
   RegistrationResult result;
   result.coarse_seconds = core::seconds_since(start);
-  std::vector<Eigen::Isometry3d> T_first_scan(n, Eigen::Isometry3d::Identity());
-  std::vector<bool> registered(n, true);
-  for (std::size_t k = 1; k < n; ++k) {
-    const int source = static_cast<int>(k);
-    int target = source - 1;
-    const PickedPairs* picks =
-        settings.coarse == CoarseMethod::kPointPairs ? picks_for(settings, source) : nullptr;
-    if (picks != nullptr) target = picks->target;
-    const auto t = static_cast<std::size_t>(target);
-    // The start: the source's initial pose against the target where the
-    // target registered, so that one scan's initial error does not add to
-    // the next one's (with a lever arm as long as the distance between them).
-    const Eigen::Isometry3d initial_T_first_source =
-        initial_T_world_scan[0].inverse() * initial_T_world_scan[k];
-    const Eigen::Isometry3d initial = T_first_scan[t].inverse() * initial_T_first_source;
-    PairReport pair = register_pair(source, target, initial, scans, samples, features, settings);
-    T_first_scan[k] =
-        pair.registered ? T_first_scan[t] * pair.icp.T_target_source : initial_T_first_source;
-    registered[k] = pair.registered && registered[t];
-    result.iterations += pair.icp.iterations;
-    result.coarse_seconds += pair.coarse.seconds;
-    result.fine_seconds += pair.seconds - pair.coarse.seconds;
-    result.pairs.push_back(std::move(pair));
-    step("registered " + scans[k].scan->name);
-  }
+  Chain chain = register_chain(scans, initial_T_world_scan, clouds, settings, steps, result);
 
   const std::vector<ScanEdge> edges =
-      overlapping_edges(scans, samples, T_first_scan, registered, settings);
+      overlapping_edges(scans, clouds.samples, chain.T_first_scan, chain.registered, settings);
   if (settings.refine_globally && n > 1 && !edges.empty()) {
-    result.global = refine_globally(samples, scans, T_first_scan, edges, settings.global);
-    T_first_scan = result.global.T_first_scan;
+    result.global =
+        refine_globally(clouds.samples, scans, chain.T_first_scan, edges, settings.global);
+    chain.T_first_scan = result.global.T_first_scan;
     result.iterations += result.global.rounds;
     result.fine_seconds += result.global.seconds;
   }
-  report_edges(scans, samples, T_first_scan, edges, settings, result);
-  step("global refinement");
+  report_edges(scans, clouds.samples, chain.T_first_scan, edges, settings, result);
+  steps.step("global refinement");
 
   for (std::size_t k = 0; k < n; ++k) {
-    result.T_world_scan.push_back(initial_T_world_scan[0] * T_first_scan[k]);
+    result.T_world_scan.push_back(initial_T_world_scan[0] * chain.T_first_scan[k]);
   }
-  result.converged = std::all_of(registered.begin(), registered.end(), [](bool r) { return r; }) &&
-                     (!settings.refine_globally || n == 1 || result.global.converged);
+  result.converged =
+      std::all_of(chain.registered.begin(), chain.registered.end(), [](bool r) { return r; }) &&
+      (!settings.refine_globally || n == 1 || result.global.converged);
   result.seconds = core::seconds_since(start);
   return result;
 }

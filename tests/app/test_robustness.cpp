@@ -110,7 +110,7 @@ TEST(Robustness, NamesThatAreNotUtf8KeepEveryJsonReportValid) {
   }
 }
 
-// libpng used to print "libpng error: Read Error" before our line.
+// The decoder's reason is part of our one line; nothing else is printed.
 TEST(Robustness, ADamagedImageGivesOneLineWithTheDecodersReason) {
   ScratchDir dir;
   const CliResult result =
