@@ -43,13 +43,7 @@ std::string format_input_error(const std::string& file_name, const FilePosition&
   return out.str();
 }
 
-InputError::InputError(std::string file, FilePosition position, std::string problem)
-    : std::runtime_error(format_input_error(file, position, problem)),
-      file_(std::move(file)),
-      position_(std::move(position)),
-      problem_(std::move(problem)) {}
-
-RuntimeFailure::RuntimeFailure(std::string file, FilePosition position, std::string problem)
+FileError::FileError(std::string file, FilePosition position, std::string problem)
     : std::runtime_error(format_input_error(file, position, problem)),
       file_(std::move(file)),
       position_(std::move(position)),

@@ -17,6 +17,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace scanbench::core {
 
@@ -29,13 +30,17 @@ struct FilePosition {
   std::string detail;  // free-form position, e.g. "key \"angles.azimuth_step_deg\""
 };
 
-class InputError : public std::runtime_error {
+// What InputError and RuntimeFailure carry: the file, where in it, and the
+// problem; what() is the one-line message format_input_error() makes.
+// Never thrown itself: callers catch the two kinds apart.
+class FileError : public std::runtime_error {
  public:
-  InputError(std::string file, FilePosition position, std::string problem);
-
   const std::string& file() const { return file_; }
   const FilePosition& position() const { return position_; }
   const std::string& problem() const { return problem_; }
+
+ protected:
+  FileError(std::string file, FilePosition position, std::string problem);
 
  private:
   std::string file_;
@@ -43,19 +48,17 @@ class InputError : public std::runtime_error {
   std::string problem_;
 };
 
-class RuntimeFailure : public std::runtime_error {
+class InputError : public FileError {
+ public:
+  InputError(std::string file, FilePosition position, std::string problem)
+      : FileError(std::move(file), std::move(position), std::move(problem)) {}
+};
+
+class RuntimeFailure : public FileError {
  public:
   // `file` names what could not be read or written ("" when none applies).
-  RuntimeFailure(std::string file, FilePosition position, std::string problem);
-
-  const std::string& file() const { return file_; }
-  const FilePosition& position() const { return position_; }
-  const std::string& problem() const { return problem_; }
-
- private:
-  std::string file_;
-  FilePosition position_;
-  std::string problem_;
+  RuntimeFailure(std::string file, FilePosition position, std::string problem)
+      : FileError(std::move(file), std::move(position), std::move(problem)) {}
 };
 
 // Work refused because it cannot fit in the memory this process may use
