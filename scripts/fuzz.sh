@@ -2,6 +2,8 @@
 # Builds the libFuzzer targets (clang, with AddressSanitizer and
 # UndefinedBehaviorSanitizer) and runs each for a while on its seed corpus.
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 60 s, all targets)
+# With FUZZ_RUNS=N in the environment each target instead runs until it has
+# executed N inputs, however long that takes (SECONDS_PER_TARGET is ignored).
 # Corpora grow in build-fuzz/corpus/<target> across runs; a finding leaves its
 # input in build-fuzz/findings/ and makes the script fail. Each target's line
 # "fuzz: <target>: N executions in S s, no finding" is what docs/reliability.md
@@ -46,15 +48,18 @@ for target in "${targets[@]}"; do
   mkdir -p "$corpus"
   seed "$target" | while read -r file; do cp -n "$file" "$corpus/" 2>/dev/null || true; done
   log=$build/$target.log
+  if [ -n "${FUZZ_RUNS:-}" ]; then limit=(-runs="$FUZZ_RUNS"); else limit=(-max_total_time="$seconds"); fi
+  started=$(date +%s)
   set +e
   "$build/bin/$target" "$corpus" -dict="$root/fuzz/dict/$(dictionary "$target").dict" \
-    -max_total_time="$seconds" -max_len="$(max_len "$target")" -timeout=10 -rss_limit_mb=4096 \
+    "${limit[@]}" -max_len="$(max_len "$target")" -timeout=10 -rss_limit_mb=4096 \
     -artifact_prefix="$build/findings/$target-" -print_final_stats=1 >"$log" 2>&1
   code=$?
   set -e
+  elapsed=$(($(date +%s) - started))
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   if [ $code -eq 0 ]; then
-    echo "fuzz: $target: $runs executions in $seconds s, no finding"
+    echo "fuzz: $target: $runs executions in $elapsed s, no finding"
   else
     echo "fuzz: $target: FINDING after $runs executions (exit $code); see $log and $build/findings/"
     tail -30 "$log"
