@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <numbers>
 
 namespace scanbench::acquisition {
 
@@ -44,6 +45,13 @@ Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col) {
 Eigen::Vector3d point_in_world(const Scan& scan, int row, int col) {
   const double range = scan.range_m[scan.index(row, col)];
   return scan.T_world_scan * (range * direction_precise(scan, row, col));
+}
+
+bool wraps_around(const Scan& scan) {
+  const auto* model = std::get_if<SphericalAngles>(&scan.angles);
+  if (model == nullptr || scan.columns < 3) return false;
+  const double step = std::abs(model->azimuth_step_rad);
+  return std::abs(step * scan.columns - 2.0 * std::numbers::pi) <= 0.5 * step;
 }
 
 std::size_t count_valid(const Scan& scan) {

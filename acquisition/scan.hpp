@@ -95,6 +95,11 @@ Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col);
 // Point of pixel (row, col) in the world frame [m], in double precision.
 Eigen::Vector3d point_in_world(const Scan& scan, int row, int col);
 
+// True when the scan's columns close the full circle of azimuth (a
+// spherical grid whose columns × |azimuth step| is 2π within half a step):
+// then column 0 neighbours the last column. False for per-pixel grids.
+bool wraps_around(const Scan& scan);
+
 // Number of pixels with a return (valid != 0).
 std::size_t count_valid(const Scan& scan);
 

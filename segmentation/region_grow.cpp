@@ -1,0 +1,236 @@
+#include "segmentation/region_grow.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <numbers>
+
+#include "segmentation/pixel_set.hpp"
+
+namespace scanbench::segmentation {
+
+namespace {
+
+float squared(float v) { return v * v; }
+
+float cos_of_degrees(double degrees) {
+  return static_cast<float>(std::cos(std::min(degrees, 180.0) * std::numbers::pi / 180.0));
+}
+
+// Whether q continues the surface of its neighbour p: q's point lies within
+// `footprints` of p's footprint (plus 4 σ of both ranges' noise) of p's
+// tangent plane, or of p's range along the beam where p has no normal.
+struct Continuity {
+  const SegmentationGrid& g;
+  float footprints;
+
+  bool operator()(std::size_t p, std::size_t q) const {
+    const Eigen::Vector3f& xp = g.point[p];
+    const Eigen::Vector3f& xq = g.point[q];
+    const Eigen::Vector3f& n = g.normal[p];
+    const float range = xp.norm();
+    const float offset = n.squaredNorm() > 0.0f ? std::abs(n.dot(xq - xp)) : std::abs(xq.norm() - range);
+    return offset <= footprints * g.footprint_m[p] + 4.0f * g.range_noise.sigma(range);
+  }
+};
+
+// One policy per channel: accept(p, q) for a step from region pixel p to
+// its neighbour q, add(q) once q joins.
+struct RangePolicy {
+  Continuity surface;
+  bool accept(std::size_t p, std::size_t q) const { return surface(p, q); }
+  void add(std::size_t) {}
+};
+
+struct ColorPolicy {
+  const SegmentationGrid& g;
+  float step2, mean2;  // squared ΔE bounds; mean2 < 0: no mean test
+  std::array<double, 3> sum{};
+  std::size_t count = 0;
+
+  bool accept(std::size_t p, std::size_t q) const {
+    const auto& a = g.lab[p];
+    const auto& b = g.lab[q];
+    if (squared(a[0] - b[0]) + squared(a[1] - b[1]) + squared(a[2] - b[2]) > step2) return false;
+    if (mean2 < 0.0f) return true;
+    const double inverse = 1.0 / static_cast<double>(count);
+    float d2 = 0.0f;
+    for (int k = 0; k < 3; ++k) d2 += squared(static_cast<float>(sum[k] * inverse) - b[k]);
+    return d2 <= mean2;
+  }
+  void add(std::size_t q) {
+    for (int k = 0; k < 3; ++k) sum[k] += g.lab[q][k];
+    ++count;
+  }
+};
+
+struct IntensityPolicy {
+  const SegmentationGrid& g;
+  float step, mean;  // mean < 0: no mean test
+  double sum = 0.0;
+  std::size_t count = 0;
+
+  bool accept(std::size_t p, std::size_t q) const {
+    const float v = g.intensity[q];
+    if (!(std::abs(v - g.intensity[p]) <= step)) return false;
+    return mean < 0.0f || std::abs(static_cast<float>(sum / static_cast<double>(count)) - v) <= mean;
+  }
+  void add(std::size_t q) {
+    sum += g.intensity[q];
+    ++count;
+  }
+};
+
+struct NormalPolicy {
+  const SegmentationGrid& g;
+  float cos_step, cos_mean;  // cos_mean < -1: no mean test
+  float plane_footprints;    // 0: no pixels taken by the plane test
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point_sum = Eigen::Vector3d::Zero();
+  std::size_t count = 0;
+
+  bool accept(std::size_t p, std::size_t q) const {
+    const Eigen::Vector3f& n = g.normal[q];
+    const Eigen::Vector3f mean = normal_sum.cast<float>().normalized();
+    if (n.squaredNorm() > 0.0f && n.dot(g.normal[p]) >= cos_step &&
+        (cos_mean < -1.0f || n.dot(mean) >= cos_mean)) {
+      return true;
+    }
+    // A normal blurred by a crease or missing next to an edge: the point
+    // itself still lies on the region's plane.
+    if (plane_footprints <= 0.0f) return false;
+    const Eigen::Vector3f centroid = (point_sum / static_cast<double>(count)).cast<float>();
+    const Eigen::Vector3f& x = g.point[q];
+    // The footprint of p, already in the region: q's own is stretched where
+    // q is seen at a grazing angle, as a perpendicular surface is.
+    return std::abs(mean.dot(x - centroid)) <=
+           plane_footprints * g.footprint_m[p] + 2.0f * g.range_noise.sigma(x.norm());
+  }
+  void add(std::size_t q) {
+    // Blurred normals of pixels taken by the plane test stay out of the mean.
+    const Eigen::Vector3d n = g.normal[q].cast<double>();
+    if (count == 0 || n.dot(normal_sum.normalized()) >= cos_mean) normal_sum += n;
+    point_sum += g.point[q].cast<double>();
+    ++count;
+  }
+};
+
+bool has_channel(const SegmentationGrid& grid, Channel channel) {
+  switch (channel) {
+    case Channel::kRange:
+      return true;
+    case Channel::kColor:
+      return !grid.lab.empty();
+    case Channel::kIntensity:
+      return !grid.intensity.empty();
+    case Channel::kNormal:
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+GrowSettings default_grow_settings(Channel channel) {
+  GrowSettings settings;
+  settings.channel = channel;
+  switch (channel) {
+    case Channel::kRange:
+      settings.tolerance = 1.0;
+      break;
+    case Channel::kColor:
+      settings.tolerance = 4.0;
+      break;
+    case Channel::kIntensity:
+      settings.tolerance = 0.04;
+      break;
+    case Channel::kNormal:
+      settings.tolerance = 6.0;
+      break;
+  }
+  return settings;
+}
+
+void RegionGrower::start_call() {
+  const std::size_t n = grid_.shape.pixel_count();
+  if (stamp_.size() != n) {
+    stamp_.assign(n, 0);
+    generation_ = 0;
+  }
+  if (++generation_ == 0) {  // wrapped after 2^32 calls: forget every stamp once
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    generation_ = 1;
+  }
+  queue_.clear();
+}
+
+GrowResult RegionGrower::grow(std::size_t seed, const GrowSettings& settings,
+                              std::span<const std::uint8_t> open) {
+  const GridShape& shape = grid_.shape;
+  assert(seed < shape.pixel_count() && "seed outside the grid");
+  assert(open.size() == shape.pixel_count() && "open mask of another grid");
+  GrowResult result;
+  if (!open[seed] || !grid_.usable[seed]) return result;
+  result.seed_open = true;
+  start_call();
+  const auto columns = static_cast<std::size_t>(shape.columns);
+  const Continuity continuity{grid_, static_cast<float>(settings.continuity_footprints)};
+
+  const auto run = [&](auto policy) {
+    const auto enqueue = [&](std::size_t i) {
+      visit(i);
+      policy.add(i);
+      queue_.push_back((static_cast<std::uint64_t>(i / columns) << 32) | (i % columns));
+    };
+    enqueue(seed);
+    for (std::size_t head = 0; head < queue_.size(); ++head) {
+      const auto row = static_cast<int>(queue_[head] >> 32);
+      const auto col = static_cast<int>(queue_[head] & 0xffffffffu);
+      const std::size_t p = shape.index(row, col);
+      shape.for_each_neighbour(row, col, [&](int r, int c) {
+        const std::size_t q = shape.index(r, c);
+        if (!open[q] || !grid_.usable[q] || stamp_[q] == generation_) return;
+        if (settings.max_pixels != 0 && queue_.size() >= settings.max_pixels) return;
+        if (!continuity(p, q) || !policy.accept(p, q)) return;
+        enqueue(q);
+      });
+    }
+  };
+
+  const auto tolerance = static_cast<float>(settings.tolerance);
+  const float mean = static_cast<float>(settings.mean_factor) * tolerance;
+  const bool with_mean = settings.mean_factor > 0.0;
+  if (!has_channel(grid_, settings.channel)) {
+    result.channel_missing = true;
+    queue_.push_back((static_cast<std::uint64_t>(seed / columns) << 32) | (seed % columns));
+  } else {
+    switch (settings.channel) {
+      case Channel::kRange:
+        run(RangePolicy{Continuity{grid_, tolerance}});
+        break;
+      case Channel::kColor:
+        run(ColorPolicy{grid_, tolerance * tolerance, with_mean ? mean * mean : -1.0f});
+        break;
+      case Channel::kIntensity: {
+        const float spread = grid_.intensity_spread;
+        run(IntensityPolicy{grid_, tolerance * spread, with_mean ? mean * spread : -1.0f});
+        break;
+      }
+      case Channel::kNormal:
+        run(NormalPolicy{grid_, cos_of_degrees(settings.tolerance),
+                         with_mean ? cos_of_degrees(settings.mean_factor * settings.tolerance)
+                                   : -2.0f,
+                         static_cast<float>(settings.plane_footprints)});
+        break;
+    }
+  }
+  result.reached_limit = settings.max_pixels != 0 && queue_.size() >= settings.max_pixels;
+  result.pixels.reserve(queue_.size());
+  for (const std::uint64_t packed : queue_) {
+    result.pixels.push_back(static_cast<std::uint32_t>((packed >> 32) * columns + (packed & 0xffffffffu)));
+  }
+  sort_pixels(result.pixels);
+  return result;
+}
+
+}  // namespace scanbench::segmentation

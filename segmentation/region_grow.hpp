@@ -1,0 +1,90 @@
+// Seeded region growing on a scan's grid (seed 004 §4.1): from the pixel the
+// user clicked, a region spreads to 8-neighbours that are open (inside the
+// lasso, off the barriers, not yet assigned, in the model: constraints.hpp)
+// and similar on the chosen channel:
+//   range      continuity of the surface: the neighbour lies within
+//              tolerance footprints (plus 4 σ of range noise) of the current
+//              pixel's tangent plane, or of its range where it has no normal;
+//   color      CIE L*a*b* ΔE to the neighbour ≤ tolerance, and to the
+//              region's running mean ≤ mean_factor × tolerance;
+//   intensity  difference to the neighbour ≤ tolerance × the scan's
+//              intensity spread, and to the running mean ≤ mean_factor × that;
+//   normal     angle to the neighbour's normal ≤ tolerance [deg], and to the
+//              region's mean normal ≤ mean_factor × tolerance (so the gentle
+//              turn of smoothed normals over a crease does not leak); or,
+//              for the pixels next to a crease or edge whose fitted normal
+//              is blurred or missing, a point within plane_footprints of the
+//              plane through the region's centroid with its mean normal.
+// Every channel also stops at depth discontinuities (the range test with
+// continuity_footprints), so a region never jumps from a façade to the
+// pane behind it. Regions are breadth-first, so the running means and the
+// result are deterministic.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "segmentation/segmentation_grid.hpp"
+
+namespace scanbench::segmentation {
+
+struct GrowSettings {
+  Channel channel = Channel::kNormal;
+  // The channel's step tolerance (units above); default_grow_settings gives
+  // each channel's default.
+  double tolerance = 6.0;
+  // The bound on the distance to the running mean, in tolerances; 0 = no
+  // mean test. Not used by the range channel.
+  double mean_factor = 3.0;
+  // The normal channel's plane test [footprints, plus 2 σ of range noise];
+  // 0 = off.
+  double plane_footprints = 0.5;
+  // The depth-discontinuity test every channel applies [footprints].
+  double continuity_footprints = 3.0;
+  // Stop once the region holds this many pixels; 0 = no limit.
+  std::size_t max_pixels = 0;
+};
+
+// The defaults of `channel`: range 1 footprint, color ΔE 4, intensity 0.04
+// spreads, normal 6°.
+GrowSettings default_grow_settings(Channel channel);
+
+struct GrowResult {
+  std::vector<std::uint32_t> pixels;  // row-major indices, ascending; empty when the seed is closed
+  bool seed_open = false;             // the seed was open: usable and not blocked
+  bool reached_limit = false;         // stopped at max_pixels
+  bool channel_missing = false;       // the scan lacks the channel: the region is the seed alone
+};
+
+// Grows regions on one prepared grid. Keeps its work arrays between calls,
+// so a click costs time in proportion to the region it grows (after the
+// first, which allocates them). One grower per thread.
+class RegionGrower {
+ public:
+  // `grid` must outlive the grower.
+  explicit RegionGrower(const SegmentationGrid& grid) : grid_(grid) {}
+
+  // Grows from pixel `seed` (row-major index, asserted inside the grid)
+  // through pixels where open[i] != 0 (open has one byte per pixel,
+  // asserted).
+  GrowResult grow(std::size_t seed, const GrowSettings& settings,
+                  std::span<const std::uint8_t> open);
+
+ private:
+  // Marks pixel i as seen in this call; false when it already was.
+  bool visit(std::size_t i) {
+    if (stamp_[i] == generation_) return false;
+    stamp_[i] = generation_;
+    return true;
+  }
+  void start_call();
+
+  const SegmentationGrid& grid_;
+  std::vector<std::uint32_t> stamp_;  // generation_ where seen in the current call
+  std::uint32_t generation_ = 0;
+  std::vector<std::uint64_t> queue_;  // (row << 32) | col, breadth-first
+};
+
+}  // namespace scanbench::segmentation
