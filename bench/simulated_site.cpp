@@ -13,6 +13,7 @@ SimulatedSite simulate_site(const std::string& name, const acquisition::sim::Sca
   SimulatedSite out;
   out.name = name;
   out.true_poses = site.scan_poses;
+  out.objects = site.scene.objects();
   for (int k = 0; k < scan_count; ++k) {
     const std::uint64_t seed = sim::hash_combine(kSiteSeed, static_cast<std::uint64_t>(k));
     sim::SimulatedScan simulated =

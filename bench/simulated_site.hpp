@@ -17,6 +17,7 @@ struct SimulatedSite {
   std::vector<acquisition::sim::ScanTruth> truth;
   std::vector<acquisition::ScanGeometry> geometry;
   std::vector<Eigen::Isometry3d> true_poses;
+  std::vector<acquisition::sim::ObjectInfo> objects;  // the truth's hierarchy; id k at k − 1
 };
 
 // Scans the first `scan_count` positions of site `name` (seed 1) with `model`,

@@ -34,7 +34,7 @@ void draw_barrier(const GridShape& shape, const Polyline& barrier, std::uint8_t 
                   std::vector<std::uint8_t>& mask);
 
 struct Constraints {
-  Polyline lasso;                 // fewer than 3 vertices: no lasso (the whole scan)
+  Polyline lasso;  // fewer than 3 vertices: no lasso (the whole scan)
   std::vector<Polyline> barriers;
 };
 

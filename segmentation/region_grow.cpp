@@ -11,15 +11,20 @@ namespace scanbench::segmentation {
 
 namespace {
 
-float squared(float v) { return v * v; }
+float squared(float v) {
+  return v * v;
+}
 
 float cos_of_degrees(double degrees) {
   return static_cast<float>(std::cos(std::min(degrees, 180.0) * std::numbers::pi / 180.0));
 }
 
-// Whether q continues the surface of its neighbour p: q's point lies within
-// `footprints` of p's footprint (plus 4 σ of both ranges' noise) of p's
-// tangent plane, or of p's range along the beam where p has no normal.
+// Whether q continues the surface of its neighbour p: each point lies
+// within `footprints` of p's footprint (plus 4 σ of range noise) of the
+// other's tangent plane (both ways: at a silhouette the tangent plane holds
+// the line of sight, so the ground behind a post lies in the post's plane,
+// but the post does not lie in the ground's); along the beam where neither
+// has a normal.
 struct Continuity {
   const SegmentationGrid& g;
   float footprints;
@@ -27,10 +32,15 @@ struct Continuity {
   bool operator()(std::size_t p, std::size_t q) const {
     const Eigen::Vector3f& xp = g.point[p];
     const Eigen::Vector3f& xq = g.point[q];
-    const Eigen::Vector3f& n = g.normal[p];
+    const Eigen::Vector3f& np = g.normal[p];
+    const Eigen::Vector3f& nq = g.normal[q];
     const float range = xp.norm();
-    const float offset = n.squaredNorm() > 0.0f ? std::abs(n.dot(xq - xp)) : std::abs(xq.norm() - range);
-    return offset <= footprints * g.footprint_m[p] + 4.0f * g.range_noise.sigma(range);
+    const float allowed = footprints * g.footprint_m[p] + 4.0f * g.range_noise.sigma(range);
+    const Eigen::Vector3f step = xq - xp;
+    if (np.squaredNorm() == 0.0f && nq.squaredNorm() == 0.0f) {
+      return std::abs(xq.norm() - range) <= allowed;
+    }
+    return std::abs(np.dot(step)) <= allowed && std::abs(nq.dot(step)) <= allowed;
   }
 };
 
@@ -73,7 +83,8 @@ struct IntensityPolicy {
   bool accept(std::size_t p, std::size_t q) const {
     const float v = g.intensity[q];
     if (!(std::abs(v - g.intensity[p]) <= step)) return false;
-    return mean < 0.0f || std::abs(static_cast<float>(sum / static_cast<double>(count)) - v) <= mean;
+    return mean < 0.0f ||
+           std::abs(static_cast<float>(sum / static_cast<double>(count)) - v) <= mean;
   }
   void add(std::size_t q) {
     sum += g.intensity[q];
@@ -140,9 +151,11 @@ GrowSettings default_grow_settings(Channel channel) {
       break;
     case Channel::kColor:
       settings.tolerance = 4.0;
+      settings.continuity_footprints = 0.0;
       break;
     case Channel::kIntensity:
       settings.tolerance = 0.04;
+      settings.continuity_footprints = 0.0;
       break;
     case Channel::kNormal:
       settings.tolerance = 6.0;
@@ -175,6 +188,7 @@ GrowResult RegionGrower::grow(std::size_t seed, const GrowSettings& settings,
   start_call();
   const auto columns = static_cast<std::size_t>(shape.columns);
   const Continuity continuity{grid_, static_cast<float>(settings.continuity_footprints)};
+  const bool check_continuity = settings.continuity_footprints > 0.0;
 
   const auto run = [&](auto policy) {
     const auto enqueue = [&](std::size_t i) {
@@ -191,7 +205,8 @@ GrowResult RegionGrower::grow(std::size_t seed, const GrowSettings& settings,
         const std::size_t q = shape.index(r, c);
         if (!open[q] || !grid_.usable[q] || stamp_[q] == generation_) return;
         if (settings.max_pixels != 0 && queue_.size() >= settings.max_pixels) return;
-        if (!continuity(p, q) || !policy.accept(p, q)) return;
+        if (check_continuity && !continuity(p, q)) return;
+        if (!policy.accept(p, q)) return;
         enqueue(q);
       });
     }
@@ -217,17 +232,18 @@ GrowResult RegionGrower::grow(std::size_t seed, const GrowSettings& settings,
         break;
       }
       case Channel::kNormal:
-        run(NormalPolicy{grid_, cos_of_degrees(settings.tolerance),
-                         with_mean ? cos_of_degrees(settings.mean_factor * settings.tolerance)
-                                   : -2.0f,
-                         static_cast<float>(settings.plane_footprints)});
+        run(NormalPolicy{
+            grid_, cos_of_degrees(settings.tolerance),
+            with_mean ? cos_of_degrees(settings.mean_factor * settings.tolerance) : -2.0f,
+            with_mean ? static_cast<float>(settings.plane_footprints) : 0.0f});
         break;
     }
   }
   result.reached_limit = settings.max_pixels != 0 && queue_.size() >= settings.max_pixels;
   result.pixels.reserve(queue_.size());
   for (const std::uint64_t packed : queue_) {
-    result.pixels.push_back(static_cast<std::uint32_t>((packed >> 32) * columns + (packed & 0xffffffffu)));
+    result.pixels.push_back(
+        static_cast<std::uint32_t>((packed >> 32) * columns + (packed & 0xffffffffu)));
   }
   sort_pixels(result.pixels);
   return result;

@@ -2,9 +2,10 @@
 // user clicked, a region spreads to 8-neighbours that are open (inside the
 // lasso, off the barriers, not yet assigned, in the model: constraints.hpp)
 // and similar on the chosen channel:
-//   range      continuity of the surface: the neighbour lies within
-//              tolerance footprints (plus 4 σ of range noise) of the current
-//              pixel's tangent plane, or of its range where it has no normal;
+//   range      continuity of the surface: the neighbour and the current
+//              pixel each lie within tolerance footprints (plus 4 σ of range
+//              noise) of the other's tangent plane (of those that have a
+//              normal; along the beam when neither has one);
 //   color      CIE L*a*b* ΔE to the neighbour ≤ tolerance, and to the
 //              region's running mean ≤ mean_factor × tolerance;
 //   intensity  difference to the neighbour ≤ tolerance × the scan's
@@ -15,10 +16,11 @@
 //              for the pixels next to a crease or edge whose fitted normal
 //              is blurred or missing, a point within plane_footprints of the
 //              plane through the region's centroid with its mean normal.
-// Every channel also stops at depth discontinuities (the range test with
-// continuity_footprints), so a region never jumps from a façade to the
-// pane behind it. Regions are breadth-first, so the running means and the
-// result are deterministic.
+// The normal channel also stops at depth discontinuities (the range test
+// with continuity_footprints), so a region never jumps from a façade to the
+// pane behind it; colour and intensity ignore depth by default, so the
+// foliage of a crown, many overlapping surfaces, is one region. Regions are
+// breadth-first, so the running means and the result are deterministic.
 #pragma once
 
 #include <cstddef>
@@ -39,16 +41,18 @@ struct GrowSettings {
   // mean test. Not used by the range channel.
   double mean_factor = 3.0;
   // The normal channel's plane test [footprints, plus 2 σ of range noise];
-  // 0 = off.
+  // 0 = off. Only with the mean test: a curved region has no plane.
   double plane_footprints = 0.5;
-  // The depth-discontinuity test every channel applies [footprints].
-  double continuity_footprints = 3.0;
+  // The depth-discontinuity test [footprints, plus 4 σ of range noise] of
+  // the colour, intensity and normal channels; 0 = off (the default of
+  // colour and intensity). The range channel's test is its tolerance.
+  double continuity_footprints = 1.0;
   // Stop once the region holds this many pixels; 0 = no limit.
   std::size_t max_pixels = 0;
 };
 
-// The defaults of `channel`: range 1 footprint, color ΔE 4, intensity 0.04
-// spreads, normal 6°.
+// The defaults of `channel`: range 1 footprint; color ΔE 4 and intensity
+// 0.04 spreads, both without the continuity test; normal 6°.
 GrowSettings default_grow_settings(Channel channel);
 
 struct GrowResult {

@@ -10,8 +10,7 @@ namespace scanbench::segmentation {
 
 namespace {
 
-constexpr std::array<std::string_view, 4> kChannelNames = {"range", "color", "intensity",
-                                                           "normal"};
+constexpr std::array<std::string_view, 4> kChannelNames = {"range", "color", "intensity", "normal"};
 
 // sRGB decoding (IEC 61966-2-1) of every 8-bit value.
 std::array<float, 256> make_linear_table() {

@@ -143,6 +143,33 @@ TEST(BenchMerge, SmokeRunReportsEveryField) {
   }
 }
 
+TEST(BenchSegmentation, SmokeRunReportsEveryField) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "segmentation", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "segmentation");
+  const nlohmann::json& ours = bench["ours"];
+  ASSERT_GE(ours["objects"].size(), 10u);
+  for (const nlohmann::json& object : ours["objects"]) {
+    for (const char* field : {"name", "kind", "channel"})
+      EXPECT_TRUE(object[field].is_string()) << field;
+    EXPECT_GE(object["iou"].get<double>(), 0.0);
+    EXPECT_LE(object["iou"].get<double>(), 1.0);
+    EXPECT_LE(object["operations"].get<int>(), 3);
+    EXPECT_GT(object["pixels"].get<int>(), 0);
+  }
+  for (const char* field : {"mean_iou", "objects_at_least_0_95", "click_latency_ms_p50",
+                            "click_latency_ms_p95", "clicks", "largest_region_pixels"})
+    EXPECT_TRUE(ours[field].is_number()) << field;
+  for (const char* peer : {"pcl_region_growing", "pcl_region_growing_rgb"}) {
+    EXPECT_GT(bench[peer]["seconds"].get<double>(), 0.0) << peer;
+    EXPECT_EQ(bench[peer]["objects"].size(), ours["objects"].size()) << peer;
+    EXPECT_LE(bench[peer]["mean_iou"].get<double>(), 1.0) << peer;
+  }
+  EXPECT_TRUE(bench["goals"]["click_latency_p95_at_most_16_ms"].is_boolean());
+}
+
 TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
   test::ScratchDir dir;
   const test::CliResult result = test::run_cli(dir, {"bench", "io", "--json", "--smoke"});

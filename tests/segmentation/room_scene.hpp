@@ -89,19 +89,27 @@ inline std::pair<double, RoomObject> cast(const Eigen::Vector3d& d) {
 
 inline std::array<std::uint8_t, 3> colour_of(RoomObject object) {
   switch (object) {
-    case kFloor: return {120, 120, 120};
-    case kWindow: return {40, 60, 90};
-    case kPoster: return {200, 30, 30};
-    default: return {200, 200, 190};
+    case kFloor:
+      return {120, 120, 120};
+    case kWindow:
+      return {40, 60, 90};
+    case kPoster:
+      return {200, 30, 30};
+    default:
+      return {200, 200, 190};
   }
 }
 
 inline float intensity_of(RoomObject object) {
   switch (object) {
-    case kFloor: return 0.4f;
-    case kWindow: return 0.1f;
-    case kPoster: return 0.9f;
-    default: return 0.6f;
+    case kFloor:
+      return 0.4f;
+    case kWindow:
+      return 0.1f;
+    case kPoster:
+      return 0.9f;
+    default:
+      return 0.6f;
   }
 }
 
@@ -120,7 +128,8 @@ inline RoomScan make_room_scan() {
   for (int row = 0; row < kRows; ++row) {
     for (int col = 0; col < kColumns; ++col) {
       const std::size_t i = scan.index(row, col);
-      const auto [range, object] = room_detail::cast(acquisition::direction_precise(scan, row, col));
+      const auto [range, object] =
+          room_detail::cast(acquisition::direction_precise(scan, row, col));
       if (object == kNothing) continue;
       scan.valid[i] = 1;
       scan.range_m[i] = static_cast<float>(range);

@@ -24,7 +24,8 @@ SegmentationGrid flat_grid(int rows, int columns, bool wraps) {
   grid.footprint_m.assign(n, 0.01f);
   grid.point.resize(n);
   for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < columns; ++c) grid.point[grid.shape.index(r, c)] = {10.0f, 0.01f * c, -0.01f * r};
+    for (int c = 0; c < columns; ++c)
+      grid.point[grid.shape.index(r, c)] = {10.0f, 0.01f * c, -0.01f * r};
   }
   return grid;
 }
@@ -89,11 +90,13 @@ TEST(DrawBarrier, NoEightConnectedStepLeaksThroughAtAnySlope) {
   for (const double dx : {0.0, 0.3, 1.0, 1.7, 5.0, 40.0}) {
     // A closed loop of four slanted barriers around the pixel (30, 60).
     Constraints constraints;
-    constraints.barriers = {{V(40 - dx, 10), V(80 + dx, 12)}, {V(80 + dx, 12), V(81 - dx, 50)},
-                            {V(81 - dx, 50), V(41 + dx, 49)}, {V(41 + dx, 49), V(40 - dx, 10)}};
+    constraints.barriers = {{V(40 - dx, 10), V(80 + dx, 12)},
+                            {V(80 + dx, 12), V(81 - dx, 50)},
+                            {V(81 - dx, 50), V(41 + dx, 49)},
+                            {V(41 + dx, 49), V(40 - dx, 10)}};
     const std::vector<std::uint8_t> open = open_pixels(grid, constraints, {});
-    const GrowResult inside = grower.grow(grid.shape.index(30, 60),
-                                          default_grow_settings(Channel::kNormal), open);
+    const GrowResult inside =
+        grower.grow(grid.shape.index(30, 60), default_grow_settings(Channel::kNormal), open);
     ASSERT_TRUE(inside.seed_open);
     EXPECT_LT(inside.pixels.size(), 60u * 50u) << "leaked at dx " << dx;
     for (const std::uint32_t p : inside.pixels) {
@@ -104,9 +107,9 @@ TEST(DrawBarrier, NoEightConnectedStepLeaksThroughAtAnySlope) {
   // Across the seam: a barrier ring around column 0 keeps the region off the rest.
   Constraints seam;
   seam.barriers = {{V(-5, 20), V(5, 20), V(5, 40), V(-5, 40), V(-5, 20)}};
-  const GrowResult ring = grower.grow(grid.shape.index(30, 0),
-                                      default_grow_settings(Channel::kNormal),
-                                      open_pixels(grid, seam, {}));
+  const GrowResult ring =
+      grower.grow(grid.shape.index(30, 0), default_grow_settings(Channel::kNormal),
+                  open_pixels(grid, seam, {}));
   EXPECT_EQ(ring.pixels.size(), 9u * 19u);  // columns 116…119, 0…4; rows 21…39
 }
 

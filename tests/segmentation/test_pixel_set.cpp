@@ -32,12 +32,10 @@ TEST(PixelSet, SetOperations) {
 TEST(PixelSet, SeparateFindsEightConnectedComponentsLargestFirst) {
   const GridShape shape{5, 10, false};
   // A diagonal pair (one component), a lone pixel, and a row of three.
-  const PixelSet pixels = {static_cast<std::uint32_t>(shape.index(0, 0)),
-                           static_cast<std::uint32_t>(shape.index(1, 1)),
-                           static_cast<std::uint32_t>(shape.index(0, 5)),
-                           static_cast<std::uint32_t>(shape.index(4, 2)),
-                           static_cast<std::uint32_t>(shape.index(4, 3)),
-                           static_cast<std::uint32_t>(shape.index(4, 4))};
+  const PixelSet pixels = {
+      static_cast<std::uint32_t>(shape.index(0, 0)), static_cast<std::uint32_t>(shape.index(1, 1)),
+      static_cast<std::uint32_t>(shape.index(0, 5)), static_cast<std::uint32_t>(shape.index(4, 2)),
+      static_cast<std::uint32_t>(shape.index(4, 3)), static_cast<std::uint32_t>(shape.index(4, 4))};
   PixelSet sorted = pixels;
   sort_pixels(sorted);
   const std::vector<PixelSet> parts = separate(shape, sorted);

@@ -7,8 +7,8 @@
 #include "segmentation/constraints.hpp"
 #include "segmentation/pixel_set.hpp"
 #include "segmentation/region_grow.hpp"
-#include "segmentation/segmentation_grid.hpp"
 #include "segmentation/room_scene.hpp"
+#include "segmentation/segmentation_grid.hpp"
 
 namespace scanbench::segmentation {
 namespace {
@@ -29,23 +29,26 @@ PixelSet truth_pixels(std::uint8_t object) {
   PixelSet pixels;
   const auto& truth = shared_room().truth;
   for (std::size_t i = 0; i < truth.size(); ++i) {
-    if (truth[i] == object && room_grid().usable[i]) pixels.push_back(static_cast<std::uint32_t>(i));
+    if (truth[i] == object && room_grid().usable[i])
+      pixels.push_back(static_cast<std::uint32_t>(i));
   }
   return pixels;
 }
 
 struct Agreement {
-  double recall = 0;        // share of the object's pixels in the region
-  std::size_t foreign = 0;  // region pixels of another object
+  double recall = 0;         // share of the object's pixels in the region
+  std::size_t foreign = 0;   // region pixels of another object
   double foreign_share = 0;  // of the region
 };
 
 Agreement agreement(const PixelSet& region, std::uint8_t object) {
   const PixelSet truth = truth_pixels(object);
   Agreement a;
-  a.recall = static_cast<double>(intersect(region, truth).size()) / static_cast<double>(truth.size());
+  a.recall =
+      static_cast<double>(intersect(region, truth).size()) / static_cast<double>(truth.size());
   a.foreign = subtract(region, truth).size();
-  a.foreign_share = static_cast<double>(a.foreign) / static_cast<double>(std::max<std::size_t>(1, region.size()));
+  a.foreign_share =
+      static_cast<double>(a.foreign) / static_cast<double>(std::max<std::size_t>(1, region.size()));
   return a;
 }
 
@@ -70,7 +73,8 @@ TEST(RegionGrow, NormalChannelTakesTheWallAndStopsAtTheCreasesAndTheRecess) {
   const GrowResult wall = grow(pixel_at(-20, 0), Channel::kNormal, everything_open());
   ASSERT_TRUE(wall.seed_open);
   // The poster is flush with the wall: the normal channel cannot see it.
-  const Agreement a = agreement(subtract(wall.pixels, truth_pixels(test::kPoster)), test::kWallPlusX);
+  const Agreement a =
+      agreement(subtract(wall.pixels, truth_pixels(test::kPoster)), test::kWallPlusX);
   // Pixels on a crease see both surfaces; the object is the one under the
   // beam centre. Nothing beyond them: no floor, no pane.
   EXPECT_LT(a.foreign_share, 0.01);
