@@ -10,6 +10,7 @@
 #include "bench/segmentation_sessions.hpp"
 #include "bench/simulated_site.hpp"
 #include "segmentation/constraints.hpp"
+#include "segmentation/proposals.hpp"
 #include "segmentation/segmentation_grid.hpp"
 
 namespace scanbench::bench {
@@ -104,8 +105,10 @@ void random_clicks(const segmentation::SegmentationGrid& grid, segmentation::Reg
   }
 }
 
-nlohmann::json pcl_json(const PclSegmentationResult& result,
-                        const std::vector<TargetObject>& targets, nlohmann::json settings) {
+// A segmentation of the whole scan (one label per pixel, −1 = none), each
+// target scored by its best-matching segment.
+nlohmann::json whole_scan_json(const PclSegmentationResult& result,
+                               const std::vector<TargetObject>& targets, nlohmann::json settings) {
   std::unordered_map<std::int32_t, std::size_t> segment_size;
   for (const std::int32_t label : result.label) {
     if (label >= 0) ++segment_size[label];
@@ -151,7 +154,29 @@ nlohmann::json run_pcl(const SimulatedSite& site, const segmentation::Segmentati
   described["min_cluster_size"] = settings.min_cluster_size;
   const PclSegmentationResult result =
       segment_with_pcl(site.scans[0], site.geometry[0], grid.usable, settings);
-  return pcl_json(result, targets, described);
+  return whole_scan_json(result, targets, described);
+}
+
+// Our automatic proposals, scored as PCL's segments are.
+nlohmann::json run_proposals(const SimulatedSite& site, const segmentation::SegmentationGrid& grid,
+                             const std::vector<TargetObject>& targets) {
+  const segmentation::ProposalSettings settings;
+  const std::vector<std::uint8_t> open = segmentation::open_pixels(grid, {}, {});
+  const segmentation::ProposalResult proposals =
+      segmentation::propose_regions(grid, open, site.geometry[0].confidence, settings);
+  PclSegmentationResult labelled;
+  labelled.label.assign(grid.usable.size(), -1);
+  for (std::size_t k = 0; k < proposals.regions.size(); ++k) {
+    for (const std::uint32_t p : proposals.regions[k])
+      labelled.label[p] = static_cast<std::int32_t>(k);
+  }
+  labelled.segments = proposals.regions.size();
+  labelled.seconds = proposals.seconds;
+  return whole_scan_json(labelled, targets,
+                         {{"channel", segmentation::channel_name(settings.grow.channel)},
+                          {"tolerance_deg", settings.grow.tolerance},
+                          {"min_pixels", settings.min_pixels},
+                          {"threads", 1}});
 }
 
 }  // namespace
@@ -223,10 +248,12 @@ nlohmann::json run_segmentation_bench(const BenchOptions& options) {
            "part. iou is what 3 operations reach; the session goes on to 6 to report "
            "operations_to_0_95. Click positions come from where the object is in the image; the "
            "grower never sees the truth. IoU over the scan's usable pixels. PCL segments the whole "
-           "scan with our normals; each object is scored by its best-matching segment. Latency: "
+           "scan with our normals, as ours_auto (our automatic proposals) does; each object is "
+           "scored by its best-matching segment. Latency: "
            "the sessions' clicks and 400 random clicks on all channels, one thread; regions above "
            "1 M pixels counted apart."},
           {"ours", ours},
+          {"ours_auto", run_proposals(site, grid, targets)},
           {"pcl_region_growing", run_pcl(site, grid, targets, PclSegmenter::kRegionGrowing)},
           {"pcl_region_growing_rgb", run_pcl(site, grid, targets, PclSegmenter::kRegionGrowingRgb)},
           {"goals",

@@ -7,8 +7,9 @@
 //     objects_at_least_0_95, click_latency_ms_p50, click_latency_ms_p95 (regions
 //     up to 1 M pixels), clicks, clicks_over_1m_pixels,
 //     click_latency_ms_p95_over_1m_pixels, largest_region_pixels, prepare_seconds;
-//   pcl_region_growing, pcl_region_growing_rgb: seconds, mean_iou, segments,
-//     objects [{name, iou}], settings;
+//   ours_auto (automatic proposals for the whole scan), pcl_region_growing,
+//     pcl_region_growing_rgb: seconds, mean_iou, segments, objects [{name, iou}],
+//     settings;
 //   goals: every_object_iou_at_least_0_95_within_3_operations,
 //     click_latency_p95_at_most_16_ms.
 // With --smoke: a 900 × 225 scan; figures not meaningful.
