@@ -49,7 +49,7 @@ struct KnownLayer {
   const char* name;
   ElementType type;
 };
-constexpr std::array<KnownLayer, 10> kKnownLayers = {{{layer::kRange, ElementType::kF32},
+constexpr std::array<KnownLayer, 12> kKnownLayers = {{{layer::kRange, ElementType::kF32},
                                                       {layer::kValid, ElementType::kU8},
                                                       {layer::kIntensity, ElementType::kF32},
                                                       {layer::kRgb, ElementType::kU8x3},
@@ -58,7 +58,9 @@ constexpr std::array<KnownLayer, 10> kKnownLayers = {{{layer::kRange, ElementTyp
                                                       {layer::kNormal, ElementType::kF32x3},
                                                       {layer::kConfidence, ElementType::kF32},
                                                       {layer::kGeometryFlags, ElementType::kU8},
-                                                      {layer::kKeep, ElementType::kU8}}};
+                                                      {layer::kKeep, ElementType::kU8},
+                                                      {layer::kSelection, ElementType::kU8},
+                                                      {layer::kMembership, ElementType::kU32}}};
 
 [[maybe_unused]] bool has_its_type(const EncodedLayer& layer) {
   for (const KnownLayer& known : kKnownLayers) {
@@ -187,7 +189,8 @@ bool Project::read_layer(
 
 std::vector<std::string> Project::layer_names(std::int64_t id) const {
   const std::string sql = sql_of({R"sql(
-SELECT )sql", kLayerColumns, R"sql( FROM (
+SELECT )sql",
+                                  kLayerColumns, R"sql( FROM (
   SELECT l.*, row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
   FROM scan_layers l JOIN commands c ON c.id = l.command_id
   WHERE l.scan_id = ?1 AND c.state = 'done') l

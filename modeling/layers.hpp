@@ -16,6 +16,9 @@
 //   confidence      f32    `scanbench geometry`
 //   geometry_flags  u8     `scanbench geometry`: acquisition::GeometryFlag bits
 //   keep            u8     `scanbench merge`: 1 = in the merged model
+//   selection       u8     segmentation: 1 = in the selection being grown
+//   membership      u32    segmentation: the object node owning the pixel;
+//                          0 = still to be segmented, kDeletedPoints = deleted
 #pragma once
 
 #include <cassert>
@@ -55,7 +58,13 @@ inline constexpr const char* kNormal = "normal";
 inline constexpr const char* kConfidence = "confidence";
 inline constexpr const char* kGeometryFlags = "geometry_flags";
 inline constexpr const char* kKeep = "keep";
+inline constexpr const char* kSelection = "selection";
+inline constexpr const char* kMembership = "membership";
 }  // namespace layer
+
+// The membership of points the user deleted (kept in the scan, out of every
+// object and of the pool still to be segmented).
+inline constexpr std::uint32_t kDeletedPoints = 0xffffffffu;
 
 // A layer compressed and ready to store.
 struct EncodedLayer {

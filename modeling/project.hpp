@@ -29,6 +29,7 @@
 // kBusyTimeoutMs.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cassert>
 #include <cstdint>
 #include <filesystem>
@@ -57,11 +58,27 @@ inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplication
 // PRAGMA user_version written by this build. Older projects are migrated on
 // open; newer ones are refused.
 // 2: scan_geometry; 3: registration_runs, merge_masks; 4: the command journal,
-// versioned poses and the per-scan layer store.
-inline constexpr int kProjectSchemaVersion = 4;
+// versioned poses and the per-scan layer store; 5: the object tree.
+inline constexpr int kProjectSchemaVersion = 5;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
+
+enum class NodeKind { kGroup, kObject };
+
+// A node of the object tree (site → building → wall …). Objects own pixels
+// of scans (their "membership" layers); groups hold other nodes. The cached
+// figures describe the points the node owns, its descendants' included.
+struct ObjectNode {
+  std::int64_t id = 0;  // > 0; stable for the node's life
+  std::string name;     // UTF-8, for people; not unique
+  NodeKind kind = NodeKind::kObject;
+  std::optional<std::int64_t> parent;  // none: a root of the tree
+  bool hidden = false;
+  std::int64_t points = 0;
+  std::optional<double> mean_footprint_m;         // [m]; none without points
+  std::optional<Eigen::AlignedBox3d> bbox_world;  // [m]; none without points
+};
 
 struct StoredScanSummary {
   std::int64_t id = 0;  // the project's id of the scan, stable for the project's life
@@ -225,6 +242,28 @@ class Project {
   // Names of the current layers of scan `id`, sorted.
   std::vector<std::string> layer_names(std::int64_t id) const;
 
+  // ---- The object tree --------------------------------------------------
+
+  // The live nodes, as the newest done command that wrote each left it,
+  // ordered by id. Throws core::InputError naming the node when its row is
+  // damaged.
+  std::vector<ObjectNode> object_nodes() const;
+
+  // An id no node of the file has (one above the largest ever stored that
+  // is still in the journal: the ids of discarded commands' nodes may come
+  // back).
+  std::int64_t new_node_id() const;
+
+  // Writes a new version of node `node.id` as part of `edit`. Asserts a
+  // positive id, a parent other than itself, a non-negative point count and
+  // finite figures; the tree's consistency (parents exist, no cycles) is the
+  // caller's.
+  void put_node(Edit& edit, const ObjectNode& node);
+
+  // Deletes node `id` as part of `edit` (a version saying "deleted": undo
+  // brings it back). No effect on a node that is not live.
+  void remove_node(Edit& edit, std::int64_t id);
+
   // ---- Commands and the journal ------------------------------------------
 
   // Starts command `name` (with its whole settings as JSON): takes the write
@@ -274,7 +313,7 @@ class Project {
   // throws core::InputError.
   struct CheckReport {
     std::vector<std::string> damage;  // one line each: what is damaged and how
-    std::size_t records = 0;          // scans, poses and journal entries checked
+    std::size_t records = 0;          // scans, poses, journal entries and node versions checked
     std::size_t layers = 0;           // layer versions decoded
   };
   CheckReport check() const;

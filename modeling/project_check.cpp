@@ -45,8 +45,7 @@ std::size_t check_scan_records(sqlite3* db, const std::string& file,
   return checked;
 }
 
-std::size_t check_commands(sqlite3* db, const std::string& file,
-                           std::vector<std::string>& damage) {
+std::size_t check_commands(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
   std::size_t checked = 0;
   const std::string sql = sql_of({"SELECT ", kCommandColumns, " FROM commands"});
   for (sqlite::Statement commands(db, sql.c_str(), file); commands.step(); ++checked) {
@@ -96,6 +95,20 @@ FROM scan_layers l JOIN scans s ON s.id = l.scan_id)sql"});
   return checked;
 }
 
+std::size_t check_nodes(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  const std::string sql = sql_of({"SELECT ", kNodeColumns, " FROM object_nodes n"});
+  for (sqlite::Statement nodes(db, sql.c_str(), file); nodes.step(); ++checked) {
+    const auto [record, stored] = read_node_record(nodes);
+    if (checksum(record) != stored) {
+      damage.push_back("object node " + std::to_string(record.node_id) +
+                       ": its version of command " + std::to_string(record.command_id) +
+                       " fails its checksum");
+    }
+  }
+  return checked;
+}
+
 }  // namespace
 
 Project::CheckReport Project::check() const {
@@ -103,6 +116,7 @@ Project::CheckReport Project::check() const {
   sqlite_checks(db(), file_name(), report.damage);
   report.records += check_scan_records(db(), file_name(), report.damage);
   report.records += check_commands(db(), file_name(), report.damage);
+  report.records += check_nodes(db(), file_name(), report.damage);
   report.layers = check_layers(db(), file_name(), report.damage);
   return report;
 }

@@ -76,8 +76,8 @@ INSERT INTO meta (key, value) VALUES
 // Tables every version has (checked before migrating) and those of the
 // current version (checked after).
 constexpr std::array<const char*, 2> kEveryVersionTables = {"meta", "scans"};
-constexpr std::array<const char*, 5> kCurrentTables = {"meta", "scans", "commands", "scan_poses",
-                                                       "scan_layers"};
+constexpr std::array<const char*, 6> kCurrentTables = {"meta",       "scans",       "commands",
+                                                       "scan_poses", "scan_layers", "object_nodes"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
   throw core::InputError(file, {}, problem);
@@ -308,6 +308,35 @@ DROP TABLE scans_v3;
 INSERT OR REPLACE INTO meta (key, value) VALUES ('revision', '0');
 )sql";
 
+// Version 5: the object tree (site → building → wall …). One row per
+// version of a node, as for poses: what the project holds is each node's
+// row of the newest done command, `live` 0 when that command deleted it.
+// Which pixels an object owns, and the selection being grown, are layers
+// ("membership", "selection"), so they need no table.
+constexpr const char* kMigrate4To5 = R"sql(
+CREATE TABLE object_nodes (
+  node_id INTEGER NOT NULL CHECK (node_id > 0),
+  command_id INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
+  live INTEGER NOT NULL CHECK (live IN (0, 1)),
+  name TEXT NOT NULL,
+  kind TEXT NOT NULL CHECK (kind IN ('group', 'object')),
+  parent INTEGER CHECK (parent IS NULL OR parent > 0),  -- a node_id; NULL: a root
+  hidden INTEGER NOT NULL CHECK (hidden IN (0, 1)),
+  points INTEGER NOT NULL CHECK (points >= 0),
+  mean_footprint_m CHECK (typeof(mean_footprint_m) IN ('real', 'null')),
+  bbox_min_x CHECK (typeof(bbox_min_x) IN ('real', 'null')),
+  bbox_min_y CHECK (typeof(bbox_min_y) IN ('real', 'null')),
+  bbox_min_z CHECK (typeof(bbox_min_z) IN ('real', 'null')),
+  bbox_max_x CHECK (typeof(bbox_max_x) IN ('real', 'null')),
+  bbox_max_y CHECK (typeof(bbox_max_y) IN ('real', 'null')),
+  bbox_max_z CHECK (typeof(bbox_max_z) IN ('real', 'null')),
+  checksum INTEGER NOT NULL DEFAULT 0,  -- of every column above
+  CHECK ((bbox_min_x IS NULL) = (bbox_max_z IS NULL)),
+  PRIMARY KEY (node_id, command_id)
+);
+CREATE INDEX object_nodes_by_command ON object_nodes (command_id);
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction; `original_version` is the version the file had when opened.
 void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
@@ -321,6 +350,9 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
     case 3:
       sqlite::execute_with_int(db, kMigrate3To4, original_version, file);
       fill_migrated_checksums(db, file);
+      return;
+    case 4:
+      sqlite::execute(db, kMigrate4To5, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

@@ -7,6 +7,7 @@
 //   3  registration_runs, merge_masks.
 //   4  commands (the journal), scan_poses, scan_layers; scan_channels,
 //      scan_geometry, merge_masks and registration_runs move into them.
+//   5  object_nodes (the object tree).
 // To change the schema: bump kProjectSchemaVersion and add a case to
 // migrate_step() in project_schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by

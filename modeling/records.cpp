@@ -36,6 +36,15 @@ std::int64_t checksum(const PoseRecord& r) {
   return sum.value();
 }
 
+std::int64_t checksum(const NodeRecord& r) {
+  RowChecksum sum;
+  sum.add(r.node_id).add(r.command_id).add(r.live).add(r.name).add(r.kind);
+  sum.add(r.parent ? std::optional<double>(static_cast<double>(*r.parent)) : std::nullopt);
+  sum.add(r.hidden).add(r.points).add(r.mean_footprint_m);
+  for (const std::optional<double>& v : r.bbox) sum.add(v);
+  return sum.value();
+}
+
 std::int64_t content_digest(std::int64_t rows, std::int64_t columns, std::string_view angle_model,
                             std::span<const std::byte> range, std::span<const std::byte> valid) {
   RowChecksum sum;
@@ -114,6 +123,21 @@ std::pair<PoseRecord, std::int64_t> read_pose_record(const sqlite::Statement& ro
   return {std::move(r), row.column_int(c + 12)};
 }
 
+std::pair<NodeRecord, std::int64_t> read_node_record(const sqlite::Statement& row) {
+  NodeRecord r;
+  r.node_id = row.column_int(0);
+  r.command_id = row.column_int(1);
+  r.live = row.column_int(2);
+  r.name = row.column_text(3);
+  r.kind = row.column_text(4);
+  if (!row.is_null(5)) r.parent = row.column_int(5);
+  r.hidden = row.column_int(6);
+  r.points = row.column_int(7);
+  r.mean_footprint_m = optional_double(row, 8);
+  for (int k = 0; k < 6; ++k) r.bbox[static_cast<std::size_t>(k)] = optional_double(row, 9 + k);
+  return {std::move(r), row.column_int(15)};
+}
+
 void fill_migrated_checksums(sqlite3* db, const std::string& file) {
   // Content digests, from the decoded range and validity (what
   // content_digest() takes for new scans).
@@ -176,7 +200,8 @@ FROM scans s JOIN scan_layers r ON r.scan_id = s.id AND r.name = 'range_m'
   }
   for (const auto& [record, sum] : layers) {
     sqlite::Statement update(
-        db, "UPDATE scan_layers SET checksum = ?4 WHERE scan_id = ?1 AND name = ?2 AND command_id = ?3",
+        db,
+        "UPDATE scan_layers SET checksum = ?4 WHERE scan_id = ?1 AND name = ?2 AND command_id = ?3",
         file);
     update.bind_int(1, record.scan_id).bind_text(2, record.name).bind_int(3, record.command_id);
     update.bind_int(4, sum).run();

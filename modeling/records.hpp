@@ -56,6 +56,20 @@ struct CommandFields {
   std::int64_t undoable = 1;
 };
 
+// A version of a node of the object tree.
+struct NodeRecord {
+  std::int64_t node_id = 0;
+  std::int64_t command_id = 0;
+  std::int64_t live = 1;
+  std::string name;
+  std::string kind;                    // "group" or "object"
+  std::optional<std::int64_t> parent;  // none: a root
+  std::int64_t hidden = 0;
+  std::int64_t points = 0;
+  std::optional<double> mean_footprint_m;
+  std::array<std::optional<double>, 6> bbox;  // min x y z, max x y z
+};
+
 // A layer version's row without its data (whose zstd frame checks itself).
 struct LayerFields {
   std::int64_t scan_id = 0;
@@ -72,6 +86,7 @@ std::int64_t checksum(const ScanRecord& record);
 std::int64_t checksum(const PoseRecord& record);
 std::int64_t checksum(const CommandFields& record);
 std::int64_t checksum(const LayerFields& record);
+std::int64_t checksum(const NodeRecord& record);
 
 // What identifies a scan's data whatever its name or pose (the same file
 // imported twice has the same): CRC-32 of its grid size, angle model and
@@ -96,6 +111,11 @@ inline constexpr const char* kCommandColumns =
 inline constexpr const char* kLayerColumns =
     "l.scan_id, l.name, l.command_id, l.element_type, l.element_count, l.codec, l.checksum";
 
+inline constexpr const char* kNodeColumns =
+    "n.node_id, n.command_id, n.live, n.name, n.kind, n.parent, n.hidden, n.points, "
+    "n.mean_footprint_m, n.bbox_min_x, n.bbox_min_y, n.bbox_min_z, n.bbox_max_x, n.bbox_max_y, "
+    "n.bbox_max_z, n.checksum";
+
 // The parts of an SQL statement put together (plain appends: GCC 12 warns
 // falsely on chains of std::string operator+ at -O3).
 std::string sql_of(std::initializer_list<std::string_view> parts);
@@ -109,6 +129,9 @@ std::pair<PoseRecord, std::int64_t> read_pose_record(const sqlite::Statement& ro
 std::pair<CommandFields, std::int64_t> read_command_fields(const sqlite::Statement& row);
 // A statement selecting kLayerColumns, from column `first`.
 std::pair<LayerFields, std::int64_t> read_layer_fields(const sqlite::Statement& row, int first);
+
+// A statement selecting kNodeColumns, from column 0.
+std::pair<NodeRecord, std::int64_t> read_node_record(const sqlite::Statement& row);
 
 // Computes and stores the checksums (and scans' content digests) of every
 // row the migration from an older version copied; inside its transaction.

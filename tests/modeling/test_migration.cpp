@@ -36,23 +36,51 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
-// fixtures/projects/version4.sbproj: two_scans.ptx and tiny_color.ptx
-// imported, then geometry computed and undone.
+// fixtures/projects/version5.sbproj: version4.sbproj (below) opened by the
+// build that introduced version 5, then the nodes "north hall" (a group) and
+// "wall south" (an object in it) created, and a rename of the wall undone.
 TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournal) {
-  static_assert(kProjectSchemaVersion == 4, "add fixtures/projects/version5.sbproj");
+  static_assert(kProjectSchemaVersion == 5, "add fixtures/projects/version6.sbproj");
   const ScratchDir dir;
-  const auto file = migrated_copy(dir, 4);
+  const auto file = migrated_copy(dir, 5);
   const std::string before = test::read_file_bytes(file);
   {
     Project project = Project::open(file);
     EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
     const std::vector<CommandRecord> history = project.history();
-    ASSERT_EQ(history.size(), 2u);
-    EXPECT_EQ(history[1].name, "geometry");
-    EXPECT_EQ(history[1].state, CommandState::kUndone);
+    ASSERT_EQ(history.size(), 3u);
+    EXPECT_EQ(history[1].name, "objects");
+    EXPECT_EQ(history[2].name, "rename");
+    EXPECT_EQ(history[2].state, CommandState::kUndone);
+    const std::vector<ObjectNode> nodes = project.object_nodes();
+    ASSERT_EQ(nodes.size(), 2u);
+    EXPECT_EQ(nodes[0].name, "north hall");
+    EXPECT_EQ(nodes[0].kind, NodeKind::kGroup);
+    EXPECT_EQ(nodes[1].name, "wall south");
+    EXPECT_EQ(nodes[1].parent, 1);
+    EXPECT_EQ(nodes[1].points, 5);
+    ASSERT_TRUE(nodes[1].bbox_world.has_value());
+    EXPECT_EQ(nodes[1].bbox_world->max(), Eigen::Vector3d(1.5, 2.0, 0.75));
   }
   EXPECT_EQ(test::read_file_bytes(file), before);
   Project project = Project::open(file);
+  ASSERT_TRUE(project.redo().has_value());
+  EXPECT_EQ(project.object_nodes()[1].name, "wall west");
+  EXPECT_TRUE(project.check().damage.empty());
+}
+
+// fixtures/projects/version4.sbproj: two_scans.ptx and tiny_color.ptx
+// imported, then geometry computed and undone.
+TEST(Migration, VersionFourKeepsItsJournalWithTheUndoneGeometry) {
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 4);
+  Project project = Project::open(file);
+  EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
+  const std::vector<CommandRecord> history = project.history();
+  ASSERT_EQ(history.size(), 2u);
+  EXPECT_EQ(history[1].name, "geometry");
+  EXPECT_EQ(history[1].state, CommandState::kUndone);
+  EXPECT_TRUE(project.object_nodes().empty());
   EXPECT_FALSE(load_geometry(project, 3).has_value());
   ASSERT_TRUE(project.redo().has_value());
   const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, 3);
@@ -84,7 +112,7 @@ TEST_P(Migration, OpensAtTheCurrentVersionWithEveryScanLoadable) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3));
+INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3, 4));
 
 TEST(Migration, VersionOneKeepsItsScans) {
   const ScratchDir dir;

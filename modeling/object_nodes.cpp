@@ -1,0 +1,141 @@
+// The object_nodes table: Project::object_nodes, new_node_id, put_node,
+// remove_node. Versioned like poses (project.hpp), checksummed like every
+// record (records.hpp).
+#include <sqlite3.h>
+
+#include <cassert>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "modeling/project.hpp"
+#include "modeling/records.hpp"
+#include "modeling/sqlite_statement.hpp"
+
+namespace scanbench::modeling {
+
+namespace {
+
+// Each node's row of the newest done command that wrote it, live or not.
+const std::string kSelectCurrent = sql_of({"SELECT ", kNodeColumns, R"sql(
+FROM object_nodes n
+WHERE n.command_id = (SELECT q.command_id FROM object_nodes q JOIN commands c ON c.id = q.command_id
+                      WHERE q.node_id = n.node_id AND c.state = 'done'
+                      ORDER BY c.seq DESC LIMIT 1)
+ORDER BY n.node_id)sql"});
+
+constexpr const char* kInsert = R"sql(
+INSERT OR REPLACE INTO object_nodes (node_id, command_id, live, name, kind, parent, hidden, points,
+                                     mean_footprint_m, bbox_min_x, bbox_min_y, bbox_min_z,
+                                     bbox_max_x, bbox_max_y, bbox_max_z, checksum)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16))sql";
+
+NodeRecord record_of(const ObjectNode& node, std::int64_t command_id, bool live) {
+  NodeRecord r;
+  r.node_id = node.id;
+  r.command_id = command_id;
+  r.live = live ? 1 : 0;
+  r.name = node.name;
+  r.kind = node.kind == NodeKind::kGroup ? "group" : "object";
+  r.parent = node.parent;
+  r.hidden = node.hidden ? 1 : 0;
+  r.points = node.points;
+  r.mean_footprint_m = node.mean_footprint_m;
+  if (node.bbox_world) {
+    for (int k = 0; k < 3; ++k) {
+      r.bbox[static_cast<std::size_t>(k)] = node.bbox_world->min()[k];
+      r.bbox[static_cast<std::size_t>(k + 3)] = node.bbox_world->max()[k];
+    }
+  }
+  return r;
+}
+
+[[noreturn]] void damaged(const std::string& file, std::int64_t id, const std::string& problem) {
+  core::FilePosition position;
+  position.detail = "object node " + std::to_string(id);
+  throw core::InputError(file, position, "project is damaged: " + problem);
+}
+
+ObjectNode node_of(const NodeRecord& r, const std::string& file) {
+  ObjectNode node;
+  node.id = r.node_id;
+  node.name = r.name;
+  if (r.kind != "group" && r.kind != "object") damaged(file, r.node_id, "unknown node kind");
+  node.kind = r.kind == "group" ? NodeKind::kGroup : NodeKind::kObject;
+  node.parent = r.parent;
+  node.hidden = r.hidden != 0;
+  node.points = r.points;
+  node.mean_footprint_m = r.mean_footprint_m;
+  if (r.bbox[0]) {
+    Eigen::AlignedBox3d box;
+    for (int k = 0; k < 3; ++k) {
+      const auto& low = r.bbox[static_cast<std::size_t>(k)];
+      const auto& high = r.bbox[static_cast<std::size_t>(k + 3)];
+      if (!low || !high) damaged(file, r.node_id, "incomplete bounding box");
+      box.min()[k] = *low;
+      box.max()[k] = *high;
+    }
+    node.bbox_world = box;
+  }
+  return node;
+}
+
+void write(sqlite3* db, const std::string& file, const NodeRecord& r) {
+  sqlite::Statement insert(db, kInsert, file);
+  insert.bind_int(1, r.node_id).bind_int(2, r.command_id).bind_int(3, r.live);
+  insert.bind_text(4, r.name).bind_text(5, r.kind);
+  if (r.parent) {
+    insert.bind_int(6, *r.parent);
+  } else {
+    insert.bind_null(6);
+  }
+  insert.bind_int(7, r.hidden).bind_int(8, r.points).bind_optional_double(9, r.mean_footprint_m);
+  for (int k = 0; k < 6; ++k)
+    insert.bind_optional_double(10 + k, r.bbox[static_cast<std::size_t>(k)]);
+  insert.bind_int(16, checksum(r)).run();
+}
+
+}  // namespace
+
+std::vector<ObjectNode> Project::object_nodes() const {
+  std::vector<ObjectNode> nodes;
+  for (sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name()); select.step();) {
+    const auto [record, stored] = read_node_record(select);
+    if (checksum(record) != stored) {
+      damaged(file_name(), record.node_id,
+              "the node's row fails its checksum (changed outside scanbench?)");
+    }
+    if (record.live) nodes.push_back(node_of(record, file_name()));
+  }
+  return nodes;
+}
+
+std::int64_t Project::new_node_id() const {
+  sqlite::Statement select(db(), "SELECT coalesce(max(node_id), 0) + 1 FROM object_nodes",
+                           file_name());
+  select.step();
+  return select.column_int(0);
+}
+
+void Project::put_node(Edit& edit, const ObjectNode& node) {
+  check_edit(edit);
+  assert(node.id > 0 && "node ids are positive");
+  assert(node.parent != node.id && "a node is not its own parent");
+  assert(node.points >= 0 && "a point count is not negative");
+  assert((!node.mean_footprint_m || std::isfinite(*node.mean_footprint_m)) && "finite footprint");
+  assert((!node.bbox_world ||
+          (node.bbox_world->min().allFinite() && node.bbox_world->max().allFinite())) &&
+         "finite bounding box");
+  write(db(), file_name(), record_of(node, edit.command_id(), true));
+}
+
+void Project::remove_node(Edit& edit, std::int64_t id) {
+  check_edit(edit);
+  for (const ObjectNode& node : object_nodes()) {
+    if (node.id == id) {
+      write(db(), file_name(), record_of(node, edit.command_id(), false));
+      return;
+    }
+  }
+}
+
+}  // namespace scanbench::modeling
