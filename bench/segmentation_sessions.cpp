@@ -219,18 +219,18 @@ SessionResult play_session(const segmentation::SegmentationGrid& grid,
     // the object (all of it at first), preferring parts thick enough to
     // click into over slivers along the region's edge.
     std::optional<Interior> click;
-    std::size_t click_size = 0;
     for (const PixelSet& part : segmentation::separate(shape, missed)) {
       if (!session.region.empty() && part.size() * 50 < target.pixels.size()) break;
       const Interior inside = most_interior(shape, part);
       const bool thicker = click && click->depth < 2 && inside.depth >= 2;
-      if (!click || thicker) click = inside, click_size = part.size();
+      if (!click || thicker) click = inside;
     }
     if (!click) break;
     const auto start = std::chrono::steady_clock::now();
     const segmentation::GrowResult grown = grower.grow(click->pixel, recipe.grow, open);
-    session.click_seconds.push_back(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    session.clicks.push_back(
+        {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+         grown.pixels.size()});
     ++session.operations;
     session.region = segmentation::unite(session.region, grown.pixels);
     const std::size_t missed_before = missed.size();
@@ -238,7 +238,6 @@ SessionResult play_session(const segmentation::SegmentationGrid& grid,
     // A click that took nothing of what was missed would be repeated in vain.
     session.progress.emplace_back(session.operations, iou(session.region, target.pixels));
     if (missed.size() == missed_before) break;
-    (void)click_size;
   }
   session.iou = iou(session.region, target.pixels);
   return session;

@@ -36,10 +36,16 @@ struct Recipe {
 // The recipe for objects of `kind` ("wall", "window", "lamp_post", …).
 Recipe recipe_for(const std::string& kind);
 
+// One click's grow: its time and the size of the region it grew.
+struct Click {
+  double seconds = 0.0;
+  std::size_t pixels = 0;
+};
+
 struct SessionResult {
   segmentation::PixelSet region;
-  int operations = 0;                 // lassos, barriers and clicks
-  std::vector<double> click_seconds;  // each click's grow alone
+  int operations = 0;         // lassos, barriers and clicks
+  std::vector<Click> clicks;  // each click's grow alone
   double iou = 0.0;
   // After each click: the operations made so far and the IoU reached.
   std::vector<std::pair<int, double>> progress;

@@ -31,12 +31,17 @@ void fill_span(const GridShape& shape, int row, double x_begin, double x_end, st
   for (long long col = first; col <= last; ++col) mark(shape, row, col, value, mask);
 }
 
+[[maybe_unused]] bool near_the_grid(const GridShape& shape, const Eigen::Vector2d& v) {
+  return v.allFinite() && v.x() >= -shape.columns && v.x() <= 2.0 * shape.columns &&
+         v.y() >= -shape.rows && v.y() <= 2.0 * shape.rows;
+}
+
 void check_vertices(const GridShape& shape, const Polyline& line,
                     const std::vector<std::uint8_t>& mask) {
   assert(mask.size() == shape.pixel_count() && "mask of another grid");
   assert(std::all_of(line.begin(), line.end(),
-                     [](const Eigen::Vector2d& v) { return v.allFinite(); }) &&
-         "vertex not finite");
+                     [&](const Eigen::Vector2d& v) { return near_the_grid(shape, v); }) &&
+         "vertex not finite or more than a grid away from it");
   (void)shape, (void)line, (void)mask;
 }
 
@@ -48,8 +53,10 @@ void fill_polygon(const GridShape& shape, const Polyline& polygon, std::uint8_t 
   if (polygon.size() < 3) return;
   double low = polygon[0].y(), high = polygon[0].y();
   for (const Eigen::Vector2d& v : polygon) low = std::min(low, v.y()), high = std::max(high, v.y());
-  const int first_row = static_cast<int>(std::max(0.0, std::ceil(low)));
-  const int last_row = static_cast<int>(std::min<double>(shape.rows - 1, std::floor(high)));
+  const int first_row =
+      static_cast<int>(std::clamp(std::ceil(low), 0.0, static_cast<double>(shape.rows)));
+  const int last_row =
+      static_cast<int>(std::clamp(std::floor(high), -1.0, static_cast<double>(shape.rows - 1)));
   std::vector<double> crossings;
   for (int row = first_row; row <= last_row; ++row) {
     crossings.clear();

@@ -4,7 +4,11 @@
 // x = column, y = row, pixel centres at integers. On a grid that wraps
 // around, x may run past either edge (a lasso or barrier across the seam)
 // and is taken modulo the column count; on other grids what lies outside is
-// clipped.
+// clipped. Vertices are unwrapped: a line across the seam goes from x =
+// columns − 2 to x = columns + 2, not to x = 2 (that would be a line the
+// other way round). Every vertex must be finite and lie within one grid
+// size of the grid (−columns ≤ x ≤ 2·columns, −rows ≤ y ≤ 2·rows; asserted):
+// callers refuse other input as bad input.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,7 +25,7 @@ using Polyline = std::vector<Eigen::Vector2d>;  // (x = column, y = row) vertice
 // Sets mask[i] = value on the pixels whose centres lie inside the closed
 // polygon (even-odd rule; the edge from the last vertex back to the first
 // closes it). A polygon of fewer than 3 vertices covers nothing. Asserts
-// the mask has one byte per pixel and the vertices are finite.
+// the mask has one byte per pixel and the vertices as above.
 void fill_polygon(const GridShape& shape, const Polyline& polygon, std::uint8_t value,
                   std::vector<std::uint8_t>& mask);
 

@@ -3,20 +3,22 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
+#include <cmath>
 
 namespace scanbench::segmentation {
 
 namespace {
 
 // Pixel indices where open, by decreasing rank (a stable counting sort on
-// the rank quantised to 1/1024 of its range: seeds need an order, not an
-// exact one), ties in row-major order.
+// the rank quantised to 1/1024 of its finite range: seeds need an order,
+// not an exact one), ties in row-major order; ranks that are not finite
+// come last.
 std::vector<std::uint32_t> seed_order(std::span<const std::uint8_t> open,
                                       std::span<const float> rank) {
   float low = 0.0f, high = 0.0f;
   bool any = false;
   for (std::size_t i = 0; i < rank.size(); ++i) {
-    if (!open[i] || !(rank[i] == rank[i])) continue;  // NaN ranks last
+    if (!open[i] || !std::isfinite(rank[i])) continue;
     low = any ? std::min(low, rank[i]) : rank[i];
     high = any ? std::max(high, rank[i]) : rank[i];
     any = true;
@@ -24,15 +26,15 @@ std::vector<std::uint32_t> seed_order(std::span<const std::uint8_t> open,
   constexpr int kBuckets = 1024;
   const float scale = high > low ? (kBuckets - 1) / (high - low) : 0.0f;
   const auto bucket = [&](std::size_t i) {
-    if (!(rank[i] == rank[i])) return kBuckets - 1;
+    if (!std::isfinite(rank[i])) return kBuckets;  // a bucket after every finite rank
     return kBuckets - 1 - static_cast<int>((rank[i] - low) * scale);
   };
-  std::vector<std::size_t> start(kBuckets + 1, 0);
+  std::vector<std::size_t> start(kBuckets + 2, 0);
   for (std::size_t i = 0; i < rank.size(); ++i) {
     if (open[i]) ++start[static_cast<std::size_t>(bucket(i)) + 1];
   }
-  for (int b = 0; b < kBuckets; ++b) start[b + 1] += start[b];
-  std::vector<std::uint32_t> order(start[kBuckets]);
+  for (int b = 0; b <= kBuckets; ++b) start[b + 1] += start[b];
+  std::vector<std::uint32_t> order(start[kBuckets + 1]);
   for (std::size_t i = 0; i < rank.size(); ++i) {
     if (open[i])
       order[start[static_cast<std::size_t>(bucket(i))]++] = static_cast<std::uint32_t>(i);

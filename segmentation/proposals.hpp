@@ -30,9 +30,11 @@ struct ProposalResult {
 
 // Proposes regions on `grid` among the pixels where open[i] != 0 (one byte
 // per pixel, asserted). Seeds are taken in order of decreasing `seed_rank`
-// (one value per pixel, asserted; the geometry's confidence, say), ties in
-// row-major order; a pixel already in a region, or in a region too small to
-// propose, is no seed. Each pixel belongs to at most one region.
+// (one value per pixel, asserted; the geometry's confidence, say), ranks
+// within 1/1024 of their finite range counting as equal and ties in
+// row-major order; pixels whose rank is not finite are seeds last. A pixel
+// already in a region, or in a region too small to propose, is no seed.
+// Each pixel belongs to at most one region.
 ProposalResult propose_regions(const SegmentationGrid& grid, std::span<const std::uint8_t> open,
                                std::span<const float> seed_rank, const ProposalSettings& settings);
 

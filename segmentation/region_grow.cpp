@@ -109,7 +109,7 @@ struct NormalPolicy {
     }
     // A normal blurred by a crease or missing next to an edge: the point
     // itself still lies on the region's plane.
-    if (plane_footprints <= 0.0f) return false;
+    if (plane_footprints <= 0.0f || normal_sum.squaredNorm() == 0.0) return false;
     const Eigen::Vector3f centroid = (point_sum / static_cast<double>(count)).cast<float>();
     const Eigen::Vector3f& x = g.point[q];
     // The footprint of p, already in the region: q's own is stretched where
@@ -126,16 +126,18 @@ struct NormalPolicy {
   }
 };
 
-bool has_channel(const SegmentationGrid& grid, Channel channel) {
+// Whether the seed carries the channel the region grows on: the scan has
+// it, and the seed's own value is there (a normal, a finite intensity).
+bool seed_has_channel(const SegmentationGrid& grid, Channel channel, std::size_t seed) {
   switch (channel) {
     case Channel::kRange:
       return true;
     case Channel::kColor:
       return !grid.lab.empty();
     case Channel::kIntensity:
-      return !grid.intensity.empty();
+      return !grid.intensity.empty() && std::isfinite(grid.intensity[seed]);
     case Channel::kNormal:
-      return true;
+      return grid.normal[seed].squaredNorm() > 0.0f;
   }
   return false;
 }
@@ -164,12 +166,10 @@ GrowSettings default_grow_settings(Channel channel) {
   return settings;
 }
 
+RegionGrower::RegionGrower(const SegmentationGrid& grid)
+    : grid_(grid), stamp_(grid.shape.pixel_count(), 0) {}
+
 void RegionGrower::start_call() {
-  const std::size_t n = grid_.shape.pixel_count();
-  if (stamp_.size() != n) {
-    stamp_.assign(n, 0);
-    generation_ = 0;
-  }
   if (++generation_ == 0) {  // wrapped after 2^32 calls: forget every stamp once
     std::fill(stamp_.begin(), stamp_.end(), 0);
     generation_ = 1;
@@ -177,74 +177,68 @@ void RegionGrower::start_call() {
   queue_.clear();
 }
 
+template <typename Policy>
+void RegionGrower::spread(std::size_t seed, const GrowSettings& settings,
+                          std::span<const std::uint8_t> open, Policy policy) {
+  const GridShape& shape = grid_.shape;
+  const Continuity continuity{grid_, static_cast<float>(settings.continuity_footprints)};
+  // The range channel's own test is continuity, at its tolerance.
+  const bool check_continuity =
+      settings.channel != Channel::kRange && settings.continuity_footprints > 0.0;
+  const auto enqueue = [&](std::size_t i) {
+    visit(i);
+    policy.add(i);
+    queue_.push_back(static_cast<std::uint32_t>(i));
+  };
+  enqueue(seed);
+  const auto columns = static_cast<std::uint32_t>(shape.columns);
+  for (std::size_t head = 0; head < queue_.size(); ++head) {
+    const std::uint32_t p = queue_[head];
+    shape.for_each_neighbour(static_cast<int>(p / columns), static_cast<int>(p % columns),
+                             [&](int r, int c) {
+                               const std::size_t q = shape.index(r, c);
+                               if (!open[q] || !grid_.usable[q] || stamp_[q] == generation_) return;
+                               if (settings.max_pixels != 0 && queue_.size() >= settings.max_pixels)
+                                 return;
+                               if (check_continuity && !continuity(p, q)) return;
+                               if (!policy.accept(p, q)) return;
+                               enqueue(q);
+                             });
+  }
+}
+
 GrowResult RegionGrower::grow(std::size_t seed, const GrowSettings& settings,
                               std::span<const std::uint8_t> open) {
-  const GridShape& shape = grid_.shape;
-  assert(seed < shape.pixel_count() && "seed outside the grid");
-  assert(open.size() == shape.pixel_count() && "open mask of another grid");
+  assert(seed < grid_.shape.pixel_count() && "seed outside the grid");
+  assert(open.size() == grid_.shape.pixel_count() && "open mask of another grid");
   GrowResult result;
   if (!open[seed] || !grid_.usable[seed]) return result;
   result.seed_open = true;
   start_call();
-  const auto columns = static_cast<std::size_t>(shape.columns);
-  const Continuity continuity{grid_, static_cast<float>(settings.continuity_footprints)};
-  const bool check_continuity = settings.continuity_footprints > 0.0;
-
-  const auto run = [&](auto policy) {
-    const auto enqueue = [&](std::size_t i) {
-      visit(i);
-      policy.add(i);
-      queue_.push_back((static_cast<std::uint64_t>(i / columns) << 32) | (i % columns));
-    };
-    enqueue(seed);
-    for (std::size_t head = 0; head < queue_.size(); ++head) {
-      const auto row = static_cast<int>(queue_[head] >> 32);
-      const auto col = static_cast<int>(queue_[head] & 0xffffffffu);
-      const std::size_t p = shape.index(row, col);
-      shape.for_each_neighbour(row, col, [&](int r, int c) {
-        const std::size_t q = shape.index(r, c);
-        if (!open[q] || !grid_.usable[q] || stamp_[q] == generation_) return;
-        if (settings.max_pixels != 0 && queue_.size() >= settings.max_pixels) return;
-        if (check_continuity && !continuity(p, q)) return;
-        if (!policy.accept(p, q)) return;
-        enqueue(q);
-      });
-    }
-  };
-
   const auto tolerance = static_cast<float>(settings.tolerance);
   const float mean = static_cast<float>(settings.mean_factor) * tolerance;
   const bool with_mean = settings.mean_factor > 0.0;
-  if (!has_channel(grid_, settings.channel)) {
-    result.channel_missing = true;
-    queue_.push_back((static_cast<std::uint64_t>(seed / columns) << 32) | (seed % columns));
+  if (!seed_has_channel(grid_, settings.channel, seed)) {
+    result.seed_lacks_channel = true;
+    queue_.push_back(static_cast<std::uint32_t>(seed));
+  } else if (settings.channel == Channel::kRange) {
+    spread(seed, settings, open, RangePolicy{Continuity{grid_, tolerance}});
+  } else if (settings.channel == Channel::kColor) {
+    spread(seed, settings, open,
+           ColorPolicy{grid_, tolerance * tolerance, with_mean ? mean * mean : -1.0f});
+  } else if (settings.channel == Channel::kIntensity) {
+    const float spread_unit = grid_.intensity_spread;
+    spread(seed, settings, open,
+           IntensityPolicy{grid_, tolerance * spread_unit, with_mean ? mean * spread_unit : -1.0f});
   } else {
-    switch (settings.channel) {
-      case Channel::kRange:
-        run(RangePolicy{Continuity{grid_, tolerance}});
-        break;
-      case Channel::kColor:
-        run(ColorPolicy{grid_, tolerance * tolerance, with_mean ? mean * mean : -1.0f});
-        break;
-      case Channel::kIntensity: {
-        const float spread = grid_.intensity_spread;
-        run(IntensityPolicy{grid_, tolerance * spread, with_mean ? mean * spread : -1.0f});
-        break;
-      }
-      case Channel::kNormal:
-        run(NormalPolicy{
-            grid_, cos_of_degrees(settings.tolerance),
-            with_mean ? cos_of_degrees(settings.mean_factor * settings.tolerance) : -2.0f,
-            with_mean ? static_cast<float>(settings.plane_footprints) : 0.0f});
-        break;
-    }
+    spread(
+        seed, settings, open,
+        NormalPolicy{grid_, cos_of_degrees(settings.tolerance),
+                     with_mean ? cos_of_degrees(settings.mean_factor * settings.tolerance) : -2.0f,
+                     with_mean ? static_cast<float>(settings.plane_footprints) : 0.0f});
   }
   result.reached_limit = settings.max_pixels != 0 && queue_.size() >= settings.max_pixels;
-  result.pixels.reserve(queue_.size());
-  for (const std::uint64_t packed : queue_) {
-    result.pixels.push_back(
-        static_cast<std::uint32_t>((packed >> 32) * columns + (packed & 0xffffffffu)));
-  }
+  result.pixels.assign(queue_.begin(), queue_.end());
   sort_pixels(result.pixels);
   return result;
 }

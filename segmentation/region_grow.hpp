@@ -58,17 +58,23 @@ GrowSettings default_grow_settings(Channel channel);
 struct GrowResult {
   std::vector<std::uint32_t> pixels;  // row-major indices, ascending; empty when the seed is closed
   bool seed_open = false;             // the seed was open: usable and not blocked
-  bool reached_limit = false;         // stopped at max_pixels
-  bool channel_missing = false;       // the scan lacks the channel: the region is the seed alone
+  // The region holds max_pixels pixels: it stopped there (and may or may
+  // not have been complete).
+  bool reached_limit = false;
+  // The seed has no value on the channel (the scan has no colour or
+  // intensity, or the seed's intensity is not finite, or the seed has no
+  // normal): the region is the seed alone.
+  bool seed_lacks_channel = false;
 };
 
 // Grows regions on one prepared grid. Keeps its work arrays between calls,
-// so a click costs time in proportion to the region it grows (after the
-// first, which allocates them). One grower per thread.
+// so a click costs time in proportion to the region it grows and its
+// boundary. One grower per thread.
 class RegionGrower {
  public:
-  // `grid` must outlive the grower.
-  explicit RegionGrower(const SegmentationGrid& grid) : grid_(grid) {}
+  // `grid` must outlive the grower. Allocates the work arrays (4 bytes per
+  // pixel) once, here.
+  explicit RegionGrower(const SegmentationGrid& grid);
 
   // Grows from pixel `seed` (row-major index, asserted inside the grid)
   // through pixels where open[i] != 0 (open has one byte per pixel,
@@ -84,11 +90,15 @@ class RegionGrower {
     return true;
   }
   void start_call();
+  // The breadth-first spread from `seed` with the channel's Policy.
+  template <typename Policy>
+  void spread(std::size_t seed, const GrowSettings& settings, std::span<const std::uint8_t> open,
+              Policy policy);
 
   const SegmentationGrid& grid_;
   std::vector<std::uint32_t> stamp_;  // generation_ where seen in the current call
   std::uint32_t generation_ = 0;
-  std::vector<std::uint64_t> queue_;  // (row << 32) | col, breadth-first
+  std::vector<std::uint32_t> queue_;  // the region's pixels, breadth-first
 };
 
 }  // namespace scanbench::segmentation

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel.hpp"
 
@@ -85,6 +86,7 @@ SegmentationGrid prepare_grid(const acquisition::Scan& scan,
   const std::size_t n = scan.pixel_count();
   assert(geometry.normal.size() == n && geometry.footprint_m.size() == n &&
          "geometry of another scan");
+  assert(n <= std::numeric_limits<std::uint32_t>::max() && "pixel indices are 32-bit");
   SegmentationGrid grid;
   grid.shape = grid_shape(scan);
   grid.range_noise = settings.range_noise;

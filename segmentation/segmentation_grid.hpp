@@ -90,7 +90,8 @@ struct GridSettings {
   int threads = 0;                      // 0 = all cores; results do not depend on it
 };
 
-// Prepares `scan` with its `geometry` (same size, asserted).
+// Prepares `scan` with its `geometry` (same size, asserted; at most 2^32 − 1
+// pixels, asserted: pixel indices are 32-bit).
 SegmentationGrid prepare_grid(const acquisition::Scan& scan,
                               const acquisition::ScanGeometry& geometry,
                               const GridSettings& settings);

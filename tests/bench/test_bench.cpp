@@ -162,7 +162,9 @@ TEST(BenchSegmentation, SmokeRunReportsEveryField) {
   for (const char* field : {"mean_iou", "objects_at_least_0_95", "click_latency_ms_p50",
                             "click_latency_ms_p95", "clicks", "largest_region_pixels"})
     EXPECT_TRUE(ours[field].is_number()) << field;
-  for (const char* peer : {"pcl_region_growing", "pcl_region_growing_rgb"}) {
+  EXPECT_GE(bench["ours_held_out"]["objects"].size(), 10u);
+  EXPECT_TRUE(bench["ours_held_out"]["mean_iou"].is_number());
+  for (const char* peer : {"ours_auto", "pcl_region_growing", "pcl_region_growing_rgb"}) {
     EXPECT_GT(bench[peer]["seconds"].get<double>(), 0.0) << peer;
     EXPECT_EQ(bench[peer]["objects"].size(), ours["objects"].size()) << peer;
     EXPECT_LE(bench[peer]["mean_iou"].get<double>(), 1.0) << peer;

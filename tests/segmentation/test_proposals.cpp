@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "segmentation/constraints.hpp"
@@ -21,13 +22,15 @@ ProposalResult propose_room(std::span<const std::uint8_t> taken = {}) {
   return propose_regions(grid, open, room.geometry.confidence, ProposalSettings{});
 }
 
-// The best IoU of any region with the usable pixels of `object`.
-double best_iou(const ProposalResult& proposals, std::uint8_t object) {
+// The best IoU of any region with the usable pixels of `objects`.
+double best_iou(const ProposalResult& proposals, std::initializer_list<std::uint8_t> objects) {
   const auto& room = shared_room();
   PixelSet truth;
   for (std::size_t i = 0; i < room.truth.size(); ++i) {
-    const bool usable = room.scan.valid[i] && !room.geometry.is_mixed(i);
-    if (room.truth[i] == object && usable) truth.push_back(static_cast<std::uint32_t>(i));
+    const bool usable = acquisition::in_model(room.scan, room.geometry, i);
+    if (usable && std::find(objects.begin(), objects.end(), room.truth[i]) != objects.end()) {
+      truth.push_back(static_cast<std::uint32_t>(i));
+    }
   }
   double best = 0.0;
   for (const PixelSet& region : proposals.regions) {
@@ -39,11 +42,13 @@ double best_iou(const ProposalResult& proposals, std::uint8_t object) {
 
 TEST(Proposals, EverySurfaceOfTheRoomIsOneRegion) {
   const ProposalResult proposals = propose_room();
-  // The poster is flush with its wall: to the normals it is the wall.
   for (const std::uint8_t object :
        {test::kFloor, test::kWallMinusX, test::kWallPlusY, test::kWallMinusY, test::kWindow}) {
-    EXPECT_GT(best_iou(proposals, object), 0.97) << int{object};
+    EXPECT_GT(best_iou(proposals, {object}), 0.97) << int{object};
   }
+  // The poster is flush with its wall: to the normals it is the wall. The
+  // wall's reveals round the window, seen edge-on, are not.
+  EXPECT_GT(best_iou(proposals, {test::kWallPlusX, test::kPoster}), 0.95);
 }
 
 TEST(Proposals, RegionsAreDisjointSortedAndLargeEnough) {
@@ -69,7 +74,7 @@ TEST(Proposals, TakenPixelsAreInNoRegion) {
   for (const PixelSet& region : proposals.regions) {
     for (const std::uint32_t p : region) ASSERT_FALSE(taken[p]) << p;
   }
-  EXPECT_GT(best_iou(proposals, test::kWallPlusY), 0.97);
+  EXPECT_GT(best_iou(proposals, {test::kWallPlusY}), 0.97);
 }
 
 }  // namespace

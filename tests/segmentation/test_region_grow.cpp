@@ -138,9 +138,38 @@ TEST(RegionGrow, TakenAndClosedPixelsAreLeftAlone) {
   const GrowResult none = grow(pixel_at(-20, 0), Channel::kNormal, open);
   EXPECT_FALSE(none.seed_open);
   EXPECT_TRUE(none.pixels.empty());
-  // Colour would run from the poster into the white wall only through taken pixels.
+  // The poster is flush with its wall: the range channel reaches the wall
+  // only through taken pixels.
   const GrowResult poster = grow(pixel_at(36, 0), Channel::kRange, open);
-  EXPECT_EQ(agreement(poster.pixels, test::kPoster).foreign, 0u);
+  const Agreement a = agreement(poster.pixels, test::kPoster);
+  EXPECT_EQ(a.foreign, 0u);
+  EXPECT_EQ(a.recall, 1.0);
+}
+
+TEST(RegionGrow, TheRangeToleranceDecidesWhichStepsAreSurface) {
+  // The pane lies 0.3 m behind the façade, about ten footprints at 5 m.
+  const GrowResult tight = grow(pixel_at(0, 20), Channel::kRange, everything_open());
+  EXPECT_EQ(intersect(tight.pixels, truth_pixels(test::kWindow)).size(), 0u);
+  GrowSettings loose = default_grow_settings(Channel::kRange);
+  loose.tolerance = 20.0;
+  RegionGrower grower(room_grid());
+  const GrowResult across = grower.grow(pixel_at(0, 20), loose, everything_open());
+  EXPECT_EQ(agreement(across.pixels, test::kWindow).recall, 1.0);
+}
+
+TEST(RegionGrow, ANormalSeedWithoutANormalIsItsRegionAlone) {
+  const SegmentationGrid& grid = room_grid();
+  std::size_t seed = grid.normal.size();
+  for (std::size_t i = 0; i < grid.normal.size(); ++i) {
+    if (grid.usable[i] && grid.normal[i].squaredNorm() == 0.0f) {
+      seed = i;
+      break;
+    }
+  }
+  ASSERT_LT(seed, grid.normal.size()) << "the room has pixels without a normal at its edges";
+  const GrowResult alone = grow(seed, Channel::kNormal, everything_open());
+  EXPECT_TRUE(alone.seed_lacks_channel);
+  EXPECT_EQ(alone.pixels, PixelSet{static_cast<std::uint32_t>(seed)});
 }
 
 TEST(RegionGrow, TheLimitStopsTheRegion) {
@@ -171,7 +200,7 @@ TEST(RegionGrow, AChannelTheScanLacksGrowsNothingButTheSeed) {
   const std::vector<std::uint8_t> open = open_pixels(grid, Constraints{}, {});
   for (const Channel channel : {Channel::kColor, Channel::kIntensity}) {
     const GrowResult result = grower.grow(pixel_at(36, 0), default_grow_settings(channel), open);
-    EXPECT_TRUE(result.channel_missing);
+    EXPECT_TRUE(result.seed_lacks_channel);
     EXPECT_EQ(result.pixels, PixelSet{static_cast<std::uint32_t>(pixel_at(36, 0))});
   }
 }
