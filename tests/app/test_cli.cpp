@@ -32,7 +32,7 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
   for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry",
-                              "register", "merge", "history", "undo", "redo", "check"}) {
+                              "register", "merge", "history", "undo", "redo", "check", "objects"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
@@ -44,6 +44,37 @@ TEST(Cli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(run_cli(dir, {}).exit_code, 2);
   EXPECT_EQ(run_cli(dir, {"frobnicate"}).exit_code, 2);
   EXPECT_EQ(run_cli(dir, {"export", "x.sbproj", "--format", "obj", "-o", "y"}).exit_code, 2);
+}
+
+TEST(Cli, ObjectsPrintsTheTreeAsATableOrJson) {
+  ScratchDir dir;
+  // Version 5's fixture holds the group "north hall" with "wall south" in it.
+  const std::filesystem::path project = dir / "objects.sbproj";
+  std::filesystem::copy_file(fixture("projects/version5.sbproj"), project);
+  const CliResult json = run_cli(dir, {"objects", project.string(), "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const nlohmann::json nodes = nlohmann::json::parse(json.out)["nodes"];
+  ASSERT_EQ(nodes.size(), 2u);
+  EXPECT_EQ(nodes[0]["name"], "north hall");
+  EXPECT_EQ(nodes[0]["kind"], "group");
+  EXPECT_TRUE(nodes[0]["parent"].is_null());
+  EXPECT_TRUE(nodes[0]["bbox_world"].is_null());
+  EXPECT_EQ(nodes[1]["parent"], 1);
+  EXPECT_EQ(nodes[1]["points"], 5);
+  EXPECT_EQ(nodes[1]["bbox_world"],
+            nlohmann::json::parse("[[-1.0, 0.5, -0.25], [1.5, 2.0, 0.75]]"));
+  const CliResult table = run_cli(dir, {"objects", project.string()});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("  north hall\n"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("    wall south\n"), std::string::npos) << table.out;  // indented
+  // A project without objects says so; a file that is not a project is bad input.
+  ASSERT_EQ(run_cli(dir, {"import", (dir / "bare.sbproj").string(),
+                          fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  EXPECT_NE(run_cli(dir, {"objects", (dir / "bare.sbproj").string()}).out.find("no objects"),
+            std::string::npos);
+  EXPECT_EQ(run_cli(dir, {"objects", fixture("good/ptx/tiny_color.ptx").string()}).exit_code, 2);
 }
 
 TEST(Cli, ImportThenInfoJsonDescribesEveryScan) {

@@ -1,0 +1,97 @@
+// scanbench objects PROJECT [--json]
+#include <fmt/core.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "modeling/project.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct ObjectsOptions {
+  std::string project;
+  bool json = false;
+};
+
+nlohmann::json to_json(const modeling::ObjectNode& node) {
+  nlohmann::json bbox = nullptr;
+  if (node.bbox_world) {
+    const Eigen::Vector3d lo = node.bbox_world->min(), hi = node.bbox_world->max();
+    bbox = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
+  }
+  return {{"id", node.id},
+          {"name", node.name},
+          {"kind", node.kind == modeling::NodeKind::kGroup ? "group" : "object"},
+          {"parent", node.parent ? nlohmann::json(*node.parent) : nlohmann::json(nullptr)},
+          {"hidden", node.hidden},
+          {"points", node.points},
+          {"mean_footprint_m",
+           node.mean_footprint_m ? nlohmann::json(*node.mean_footprint_m) : nlohmann::json()},
+          {"bbox_world", bbox}};
+}
+
+// The tree depth first, children by id, each level indented by two spaces.
+// A node whose parent is not in the tree is printed as a root.
+void print_tree(const std::vector<modeling::ObjectNode>& nodes) {
+  std::map<std::int64_t, const modeling::ObjectNode*> by_id;
+  for (const modeling::ObjectNode& node : nodes) by_id[node.id] = &node;
+  std::map<std::int64_t, std::vector<const modeling::ObjectNode*>> children;
+  std::vector<const modeling::ObjectNode*> roots;
+  for (const modeling::ObjectNode& node : nodes) {
+    if (node.parent && by_id.count(*node.parent)) {
+      children[*node.parent].push_back(&node);
+    } else {
+      roots.push_back(&node);
+    }
+  }
+  fmt::print("{:>5}  {:<7} {:>10}  {}\n", "id", "kind", "points", "name");
+  const std::function<void(const modeling::ObjectNode&, int)> print = [&](const auto& node,
+                                                                          int depth) {
+    fmt::print("{:>5}  {:<7} {:>10}  {}{}{}\n", node.id,
+               node.kind == modeling::NodeKind::kGroup ? "group" : "object", node.points,
+               std::string(static_cast<std::size_t>(2 * depth), ' '), node.name,
+               node.hidden ? " (hidden)" : "");
+    for (const modeling::ObjectNode* child : children[node.id]) print(*child, depth + 1);
+  };
+  for (const modeling::ObjectNode* root : roots) print(*root, 0);
+}
+
+void run_objects(const ObjectsOptions& options) {
+  const modeling::Project project = modeling::Project::open_for_reading(options.project);
+  const std::vector<modeling::ObjectNode> nodes = project.object_nodes();
+  if (!options.json) {
+    if (nodes.empty()) {
+      fmt::print("{}: no objects yet\n", options.project);
+      return;
+    }
+    print_tree(nodes);
+    return;
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (const modeling::ObjectNode& node : nodes) out.push_back(to_json(node));
+  fmt::print("{}\n", nlohmann::json{{"nodes", out}}.dump(2, ' ', false,
+                                                         nlohmann::json::error_handler_t::replace));
+}
+
+}  // namespace
+
+void add_objects_command(CLI::App& app) {
+  auto options = std::make_shared<ObjectsOptions>();
+  CLI::App* command = app.add_subcommand(
+      "objects", "Print the project's object tree (site, buildings, walls, …) as a tree or JSON.");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_flag("--json", options->json,
+                    "Print {\"nodes\": [{id, name, kind, parent, hidden, points, "
+                    "mean_footprint_m, bbox_world}]}");
+  command->callback([options] { run_objects(*options); });
+}
+
+}  // namespace scanbench::app
