@@ -1,6 +1,7 @@
 // libFuzzer target: opening a project file and reading all of it, as info,
-// history, export and check would: open (migrating an older version), list
-// and load every scan with its layers, read the journal, check the file.
+// history, objects, export and check would: open (migrating an older
+// version), list and load every scan with its layers, read the journal and
+// the object tree, check the file.
 #include "fuzz/fuzz_file.hpp"
 #include "modeling/project.hpp"
 #include "modeling/scan_layers.hpp"
@@ -15,6 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   scanbench::fuzz::expect_refusal_or_success([&] {
     const Project project = Project::open(path);
     static_cast<void>(project.history());
+    static_cast<void>(project.object_nodes());
     for (const auto& stored : project.scans()) {
       static_cast<void>(project.load_scan(stored.id));
       static_cast<void>(scanbench::modeling::load_geometry(project, stored.id));
