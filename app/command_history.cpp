@@ -56,6 +56,21 @@ std::string summary(const modeling::CommandRecord& c) {
   if (c.name == "merge" && result.contains("kept")) {
     return fmt::format("{} of {} points kept", result.value("kept", 0), result.value("points", 0));
   }
+  if (c.name == "select" && result.contains("selected_pixels")) {
+    return fmt::format("scan {}: {} pixels selected", settings.value("scan", 0),
+                       result.value("selected_pixels", 0));
+  }
+  if (c.name == "commit" && result.contains("node")) {
+    return fmt::format("object {} \"{}\", {} points", result.value("node", 0),
+                       settings.value("name", ""), result.value("points", 0));
+  }
+  if ((c.name == "group" || c.name == "edit") && result.contains("node")) {
+    return fmt::format("node {}", result.value("node", 0));
+  }
+  if (c.name == "delete" && result.contains("nodes")) {
+    return fmt::format("{} node(s), points to the {}", result["nodes"].size(),
+                       settings.value("points", "pool") == "pool" ? "pool" : "deleted");
+  }
   return "";
 }
 

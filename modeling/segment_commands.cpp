@@ -1,0 +1,382 @@
+#include "modeling/segment_commands.hpp"
+
+#include <algorithm>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "modeling/scan_layers.hpp"
+#include "segmentation/pixel_set.hpp"
+
+namespace scanbench::modeling {
+
+namespace {
+
+using Tree = std::map<std::int64_t, ObjectNode>;
+
+[[noreturn]] void refuse(const std::string& where, const std::string& problem) {
+  core::FilePosition position;
+  position.detail = where;
+  throw core::InputError("", position, problem);
+}
+
+std::string dump(const nlohmann::json& json) {
+  return json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+Tree load_tree(const Project& project) {
+  Tree tree;
+  for (ObjectNode& node : project.object_nodes()) tree.emplace(node.id, std::move(node));
+  return tree;
+}
+
+const ObjectNode& require_node(const Tree& tree, std::int64_t id) {
+  const auto found = tree.find(id);
+  if (found == tree.end()) refuse("node " + std::to_string(id), "no such node");
+  return found->second;
+}
+
+void require_group(const Tree& tree, std::optional<std::int64_t> parent) {
+  if (parent && require_node(tree, *parent).kind != NodeKind::kGroup) {
+    refuse("node " + std::to_string(*parent), "is an object, not a group: it cannot hold nodes");
+  }
+}
+
+void require_name(const std::string& name) {
+  if (name.empty()) refuse("name", "a node needs a name");
+}
+
+// True when `ancestor` is `node` or above it.
+bool is_at_or_above(const Tree& tree, std::int64_t ancestor, std::int64_t node) {
+  for (std::optional<std::int64_t> at = node; at;) {
+    if (*at == ancestor) return true;
+    const auto found = tree.find(*at);
+    at = found == tree.end() ? std::nullopt : found->second.parent;
+  }
+  return false;
+}
+
+std::vector<std::uint32_t> load_membership(const Project& project, std::int64_t scan_id,
+                                           std::size_t pixels) {
+  auto stored = project.load_layer<std::uint32_t>(scan_id, layer::kMembership, ElementType::kU32);
+  return stored ? std::move(*stored) : std::vector<std::uint32_t>(pixels, 0);
+}
+
+segmentation::PixelSet load_selection(const Project& project, std::int64_t scan_id) {
+  const auto stored =
+      project.load_layer<std::uint8_t>(scan_id, layer::kSelection, ElementType::kU8);
+  return stored ? segmentation::from_mask(*stored) : segmentation::PixelSet{};
+}
+
+void put_selection(Project& project, Project::Edit& edit, std::int64_t scan_id,
+                   const segmentation::GridShape& shape, const segmentation::PixelSet& selection) {
+  if (selection.empty()) {
+    project.remove_layer(edit, scan_id, layer::kSelection);
+    return;
+  }
+  const std::vector<std::uint8_t> mask = segmentation::to_mask(shape, selection);
+  project.put_layer(edit, scan_id,
+                    encode_layer<std::uint8_t>(layer::kSelection, ElementType::kU8, mask));
+}
+
+void put_membership(Project& project, Project::Edit& edit, std::int64_t scan_id,
+                    const std::vector<std::uint32_t>& membership) {
+  project.put_layer(edit, scan_id,
+                    encode_layer<std::uint32_t>(layer::kMembership, ElementType::kU32, membership));
+}
+
+// What a node's cached figures sum up.
+struct Figures {
+  std::int64_t points = 0;
+  double footprint_sum = 0.0;
+  Eigen::AlignedBox3d box;  // starts empty
+
+  void add(const Figures& other) {
+    points += other.points;
+    footprint_sum += other.footprint_sum;
+    if (!other.box.isEmpty()) box.extend(other.box);
+  }
+};
+
+// Every node's figures from the membership layers of all scans (`changed`
+// holds the memberships this command writes, in place of the stored ones),
+// groups summing their descendants.
+std::map<std::int64_t, Figures> compute_figures(
+    const Project& project, const Tree& tree,
+    const std::map<std::int64_t, std::vector<std::uint32_t>>& changed) {
+  std::map<std::int64_t, Figures> own;
+  for (const StoredScanSummary& stored : project.scans()) {
+    const auto replaced = changed.find(stored.id);
+    const std::vector<std::string> names = project.layer_names(stored.id);
+    const bool has_layer = replaced != changed.end() ||
+                           std::find(names.begin(), names.end(), layer::kMembership) != names.end();
+    if (!has_layer) continue;
+    const acquisition::Scan scan = project.load_scan(stored.id);
+    const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
+    const std::vector<std::uint32_t> membership =
+        replaced != changed.end() ? replaced->second
+                                  : load_membership(project, stored.id, scan.pixel_count());
+    for (int row = 0; row < scan.rows; ++row) {
+      for (int col = 0; col < scan.columns; ++col) {
+        const std::uint32_t owner = membership[scan.index(row, col)];
+        if (owner == 0 || owner == kDeletedPoints) continue;
+        Figures& f = own[owner];
+        ++f.points;
+        if (geometry) f.footprint_sum += geometry->footprint_m[scan.index(row, col)];
+        f.box.extend(acquisition::point_in_world(scan, row, col));
+      }
+    }
+  }
+  std::map<std::int64_t, Figures> total;
+  for (const auto& [id, figures] : own) {
+    for (std::optional<std::int64_t> at = id; at && tree.count(*at); at = tree.at(*at).parent) {
+      total[*at].add(figures);
+    }
+  }
+  return total;
+}
+
+// Writes a new version of every node whose figures `figures` changes.
+void refresh_figures(Project& project, Project::Edit& edit, const Tree& tree,
+                     const std::map<std::int64_t, Figures>& figures) {
+  for (const auto& [id, node] : tree) {
+    ObjectNode updated = node;
+    const auto found = figures.find(id);
+    const Figures f = found == figures.end() ? Figures{} : found->second;
+    updated.points = f.points;
+    updated.mean_footprint_m =
+        f.points > 0 ? std::optional<double>(f.footprint_sum / static_cast<double>(f.points))
+                     : std::nullopt;
+    updated.bbox_world = f.box.isEmpty() ? std::nullopt : std::optional<Eigen::AlignedBox3d>(f.box);
+    const bool same =
+        updated.points == node.points && updated.mean_footprint_m == node.mean_footprint_m &&
+        updated.bbox_world.has_value() == node.bbox_world.has_value() &&
+        (!updated.bbox_world || (updated.bbox_world->min() == node.bbox_world->min() &&
+                                 updated.bbox_world->max() == node.bbox_world->max()));
+    if (!same) project.put_node(edit, updated);
+  }
+}
+
+nlohmann::json polyline_json(const segmentation::Polyline& line) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Eigen::Vector2d& v : line) out.push_back({v.x(), v.y()});
+  return out;
+}
+
+nlohmann::json select_json(const SelectSettings& s) {
+  nlohmann::json barriers = nlohmann::json::array();
+  for (const segmentation::Polyline& line : s.constraints.barriers)
+    barriers.push_back(polyline_json(line));
+  constexpr const char* kModes[] = {"replace", "add", "subtract"};
+  return {{"scan", s.scan_id},
+          {"seed", {s.seed_row, s.seed_col}},
+          {"mode", kModes[static_cast<int>(s.mode)]},
+          {"channel", segmentation::channel_name(s.grow.channel)},
+          {"tolerance", s.grow.tolerance},
+          {"mean_factor", s.grow.mean_factor},
+          {"plane_footprints", s.grow.plane_footprints},
+          {"continuity_footprints", s.grow.continuity_footprints},
+          {"max_pixels", s.grow.max_pixels},
+          {"lasso", polyline_json(s.constraints.lasso)},
+          {"barriers", barriers},
+          {"range_noise",
+           {{"noise_m", s.range_noise.noise_m}, {"noise_per_m", s.range_noise.noise_per_m}}}};
+}
+
+nlohmann::json parent_json(std::optional<std::int64_t> parent) {
+  return parent ? nlohmann::json(*parent) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+SelectResult select_region(Project& project, const SelectSettings& settings) {
+  const std::int64_t revision = project.revision();
+  const std::string where = "scan " + std::to_string(settings.scan_id);
+  const acquisition::Scan scan = project.load_scan(settings.scan_id);
+  if (settings.seed_row < 0 || settings.seed_row >= scan.rows || settings.seed_col < 0 ||
+      settings.seed_col >= scan.columns) {
+    refuse(where, "seed (" + std::to_string(settings.seed_row) + ", " +
+                      std::to_string(settings.seed_col) + ") is outside the " +
+                      std::to_string(scan.rows) + " × " + std::to_string(scan.columns) + " grid");
+  }
+  const std::optional<acquisition::ScanGeometry> geometry =
+      load_geometry(project, settings.scan_id);
+  if (!geometry) refuse(where, "has no geometry: run `scanbench geometry` first");
+  segmentation::GridSettings grid_settings;
+  grid_settings.range_noise = settings.range_noise;
+  const segmentation::SegmentationGrid grid =
+      segmentation::prepare_grid(scan, *geometry, grid_settings);
+  const std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, scan.pixel_count());
+  std::vector<std::uint8_t> taken(membership.size());
+  for (std::size_t i = 0; i < taken.size(); ++i) taken[i] = membership[i] != 0;
+  const std::vector<std::uint8_t> open =
+      segmentation::open_pixels(grid, settings.constraints, taken);
+  segmentation::RegionGrower grower(grid);
+  const segmentation::GrowResult grown =
+      grower.grow(scan.index(settings.seed_row, settings.seed_col), settings.grow, open);
+  const segmentation::PixelSet before = load_selection(project, settings.scan_id);
+  segmentation::PixelSet selection;
+  switch (settings.mode) {
+    case SelectMode::kReplace:
+      selection = grown.pixels;
+      break;
+    case SelectMode::kAdd:
+      selection = segmentation::unite(before, grown.pixels);
+      break;
+    case SelectMode::kSubtract:
+      selection = segmentation::subtract(before, grown.pixels);
+      break;
+  }
+  Project::Edit edit = project.begin_command("select", dump(select_json(settings)), revision);
+  put_selection(project, edit, settings.scan_id, grid.shape, selection);
+  SelectResult result{edit.command_id(), grown.pixels.size(), selection.size(), grown.seed_open};
+  edit.commit(dump({{"region_pixels", result.region_pixels},
+                    {"selected_pixels", result.selected_pixels},
+                    {"seed_open", result.seed_open}}));
+  return result;
+}
+
+NodeCommandResult commit_selection(Project& project, const CommitSettings& settings) {
+  const std::int64_t revision = project.revision();
+  const std::string where = "scan " + std::to_string(settings.scan_id);
+  require_name(settings.name);
+  Tree tree = load_tree(project);
+  require_group(tree, settings.parent);
+  const acquisition::Scan scan = project.load_scan(settings.scan_id);
+  const segmentation::PixelSet selection = load_selection(project, settings.scan_id);
+  std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, scan.pixel_count());
+  ObjectNode node;
+  node.id = project.new_node_id();
+  node.name = settings.name;
+  node.parent = settings.parent;
+  std::size_t taken = 0;
+  for (const std::uint32_t p : selection) {
+    if (membership[p] != 0) continue;  // another object's since the selection grew
+    membership[p] = static_cast<std::uint32_t>(node.id);
+    ++taken;
+  }
+  if (taken == 0) refuse(where, "the selection is empty: grow a region first");
+  tree.emplace(node.id, node);
+  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
+  Project::Edit edit = project.begin_command("commit",
+                                             dump({{"scan", settings.scan_id},
+                                                   {"name", settings.name},
+                                                   {"parent", parent_json(settings.parent)}}),
+                                             revision);
+  project.put_node(edit, node);
+  put_membership(project, edit, settings.scan_id, membership);
+  project.remove_layer(edit, settings.scan_id, layer::kSelection);
+  refresh_figures(project, edit, tree, figures);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"node", node.id}, {"points", taken}}));
+  return {command_id, node.id};
+}
+
+NodeCommandResult group_nodes(Project& project, const GroupSettings& settings) {
+  const std::int64_t revision = project.revision();
+  require_name(settings.name);
+  Tree tree = load_tree(project);
+  require_group(tree, settings.parent);
+  ObjectNode group;
+  group.id = project.new_node_id();
+  group.name = settings.name;
+  group.kind = NodeKind::kGroup;
+  group.parent = settings.parent;
+  for (const std::int64_t child : settings.children) {
+    require_node(tree, child);
+    if (settings.parent && is_at_or_above(tree, child, *settings.parent)) {
+      refuse("node " + std::to_string(child), "cannot go into a group below itself");
+    }
+  }
+  tree.emplace(group.id, group);
+  for (const std::int64_t child : settings.children) tree.at(child).parent = group.id;
+  const auto figures = compute_figures(project, tree, {});
+  Project::Edit edit = project.begin_command("group",
+                                             dump({{"name", settings.name},
+                                                   {"parent", parent_json(settings.parent)},
+                                                   {"children", settings.children}}),
+                                             revision);
+  project.put_node(edit, group);
+  for (const std::int64_t child : settings.children) project.put_node(edit, tree.at(child));
+  refresh_figures(project, edit, tree, figures);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"node", group.id}}));
+  return {command_id, group.id};
+}
+
+NodeCommandResult edit_node(Project& project, const NodeEdit& change) {
+  const std::int64_t revision = project.revision();
+  Tree tree = load_tree(project);
+  ObjectNode node = require_node(tree, change.node);
+  nlohmann::json settings = {{"node", change.node}};
+  if (change.name) {
+    require_name(*change.name);
+    node.name = *change.name;
+    settings["name"] = *change.name;
+  }
+  if (change.hidden) {
+    node.hidden = *change.hidden;
+    settings["hidden"] = *change.hidden;
+  }
+  if (change.parent) {
+    require_group(tree, *change.parent);
+    if (*change.parent && is_at_or_above(tree, change.node, **change.parent)) {
+      refuse("node " + std::to_string(change.node), "cannot go into a group below itself");
+    }
+    node.parent = *change.parent;
+    settings["parent"] = parent_json(*change.parent);
+  }
+  tree[node.id] = node;
+  const auto figures =
+      change.parent ? compute_figures(project, tree, {}) : std::map<std::int64_t, Figures>{};
+  Project::Edit edit = project.begin_command("edit", dump(settings), revision);
+  project.put_node(edit, node);
+  if (change.parent) refresh_figures(project, edit, tree, figures);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"node", node.id}}));
+  return {command_id, node.id};
+}
+
+NodeCommandResult delete_node(Project& project, const DeleteSettings& settings) {
+  const std::int64_t revision = project.revision();
+  Tree tree = load_tree(project);
+  require_node(tree, settings.node);
+  std::vector<std::int64_t> gone;
+  for (const auto& [id, node] : tree) {
+    if (is_at_or_above(tree, settings.node, id)) gone.push_back(id);
+  }
+  const std::uint32_t replacement = settings.points == DeletedPoints::kToPool ? 0 : kDeletedPoints;
+  std::map<std::int64_t, std::vector<std::uint32_t>> changed;
+  for (const StoredScanSummary& stored : project.scans()) {
+    auto membership =
+        project.load_layer<std::uint32_t>(stored.id, layer::kMembership, ElementType::kU32);
+    if (!membership) continue;
+    bool touched = false;
+    for (std::uint32_t& owner : *membership) {
+      if (owner == 0 || owner == kDeletedPoints) continue;
+      if (std::find(gone.begin(), gone.end(), static_cast<std::int64_t>(owner)) == gone.end())
+        continue;
+      owner = replacement;
+      touched = true;
+    }
+    if (touched) changed.emplace(stored.id, std::move(*membership));
+  }
+  for (const std::int64_t id : gone) tree.erase(id);
+  const auto figures = compute_figures(project, tree, changed);
+  Project::Edit edit = project.begin_command(
+      "delete",
+      dump({{"node", settings.node},
+            {"points", settings.points == DeletedPoints::kToPool ? "pool" : "deleted"}}),
+      revision);
+  for (const std::int64_t id : gone) project.remove_node(edit, id);
+  for (const auto& [scan_id, membership] : changed)
+    put_membership(project, edit, scan_id, membership);
+  refresh_figures(project, edit, tree, figures);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"nodes", gone}}));
+  return {command_id, settings.node};
+}
+
+}  // namespace scanbench::modeling

@@ -1,0 +1,275 @@
+// The segmentation's commands on a project: regions grown into a selection,
+// committed as objects, the tree edited, and every change undone and redone
+// exactly, across processes, for a long random session too.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "modeling/scan_layers.hpp"
+#include "modeling/segment_commands.hpp"
+#include "project_test_support.hpp"
+#include "segmentation/room_scene.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::ScratchDir;
+using ::testing::HasSubstr;
+
+// A project holding the room of tests/segmentation/room_scene.hpp with its
+// geometry; returns the scan's id.
+std::int64_t store_room(Project& project) {
+  const test::RoomScan& room = test::shared_room();
+  const std::int64_t id = test::insert_committed(project, room.scan);
+  Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const EncodedLayer& layer : encode_geometry(room.geometry))
+    project.put_layer(edit, id, layer);
+  edit.commit("{}");
+  return id;
+}
+
+// The pixel of the room looking at azimuth / elevation [deg] (0.5° grid).
+std::pair<int, int> pixel_at(double azimuth_deg, double elevation_deg) {
+  return {static_cast<int>(std::lround((30.0 - elevation_deg) / 0.5)),
+          static_cast<int>(std::lround((azimuth_deg + 180.0) / 0.5 - 0.5)) % 720};
+}
+
+SelectSettings select_at(std::int64_t scan, double azimuth_deg, double elevation_deg,
+                         SelectMode mode = SelectMode::kReplace,
+                         segmentation::Channel channel = segmentation::Channel::kNormal) {
+  SelectSettings settings;
+  settings.scan_id = scan;
+  std::tie(settings.seed_row, settings.seed_col) = pixel_at(azimuth_deg, elevation_deg);
+  settings.mode = mode;
+  settings.grow = segmentation::default_grow_settings(channel);
+  return settings;
+}
+
+std::size_t count_owned(const Project& project, std::int64_t scan, std::uint32_t owner) {
+  const auto membership =
+      project.load_layer<std::uint32_t>(scan, layer::kMembership, ElementType::kU32);
+  if (!membership) return owner == 0 ? test::shared_room().scan.pixel_count() : 0;
+  return static_cast<std::size_t>(std::count(membership->begin(), membership->end(), owner));
+}
+
+// Everything a segmentation session changes: the tree and each scan's
+// selection and membership, bit for bit.
+std::string state_of(const Project& project) {
+  std::ostringstream out;
+  for (const ObjectNode& n : project.object_nodes()) {
+    out << n.id << '|' << n.name << '|' << static_cast<int>(n.kind) << '|' << n.parent.value_or(-1)
+        << '|' << n.hidden << '|' << n.points << '|' << n.mean_footprint_m.value_or(-1.0);
+    if (n.bbox_world)
+      out << '|' << n.bbox_world->min().transpose() << n.bbox_world->max().transpose();
+    out << '\n';
+  }
+  for (const StoredScanSummary& s : project.scans()) {
+    for (const char* name : {layer::kSelection, layer::kMembership}) {
+      out << s.id << name;
+      if (const auto u8 = project.load_layer<std::uint8_t>(
+              s.id, name,
+              name == std::string(layer::kSelection) ? ElementType::kU8 : ElementType::kU32)) {
+        out << std::string(u8->begin(), u8->end());
+      }
+    }
+  }
+  return out.str();
+}
+
+TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
+  const SelectResult selected = select_region(project, select_at(scan, -20, 0));
+  ASSERT_TRUE(selected.seed_open);
+  EXPECT_GT(selected.selected_pixels, 10000u);
+  const NodeCommandResult wall = commit_selection(project, {scan, "wall +x", room.node_id});
+  const std::vector<ObjectNode> nodes = project.object_nodes();
+  ASSERT_EQ(nodes.size(), 2u);
+  EXPECT_EQ(nodes[1].id, wall.node_id);
+  EXPECT_EQ(nodes[1].parent, room.node_id);
+  EXPECT_EQ(nodes[1].points, static_cast<std::int64_t>(selected.selected_pixels));
+  EXPECT_EQ(nodes[0].points, nodes[1].points);  // the group sums its objects
+  ASSERT_TRUE(nodes[1].bbox_world.has_value());
+  // The wall's plane, its reveals 0.3 m deep, and the pixels on its creases.
+  EXPECT_GT(nodes[1].bbox_world->min().x(), 4.9);
+  EXPECT_LT(nodes[1].bbox_world->max().x(), 5.31);
+  EXPECT_GT(*nodes[1].mean_footprint_m, 0.0);
+  EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(wall.node_id)),
+            selected.selected_pixels);
+  EXPECT_FALSE(project.load_layer<std::uint8_t>(scan, layer::kSelection, ElementType::kU8));
+  // The wall's pixels are no longer in the pool: a click on them grows nothing.
+  EXPECT_FALSE(select_region(project, select_at(scan, -20, 0)).seed_open);
+}
+
+TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
+  const ScratchDir dir;
+  std::int64_t scan = 0;
+  std::size_t wall_only = 0;
+  std::size_t committed = 0;
+  std::string before_commit;
+  {
+    Project project = Project::create(dir / "p.sbproj");
+    scan = store_room(project);
+    wall_only = select_region(project, select_at(scan, -20, 0)).selected_pixels;
+    const SelectResult both = select_region(project, select_at(scan, 0, -45, SelectMode::kAdd));
+    EXPECT_GT(both.selected_pixels, wall_only);  // the floor joined
+    // The floor's region also holds the pixels on its crease with the wall.
+    const SelectResult back =
+        select_region(project, select_at(scan, 0, -45, SelectMode::kSubtract));
+    EXPECT_LE(back.selected_pixels, wall_only);
+    EXPECT_GT(back.selected_pixels, wall_only * 98 / 100);
+    committed = back.selected_pixels;
+    before_commit = state_of(project);
+    commit_selection(project, {scan, "wall", std::nullopt});
+  }
+  {
+    Project project = Project::open(dir / "p.sbproj");
+    ASSERT_TRUE(project.undo().has_value());
+    EXPECT_EQ(state_of(project), before_commit);
+  }
+  Project project = Project::open(dir / "p.sbproj");
+  ASSERT_TRUE(project.redo().has_value());
+  EXPECT_EQ(project.object_nodes().size(), 1u);
+  EXPECT_EQ(project.object_nodes()[0].points, static_cast<std::int64_t>(committed));
+}
+
+TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
+  const std::size_t floor = select_region(project, select_at(scan, 0, -45)).selected_pixels;
+  const NodeCommandResult object = commit_selection(project, {scan, "floor", room.node_id});
+  delete_node(project, {room.node_id, DeletedPoints::kDeleted});
+  EXPECT_TRUE(project.object_nodes().empty());  // the group and the floor in it
+  EXPECT_EQ(count_owned(project, scan, kDeletedPoints), floor);
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(object.node_id)), floor);
+  delete_node(project, {object.node_id, DeletedPoints::kToPool});
+  EXPECT_EQ(project.object_nodes().size(), 1u);
+  EXPECT_EQ(project.object_nodes()[0].points, 0);
+  EXPECT_TRUE(select_region(project, select_at(scan, 0, -45)).seed_open);
+}
+
+TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const NodeCommandResult site = group_nodes(project, {"site", std::nullopt, {}});
+  const NodeCommandResult hall = group_nodes(project, {"hall", site.node_id, {}});
+  const std::int64_t revision = project.revision();
+  const auto refused = [&](auto&& command, const char* expected) {
+    try {
+      command();
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const core::InputError& error) {
+      EXPECT_THAT(error.what(), HasSubstr(expected));
+    }
+    EXPECT_EQ(project.revision(), revision) << expected;
+  };
+  SelectSettings outside = select_at(scan, 0, 0);
+  outside.seed_row = 180;
+  refused([&] { select_region(project, outside); }, "outside the 180 × 720 grid");
+  refused([&] { commit_selection(project, {scan, "wall", std::nullopt}); }, "selection is empty");
+  refused([&] { commit_selection(project, {scan, "", std::nullopt}); }, "needs a name");
+  refused([&] { group_nodes(project, {"x", 99, {}}); }, "node 99");
+  refused(
+      [&] {
+        edit_node(project, {site.node_id, std::nullopt, std::nullopt, hall.node_id});
+      },
+      "below itself");
+  refused([&] { delete_node(project, {42, DeletedPoints::kToPool}); }, "node 42");
+}
+
+std::int64_t newest_done(const Project& project) {
+  std::int64_t newest = 0;
+  for (const CommandRecord& c : project.history()) {
+    if (c.state == CommandState::kDone) newest = c.id;
+  }
+  return newest;
+}
+
+// The property: a long random session of every operation, then undo until
+// the session's first command is gone, leaves the state it began with.
+TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
+  const ScratchDir scratch;
+  // fsync is the cost of each command; tmpfs makes the thousand cheap.
+  const std::filesystem::path shm = "/dev/shm";
+  const std::filesystem::path file =
+      std::filesystem::is_directory(shm)
+          ? shm / ("scanbench-property-" + std::to_string(::getpid()) + ".sbproj")
+          : scratch / "p.sbproj";
+  remove_project_files(file);
+  Project project = Project::create(file);
+  const std::int64_t scan = store_room(project);
+  const std::int64_t baseline = project.history().back().id;
+  const std::string initial = state_of(project);
+  std::mt19937 random(2026);
+  const auto pick = [&](int n) { return std::uniform_int_distribution<int>(0, n - 1)(random); };
+  int applied = 0, refused = 0;
+  for (int k = 0; k < 1000; ++k) {
+    const std::vector<ObjectNode> nodes = project.object_nodes();
+    const auto some_node = [&] {
+      return nodes[static_cast<std::size_t>(pick(static_cast<int>(nodes.size())))].id;
+    };
+    try {
+      switch (pick(nodes.empty() ? 4 : 9)) {
+        case 0:
+        case 1:
+        case 2: {
+          SelectSettings s =
+              select_at(scan, pick(360) - 180.0, pick(90) - 60.0, static_cast<SelectMode>(pick(3)),
+                        static_cast<segmentation::Channel>(pick(4)));
+          select_region(project, s);
+          break;
+        }
+        case 3:
+          if (pick(2))
+            commit_selection(project, {scan, "object " + std::to_string(k), std::nullopt});
+          else
+            group_nodes(project, {"group " + std::to_string(k), std::nullopt, {}});
+          break;
+        case 4:
+          group_nodes(project, {"group " + std::to_string(k), std::nullopt, {some_node()}});
+          break;
+        case 5:
+          edit_node(project,
+                    {some_node(), "renamed " + std::to_string(k), pick(2) == 0, std::nullopt});
+          break;
+        case 6:
+          edit_node(project, {some_node(), std::nullopt, std::nullopt,
+                              std::optional<std::int64_t>(some_node())});
+          break;
+        case 7:
+          delete_node(project,
+                      {some_node(), pick(2) ? DeletedPoints::kToPool : DeletedPoints::kDeleted});
+          break;
+        default:
+          if (pick(2) && newest_done(project) > baseline) {
+            project.undo();
+          } else {
+            project.redo();
+          }
+          break;
+      }
+      ++applied;
+    } catch (const core::InputError&) {
+      ++refused;  // a parent that is an object, a cycle, an empty selection: refused, unwritten
+    }
+  }
+  EXPECT_GT(applied, 700);
+  while (newest_done(project) > baseline) ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(state_of(project), initial);
+  remove_project_files(file);
+  RecordProperty("refused", refused);
+}
+
+}  // namespace
+}  // namespace scanbench::modeling
