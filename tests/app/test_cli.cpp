@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -75,6 +76,79 @@ TEST(Cli, ObjectsPrintsTheTreeAsATableOrJson) {
   EXPECT_NE(run_cli(dir, {"objects", (dir / "bare.sbproj").string()}).out.find("no objects"),
             std::string::npos);
   EXPECT_EQ(run_cli(dir, {"objects", fixture("good/ptx/tiny_color.ptx").string()}).exit_code, 2);
+}
+
+// A project of two_scans.ptx with its geometry, and a script file.
+std::filesystem::path segmentable_project(const ScratchDir& dir) {
+  const std::filesystem::path project = dir / "segment.sbproj";
+  EXPECT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  EXPECT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
+  return project;
+}
+
+std::filesystem::path write_script(const ScratchDir& dir, const std::string& name,
+                                   const std::string& text) {
+  const std::filesystem::path file = dir / name;
+  std::ofstream(file) << text;
+  return file;
+}
+
+TEST(Cli, SegmentScriptBuildsTheTreeAndEachOpIsUndoable) {
+  ScratchDir dir;
+  const std::filesystem::path project = segmentable_project(dir);
+  const std::filesystem::path script = write_script(dir, "ops.json", R"json({"scan": 1, "ops": [
+    {"op": "group", "name": "site"},
+    {"op": "lasso", "points": [[-0.5, -0.5], [3.5, -0.5], [3.5, 2.5], [-0.5, 2.5]]},
+    {"op": "grow", "seed": [0, 0], "channel": "range", "tolerance": 50},
+    {"op": "commit", "name": "wall", "parent": "site"},
+    {"op": "rename", "node": "wall", "name": "wall south"}]})json");
+  const CliResult run =
+      run_cli(dir, {"segment", project.string(), "--script", script.string(), "--json"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json ops = nlohmann::json::parse(run.out)["ops"];
+  ASSERT_EQ(ops.size(), 5u);
+  EXPECT_TRUE(ops[1]["command"].is_null());  // a lasso is the tool's state, not a change
+  EXPECT_EQ(ops[2]["result"]["selected_pixels"], 12);
+  const auto nodes = [&] {
+    return nlohmann::json::parse(
+        run_cli(dir, {"objects", project.string(), "--json"}).out)["nodes"];
+  };
+  ASSERT_EQ(nodes().size(), 2u);
+  EXPECT_EQ(nodes()[1]["name"], "wall south");
+  EXPECT_EQ(nodes()[1]["points"], 12);
+  EXPECT_EQ(nodes()[0]["points"], 12);  // the group sums its objects
+  // Each op is a command of its own, undone from other processes.
+  ASSERT_EQ(run_cli(dir, {"undo", project.string()}).exit_code, 0);
+  EXPECT_EQ(nodes()[1]["name"], "wall");
+  ASSERT_EQ(run_cli(dir, {"undo", project.string()}).exit_code, 0);
+  EXPECT_EQ(nodes().size(), 1u);
+}
+
+TEST(Cli, ARefusedSegmentScriptLeavesTheTreeAsItWas) {
+  ScratchDir dir;
+  const std::filesystem::path project = segmentable_project(dir);
+  const std::string before = run_cli(dir, {"objects", project.string(), "--json"}).out;
+  // Refused while it runs: its first two ops are taken back.
+  const std::filesystem::path late = write_script(dir, "late.json", R"json({"ops": [
+    {"op": "group", "name": "site"},
+    {"op": "grow", "seed": [0, 0], "channel": "range", "tolerance": 50},
+    {"op": "commit", "name": "wall", "parent": "no such group"}]})json");
+  const CliResult refused = run_cli(dir, {"segment", project.string(), "--script", late.string()});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("op 3 (commit)"), std::string::npos) << refused.err;
+  EXPECT_EQ(run_cli(dir, {"objects", project.string(), "--json"}).out, before);
+  // Refused before it runs: bad JSON, an unknown op, a seed off the grid.
+  for (const std::string& text :
+       {std::string("{\"ops\": ["), std::string(R"({"ops": [{"op": "paint"}]})"),
+        std::string(R"({"ops": [{"op": "grow", "seed": [0, 99]}]})")}) {
+    const std::filesystem::path bad = write_script(dir, "bad.json", text);
+    const CliResult result = run_cli(dir, {"segment", project.string(), "--script", bad.string()});
+    EXPECT_EQ(result.exit_code, 2) << text;
+    EXPECT_NE(result.err.find("bad.json"), std::string::npos) << result.err;
+    EXPECT_EQ(run_cli(dir, {"objects", project.string(), "--json"}).out, before) << text;
+  }
 }
 
 TEST(Cli, ImportThenInfoJsonDescribesEveryScan) {

@@ -1,0 +1,56 @@
+// scanbench segment PROJECT --script OPS.json [--json]
+#include <fmt/core.h>
+
+#include <memory>
+#include <string>
+
+#include "app/commands.hpp"
+#include "modeling/segment_script.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct SegmentOptions {
+  std::string project;
+  std::string script;
+  bool json = false;
+};
+
+void run_segment(const SegmentOptions& options) {
+  modeling::Project project = modeling::Project::open(options.project);
+  const modeling::SegmentScriptResult result =
+      modeling::run_segment_script(project, options.script);
+  if (options.json) {
+    fmt::print("{}\n", nlohmann::json{{"ops", result.ops}}.dump(
+                           2, ' ', false, nlohmann::json::error_handler_t::replace));
+    return;
+  }
+  for (std::size_t k = 0; k < result.ops.size(); ++k) {
+    const nlohmann::json& op = result.ops[k];
+    fmt::print("{:>4}  {:<9} {:>8}  {}\n", k + 1, op["op"].get<std::string>(),
+               op["command"].is_null() ? std::string("-") : op["command"].dump(),
+               op["result"].dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  }
+  fmt::print("{} op(s) applied to {}; `scanbench objects` shows the tree\n", result.ops.size(),
+             options.project);
+}
+
+}  // namespace
+
+void add_segment_command(CLI::App& app) {
+  auto options = std::make_shared<SegmentOptions>();
+  CLI::App* command = app.add_subcommand(
+      "segment",
+      "Segment scans into the object tree from a script of the workbench's operations (lasso, "
+      "barrier, grow, add, subtract, commit, group, rename, hide, show, reparent, delete, "
+      "undo, redo); each change is one undoable command. A refused script changes nothing.");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--script", options->script, "The operations, as JSON (docs/segmentation.md)")
+      ->required();
+  command->add_flag("--json", options->json, "Print one JSON object");
+  command->callback([options] { run_segment(*options); });
+}
+
+}  // namespace scanbench::app

@@ -1,0 +1,390 @@
+#include "modeling/segment_script.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "modeling/segment_commands.hpp"
+
+namespace scanbench::modeling {
+
+namespace {
+
+constexpr std::uintmax_t kMaxScriptBytes = 16u << 20;
+
+// One op of the file, checked and typed.
+struct Op {
+  std::string name;
+  std::optional<std::int64_t> scan;
+  segmentation::Polyline points;                   // lasso, barrier
+  Eigen::Vector2d seed = Eigen::Vector2d::Zero();  // grow, add, subtract
+  segmentation::GrowSettings grow;
+  std::string text;                      // commit, group, rename: the name
+  nlohmann::json node;                   // a NODE reference
+  std::optional<nlohmann::json> parent;  // given: a NODE or null
+  std::vector<nlohmann::json> children;  // group
+  DeletedPoints deleted_points = DeletedPoints::kToPool;  // delete
+};
+
+// Where in the script: "op 3 (grow)".
+std::string where(std::size_t index, const std::string& name) {
+  return "op " + std::to_string(index + 1) + (name.empty() ? "" : " (" + name + ")");
+}
+
+[[noreturn]] void refuse(const std::string& file, const std::string& at,
+                         const std::string& problem) {
+  core::FilePosition position;
+  position.detail = at;
+  throw core::InputError(file, position, problem);
+}
+
+// Reads the parts of one op; `bad` throws naming the op.
+class OpReader {
+ public:
+  OpReader(const nlohmann::json& json, std::string file, std::string at)
+      : json_(json), file_(std::move(file)), at_(std::move(at)) {}
+
+  [[noreturn]] void bad(const std::string& problem) const { refuse(file_, at_, problem); }
+
+  bool has(const char* key) const { return json_.contains(key); }
+
+  std::string text(const char* key) const {
+    if (!json_.contains(key) || !json_[key].is_string())
+      bad(std::string("key \"") + key + "\" must be a string");
+    return json_[key].get<std::string>();
+  }
+
+  double number(const char* key) const {
+    if (!json_[key].is_number()) bad(std::string("key \"") + key + "\" must be a number");
+    const double value = json_[key].get<double>();
+    if (!std::isfinite(value)) bad(std::string("key \"") + key + "\" is not finite");
+    return value;
+  }
+
+  Eigen::Vector2d point(const nlohmann::json& p, const char* key) const {
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
+      bad(std::string("key \"") + key + "\" needs points [x, y]");
+    }
+    const Eigen::Vector2d v(p[0].get<double>(), p[1].get<double>());
+    if (!v.allFinite()) bad(std::string("key \"") + key + "\" holds a point that is not finite");
+    return v;
+  }
+
+  segmentation::Polyline points(std::size_t at_least) const {
+    if (!json_.contains("points") || !json_["points"].is_array())
+      bad("key \"points\" must be an array of [x, y]");
+    segmentation::Polyline line;
+    for (const nlohmann::json& p : json_["points"]) line.push_back(point(p, "points"));
+    if (line.size() < at_least)
+      bad("key \"points\" needs at least " + std::to_string(at_least) + " points");
+    return line;
+  }
+
+  nlohmann::json node(const char* key, bool null_allowed) const {
+    if (!json_.contains(key)) bad(std::string("key \"") + key + "\" is missing");
+    const nlohmann::json& value = json_[key];
+    if (value.is_number_integer() || value.is_string() || (null_allowed && value.is_null()))
+      return value;
+    bad(std::string("key \"") + key + "\" must be a node id or name" +
+        (null_allowed ? ", or null" : ""));
+  }
+
+  const nlohmann::json& json() const { return json_; }
+
+ private:
+  const nlohmann::json& json_;
+  std::string file_;
+  std::string at_;
+};
+
+void read_grow(const OpReader& in, Op& op) {
+  if (!in.has("seed")) in.bad("key \"seed\" is missing");
+  op.seed = in.point(in.json()["seed"], "seed");
+  segmentation::Channel channel = segmentation::Channel::kNormal;
+  if (in.has("channel")) {
+    const std::optional<segmentation::Channel> named =
+        segmentation::channel_from_name(in.text("channel"));
+    if (!named)
+      in.bad("unknown channel \"" + in.text("channel") + "\" (range, color, intensity, normal)");
+    channel = *named;
+  }
+  op.grow = segmentation::default_grow_settings(channel);
+  if (in.has("tolerance")) {
+    op.grow.tolerance = in.number("tolerance");
+    if (op.grow.tolerance <= 0.0) in.bad("key \"tolerance\" must be positive");
+  }
+}
+
+Op read_op(const nlohmann::json& json, std::size_t index, const std::string& file) {
+  if (!json.is_object() || !json.contains("op") || !json["op"].is_string()) {
+    refuse(file, where(index, ""), "an op is an object with a string \"op\"");
+  }
+  Op op;
+  op.name = json["op"].get<std::string>();
+  const OpReader in(json, file, where(index, op.name));
+  if (in.has("scan")) {
+    if (!json["scan"].is_number_integer()) in.bad("key \"scan\" must be a scan id");
+    op.scan = json["scan"].get<std::int64_t>();
+  }
+  if (op.name == "lasso") {
+    op.points = in.points(3);
+  } else if (op.name == "barrier") {
+    op.points = in.points(1);
+  } else if (op.name == "grow" || op.name == "add" || op.name == "subtract") {
+    read_grow(in, op);
+  } else if (op.name == "commit" || op.name == "group") {
+    op.text = in.text("name");
+    if (in.has("parent")) op.parent = in.node("parent", true);
+    if (op.name == "group" && in.has("children")) {
+      if (!json["children"].is_array()) in.bad("key \"children\" must be an array of nodes");
+      for (std::size_t k = 0; k < json["children"].size(); ++k) {
+        const nlohmann::json& child = json["children"][k];
+        if (!child.is_number_integer() && !child.is_string())
+          in.bad("key \"children\" must hold node ids or names");
+        op.children.push_back(child);
+      }
+    }
+  } else if (op.name == "rename") {
+    op.node = in.node("node", false);
+    op.text = in.text("name");
+  } else if (op.name == "hide" || op.name == "show") {
+    op.node = in.node("node", false);
+  } else if (op.name == "reparent") {
+    op.node = in.node("node", false);
+    op.parent = in.node("parent", true);
+  } else if (op.name == "delete") {
+    op.node = in.node("node", false);
+    const std::string points = in.has("points") ? in.text("points") : "pool";
+    if (points != "pool" && points != "deleted")
+      in.bad("key \"points\" must be \"pool\" or \"deleted\"");
+    op.deleted_points = points == "pool" ? DeletedPoints::kToPool : DeletedPoints::kDeleted;
+  } else if (op.name != "clear" && op.name != "undo" && op.name != "redo") {
+    in.bad("unknown op \"" + op.name + "\"");
+  }
+  return op;
+}
+
+nlohmann::json read_script(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) refuse(name, "", "is not a regular file");
+  if (std::filesystem::file_size(file, error) > kMaxScriptBytes)
+    refuse(name, "", "is larger than 16 MB");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw core::RuntimeFailure(name, {}, "cannot read the script");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    return nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::parse_error& e) {
+    core::FilePosition position;
+    position.detail = "byte " + std::to_string(e.byte);
+    throw core::InputError(name, position, "not JSON");
+  }
+}
+
+// The script's state between ops, and what it did to the journal.
+class Runner {
+ public:
+  Runner(Project& project, std::string file) : project_(project), file_(std::move(file)) {
+    const std::vector<StoredScanSummary> scans = project.scans();
+    if (!scans.empty()) scan_ = scans.front().id;
+  }
+
+  void set_default_scan(std::int64_t scan) { scan_ = scan; }
+
+  nlohmann::json apply(const Op& op, const std::string& at);
+  void roll_back() noexcept;
+
+ private:
+  std::int64_t scan_of(const Op& op, const std::string& at) const;
+  std::int64_t node_of(const nlohmann::json& reference, const std::string& at) const;
+  std::optional<std::int64_t> parent_of(const nlohmann::json& reference,
+                                        const std::string& at) const;
+  void check_points(const segmentation::Polyline& line, std::int64_t scan,
+                    const std::string& at) const;
+  nlohmann::json made(std::int64_t command_id, nlohmann::json result) {
+    actions_.push_back({Action::kMade, command_id});
+    return {{"command", command_id}, {"result", std::move(result)}};
+  }
+
+  struct Action {
+    enum Kind { kMade, kUndid, kRedid } kind;
+    std::int64_t command_id;
+  };
+
+  Project& project_;
+  std::string file_;
+  std::optional<std::int64_t> scan_;
+  segmentation::Constraints constraints_;
+  std::vector<Action> actions_;
+};
+
+std::int64_t Runner::scan_of(const Op& op, const std::string& at) const {
+  const std::optional<std::int64_t> scan = op.scan ? op.scan : scan_;
+  if (!scan) refuse(file_, at, "the project has no scan");
+  for (const StoredScanSummary& stored : project_.scans()) {
+    if (stored.id == *scan) return *scan;
+  }
+  refuse(file_, at, "no scan with id " + std::to_string(*scan));
+}
+
+std::int64_t Runner::node_of(const nlohmann::json& reference, const std::string& at) const {
+  if (reference.is_number_integer()) return reference.get<std::int64_t>();
+  const std::string name = reference.get<std::string>();
+  std::optional<std::int64_t> found;
+  for (const ObjectNode& node : project_.object_nodes()) {
+    if (node.name != name) continue;
+    if (found) refuse(file_, at, "more than one node is called \"" + name + "\": use its id");
+    found = node.id;
+  }
+  if (!found) refuse(file_, at, "no node is called \"" + name + "\"");
+  return *found;
+}
+
+std::optional<std::int64_t> Runner::parent_of(const nlohmann::json& reference,
+                                              const std::string& at) const {
+  if (reference.is_null()) return std::nullopt;
+  return node_of(reference, at);
+}
+
+void Runner::check_points(const segmentation::Polyline& line, std::int64_t scan,
+                          const std::string& at) const {
+  for (const StoredScanSummary& stored : project_.scans()) {
+    if (stored.id != scan) continue;
+    const double rows = static_cast<double>(stored.summary.rows);
+    const double columns = static_cast<double>(stored.summary.columns);
+    for (const Eigen::Vector2d& v : line) {
+      if (v.x() < -columns || v.x() > 2 * columns || v.y() < -rows || v.y() > 2 * rows) {
+        refuse(file_, at,
+               "point (" + std::to_string(v.x()) + ", " + std::to_string(v.y()) +
+                   ") lies more than a grid size away from the scan's grid");
+      }
+    }
+    return;
+  }
+  refuse(file_, at, "no scan with id " + std::to_string(scan));
+}
+
+nlohmann::json Runner::apply(const Op& op, const std::string& at) {
+  if (op.name == "lasso" || op.name == "barrier") {
+    const std::int64_t scan = scan_of(op, at);
+    check_points(op.points, scan, at);
+    if (op.name == "lasso")
+      constraints_.lasso = op.points;
+    else
+      constraints_.barriers.push_back(op.points);
+    return {{"command", nullptr}, {"result", {{"points", op.points.size()}}}};
+  }
+  if (op.name == "clear") {
+    constraints_ = {};
+    return {{"command", nullptr}, {"result", nlohmann::json::object()}};
+  }
+  if (op.name == "grow" || op.name == "add" || op.name == "subtract") {
+    SelectSettings s;
+    s.scan_id = scan_of(op, at);
+    s.seed_col = static_cast<int>(std::llround(std::clamp(op.seed.x(), -1.0, 1e9)));
+    s.seed_row = static_cast<int>(std::llround(std::clamp(op.seed.y(), -1.0, 1e9)));
+    s.mode = op.name == "grow"  ? SelectMode::kReplace
+             : op.name == "add" ? SelectMode::kAdd
+                                : SelectMode::kSubtract;
+    s.grow = op.grow;
+    s.constraints = constraints_;
+    const SelectResult r = select_region(project_, s);
+    return made(r.command_id, {{"region_pixels", r.region_pixels},
+                               {"selected_pixels", r.selected_pixels},
+                               {"seed_open", r.seed_open}});
+  }
+  if (op.name == "commit") {
+    const std::optional<std::int64_t> parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
+    const NodeCommandResult r = commit_selection(project_, {scan_of(op, at), op.text, parent});
+    return made(r.command_id, {{"node", r.node_id}});
+  }
+  if (op.name == "group") {
+    GroupSettings s{op.text, op.parent ? parent_of(*op.parent, at) : std::nullopt, {}};
+    for (const nlohmann::json& child : op.children) s.children.push_back(node_of(child, at));
+    const NodeCommandResult r = group_nodes(project_, s);
+    return made(r.command_id, {{"node", r.node_id}});
+  }
+  if (op.name == "rename" || op.name == "hide" || op.name == "show" || op.name == "reparent") {
+    NodeEdit edit;
+    edit.node = node_of(op.node, at);
+    if (op.name == "rename") edit.name = op.text;
+    if (op.name == "hide" || op.name == "show") edit.hidden = op.name == "hide";
+    if (op.name == "reparent") edit.parent = parent_of(*op.parent, at);
+    const NodeCommandResult r = edit_node(project_, edit);
+    return made(r.command_id, {{"node", r.node_id}});
+  }
+  if (op.name == "delete") {
+    const NodeCommandResult r = delete_node(project_, {node_of(op.node, at), op.deleted_points});
+    return made(r.command_id, {{"node", r.node_id}});
+  }
+  const bool undo = op.name == "undo";
+  const std::optional<CommandRecord> changed = undo ? project_.undo() : project_.redo();
+  if (!changed) refuse(file_, at, undo ? "nothing to undo" : "nothing to redo");
+  actions_.push_back({undo ? Action::kUndid : Action::kRedid, changed->id});
+  return {{"command", changed->id}, {"result", {{undo ? "undid" : "redid", changed->name}}}};
+}
+
+// Takes back what the script did, newest first: its commands undone, its
+// undos redone, its redos undone. An undo the script made before one of its
+// own commands cannot come back (that command ended the redo chain); the
+// rest still is taken back.
+void Runner::roll_back() noexcept {
+  try {
+    for (auto action = actions_.rbegin(); action != actions_.rend(); ++action) {
+      if (action->kind == Action::kUndid) {
+        project_.redo();
+      } else {
+        project_.undo();
+      }
+    }
+  } catch (...) {  // the error being reported matters more than a failed roll-back
+  }
+  actions_.clear();
+}
+
+}  // namespace
+
+SegmentScriptResult run_segment_script(Project& project, const std::filesystem::path& script) {
+  const std::string file = script.string();
+  const nlohmann::json document = read_script(script);
+  if (!document.is_object() || !document.contains("ops") || !document["ops"].is_array()) {
+    refuse(file, "", "a script is an object with an array \"ops\"");
+  }
+  std::vector<Op> ops;
+  for (std::size_t k = 0; k < document["ops"].size(); ++k)
+    ops.push_back(read_op(document["ops"][k], k, file));
+  Runner runner(project, file);
+  if (document.contains("scan")) {
+    if (!document["scan"].is_number_integer()) refuse(file, "key \"scan\"", "must be a scan id");
+    runner.set_default_scan(document["scan"].get<std::int64_t>());
+  }
+  SegmentScriptResult result;
+  for (std::size_t k = 0; k < ops.size(); ++k) {
+    const std::string at = where(k, ops[k].name);
+    try {
+      nlohmann::json done = runner.apply(ops[k], at);
+      done["op"] = ops[k].name;
+      result.ops.push_back(std::move(done));
+    } catch (const core::InputError& error) {
+      runner.roll_back();
+      if (!error.file().empty()) throw;
+      // The command's own error names the scan or node; say which op it was.
+      core::FilePosition position = error.position();
+      position.detail = at + (position.detail.empty() ? "" : ", " + position.detail);
+      throw core::InputError(file, position, error.problem());
+    } catch (...) {
+      runner.roll_back();
+      throw;
+    }
+  }
+  return result;
+}
+
+}  // namespace scanbench::modeling
