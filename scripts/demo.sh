@@ -8,12 +8,15 @@
 #   geometry  per-point footprints, normals and mixed-pixel flags
 #   register  coarse (features) + point-to-plane ICP + global refinement
 #   merge     keep masks: each surface from the scan that sampled it most finely
+#   segment   scan 1 into an object tree (campus → buildings → walls, windows,
+#             doors, a roof, a sign; trees → crowns, trunks) from the clicks,
+#             lassos and channels in scripts/campus_segment.json
 #   history   the journal of those commands; undo and redo of the merge
 #   info      table and JSON
 #   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as PLY
 #   bench     raw-scan I/O throughput against PCL's reader
-# Output goes to DEMO_OUT (default: out/demo/). Later stages (segment,
-# render) join this script as they land.
+# Output goes to DEMO_OUT (default: out/demo/). Later stages (render) join
+# this script as they land.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/build.sh"
@@ -45,9 +48,15 @@ phase "register"
 phase "merge"
 "$scanbench" merge "$project"
 
+phase "segment"
+# Each click, commit and group is a command of its own. The click positions
+# are those of the campus at seed 1, the site simulated above.
+"$scanbench" segment "$project" --script "$root/scripts/campus_segment.json"
+"$scanbench" objects "$project"
+
 phase "history"
 # Every stage above is a command in the project's journal; undo takes the
-# merge back (its keep masks are gone), redo restores it exactly.
+# last commit back (the crown returns to the pool), redo restores it exactly.
 "$scanbench" history "$project"
 "$scanbench" undo "$project"
 "$scanbench" redo "$project"
