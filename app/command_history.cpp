@@ -67,6 +67,13 @@ std::string summary(const modeling::CommandRecord& c) {
   if ((c.name == "group" || c.name == "edit") && result.contains("node")) {
     return fmt::format("node {}", result.value("node", 0));
   }
+  if (c.name == "separate" && result.contains("nodes")) {
+    return fmt::format("{} part(s)", result["nodes"].size());
+  }
+  if (c.name == "propose" && result.contains("proposals")) {
+    return fmt::format("{} proposal(s), {} points", result.value("proposals", 0),
+                       result.value("pixels", 0));
+  }
   if (c.name == "delete" && result.contains("nodes")) {
     return fmt::format("{} node(s), points to the {}", result["nodes"].size(),
                        settings.value("points", "pool") == "pool" ? "pool" : "deleted");

@@ -43,7 +43,8 @@ void add_segment_command(CLI::App& app) {
       "segment",
       "Segment scans into the object tree from a script of the workbench's operations (lasso, "
       "barrier, grow, add, subtract, commit, group, rename, hide, show, reparent, delete, "
-      "undo, redo); each change is one undoable command. A refused script changes nothing.");
+      "separate, auto, undo, redo); each change is one undoable command. A refused script "
+      "changes nothing.");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);

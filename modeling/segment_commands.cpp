@@ -187,31 +187,152 @@ nlohmann::json parent_json(std::optional<std::int64_t> parent) {
   return parent ? nlohmann::json(*parent) : nlohmann::json(nullptr);
 }
 
+StoredScanSummary require_scan(const Project& project, std::int64_t scan_id) {
+  for (const StoredScanSummary& stored : project.scans()) {
+    if (stored.id == scan_id) return stored;
+  }
+  refuse("scan " + std::to_string(scan_id), "no such scan");
+}
+
+// 1 where an object owns the pixel or it is deleted: closed to growing.
+std::vector<std::uint8_t> taken_mask(const std::vector<std::uint32_t>& membership) {
+  std::vector<std::uint8_t> taken(membership.size());
+  for (std::size_t i = 0; i < taken.size(); ++i) taken[i] = membership[i] != 0;
+  return taken;
+}
+
+// The scan, its geometry (refused when missing) and the grid a region grows on.
+struct Prepared {
+  acquisition::Scan scan;
+  acquisition::ScanGeometry geometry;
+  segmentation::SegmentationGrid grid;
+};
+
+Prepared prepare(const Project& project, std::int64_t scan_id,
+                 const acquisition::RangeNoise& noise) {
+  Prepared p;
+  p.scan = project.load_scan(scan_id);
+  std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, scan_id);
+  if (!geometry) {
+    refuse("scan " + std::to_string(scan_id), "has no geometry: run `scanbench geometry` first");
+  }
+  p.geometry = std::move(*geometry);
+  segmentation::GridSettings settings;
+  settings.range_noise = noise;
+  p.grid = segmentation::prepare_grid(p.scan, p.geometry, settings);
+  return p;
+}
+
 }  // namespace
+
+SeparateResult separate_object(Project& project, const SeparateSettings& settings) {
+  const std::int64_t revision = project.revision();
+  Tree tree = load_tree(project);
+  const ObjectNode object = require_node(tree, settings.node);
+  if (object.kind != NodeKind::kObject) {
+    refuse("node " + std::to_string(settings.node), "is a group: only objects own pixels");
+  }
+  const acquisition::Scan scan = project.load_scan(settings.scan_id);
+  std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, scan.pixel_count());
+  segmentation::PixelSet owned;
+  for (std::size_t i = 0; i < membership.size(); ++i) {
+    if (membership[i] == static_cast<std::uint32_t>(object.id))
+      owned.push_back(static_cast<std::uint32_t>(i));
+  }
+  const std::vector<segmentation::PixelSet> parts =
+      segmentation::separate(segmentation::grid_shape(scan), owned);
+  SeparateResult result;
+  result.nodes.push_back(object.id);
+  std::vector<ObjectNode> made;
+  std::int64_t next = project.new_node_id();
+  for (std::size_t k = 1; k < parts.size(); ++k) {
+    ObjectNode part = object;
+    part.id = next++;
+    part.name = object.name + " " + std::to_string(k + 1);
+    for (const std::uint32_t p : parts[k]) membership[p] = static_cast<std::uint32_t>(part.id);
+    tree.emplace(part.id, part);
+    made.push_back(part);
+    result.nodes.push_back(part.id);
+  }
+  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
+  Project::Edit edit = project.begin_command(
+      "separate", dump({{"node", settings.node}, {"scan", settings.scan_id}}), revision);
+  for (const ObjectNode& part : made) project.put_node(edit, part);
+  if (!made.empty()) put_membership(project, edit, settings.scan_id, membership);
+  refresh_figures(project, edit, tree, figures);
+  result.command_id = edit.command_id();
+  edit.commit(dump({{"nodes", result.nodes}}));
+  return result;
+}
+
+SeparateResult propose_objects(Project& project, const ProposeSettings& settings) {
+  const std::int64_t revision = project.revision();
+  require_name(settings.group_name);
+  Tree tree = load_tree(project);
+  require_group(tree, settings.parent);
+  const Prepared p = prepare(project, settings.scan_id, settings.range_noise);
+  std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, p.scan.pixel_count());
+  const std::vector<std::uint8_t> open =
+      segmentation::open_pixels(p.grid, {}, taken_mask(membership));
+  const segmentation::ProposalResult proposed =
+      segmentation::propose_regions(p.grid, open, p.geometry.confidence, settings.proposals);
+  ObjectNode group;
+  group.id = project.new_node_id();
+  group.name = settings.group_name;
+  group.kind = NodeKind::kGroup;
+  group.parent = settings.parent;
+  tree.emplace(group.id, group);
+  SeparateResult result;
+  std::vector<ObjectNode> made;
+  for (std::size_t k = 0; k < proposed.regions.size(); ++k) {
+    ObjectNode object;
+    object.id = group.id + 1 + static_cast<std::int64_t>(k);
+    object.name = "proposal " + std::to_string(k + 1);
+    object.parent = group.id;
+    for (const std::uint32_t px : proposed.regions[k])
+      membership[px] = static_cast<std::uint32_t>(object.id);
+    tree.emplace(object.id, object);
+    made.push_back(object);
+    result.nodes.push_back(object.id);
+  }
+  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
+  Project::Edit edit = project.begin_command(
+      "propose",
+      dump({{"scan", settings.scan_id},
+            {"group", settings.group_name},
+            {"parent", parent_json(settings.parent)},
+            {"channel", segmentation::channel_name(settings.proposals.grow.channel)},
+            {"tolerance", settings.proposals.grow.tolerance},
+            {"min_pixels", settings.proposals.min_pixels}}),
+      revision);
+  project.put_node(edit, group);
+  for (const ObjectNode& object : made) project.put_node(edit, object);
+  if (!made.empty()) put_membership(project, edit, settings.scan_id, membership);
+  refresh_figures(project, edit, tree, figures);
+  result.command_id = edit.command_id();
+  edit.commit(dump({{"group", group.id}, {"proposals", made.size()}, {"pixels", proposed.pixels}}));
+  return result;
+}
 
 SelectResult select_region(Project& project, const SelectSettings& settings) {
   const std::int64_t revision = project.revision();
   const std::string where = "scan " + std::to_string(settings.scan_id);
-  const acquisition::Scan scan = project.load_scan(settings.scan_id);
-  if (settings.seed_row < 0 || settings.seed_row >= scan.rows || settings.seed_col < 0 ||
-      settings.seed_col >= scan.columns) {
+  const StoredScanSummary summary = require_scan(project, settings.scan_id);
+  const int rows = summary.summary.rows, columns = summary.summary.columns;
+  if (settings.seed_row < 0 || settings.seed_row >= rows || settings.seed_col < 0 ||
+      settings.seed_col >= columns) {
     refuse(where, "seed (" + std::to_string(settings.seed_row) + ", " +
                       std::to_string(settings.seed_col) + ") is outside the " +
-                      std::to_string(scan.rows) + " × " + std::to_string(scan.columns) + " grid");
+                      std::to_string(rows) + " × " + std::to_string(columns) + " grid");
   }
-  const std::optional<acquisition::ScanGeometry> geometry =
-      load_geometry(project, settings.scan_id);
-  if (!geometry) refuse(where, "has no geometry: run `scanbench geometry` first");
-  segmentation::GridSettings grid_settings;
-  grid_settings.range_noise = settings.range_noise;
-  const segmentation::SegmentationGrid grid =
-      segmentation::prepare_grid(scan, *geometry, grid_settings);
-  const std::vector<std::uint32_t> membership =
-      load_membership(project, settings.scan_id, scan.pixel_count());
-  std::vector<std::uint8_t> taken(membership.size());
-  for (std::size_t i = 0; i < taken.size(); ++i) taken[i] = membership[i] != 0;
-  const std::vector<std::uint8_t> open =
-      segmentation::open_pixels(grid, settings.constraints, taken);
+  const Prepared prepared = prepare(project, settings.scan_id, settings.range_noise);
+  const acquisition::Scan& scan = prepared.scan;
+  const segmentation::SegmentationGrid& grid = prepared.grid;
+  const std::vector<std::uint8_t> open = segmentation::open_pixels(
+      grid, settings.constraints,
+      taken_mask(load_membership(project, settings.scan_id, scan.pixel_count())));
   segmentation::RegionGrower grower(grid);
   const segmentation::GrowResult grown =
       grower.grow(scan.index(settings.seed_row, settings.seed_col), settings.grow, open);

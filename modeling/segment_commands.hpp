@@ -22,6 +22,7 @@
 #include "acquisition/range_noise.hpp"
 #include "modeling/project.hpp"
 #include "segmentation/constraints.hpp"
+#include "segmentation/proposals.hpp"
 #include "segmentation/region_grow.hpp"
 
 namespace scanbench::modeling {
@@ -100,5 +101,34 @@ struct DeleteSettings {
 // Deletes a node with everything below it; its objects' points go back to
 // the pool or are marked deleted.
 NodeCommandResult delete_node(Project& project, const DeleteSettings& settings);
+
+struct SeparateSettings {
+  std::int64_t node = 0;     // an object
+  std::int64_t scan_id = 0;  // the scan whose pixels are split
+};
+
+struct SeparateResult {
+  std::int64_t command_id = 0;
+  std::vector<std::int64_t> nodes;  // the object (its largest part) first, then the new ones
+};
+
+// Splits an object's pixels in one scan into their 8-connected parts: the
+// largest stays the object, each other part becomes a new object beside it
+// ("NAME 2", "NAME 3", …), with all its figures.
+SeparateResult separate_object(Project& project, const SeparateSettings& settings);
+
+struct ProposeSettings {
+  std::int64_t scan_id = 0;
+  std::string group_name = "proposals";  // the group that receives them
+  std::optional<std::int64_t> parent;    // of that group; none: a root
+  segmentation::ProposalSettings proposals;
+  acquisition::RangeNoise range_noise;
+};
+
+// Automatic proposals (segmentation/proposals.hpp) on the scan's pixels still
+// to be segmented, each committed as an object "proposal K" in a new group,
+// for the user to accept (rename, reparent), merge (group) or reject
+// (delete back to the pool). One command: undo takes them all back.
+SeparateResult propose_objects(Project& project, const ProposeSettings& settings);
 
 }  // namespace scanbench::modeling

@@ -24,11 +24,12 @@ struct Op {
   segmentation::Polyline points;                   // lasso, barrier
   Eigen::Vector2d seed = Eigen::Vector2d::Zero();  // grow, add, subtract
   segmentation::GrowSettings grow;
-  std::string text;                      // commit, group, rename: the name
-  nlohmann::json node;                   // a NODE reference
-  std::optional<nlohmann::json> parent;  // given: a NODE or null
-  std::vector<nlohmann::json> children;  // group
+  std::string text;                                       // commit, group, rename: the name
+  nlohmann::json node;                                    // a NODE reference
+  std::optional<nlohmann::json> parent;                   // given: a NODE or null
+  std::vector<nlohmann::json> children;                   // group
   DeletedPoints deleted_points = DeletedPoints::kToPool;  // delete
+  std::size_t min_pixels = segmentation::ProposalSettings{}.min_pixels;  // auto
 };
 
 // Where in the script: "op 3 (grow)".
@@ -163,6 +164,25 @@ Op read_op(const nlohmann::json& json, std::size_t index, const std::string& fil
     if (points != "pool" && points != "deleted")
       in.bad("key \"points\" must be \"pool\" or \"deleted\"");
     op.deleted_points = points == "pool" ? DeletedPoints::kToPool : DeletedPoints::kDeleted;
+  } else if (op.name == "separate") {
+    op.node = in.node("node", false);
+  } else if (op.name == "auto") {
+    op.text = in.has("group") ? in.text("group") : "proposals";
+    if (in.has("parent")) op.parent = in.node("parent", true);
+    const std::optional<segmentation::Channel> channel =
+        in.has("channel") ? segmentation::channel_from_name(in.text("channel"))
+                          : std::optional<segmentation::Channel>(segmentation::Channel::kNormal);
+    if (!channel)
+      in.bad("unknown channel \"" + in.text("channel") + "\" (range, color, intensity, normal)");
+    op.grow = segmentation::default_grow_settings(*channel);
+    if (in.has("tolerance")) {
+      op.grow.tolerance = in.number("tolerance");
+      if (op.grow.tolerance <= 0.0) in.bad("key \"tolerance\" must be positive");
+    }
+    if (in.has("min_pixels")) {
+      if (!json["min_pixels"].is_number_unsigned()) in.bad("key \"min_pixels\" must be a count");
+      op.min_pixels = json["min_pixels"].get<std::size_t>();
+    }
   } else if (op.name != "clear" && op.name != "undo" && op.name != "redo") {
     in.bad("unknown op \"" + op.name + "\"");
   }
@@ -319,6 +339,20 @@ nlohmann::json Runner::apply(const Op& op, const std::string& at) {
     if (op.name == "reparent") edit.parent = parent_of(*op.parent, at);
     const NodeCommandResult r = edit_node(project_, edit);
     return made(r.command_id, {{"node", r.node_id}});
+  }
+  if (op.name == "separate") {
+    const SeparateResult r = separate_object(project_, {node_of(op.node, at), scan_of(op, at)});
+    return made(r.command_id, {{"nodes", r.nodes}});
+  }
+  if (op.name == "auto") {
+    ProposeSettings s;
+    s.scan_id = scan_of(op, at);
+    s.group_name = op.text;
+    s.parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
+    s.proposals.grow = op.grow;
+    s.proposals.min_pixels = op.min_pixels;
+    const SeparateResult r = propose_objects(project_, s);
+    return made(r.command_id, {{"proposals", r.nodes.size()}});
   }
   if (op.name == "delete") {
     const NodeCommandResult r = delete_node(project_, {node_of(op.node, at), op.deleted_points});

@@ -15,6 +15,9 @@
 //      {"op": "hide", "node": NODE}, {"op": "show", "node": NODE},
 //      {"op": "reparent", "node": NODE, "parent": NODE or null},
 //      {"op": "delete", "node": NODE, "points": "pool" or "deleted"},
+//      {"op": "separate", "node": NODE},          an object's parts in the scan
+//      {"op": "auto", "group": "proposals", "parent": NODE,
+//       "channel": "normal", "tolerance": 6, "min_pixels": 200},
 //      {"op": "undo"}, {"op": "redo"}]}
 //
 // Image coordinates: x = column, y = row of the scan's grid (constraints.hpp).

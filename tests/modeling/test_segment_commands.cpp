@@ -158,6 +158,49 @@ TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
   EXPECT_TRUE(select_region(project, select_at(scan, 0, -45)).seed_open);
 }
 
+TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const std::size_t pane = select_region(project, select_at(scan, 0, 8)).selected_pixels;
+  const std::size_t both = select_region(project, select_at(scan, 36, 0, SelectMode::kAdd,
+                                                            segmentation::Channel::kColor))
+                               .selected_pixels;
+  const NodeCommandResult object =
+      commit_selection(project, {scan, "pane and poster", std::nullopt});
+  const SeparateResult parts = separate_object(project, {object.node_id, scan});
+  ASSERT_EQ(parts.nodes.size(), 2u);
+  const std::vector<ObjectNode> nodes = project.object_nodes();
+  ASSERT_EQ(nodes.size(), 2u);
+  EXPECT_EQ(nodes[1].name, "pane and poster 2");
+  EXPECT_EQ(nodes[0].points + nodes[1].points, static_cast<std::int64_t>(both));
+  EXPECT_TRUE(nodes[0].points == static_cast<std::int64_t>(pane) ||
+              nodes[1].points == static_cast<std::int64_t>(pane));
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(project.object_nodes().size(), 1u);
+}
+
+TEST(SegmentCommands, ProposalsCoverThePoolInOneUndoableCommand) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  select_region(project, select_at(scan, 0, -45));
+  const NodeCommandResult floor = commit_selection(project, {scan, "floor", std::nullopt});
+  const std::string before = state_of(project);
+  ProposeSettings settings;
+  settings.scan_id = scan;
+  const SeparateResult proposed = propose_objects(project, settings);
+  ASSERT_GE(proposed.nodes.size(), 5u);  // four walls and the pane at least
+  const std::vector<ObjectNode> nodes = project.object_nodes();
+  EXPECT_EQ(nodes[1].name, "proposals");
+  EXPECT_EQ(nodes[1].kind, NodeKind::kGroup);
+  EXPECT_EQ(nodes[0].id, floor.node_id);
+  EXPECT_EQ(nodes[0].points, static_cast<std::int64_t>(count_owned(
+                                 project, scan, static_cast<std::uint32_t>(floor.node_id))));
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(state_of(project), before);
+}
+
 TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
   const ScratchDir dir;
   Project project = Project::create(dir / "p.sbproj");
@@ -220,7 +263,7 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
       return nodes[static_cast<std::size_t>(pick(static_cast<int>(nodes.size())))].id;
     };
     try {
-      switch (pick(nodes.empty() ? 4 : 9)) {
+      switch (pick(nodes.empty() ? 4 : 11)) {
         case 0:
         case 1:
         case 2: {
@@ -250,6 +293,17 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
         case 7:
           delete_node(project,
                       {some_node(), pick(2) ? DeletedPoints::kToPool : DeletedPoints::kDeleted});
+          break;
+        case 9:
+          separate_object(project, {some_node(), scan});
+          break;
+        case 10:
+          if (pick(10) == 0) {  // a whole scan's proposals: now and then
+            ProposeSettings s;
+            s.scan_id = scan;
+            s.proposals.min_pixels = 2000;
+            propose_objects(project, s);
+          }
           break;
         default:
           if (pick(2) && newest_done(project) > baseline) {
