@@ -236,26 +236,26 @@ std::vector<CommandRecord> Project::history() const {
   return records;
 }
 
-std::optional<CommandRecord> Project::undo() {
+std::optional<CommandRecord> Project::undo(std::optional<std::int64_t> only) {
   assert(sqlite3_get_autocommit(db()) != 0 && "undo while an Edit is open");
   sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
   Edit journal(db(), file_name(), 0, Edit::Kind::kJournal);
   std::optional<CommandRecord> last =
       select_one(db(), file_name(), "WHERE state = 'done' ORDER BY seq DESC LIMIT 1");
-  if (!last || !last->undoable) return std::nullopt;
+  if (!last || !last->undoable || (only && last->id != *only)) return std::nullopt;
   set_state(db(), file_name(), last->id, "undone");
   journal.finish_transaction();
   last->state = CommandState::kUndone;
   return last;
 }
 
-std::optional<CommandRecord> Project::redo() {
+std::optional<CommandRecord> Project::redo(std::optional<std::int64_t> only) {
   assert(sqlite3_get_autocommit(db()) != 0 && "redo while an Edit is open");
   sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
   Edit journal(db(), file_name(), 0, Edit::Kind::kJournal);
   std::optional<CommandRecord> next =
       select_one(db(), file_name(), "WHERE state = 'undone' ORDER BY seq LIMIT 1");
-  if (!next) return std::nullopt;
+  if (!next || (only && next->id != *only)) return std::nullopt;
   set_state(db(), file_name(), next->id, "done");
   journal.finish_transaction();
   next->state = CommandState::kDone;

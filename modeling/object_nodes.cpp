@@ -118,7 +118,7 @@ std::int64_t Project::new_node_id() const {
 
 void Project::put_node(Edit& edit, const ObjectNode& node) {
   check_edit(edit);
-  assert(node.id > 0 && "node ids are positive");
+  assert(node.id > 0 && node.id < kDeletedPoints && "node ids fit a membership layer");
   assert(node.parent != node.id && "a node is not its own parent");
   assert(node.points >= 0 && "a point count is not negative");
   assert((!node.mean_footprint_m || std::isfinite(*node.mean_footprint_m)) && "finite footprint");

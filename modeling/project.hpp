@@ -292,12 +292,13 @@ class Project {
 
   // Marks the newest done command undone, in one transaction, and returns
   // it; none when there is nothing to undo: no done command, or the newest
-  // one is what an older project held before it had a journal.
-  std::optional<CommandRecord> undo();
+  // one is what an older project held before it had a journal, or it is not
+  // command `only` (when given: a caller taking back exactly what it did).
+  std::optional<CommandRecord> undo(std::optional<std::int64_t> only = std::nullopt);
 
   // Marks the oldest undone command done again and returns it; none when
-  // nothing was undone.
-  std::optional<CommandRecord> redo();
+  // nothing was undone, or (when `only` is given) it is not command `only`.
+  std::optional<CommandRecord> redo(std::optional<std::int64_t> only = std::nullopt);
 
   // The result of the newest done command called `name`, or none.
   std::optional<std::string> latest_result(std::string_view name) const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <unordered_set>
 
 #include "core/errors.hpp"
 #include "modeling/scan_layers.hpp"
@@ -88,11 +89,13 @@ void put_membership(Project& project, Project::Edit& edit, std::int64_t scan_id,
 // What a node's cached figures sum up.
 struct Figures {
   std::int64_t points = 0;
+  std::int64_t with_footprint = 0;  // points of scans that have geometry
   double footprint_sum = 0.0;
   Eigen::AlignedBox3d box;  // starts empty
 
   void add(const Figures& other) {
     points += other.points;
+    with_footprint += other.with_footprint;
     footprint_sum += other.footprint_sum;
     if (!other.box.isEmpty()) box.extend(other.box);
   }
@@ -122,7 +125,10 @@ std::map<std::int64_t, Figures> compute_figures(
         if (owner == 0 || owner == kDeletedPoints) continue;
         Figures& f = own[owner];
         ++f.points;
-        if (geometry) f.footprint_sum += geometry->footprint_m[scan.index(row, col)];
+        if (geometry) {
+          f.footprint_sum += geometry->footprint_m[scan.index(row, col)];
+          ++f.with_footprint;
+        }
         f.box.extend(acquisition::point_in_world(scan, row, col));
       }
     }
@@ -145,8 +151,9 @@ void refresh_figures(Project& project, Project::Edit& edit, const Tree& tree,
     const Figures f = found == figures.end() ? Figures{} : found->second;
     updated.points = f.points;
     updated.mean_footprint_m =
-        f.points > 0 ? std::optional<double>(f.footprint_sum / static_cast<double>(f.points))
-                     : std::nullopt;
+        f.with_footprint > 0
+            ? std::optional<double>(f.footprint_sum / static_cast<double>(f.with_footprint))
+            : std::nullopt;
     updated.bbox_world = f.box.isEmpty() ? std::nullopt : std::optional<Eigen::AlignedBox3d>(f.box);
     const bool same =
         updated.points == node.points && updated.mean_footprint_m == node.mean_footprint_m &&
@@ -185,6 +192,16 @@ nlohmann::json select_json(const SelectSettings& s) {
 
 nlohmann::json parent_json(std::optional<std::int64_t> parent) {
   return parent ? nlohmann::json(*parent) : nlohmann::json(nullptr);
+}
+
+// `count` node ids from the project's next free one; refused when they would
+// reach kDeletedPoints, the largest a membership layer can name.
+std::int64_t fresh_ids(const Project& project, std::size_t count) {
+  const std::int64_t first = project.new_node_id();
+  if (first + static_cast<std::int64_t>(count) > static_cast<std::int64_t>(kDeletedPoints)) {
+    refuse("object tree", "the project has used every node id a membership layer can hold");
+  }
+  return first;
 }
 
 StoredScanSummary require_scan(const Project& project, std::int64_t scan_id) {
@@ -245,7 +262,7 @@ SeparateResult separate_object(Project& project, const SeparateSettings& setting
   SeparateResult result;
   result.nodes.push_back(object.id);
   std::vector<ObjectNode> made;
-  std::int64_t next = project.new_node_id();
+  std::int64_t next = fresh_ids(project, parts.empty() ? 0 : parts.size() - 1);
   for (std::size_t k = 1; k < parts.size(); ++k) {
     ObjectNode part = object;
     part.id = next++;
@@ -279,7 +296,7 @@ SeparateResult propose_objects(Project& project, const ProposeSettings& settings
   const segmentation::ProposalResult proposed =
       segmentation::propose_regions(p.grid, open, p.geometry.confidence, settings.proposals);
   ObjectNode group;
-  group.id = project.new_node_id();
+  group.id = fresh_ids(project, 1 + proposed.regions.size());
   group.name = settings.group_name;
   group.kind = NodeKind::kGroup;
   group.parent = settings.parent;
@@ -369,7 +386,7 @@ NodeCommandResult commit_selection(Project& project, const CommitSettings& setti
   std::vector<std::uint32_t> membership =
       load_membership(project, settings.scan_id, scan.pixel_count());
   ObjectNode node;
-  node.id = project.new_node_id();
+  node.id = fresh_ids(project, 1);
   node.name = settings.name;
   node.parent = settings.parent;
   std::size_t taken = 0;
@@ -401,7 +418,7 @@ NodeCommandResult group_nodes(Project& project, const GroupSettings& settings) {
   Tree tree = load_tree(project);
   require_group(tree, settings.parent);
   ObjectNode group;
-  group.id = project.new_node_id();
+  group.id = fresh_ids(project, 1);
   group.name = settings.name;
   group.kind = NodeKind::kGroup;
   group.parent = settings.parent;
@@ -469,6 +486,7 @@ NodeCommandResult delete_node(Project& project, const DeleteSettings& settings) 
     if (is_at_or_above(tree, settings.node, id)) gone.push_back(id);
   }
   const std::uint32_t replacement = settings.points == DeletedPoints::kToPool ? 0 : kDeletedPoints;
+  const std::unordered_set<std::uint32_t> gone_ids(gone.begin(), gone.end());
   std::map<std::int64_t, std::vector<std::uint32_t>> changed;
   for (const StoredScanSummary& stored : project.scans()) {
     auto membership =
@@ -477,8 +495,7 @@ NodeCommandResult delete_node(Project& project, const DeleteSettings& settings) 
     bool touched = false;
     for (std::uint32_t& owner : *membership) {
       if (owner == 0 || owner == kDeletedPoints) continue;
-      if (std::find(gone.begin(), gone.end(), static_cast<std::int64_t>(owner)) == gone.end())
-        continue;
+      if (!gone_ids.count(owner)) continue;
       owner = replacement;
       touched = true;
     }

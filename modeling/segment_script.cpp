@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -103,21 +104,104 @@ class OpReader {
   std::string at_;
 };
 
-void read_grow(const OpReader& in, Op& op) {
-  if (!in.has("seed")) in.bad("key \"seed\" is missing");
-  op.seed = in.point(in.json()["seed"], "seed");
+constexpr std::size_t kMaxVertices = 10000;  // per lasso or barrier: a hand-drawn line
+
+// Each op and the keys it may have ("op" and "scan" besides): a misspelt
+// key is refused, not silently left at its default.
+const std::map<std::string, std::vector<std::string>>& op_keys() {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"lasso", {"points"}},
+      {"barrier", {"points"}},
+      {"clear", {}},
+      {"grow", {"seed", "channel", "tolerance"}},
+      {"add", {"seed", "channel", "tolerance"}},
+      {"subtract", {"seed", "channel", "tolerance"}},
+      {"commit", {"name", "parent"}},
+      {"group", {"name", "parent", "children"}},
+      {"rename", {"node", "name"}},
+      {"hide", {"node"}},
+      {"show", {"node"}},
+      {"reparent", {"node", "parent"}},
+      {"delete", {"node", "points"}},
+      {"separate", {"node"}},
+      {"auto", {"group", "parent", "channel", "tolerance", "min_pixels"}},
+      {"undo", {}},
+      {"redo", {}}};
+  return keys;
+}
+
+// The channel and tolerance of grow, add, subtract and auto.
+segmentation::GrowSettings read_channel(const OpReader& in) {
   segmentation::Channel channel = segmentation::Channel::kNormal;
   if (in.has("channel")) {
     const std::optional<segmentation::Channel> named =
         segmentation::channel_from_name(in.text("channel"));
-    if (!named)
+    if (!named) {
       in.bad("unknown channel \"" + in.text("channel") + "\" (range, color, intensity, normal)");
+    }
     channel = *named;
   }
-  op.grow = segmentation::default_grow_settings(channel);
+  segmentation::GrowSettings grow = segmentation::default_grow_settings(channel);
   if (in.has("tolerance")) {
-    op.grow.tolerance = in.number("tolerance");
-    if (op.grow.tolerance <= 0.0) in.bad("key \"tolerance\" must be positive");
+    grow.tolerance = in.number("tolerance");
+    if (grow.tolerance <= 0.0) in.bad("key \"tolerance\" must be positive");
+  }
+  return grow;
+}
+
+std::string read_name(const OpReader& in) {
+  std::string name = in.text("name");
+  if (name.empty()) in.bad("key \"name\" is empty");
+  return name;
+}
+
+// Ops on pixels: lasso, barrier, grow, add, subtract, auto.
+void read_pixel_op(const OpReader& in, Op& op) {
+  if (op.name == "lasso" || op.name == "barrier") {
+    op.points = in.points(op.name == "lasso" ? 3 : 1);
+    if (op.points.size() > kMaxVertices) in.bad("more than 10000 points");
+  } else if (op.name == "auto") {
+    op.text = in.has("group") ? in.text("group") : "proposals";
+    if (op.text.empty()) in.bad("key \"group\" is empty");
+    if (in.has("parent")) op.parent = in.node("parent", true);
+    op.grow = read_channel(in);
+    if (in.has("min_pixels")) {
+      if (!in.json()["min_pixels"].is_number_unsigned())
+        in.bad("key \"min_pixels\" must be a count");
+      op.min_pixels = in.json()["min_pixels"].get<std::size_t>();
+    }
+  } else if (op.name != "clear") {  // grow, add, subtract
+    if (!in.has("seed")) in.bad("key \"seed\" is missing");
+    op.seed = in.point(in.json()["seed"], "seed");
+    op.grow = read_channel(in);
+  }
+}
+
+// Ops on the tree: commit, group, rename, hide, show, reparent, delete, separate.
+void read_tree_op(const OpReader& in, Op& op) {
+  if (op.name == "commit" || op.name == "group" || op.name == "rename") op.text = read_name(in);
+  if (op.name != "commit" && op.name != "group") op.node = in.node("node", false);
+  if (op.name == "commit" || op.name == "group") {
+    if (in.has("parent")) op.parent = in.node("parent", true);
+  } else if (op.name == "reparent") {
+    op.parent = in.node("parent", true);
+  }
+  if (op.name == "group" && in.has("children")) {
+    const nlohmann::json& children = in.json()["children"];
+    if (!children.is_array()) in.bad("key \"children\" must be an array of nodes");
+    for (const nlohmann::json& child : children) {
+      if (!child.is_number_integer() && !child.is_string()) {
+        in.bad("key \"children\" must hold node ids or names");
+      }
+      op.children.push_back(child);
+    }
+  }
+  if (op.name == "delete") {
+    const std::string points = in.has("points") ? in.text("points") : "pool";
+    if (points != "pool" && points != "deleted") {
+      in.bad("key \"points\" must be \"pool\" or \"deleted\"");
+    }
+    op.deleted_points = points == "pool" ? DeletedPoints::kToPool : DeletedPoints::kDeleted;
   }
 }
 
@@ -128,63 +212,25 @@ Op read_op(const nlohmann::json& json, std::size_t index, const std::string& fil
   Op op;
   op.name = json["op"].get<std::string>();
   const OpReader in(json, file, where(index, op.name));
+  const auto known = op_keys().find(op.name);
+  if (known == op_keys().end()) in.bad("unknown op \"" + op.name + "\"");
+  for (const auto& [key, value] : json.items()) {
+    const std::vector<std::string>& allowed = known->second;
+    if (key != "op" && key != "scan" &&
+        std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+      in.bad("unknown key \"" + key + "\"");
+    }
+  }
   if (in.has("scan")) {
     if (!json["scan"].is_number_integer()) in.bad("key \"scan\" must be a scan id");
     op.scan = json["scan"].get<std::int64_t>();
   }
-  if (op.name == "lasso") {
-    op.points = in.points(3);
-  } else if (op.name == "barrier") {
-    op.points = in.points(1);
-  } else if (op.name == "grow" || op.name == "add" || op.name == "subtract") {
-    read_grow(in, op);
-  } else if (op.name == "commit" || op.name == "group") {
-    op.text = in.text("name");
-    if (in.has("parent")) op.parent = in.node("parent", true);
-    if (op.name == "group" && in.has("children")) {
-      if (!json["children"].is_array()) in.bad("key \"children\" must be an array of nodes");
-      for (std::size_t k = 0; k < json["children"].size(); ++k) {
-        const nlohmann::json& child = json["children"][k];
-        if (!child.is_number_integer() && !child.is_string())
-          in.bad("key \"children\" must hold node ids or names");
-        op.children.push_back(child);
-      }
-    }
-  } else if (op.name == "rename") {
-    op.node = in.node("node", false);
-    op.text = in.text("name");
-  } else if (op.name == "hide" || op.name == "show") {
-    op.node = in.node("node", false);
-  } else if (op.name == "reparent") {
-    op.node = in.node("node", false);
-    op.parent = in.node("parent", true);
-  } else if (op.name == "delete") {
-    op.node = in.node("node", false);
-    const std::string points = in.has("points") ? in.text("points") : "pool";
-    if (points != "pool" && points != "deleted")
-      in.bad("key \"points\" must be \"pool\" or \"deleted\"");
-    op.deleted_points = points == "pool" ? DeletedPoints::kToPool : DeletedPoints::kDeleted;
-  } else if (op.name == "separate") {
-    op.node = in.node("node", false);
-  } else if (op.name == "auto") {
-    op.text = in.has("group") ? in.text("group") : "proposals";
-    if (in.has("parent")) op.parent = in.node("parent", true);
-    const std::optional<segmentation::Channel> channel =
-        in.has("channel") ? segmentation::channel_from_name(in.text("channel"))
-                          : std::optional<segmentation::Channel>(segmentation::Channel::kNormal);
-    if (!channel)
-      in.bad("unknown channel \"" + in.text("channel") + "\" (range, color, intensity, normal)");
-    op.grow = segmentation::default_grow_settings(*channel);
-    if (in.has("tolerance")) {
-      op.grow.tolerance = in.number("tolerance");
-      if (op.grow.tolerance <= 0.0) in.bad("key \"tolerance\" must be positive");
-    }
-    if (in.has("min_pixels")) {
-      if (!json["min_pixels"].is_number_unsigned()) in.bad("key \"min_pixels\" must be a count");
-      op.min_pixels = json["min_pixels"].get<std::size_t>();
-    }
-  } else if (op.name != "clear" && op.name != "undo" && op.name != "redo") {
-    in.bad("unknown op \"" + op.name + "\"");
+  static const std::vector<std::string> kPixelOps = {"lasso", "barrier",  "clear", "grow",
+                                                     "add",   "subtract", "auto"};
+  if (std::find(kPixelOps.begin(), kPixelOps.end(), op.name) != kPixelOps.end()) {
+    read_pixel_op(in, op);
+  } else if (op.name != "undo" && op.name != "redo") {
+    read_tree_op(in, op);
   }
   return op;
 }
@@ -219,14 +265,20 @@ class Runner {
   void set_default_scan(std::int64_t scan) { scan_ = scan; }
 
   nlohmann::json apply(const Op& op, const std::string& at);
-  void roll_back() noexcept;
+  // Takes back what the script did; the empty string when all of it was,
+  // else what stays.
+  std::string roll_back() noexcept;
 
  private:
-  std::int64_t scan_of(const Op& op, const std::string& at) const;
+  nlohmann::json apply_pixels(const Op& op, const std::string& at);
+  nlohmann::json apply_tree(const Op& op, const std::string& at);
+  nlohmann::json apply_journal(const Op& op, const std::string& at);
+  // The scan's size, or refused when there is no such scan.
+  StoredScanSummary scan_of(const Op& op, const std::string& at) const;
   std::int64_t node_of(const nlohmann::json& reference, const std::string& at) const;
   std::optional<std::int64_t> parent_of(const nlohmann::json& reference,
                                         const std::string& at) const;
-  void check_points(const segmentation::Polyline& line, std::int64_t scan,
+  void check_points(const segmentation::Polyline& line, const StoredScanSummary& scan,
                     const std::string& at) const;
   nlohmann::json made(std::int64_t command_id, nlohmann::json result) {
     actions_.push_back({Action::kMade, command_id});
@@ -242,14 +294,15 @@ class Runner {
   std::string file_;
   std::optional<std::int64_t> scan_;
   segmentation::Constraints constraints_;
+  std::optional<std::int64_t> constraints_scan_;  // the scan they were drawn on
   std::vector<Action> actions_;
 };
 
-std::int64_t Runner::scan_of(const Op& op, const std::string& at) const {
+StoredScanSummary Runner::scan_of(const Op& op, const std::string& at) const {
   const std::optional<std::int64_t> scan = op.scan ? op.scan : scan_;
   if (!scan) refuse(file_, at, "the project has no scan");
   for (const StoredScanSummary& stored : project_.scans()) {
-    if (stored.id == *scan) return *scan;
+    if (stored.id == *scan) return stored;
   }
   refuse(file_, at, "no scan with id " + std::to_string(*scan));
 }
@@ -273,56 +326,71 @@ std::optional<std::int64_t> Runner::parent_of(const nlohmann::json& reference,
   return node_of(reference, at);
 }
 
-void Runner::check_points(const segmentation::Polyline& line, std::int64_t scan,
+void Runner::check_points(const segmentation::Polyline& line, const StoredScanSummary& scan,
                           const std::string& at) const {
-  for (const StoredScanSummary& stored : project_.scans()) {
-    if (stored.id != scan) continue;
-    const double rows = static_cast<double>(stored.summary.rows);
-    const double columns = static_cast<double>(stored.summary.columns);
-    for (const Eigen::Vector2d& v : line) {
-      if (v.x() < -columns || v.x() > 2 * columns || v.y() < -rows || v.y() > 2 * rows) {
-        refuse(file_, at,
-               "point (" + std::to_string(v.x()) + ", " + std::to_string(v.y()) +
-                   ") lies more than a grid size away from the scan's grid");
-      }
+  const double rows = static_cast<double>(scan.summary.rows);
+  const double columns = static_cast<double>(scan.summary.columns);
+  for (const Eigen::Vector2d& v : line) {
+    if (v.x() < -columns || v.x() > 2 * columns || v.y() < -rows || v.y() > 2 * rows) {
+      refuse(file_, at,
+             "point (" + std::to_string(v.x()) + ", " + std::to_string(v.y()) +
+                 ") lies more than a grid size away from the scan's grid");
     }
-    return;
   }
-  refuse(file_, at, "no scan with id " + std::to_string(scan));
 }
 
-nlohmann::json Runner::apply(const Op& op, const std::string& at) {
-  if (op.name == "lasso" || op.name == "barrier") {
-    const std::int64_t scan = scan_of(op, at);
-    check_points(op.points, scan, at);
-    if (op.name == "lasso")
-      constraints_.lasso = op.points;
-    else
-      constraints_.barriers.push_back(op.points);
-    return {{"command", nullptr}, {"result", {{"points", op.points.size()}}}};
-  }
+nlohmann::json Runner::apply_pixels(const Op& op, const std::string& at) {
   if (op.name == "clear") {
     constraints_ = {};
+    constraints_scan_.reset();
     return {{"command", nullptr}, {"result", nlohmann::json::object()}};
   }
-  if (op.name == "grow" || op.name == "add" || op.name == "subtract") {
-    SelectSettings s;
-    s.scan_id = scan_of(op, at);
-    s.seed_col = static_cast<int>(std::llround(std::clamp(op.seed.x(), -1.0, 1e9)));
-    s.seed_row = static_cast<int>(std::llround(std::clamp(op.seed.y(), -1.0, 1e9)));
-    s.mode = op.name == "grow"  ? SelectMode::kReplace
-             : op.name == "add" ? SelectMode::kAdd
-                                : SelectMode::kSubtract;
-    s.grow = op.grow;
-    s.constraints = constraints_;
-    const SelectResult r = select_region(project_, s);
-    return made(r.command_id, {{"region_pixels", r.region_pixels},
-                               {"selected_pixels", r.selected_pixels},
-                               {"seed_open", r.seed_open}});
+  const StoredScanSummary scan = scan_of(op, at);
+  const bool drawing = op.name == "lasso" || op.name == "barrier";
+  if ((drawing || op.name != "auto") && constraints_scan_ && *constraints_scan_ != scan.id) {
+    refuse(file_, at,
+           "the lasso and barriers were drawn on scan " + std::to_string(*constraints_scan_) +
+               ": \"clear\" them first");
   }
+  if (drawing) {
+    check_points(op.points, scan, at);
+    if (op.name == "lasso") {
+      constraints_.lasso = op.points;
+    } else {
+      constraints_.barriers.push_back(op.points);
+    }
+    constraints_scan_ = scan.id;
+    return {{"command", nullptr}, {"result", {{"points", op.points.size()}}}};
+  }
+  if (op.name == "auto") {
+    ProposeSettings s;
+    s.scan_id = scan.id;
+    s.group_name = op.text;
+    s.parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
+    s.proposals.grow = op.grow;
+    s.proposals.min_pixels = op.min_pixels;
+    const SeparateResult r = propose_objects(project_, s);
+    return made(r.command_id, {{"proposals", r.nodes.size()}});
+  }
+  SelectSettings s;
+  s.scan_id = scan.id;
+  s.seed_col = static_cast<int>(std::llround(std::clamp(op.seed.x(), -1.0, 1e9)));
+  s.seed_row = static_cast<int>(std::llround(std::clamp(op.seed.y(), -1.0, 1e9)));
+  s.mode = op.name == "grow"  ? SelectMode::kReplace
+           : op.name == "add" ? SelectMode::kAdd
+                              : SelectMode::kSubtract;
+  s.grow = op.grow;
+  s.constraints = constraints_;
+  const SelectResult r = select_region(project_, s);
+  return made(r.command_id, {{"region_pixels", r.region_pixels},
+                             {"selected_pixels", r.selected_pixels},
+                             {"seed_open", r.seed_open}});
+}
+
+nlohmann::json Runner::apply_tree(const Op& op, const std::string& at) {
   if (op.name == "commit") {
     const std::optional<std::int64_t> parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
-    const NodeCommandResult r = commit_selection(project_, {scan_of(op, at), op.text, parent});
+    const NodeCommandResult r = commit_selection(project_, {scan_of(op, at).id, op.text, parent});
     return made(r.command_id, {{"node", r.node_id}});
   }
   if (op.name == "group") {
@@ -331,33 +399,24 @@ nlohmann::json Runner::apply(const Op& op, const std::string& at) {
     const NodeCommandResult r = group_nodes(project_, s);
     return made(r.command_id, {{"node", r.node_id}});
   }
-  if (op.name == "rename" || op.name == "hide" || op.name == "show" || op.name == "reparent") {
-    NodeEdit edit;
-    edit.node = node_of(op.node, at);
-    if (op.name == "rename") edit.name = op.text;
-    if (op.name == "hide" || op.name == "show") edit.hidden = op.name == "hide";
-    if (op.name == "reparent") edit.parent = parent_of(*op.parent, at);
-    const NodeCommandResult r = edit_node(project_, edit);
-    return made(r.command_id, {{"node", r.node_id}});
-  }
   if (op.name == "separate") {
-    const SeparateResult r = separate_object(project_, {node_of(op.node, at), scan_of(op, at)});
+    const SeparateResult r = separate_object(project_, {node_of(op.node, at), scan_of(op, at).id});
     return made(r.command_id, {{"nodes", r.nodes}});
-  }
-  if (op.name == "auto") {
-    ProposeSettings s;
-    s.scan_id = scan_of(op, at);
-    s.group_name = op.text;
-    s.parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
-    s.proposals.grow = op.grow;
-    s.proposals.min_pixels = op.min_pixels;
-    const SeparateResult r = propose_objects(project_, s);
-    return made(r.command_id, {{"proposals", r.nodes.size()}});
   }
   if (op.name == "delete") {
     const NodeCommandResult r = delete_node(project_, {node_of(op.node, at), op.deleted_points});
     return made(r.command_id, {{"node", r.node_id}});
   }
+  NodeEdit edit;  // rename, hide, show, reparent
+  edit.node = node_of(op.node, at);
+  if (op.name == "rename") edit.name = op.text;
+  if (op.name == "hide" || op.name == "show") edit.hidden = op.name == "hide";
+  if (op.name == "reparent") edit.parent = parent_of(*op.parent, at);
+  const NodeCommandResult r = edit_node(project_, edit);
+  return made(r.command_id, {{"node", r.node_id}});
+}
+
+nlohmann::json Runner::apply_journal(const Op& op, const std::string& at) {
   const bool undo = op.name == "undo";
   const std::optional<CommandRecord> changed = undo ? project_.undo() : project_.redo();
   if (!changed) refuse(file_, at, undo ? "nothing to undo" : "nothing to redo");
@@ -365,22 +424,40 @@ nlohmann::json Runner::apply(const Op& op, const std::string& at) {
   return {{"command", changed->id}, {"result", {{undo ? "undid" : "redid", changed->name}}}};
 }
 
+nlohmann::json Runner::apply(const Op& op, const std::string& at) {
+  if (op.name == "undo" || op.name == "redo") return apply_journal(op, at);
+  static const std::vector<std::string> kPixelOps = {"lasso", "barrier",  "clear", "grow",
+                                                     "add",   "subtract", "auto"};
+  if (std::find(kPixelOps.begin(), kPixelOps.end(), op.name) != kPixelOps.end()) {
+    return apply_pixels(op, at);
+  }
+  return apply_tree(op, at);
+}
+
 // Takes back what the script did, newest first: its commands undone, its
-// undos redone, its redos undone. An undo the script made before one of its
-// own commands cannot come back (that command ended the redo chain); the
-// rest still is taken back.
-void Runner::roll_back() noexcept {
+// undos redone, its redos undone, each only when it is exactly that command
+// (Project::undo/redo with `only`). It stops at the first that is not: an
+// undo the script made before one of its own commands cannot come back
+// (that command ended the redo chain), and another process may have written
+// meanwhile.
+std::string Runner::roll_back() noexcept {
+  std::string left;
   try {
     for (auto action = actions_.rbegin(); action != actions_.rend(); ++action) {
-      if (action->kind == Action::kUndid) {
-        project_.redo();
-      } else {
-        project_.undo();
+      const bool ok = action->kind == Action::kUndid
+                          ? project_.redo(action->command_id).has_value()
+                          : project_.undo(action->command_id).has_value();
+      if (!ok) {
+        left = "; what the script did up to command " + std::to_string(action->command_id) +
+               " could not be taken back";
+        break;
       }
     }
-  } catch (...) {  // the error being reported matters more than a failed roll-back
+  } catch (const std::exception& error) {
+    left = std::string("; taking back what the script did failed: ") + error.what();
   }
   actions_.clear();
+  return left;
 }
 
 }  // namespace
@@ -407,12 +484,19 @@ SegmentScriptResult run_segment_script(Project& project, const std::filesystem::
       done["op"] = ops[k].name;
       result.ops.push_back(std::move(done));
     } catch (const core::InputError& error) {
-      runner.roll_back();
-      if (!error.file().empty()) throw;
-      // The command's own error names the scan or node; say which op it was.
+      // The script's file, unless the project itself is at fault; the op either way.
+      const std::string left = runner.roll_back();
+      core::FilePosition position = error.position();
+      if (position.detail.rfind("op ", 0) != 0) {
+        position.detail = at + (position.detail.empty() ? "" : ", " + position.detail);
+      }
+      throw core::InputError(error.file().empty() ? file : error.file(), position,
+                             error.problem() + left);
+    } catch (const core::RuntimeFailure& error) {
+      const std::string left = runner.roll_back();
       core::FilePosition position = error.position();
       position.detail = at + (position.detail.empty() ? "" : ", " + position.detail);
-      throw core::InputError(file, position, error.problem());
+      throw core::RuntimeFailure(error.file(), position, error.problem() + left);
     } catch (...) {
       runner.roll_back();
       throw;

@@ -139,10 +139,14 @@ TEST(Cli, ARefusedSegmentScriptLeavesTheTreeAsItWas) {
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.err.find("op 3 (commit)"), std::string::npos) << refused.err;
   EXPECT_EQ(run_cli(dir, {"objects", project.string(), "--json"}).out, before);
-  // Refused before it runs: bad JSON, an unknown op, a seed off the grid.
+  // Refused before it runs (bad JSON, an unknown op, a misspelt key) or
+  // while it runs (a seed off the grid, a lasso of scan 1 used on scan 2).
   for (const std::string& text :
        {std::string("{\"ops\": ["), std::string(R"({"ops": [{"op": "paint"}]})"),
-        std::string(R"({"ops": [{"op": "grow", "seed": [0, 99]}]})")}) {
+        std::string(R"({"ops": [{"op": "grow", "seed": [0, 0], "tolerence": 3}]})"),
+        std::string(R"({"ops": [{"op": "group", "name": "g"}, {"op": "grow", "seed": [0, 99]}]})"),
+        std::string(R"({"ops": [{"op": "lasso", "points": [[0, 0], [3, 0], [3, 2]]},
+                                {"op": "grow", "seed": [0, 0], "scan": 2}]})")}) {
     const std::filesystem::path bad = write_script(dir, "bad.json", text);
     const CliResult result = run_cli(dir, {"segment", project.string(), "--script", bad.string()});
     EXPECT_EQ(result.exit_code, 2) << text;

@@ -61,6 +61,7 @@ std::size_t count_owned(const Project& project, std::int64_t scan, std::uint32_t
 // selection and membership, bit for bit.
 std::string state_of(const Project& project) {
   std::ostringstream out;
+  out.precision(17);  // every bit of a coordinate
   for (const ObjectNode& n : project.object_nodes()) {
     out << n.id << '|' << n.name << '|' << static_cast<int>(n.kind) << '|' << n.parent.value_or(-1)
         << '|' << n.hidden << '|' << n.points << '|' << n.mean_footprint_m.value_or(-1.0);
