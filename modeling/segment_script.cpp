@@ -23,7 +23,8 @@ struct Op {
   std::string name;
   std::optional<std::int64_t> scan;
   segmentation::Polyline points;                   // lasso, barrier
-  Eigen::Vector2d seed = Eigen::Vector2d::Zero();  // grow, add, subtract
+  Eigen::Vector2d seed = Eigen::Vector2d::Zero();  // seed, grow, add, subtract
+  bool has_seed = true;  // grow, add, subtract: false = the last seed op's
   segmentation::GrowSettings grow;
   std::string text;                                       // commit, group, rename: the name
   nlohmann::json node;                                    // a NODE reference
@@ -113,6 +114,7 @@ const std::map<std::string, std::vector<std::string>>& op_keys() {
       {"lasso", {"points"}},
       {"barrier", {"points"}},
       {"clear", {}},
+      {"seed", {"at"}},
       {"grow", {"seed", "channel", "tolerance"}},
       {"add", {"seed", "channel", "tolerance"}},
       {"subtract", {"seed", "channel", "tolerance"}},
@@ -128,6 +130,14 @@ const std::map<std::string, std::vector<std::string>>& op_keys() {
       {"undo", {}},
       {"redo", {}}};
   return keys;
+}
+
+// Ops on pixels and the tools (read_pixel_op, Runner::apply_pixels); the
+// others are on the tree or the journal.
+bool is_pixel_op(const std::string& name) {
+  static const std::vector<std::string> kPixelOps = {"lasso", "barrier", "clear",    "seed",
+                                                     "grow",  "add",     "subtract", "auto"};
+  return std::find(kPixelOps.begin(), kPixelOps.end(), name) != kPixelOps.end();
 }
 
 // The channel and tolerance of grow, add, subtract and auto.
@@ -170,9 +180,12 @@ void read_pixel_op(const OpReader& in, Op& op) {
         in.bad("key \"min_pixels\" must be a count");
       op.min_pixels = in.json()["min_pixels"].get<std::size_t>();
     }
-  } else if (op.name != "clear") {  // grow, add, subtract
-    if (!in.has("seed")) in.bad("key \"seed\" is missing");
-    op.seed = in.point(in.json()["seed"], "seed");
+  } else if (op.name == "seed") {
+    if (!in.has("at")) in.bad("key \"at\" is missing");
+    op.seed = in.point(in.json()["at"], "at");
+  } else if (op.name != "clear") {  // grow, add, subtract: at "seed", or the last seed op's
+    op.has_seed = in.has("seed");
+    if (op.has_seed) op.seed = in.point(in.json()["seed"], "seed");
     op.grow = read_channel(in);
   }
 }
@@ -225,9 +238,7 @@ Op read_op(const nlohmann::json& json, std::size_t index, const std::string& fil
     if (!json["scan"].is_number_integer()) in.bad("key \"scan\" must be a scan id");
     op.scan = json["scan"].get<std::int64_t>();
   }
-  static const std::vector<std::string> kPixelOps = {"lasso", "barrier",  "clear", "grow",
-                                                     "add",   "subtract", "auto"};
-  if (std::find(kPixelOps.begin(), kPixelOps.end(), op.name) != kPixelOps.end()) {
+  if (is_pixel_op(op.name)) {
     read_pixel_op(in, op);
   } else if (op.name != "undo" && op.name != "redo") {
     read_tree_op(in, op);
@@ -295,6 +306,7 @@ class Runner {
   std::optional<std::int64_t> scan_;
   segmentation::Constraints constraints_;
   std::optional<std::int64_t> constraints_scan_;  // the scan they were drawn on
+  std::optional<Eigen::Vector2d> seed_;           // the last seed op's point
   std::vector<Action> actions_;
 };
 
@@ -345,6 +357,10 @@ nlohmann::json Runner::apply_pixels(const Op& op, const std::string& at) {
     constraints_scan_.reset();
     return {{"command", nullptr}, {"result", nlohmann::json::object()}};
   }
+  if (op.name == "seed") {
+    seed_ = op.seed;
+    return {{"command", nullptr}, {"result", {{"seed", {op.seed.x(), op.seed.y()}}}}};
+  }
   const StoredScanSummary scan = scan_of(op, at);
   const bool drawing = op.name == "lasso" || op.name == "barrier";
   if ((drawing || op.name != "auto") && constraints_scan_ && *constraints_scan_ != scan.id) {
@@ -372,10 +388,12 @@ nlohmann::json Runner::apply_pixels(const Op& op, const std::string& at) {
     const SeparateResult r = propose_objects(project_, s);
     return made(r.command_id, {{"proposals", r.nodes.size()}});
   }
+  if (!op.has_seed && !seed_) refuse(file_, at, "no \"seed\": give one, or a seed op before");
+  const Eigen::Vector2d seed = op.has_seed ? op.seed : *seed_;
   SelectSettings s;
   s.scan_id = scan.id;
-  s.seed_col = static_cast<int>(std::llround(std::clamp(op.seed.x(), -1.0, 1e9)));
-  s.seed_row = static_cast<int>(std::llround(std::clamp(op.seed.y(), -1.0, 1e9)));
+  s.seed_col = static_cast<int>(std::llround(std::clamp(seed.x(), -1.0, 1e9)));
+  s.seed_row = static_cast<int>(std::llround(std::clamp(seed.y(), -1.0, 1e9)));
   s.mode = op.name == "grow"  ? SelectMode::kReplace
            : op.name == "add" ? SelectMode::kAdd
                               : SelectMode::kSubtract;
@@ -426,11 +444,7 @@ nlohmann::json Runner::apply_journal(const Op& op, const std::string& at) {
 
 nlohmann::json Runner::apply(const Op& op, const std::string& at) {
   if (op.name == "undo" || op.name == "redo") return apply_journal(op, at);
-  static const std::vector<std::string> kPixelOps = {"lasso", "barrier",  "clear", "grow",
-                                                     "add",   "subtract", "auto"};
-  if (std::find(kPixelOps.begin(), kPixelOps.end(), op.name) != kPixelOps.end()) {
-    return apply_pixels(op, at);
-  }
+  if (is_pixel_op(op.name)) return apply_pixels(op, at);
   return apply_tree(op, at);
 }
 

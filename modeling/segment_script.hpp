@@ -7,6 +7,7 @@
 //      {"op": "lasso", "points": [[x, y], ...]},  limits the next grows (≥ 3 points)
 //      {"op": "barrier", "points": [[x, y], ...]},  stops them (≥ 1 point)
 //      {"op": "clear"},                           no lasso, no barriers
+//      {"op": "seed", "at": [x, y]},             the click; grows below may omit "seed"
 //      {"op": "grow", "seed": [x, y], "channel": "normal", "tolerance": 6},
 //      {"op": "add", ...}, {"op": "subtract", ...}, as grow, on the selection
 //      {"op": "commit", "name": "wall", "parent": NODE},

@@ -101,16 +101,18 @@ TEST(Cli, SegmentScriptBuildsTheTreeAndEachOpIsUndoable) {
   const std::filesystem::path script = write_script(dir, "ops.json", R"json({"scan": 1, "ops": [
     {"op": "group", "name": "site"},
     {"op": "lasso", "points": [[-0.5, -0.5], [3.5, -0.5], [3.5, 2.5], [-0.5, 2.5]]},
-    {"op": "grow", "seed": [0, 0], "channel": "range", "tolerance": 50},
+    {"op": "seed", "at": [0, 0]},
+    {"op": "grow", "channel": "range", "tolerance": 50},
     {"op": "commit", "name": "wall", "parent": "site"},
     {"op": "rename", "node": "wall", "name": "wall south"}]})json");
   const CliResult run =
       run_cli(dir, {"segment", project.string(), "--script", script.string(), "--json"});
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json ops = nlohmann::json::parse(run.out)["ops"];
-  ASSERT_EQ(ops.size(), 5u);
-  EXPECT_TRUE(ops[1]["command"].is_null());  // a lasso is the tool's state, not a change
-  EXPECT_EQ(ops[2]["result"]["selected_pixels"], 12);
+  ASSERT_EQ(ops.size(), 6u);
+  EXPECT_TRUE(ops[1]["command"].is_null());  // a lasso or a seed is the tool's state, not a change
+  EXPECT_TRUE(ops[2]["command"].is_null());
+  EXPECT_EQ(ops[3]["result"]["selected_pixels"], 12);
   const auto nodes = [&] {
     return nlohmann::json::parse(
         run_cli(dir, {"objects", project.string(), "--json"}).out)["nodes"];
