@@ -418,6 +418,16 @@ void check_file_header(const std::filesystem::path& file) {
       !std::equal(kMagic, kMagic + 16, header.begin())) {
     refuse(name, "not a scanbench project (not an SQLite database)");
   }
+  // SQLite's file format versions (bytes 18 and 19) are 1 or 2; with a
+  // higher write version SQLite opens the file read-only, with a higher read
+  // version not at all: a damaged header, not a file to open.
+  const auto write_version = static_cast<unsigned char>(header[18]);
+  const auto read_version = static_cast<unsigned char>(header[19]);
+  if (write_version < 1 || write_version > 2 || read_version < 1 || read_version > 2) {
+    refuse(name, "project file is damaged: its header gives SQLite file format versions " +
+                     std::to_string(write_version) + " and " + std::to_string(read_version) +
+                     " (1 or 2 expected)");
+  }
   // SQLite file format: user_version at byte 60, application_id at byte 68,
   // both big-endian.
   check_identity(big_endian_u32(header.data() + 68),

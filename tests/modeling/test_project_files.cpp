@@ -145,6 +145,22 @@ TEST(ProjectFiles, RefusesADamagedProjectUntouched) {
   expect_refused(file, "project file is damaged");
 }
 
+// Found by fuzz_project: SQLite opens a file whose header gives a write
+// version above 2 read-only, so its migration failed as if the disk were
+// read-only (a runtime failure) instead of as the damaged file it is.
+TEST(ProjectFiles, RefusesAHeaderOfAnUnknownSqliteFileFormatUntouched) {
+  const ScratchDir dir;
+  for (const int byte : {18, 19}) {
+    const auto file = dir / ("format " + std::to_string(byte) + ".sbproj");
+    std::filesystem::copy_file(test::fixture("projects/version1.sbproj"), file);
+    std::string bytes = test::read_file_bytes(file);
+    bytes[static_cast<std::size_t>(byte)] = '\x04';
+    write_file(file, bytes);
+    expect_refused(file, "SQLite file format versions");
+    EXPECT_EQ(test::read_file_bytes(file), bytes);
+  }
+}
+
 TEST(ProjectFiles, RefusesTheCommittedBadFixtures) {
   const ScratchDir dir;
   for (const std::string name : {"project_not_sqlite.sbproj", "project_foreign_sqlite.sbproj"}) {
