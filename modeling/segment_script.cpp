@@ -340,10 +340,9 @@ std::optional<std::int64_t> Runner::parent_of(const nlohmann::json& reference,
 
 void Runner::check_points(const segmentation::Polyline& line, const StoredScanSummary& scan,
                           const std::string& at) const {
-  const double rows = static_cast<double>(scan.summary.rows);
-  const double columns = static_cast<double>(scan.summary.columns);
+  const segmentation::GridShape shape{scan.summary.rows, scan.summary.columns, false};
   for (const Eigen::Vector2d& v : line) {
-    if (v.x() < -columns || v.x() > 2 * columns || v.y() < -rows || v.y() > 2 * rows) {
+    if (!segmentation::within_reach(shape, v)) {
       refuse(file_, at,
              "point (" + std::to_string(v.x()) + ", " + std::to_string(v.y()) +
                  ") lies more than a grid size away from the scan's grid");

@@ -31,21 +31,21 @@ void fill_span(const GridShape& shape, int row, double x_begin, double x_end, st
   for (long long col = first; col <= last; ++col) mark(shape, row, col, value, mask);
 }
 
-[[maybe_unused]] bool near_the_grid(const GridShape& shape, const Eigen::Vector2d& v) {
-  return v.allFinite() && v.x() >= -shape.columns && v.x() <= 2.0 * shape.columns &&
-         v.y() >= -shape.rows && v.y() <= 2.0 * shape.rows;
-}
-
 void check_vertices(const GridShape& shape, const Polyline& line,
                     const std::vector<std::uint8_t>& mask) {
   assert(mask.size() == shape.pixel_count() && "mask of another grid");
   assert(std::all_of(line.begin(), line.end(),
-                     [&](const Eigen::Vector2d& v) { return near_the_grid(shape, v); }) &&
+                     [&](const Eigen::Vector2d& v) { return within_reach(shape, v); }) &&
          "vertex not finite or more than a grid away from it");
   (void)shape, (void)line, (void)mask;
 }
 
 }  // namespace
+
+bool within_reach(const GridShape& shape, const Eigen::Vector2d& v) {
+  return v.allFinite() && v.x() >= -shape.columns && v.x() <= 2.0 * shape.columns &&
+         v.y() >= -shape.rows && v.y() <= 2.0 * shape.rows;
+}
 
 void fill_polygon(const GridShape& shape, const Polyline& polygon, std::uint8_t value,
                   std::vector<std::uint8_t>& mask) {

@@ -22,6 +22,10 @@ namespace scanbench::segmentation {
 
 using Polyline = std::vector<Eigen::Vector2d>;  // (x = column, y = row) vertices
 
+// Whether vertex `v` is finite and within one grid size of the grid (the
+// bound above): what callers check before they hand vertices over.
+bool within_reach(const GridShape& shape, const Eigen::Vector2d& v);
+
 // Sets mask[i] = value on the pixels whose centres lie inside the closed
 // polygon (even-odd rule; the edge from the last vertex back to the first
 // closes it). A polygon of fewer than 3 vertices covers nothing. Asserts
