@@ -381,10 +381,12 @@ NodeCommandResult commit_selection(Project& project, const CommitSettings& setti
   require_name(settings.name);
   Tree tree = load_tree(project);
   require_group(tree, settings.parent);
-  const acquisition::Scan scan = project.load_scan(settings.scan_id);
+  // The grid's size from the summary: compute_figures decodes the scan itself.
+  const StoredScanSummary stored = require_scan(project, settings.scan_id);
   const segmentation::PixelSet selection = load_selection(project, settings.scan_id);
   std::vector<std::uint32_t> membership =
-      load_membership(project, settings.scan_id, scan.pixel_count());
+      load_membership(project, settings.scan_id,
+                      static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns);
   ObjectNode node;
   node.id = fresh_ids(project, 1);
   node.name = settings.name;
