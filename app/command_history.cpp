@@ -67,6 +67,10 @@ std::string summary(const modeling::CommandRecord& c) {
   if ((c.name == "group" || c.name == "edit") && result.contains("node")) {
     return fmt::format("node {}", result.value("node", 0));
   }
+  if (c.name == "ungroup" && result.contains("children")) {
+    return fmt::format("group {} dissolved, {} child(ren) moved up", result.value("node", 0),
+                       result["children"].size());
+  }
   if (c.name == "separate" && result.contains("nodes")) {
     return fmt::format("{} part(s)", result["nodes"].size());
   }

@@ -479,6 +479,29 @@ NodeCommandResult edit_node(Project& project, const NodeEdit& change) {
   return {command_id, node.id};
 }
 
+UngroupResult ungroup_node(Project& project, std::int64_t group) {
+  const std::int64_t revision = project.revision();
+  Tree tree = load_tree(project);
+  const ObjectNode dissolved = require_node(tree, group);
+  if (dissolved.kind != NodeKind::kGroup) {
+    refuse("node " + std::to_string(group),
+           "is an object, not a group: there is nothing to ungroup");
+  }
+  UngroupResult result;
+  for (auto& [id, node] : tree) {
+    if (node.parent != group) continue;
+    node.parent = dissolved.parent;
+    result.children.push_back(id);
+  }
+  // The ancestors keep the same descendants' points: no figure changes.
+  Project::Edit edit = project.begin_command("ungroup", dump({{"node", group}}), revision);
+  for (const std::int64_t child : result.children) project.put_node(edit, tree.at(child));
+  project.remove_node(edit, group);
+  result.command_id = edit.command_id();
+  edit.commit(dump({{"node", group}, {"children", result.children}}));
+  return result;
+}
+
 NodeCommandResult delete_node(Project& project, const DeleteSettings& settings) {
   const std::int64_t revision = project.revision();
   Tree tree = load_tree(project);

@@ -88,6 +88,15 @@ struct NodeEdit {
 // Renames, hides or shows, or reparents a node (what `edit` holds).
 NodeCommandResult edit_node(Project& project, const NodeEdit& edit);
 
+struct UngroupResult {
+  std::int64_t command_id = 0;
+  std::vector<std::int64_t> children;  // moved to the group's parent, in id order
+};
+
+// Dissolves a group: its children move up to the group's parent (or become
+// roots), keeping their points, and the group is removed.
+UngroupResult ungroup_node(Project& project, std::int64_t group);
+
 enum class DeletedPoints {
   kToPool,   // the points are to be segmented again
   kDeleted,  // the points are marked deleted

@@ -125,6 +125,7 @@ const std::map<std::string, std::vector<std::string>>& op_keys() {
       {"show", {"node"}},
       {"reparent", {"node", "parent"}},
       {"delete", {"node", "points"}},
+      {"ungroup", {"node"}},
       {"separate", {"node"}},
       {"auto", {"group", "parent", "channel", "tolerance", "min_pixels"}},
       {"undo", {}},
@@ -190,7 +191,8 @@ void read_pixel_op(const OpReader& in, Op& op) {
   }
 }
 
-// Ops on the tree: commit, group, rename, hide, show, reparent, delete, separate.
+// Ops on the tree: commit, group, ungroup, rename, hide, show, reparent,
+// delete, separate.
 void read_tree_op(const OpReader& in, Op& op) {
   if (op.name == "commit" || op.name == "group" || op.name == "rename") op.text = read_name(in);
   if (op.name != "commit" && op.name != "group") op.node = in.node("node", false);
@@ -419,6 +421,10 @@ nlohmann::json Runner::apply_tree(const Op& op, const std::string& at) {
   if (op.name == "separate") {
     const SeparateResult r = separate_object(project_, {node_of(op.node, at), scan_of(op, at).id});
     return made(r.command_id, {{"nodes", r.nodes}});
+  }
+  if (op.name == "ungroup") {
+    const UngroupResult r = ungroup_node(project_, node_of(op.node, at));
+    return made(r.command_id, {{"children", r.children}});
   }
   if (op.name == "delete") {
     const NodeCommandResult r = delete_node(project_, {node_of(op.node, at), op.deleted_points});

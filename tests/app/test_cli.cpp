@@ -126,6 +126,15 @@ TEST(Cli, SegmentScriptBuildsTheTreeAndEachOpIsUndoable) {
   EXPECT_EQ(nodes()[1]["name"], "wall");
   ASSERT_EQ(run_cli(dir, {"undo", project.string()}).exit_code, 0);
   EXPECT_EQ(nodes().size(), 1u);
+  // Redone, grouped into a building under the site, and ungrouped again.
+  const std::filesystem::path more = write_script(dir, "more.json", R"json({"scan": 1, "ops": [
+    {"op": "redo"}, {"op": "redo"},
+    {"op": "group", "name": "building", "parent": "site", "children": ["wall south"]},
+    {"op": "ungroup", "node": "building"}]})json");
+  ASSERT_EQ(run_cli(dir, {"segment", project.string(), "--script", more.string()}).exit_code, 0);
+  ASSERT_EQ(nodes().size(), 2u);
+  EXPECT_EQ(nodes()[1]["name"], "wall south");
+  EXPECT_EQ(nodes()[1]["parent"], nodes()[0]["id"]);
 }
 
 TEST(Cli, ARefusedSegmentScriptLeavesTheTreeAsItWas) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -159,6 +160,32 @@ TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
   EXPECT_TRUE(select_region(project, select_at(scan, 0, -45)).seed_open);
 }
 
+TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const NodeCommandResult site = group_nodes(project, {"site", std::nullopt, {}});
+  const NodeCommandResult room = group_nodes(project, {"room", site.node_id, {}});
+  select_region(project, select_at(scan, 0, -45));
+  const NodeCommandResult floor = commit_selection(project, {scan, "floor", room.node_id});
+  const std::string before = state_of(project);
+  const UngroupResult ungrouped = ungroup_node(project, room.node_id);
+  EXPECT_EQ(ungrouped.children, std::vector<std::int64_t>{floor.node_id});
+  const std::vector<ObjectNode> nodes = project.object_nodes();
+  ASSERT_EQ(nodes.size(), 2u);  // the site and the floor
+  EXPECT_EQ(nodes[1].id, floor.node_id);
+  EXPECT_EQ(nodes[1].parent, site.node_id);
+  EXPECT_EQ(nodes[0].points, nodes[1].points);  // the site still sums the floor
+  try {
+    ungroup_node(project, floor.node_id);
+    ADD_FAILURE() << "an object was ungrouped";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("not a group"));
+  }
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(state_of(project), before);
+}
+
 TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
   const ScratchDir dir;
   Project project = Project::create(dir / "p.sbproj");
@@ -232,6 +259,32 @@ TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
   refused([&] { delete_node(project, {42, DeletedPoints::kToPool}); }, "node 42");
 }
 
+// What must hold after every command: each parent is a live group, and each
+// object's point count is what the membership layer gives it (a group's, the
+// sum below it).
+void expect_consistent_tree(const Project& project, std::int64_t scan, int step) {
+  const std::vector<ObjectNode> nodes = project.object_nodes();
+  std::map<std::int64_t, const ObjectNode*> by_id;
+  for (const ObjectNode& n : nodes) by_id[n.id] = &n;
+  std::map<std::int64_t, std::int64_t> owned;  // points below each node
+  const auto membership =
+      project.load_layer<std::uint32_t>(scan, layer::kMembership, ElementType::kU32);
+  if (membership) {
+    for (const std::uint32_t owner : *membership) {
+      if (owner == 0 || owner == kDeletedPoints) continue;
+      ASSERT_TRUE(by_id.count(owner)) << "step " << step << ": pixels of a removed node " << owner;
+      for (std::optional<std::int64_t> at = owner; at; at = by_id.at(*at)->parent) ++owned[*at];
+    }
+  }
+  for (const ObjectNode& n : nodes) {
+    if (n.parent) {
+      ASSERT_TRUE(by_id.count(*n.parent)) << "step " << step << ": node " << n.id;
+      EXPECT_EQ(by_id.at(*n.parent)->kind, NodeKind::kGroup) << "step " << step;
+    }
+    EXPECT_EQ(n.points, owned[n.id]) << "step " << step << ": node " << n.id;
+  }
+}
+
 std::int64_t newest_done(const Project& project) {
   std::int64_t newest = 0;
   for (const CommandRecord& c : project.history()) {
@@ -264,7 +317,7 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
       return nodes[static_cast<std::size_t>(pick(static_cast<int>(nodes.size())))].id;
     };
     try {
-      switch (pick(nodes.empty() ? 4 : 11)) {
+      switch (pick(nodes.empty() ? 4 : 12)) {
         case 0:
         case 1:
         case 2: {
@@ -298,6 +351,9 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
         case 9:
           separate_object(project, {some_node(), scan});
           break;
+        case 11:
+          ungroup_node(project, some_node());
+          break;
         case 10:
           if (pick(10) == 0) {  // a whole scan's proposals: now and then
             ProposeSettings s;
@@ -318,6 +374,8 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
     } catch (const core::InputError&) {
       ++refused;  // a parent that is an object, a cycle, an empty selection: refused, unwritten
     }
+    expect_consistent_tree(project, scan, k);
+    if (HasFatalFailure() || HasFailure()) break;
   }
   EXPECT_GT(applied, 700);
   while (newest_done(project) > baseline) ASSERT_TRUE(project.undo().has_value());
