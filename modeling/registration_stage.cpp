@@ -5,6 +5,7 @@
 
 #include "core/errors.hpp"
 #include "modeling/scan_layers.hpp"
+#include "modeling/segment_commands.hpp"
 #include "modeling/settings_json.hpp"
 
 namespace scanbench::modeling {
@@ -164,9 +165,14 @@ RegisterStageResult register_project(Project& project, const RegisterStageSettin
   out.result = registration::register_scans(loaded.prepared, initial, run, &progress);
   out.report_json = report_json(out.result, loaded.ids, loaded.scans);
   progress.throw_if_cancelled(kStage);
+  std::map<std::int64_t, Eigen::Isometry3d> moved;
+  for (std::size_t k = 0; k < loaded.ids.size(); ++k)
+    moved.emplace(loaded.ids[k], out.result.T_world_scan[k]);
+  const std::vector<ObjectNode> refigured = node_figures_after_moving(project, moved);
 
   Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
   out.command_id = edit.command_id();
+  for (const ObjectNode& node : refigured) project.put_node(edit, node);
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
     out.names.push_back(loaded.scans[k].name);
     loaded.scans[k].T_world_scan = out.result.T_world_scan[k];

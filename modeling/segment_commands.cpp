@@ -102,11 +102,12 @@ struct Figures {
 };
 
 // Every node's figures from the membership layers of all scans (`changed`
-// holds the memberships this command writes, in place of the stored ones),
-// groups summing their descendants.
+// holds the memberships this command writes, in place of the stored ones;
+// `moved` the poses it writes), groups summing their descendants.
 std::map<std::int64_t, Figures> compute_figures(
     const Project& project, const Tree& tree,
-    const std::map<std::int64_t, std::vector<std::uint32_t>>& changed) {
+    const std::map<std::int64_t, std::vector<std::uint32_t>>& changed,
+    const std::map<std::int64_t, Eigen::Isometry3d>& moved = {}) {
   std::map<std::int64_t, Figures> own;
   for (const StoredScanSummary& stored : project.scans()) {
     const auto replaced = changed.find(stored.id);
@@ -114,7 +115,9 @@ std::map<std::int64_t, Figures> compute_figures(
     const bool has_layer = replaced != changed.end() ||
                            std::find(names.begin(), names.end(), layer::kMembership) != names.end();
     if (!has_layer) continue;
-    const acquisition::Scan scan = project.load_scan(stored.id);
+    acquisition::Scan scan = project.load_scan(stored.id);
+    if (const auto pose = moved.find(stored.id); pose != moved.end())
+      scan.T_world_scan = pose->second;
     const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
     const std::vector<std::uint32_t> membership =
         replaced != changed.end() ? replaced->second
@@ -142,9 +145,10 @@ std::map<std::int64_t, Figures> compute_figures(
   return total;
 }
 
-// Writes a new version of every node whose figures `figures` changes.
-void refresh_figures(Project& project, Project::Edit& edit, const Tree& tree,
-                     const std::map<std::int64_t, Figures>& figures) {
+// The nodes of `tree` whose figures `figures` changes, with the new figures.
+std::vector<ObjectNode> with_new_figures(const Tree& tree,
+                                         const std::map<std::int64_t, Figures>& figures) {
+  std::vector<ObjectNode> changed;
   for (const auto& [id, node] : tree) {
     ObjectNode updated = node;
     const auto found = figures.find(id);
@@ -160,8 +164,15 @@ void refresh_figures(Project& project, Project::Edit& edit, const Tree& tree,
         updated.bbox_world.has_value() == node.bbox_world.has_value() &&
         (!updated.bbox_world || (updated.bbox_world->min() == node.bbox_world->min() &&
                                  updated.bbox_world->max() == node.bbox_world->max()));
-    if (!same) project.put_node(edit, updated);
+    if (!same) changed.push_back(std::move(updated));
   }
+  return changed;
+}
+
+// Writes a new version of every node whose figures `figures` changes.
+void refresh_figures(Project& project, Project::Edit& edit, const Tree& tree,
+                     const std::map<std::int64_t, Figures>& figures) {
+  for (const ObjectNode& node : with_new_figures(tree, figures)) project.put_node(edit, node);
 }
 
 nlohmann::json polyline_json(const segmentation::Polyline& line) {
@@ -477,6 +488,13 @@ NodeCommandResult edit_node(Project& project, const NodeEdit& change) {
   const std::int64_t command_id = edit.command_id();
   edit.commit(dump({{"node", node.id}}));
   return {command_id, node.id};
+}
+
+std::vector<ObjectNode> node_figures_after_moving(
+    const Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses) {
+  const Tree tree = load_tree(project);
+  if (tree.empty()) return {};
+  return with_new_figures(tree, compute_figures(project, tree, {}, poses));
 }
 
 UngroupResult ungroup_node(Project& project, std::int64_t group) {

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -139,5 +140,12 @@ struct ProposeSettings {
 // for the user to accept (rename, reparent), merge (group) or reject
 // (delete back to the pool). One command: undo takes them all back.
 SeparateResult propose_objects(Project& project, const ProposeSettings& settings);
+
+// The nodes whose figures (point count, mean footprint, world bounding box)
+// change when the scans of `poses` move there, each with its new figures:
+// what a command that moves scans (the register stage) writes with put_node
+// in its own Edit, so the tree's boxes follow the scans and undo with them.
+std::vector<ObjectNode> node_figures_after_moving(
+    const Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses);
 
 }  // namespace scanbench::modeling

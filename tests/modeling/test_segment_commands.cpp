@@ -186,6 +186,28 @@ TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
   EXPECT_EQ(state_of(project), before);
 }
 
+TEST(SegmentCommands, MovingAScanMovesItsObjectsBoxes) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
+  select_region(project, select_at(scan, -20, 0));
+  commit_selection(project, {scan, "wall +x", room.node_id});
+  const std::vector<ObjectNode> before = project.object_nodes();
+  const Eigen::Vector3d shift(10.0, -2.0, 0.5);
+  const Eigen::Isometry3d moved =
+      Eigen::Translation3d(shift) * project.load_scan(scan).T_world_scan;
+  const std::vector<ObjectNode> after = node_figures_after_moving(project, {{scan, moved}});
+  ASSERT_EQ(after.size(), 2u);  // the wall and its group
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(after[k].id, before[k].id);
+    EXPECT_EQ(after[k].points, before[k].points);
+    EXPECT_TRUE(after[k].bbox_world->min().isApprox(before[k].bbox_world->min() + shift, 1e-12));
+    EXPECT_TRUE(after[k].bbox_world->max().isApprox(before[k].bbox_world->max() + shift, 1e-12));
+  }
+  EXPECT_TRUE(node_figures_after_moving(project, {}).empty());  // nothing moved, nothing stale
+}
+
 TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
   const ScratchDir dir;
   Project project = Project::create(dir / "p.sbproj");
