@@ -1,5 +1,6 @@
 #include "acquisition/scan.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <numbers>
@@ -58,6 +59,23 @@ std::size_t count_valid(const Scan& scan) {
   std::size_t count = 0;
   for (const std::uint8_t v : scan.valid) count += v != 0;
   return count;
+}
+
+std::pair<float, float> intensity_range(const Scan& scan, const std::vector<std::uint8_t>& usable) {
+  assert(!scan.has_intensity() || usable.size() == scan.pixel_count());
+  std::vector<float> values;
+  values.reserve(scan.intensity.size());
+  for (std::size_t i = 0; i < scan.intensity.size(); ++i) {
+    if (usable[i] && std::isfinite(scan.intensity[i])) values.push_back(scan.intensity[i]);
+  }
+  if (values.size() < 2) return {0.0f, 1.0f};
+  const auto at = [&values](double share) {
+    const auto k = static_cast<std::ptrdiff_t>(share * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), values.begin() + k, values.end());
+    return values[static_cast<std::size_t>(k)];
+  };
+  const float low = at(0.02);
+  return {low, at(0.98)};
 }
 
 std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan) {

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -102,6 +103,12 @@ bool wraps_around(const Scan& scan);
 
 // Number of pixels with a return (valid != 0).
 std::size_t count_valid(const Scan& scan);
+
+// The intensities of the pixels `usable` marks (finite ones) at the 2nd and
+// 98th percentile: the spread a scan's intensities really take, unswayed by
+// a few retro-reflectors. {0, 1} when the scan has fewer than 2 such values.
+// Asserts usable.size() == pixel_count() when the scan has intensity.
+std::pair<float, float> intensity_range(const Scan& scan, const std::vector<std::uint8_t>& usable);
 
 // Axis-aligned bounds of the valid points in the world frame [m]; empty
 // optional when the scan has no valid point.

@@ -30,18 +30,7 @@ float lab_f(float t) {
 }
 
 float intensity_spread(const acquisition::Scan& scan, const std::vector<std::uint8_t>& usable) {
-  std::vector<float> values;
-  values.reserve(scan.intensity.size());
-  for (std::size_t i = 0; i < scan.intensity.size(); ++i) {
-    if (usable[i] && std::isfinite(scan.intensity[i])) values.push_back(scan.intensity[i]);
-  }
-  if (values.size() < 2) return 1.0f;
-  const auto at = [&values](double share) {
-    const auto k = static_cast<std::ptrdiff_t>(share * static_cast<double>(values.size() - 1));
-    std::nth_element(values.begin(), values.begin() + k, values.end());
-    return values[static_cast<std::size_t>(k)];
-  };
-  const float low = at(0.02), high = at(0.98);
+  const auto [low, high] = acquisition::intensity_range(scan, usable);
   return high > low ? high - low : 1.0f;
 }
 

@@ -13,7 +13,7 @@
 #include "modeling/scan_layers.hpp"
 #include "modeling/segment_commands.hpp"
 #include "project_test_support.hpp"
-#include "segmentation/room_scene.hpp"
+#include "room_project.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -21,24 +21,6 @@ namespace {
 
 using test::ScratchDir;
 using ::testing::HasSubstr;
-
-// A project holding the room of tests/segmentation/room_scene.hpp with its
-// geometry; returns the scan's id.
-std::int64_t store_room(Project& project) {
-  const test::RoomScan& room = test::shared_room();
-  const std::int64_t id = test::insert_committed(project, room.scan);
-  Project::Edit edit = project.begin_command("geometry", "{}");
-  for (const EncodedLayer& layer : encode_geometry(room.geometry))
-    project.put_layer(edit, id, layer);
-  edit.commit("{}");
-  return id;
-}
-
-// The pixel of the room looking at azimuth / elevation [deg] (0.5° grid).
-std::pair<int, int> pixel_at(double azimuth_deg, double elevation_deg) {
-  return {static_cast<int>(std::lround((30.0 - elevation_deg) / 0.5)),
-          static_cast<int>(std::lround((azimuth_deg + 180.0) / 0.5 - 0.5)) % 720};
-}
 
 SelectSettings select_at(std::int64_t scan, double azimuth_deg, double elevation_deg,
                          SelectMode mode = SelectMode::kReplace,

@@ -1,0 +1,194 @@
+#include "modeling/render_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "acquisition/scan_geometry.hpp"
+#include "core/errors.hpp"
+#include "modeling/scan_layers.hpp"
+
+namespace scanbench::modeling {
+
+namespace {
+
+// The points to draw, before they are tiled: in scan and pixel order.
+struct Gathered {
+  RenderPoints points;
+  std::map<std::uint32_t, std::vector<std::uint32_t>> by_node;  // owner → indices
+};
+
+// For every node, whether it is shown: not hidden, nor any group above it.
+std::map<std::int64_t, bool> shown_nodes(const std::vector<ObjectNode>& nodes) {
+  std::map<std::int64_t, const ObjectNode*> by_id;
+  for (const ObjectNode& n : nodes) by_id[n.id] = &n;
+  std::map<std::int64_t, bool> shown;
+  for (const ObjectNode& n : nodes) {
+    bool visible = true;
+    for (const ObjectNode* at = &n; at;) {
+      visible = visible && !at->hidden;
+      const auto parent = at->parent ? by_id.find(*at->parent) : by_id.end();
+      at = parent == by_id.end() ? nullptr : parent->second;
+    }
+    shown[n.id] = visible;
+  }
+  return shown;
+}
+
+void gather_scan(const Project& project, const StoredScanSummary& stored,
+                 const RenderModelSettings& settings, const std::map<std::int64_t, bool>& shown,
+                 const Eigen::Vector3d& origin, Gathered& out, RenderModelCounts& counts) {
+  const acquisition::Scan scan = project.load_scan(stored.id);
+  const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
+  if (!geometry) {
+    core::FilePosition position;
+    position.detail = "scan " + std::to_string(stored.id) + " (" + scan.name + ")";
+    throw core::InputError(project.path().string(), position,
+                           "has no geometry (footprints and normals): run `scanbench geometry`");
+  }
+  const auto keep = settings.merged_only ? project.load_layer<std::uint8_t>(stored.id, layer::kKeep,
+                                                                            ElementType::kU8)
+                                         : std::nullopt;
+  const auto membership =
+      project.load_layer<std::uint32_t>(stored.id, layer::kMembership, ElementType::kU32);
+  std::vector<std::uint8_t> usable(scan.pixel_count());
+  for (std::size_t i = 0; i < usable.size(); ++i)
+    usable[i] = acquisition::in_model(scan, *geometry, i);
+  const auto [low, high] = acquisition::intensity_range(scan, usable);
+  const float spread = high > low ? high - low : 1.0f;
+  const Eigen::Matrix3f rotation = scan.T_world_scan.linear().cast<float>();
+  RenderPoints& p = out.points;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (!usable[i]) continue;
+      ++counts.in_model;
+      if (keep && (*keep)[i] == 0) {
+        ++counts.merged_away;
+        continue;
+      }
+      std::uint32_t owner = membership ? (*membership)[i] : 0;
+      if (owner == kDeletedPoints) {
+        ++counts.deleted;
+        continue;
+      }
+      if (owner != 0) {
+        const auto found = shown.find(owner);
+        if (found == shown.end()) {
+          owner = 0;  // a node no longer in the tree owns nothing
+        } else if (!found->second) {
+          ++counts.hidden;  // kept, for the renderer to skip until it is shown again
+        }
+      }
+      const float level =
+          scan.has_intensity() ? std::clamp((scan.intensity[i] - low) / spread, 0.0f, 1.0f) : 0.5f;
+      std::array<std::uint8_t, 4> rgba{};
+      if (scan.has_color()) {
+        rgba = {scan.rgb[3 * i], scan.rgb[3 * i + 1], scan.rgb[3 * i + 2], 255};
+      } else {
+        const auto grey = static_cast<std::uint8_t>(std::lround(255.0f * level));
+        rgba = {grey, grey, grey, 255};
+      }
+      out.by_node[owner].push_back(static_cast<std::uint32_t>(p.position.size()));
+      p.position.push_back((acquisition::point_in_world(scan, row, col) - origin).cast<float>());
+      p.normal.push_back(geometry->has_normal(i) ? Eigen::Vector3f(rotation * geometry->normal[i])
+                                                 : Eigen::Vector3f::Zero());
+      p.footprint_m.push_back(geometry->footprint_m[i]);
+      p.rgba.push_back(rgba);
+      p.intensity.push_back(level);
+      p.node.push_back(owner);
+    }
+  }
+}
+
+// Appends the gathered points `indices` to `out` in `order`.
+void append_points(const RenderPoints& from, const std::vector<std::uint32_t>& order,
+                   RenderPoints& out) {
+  for (const std::uint32_t k : order) {
+    out.position.push_back(from.position[k]);
+    out.normal.push_back(from.normal[k]);
+    out.footprint_m.push_back(from.footprint_m[k]);
+    out.rgba.push_back(from.rgba[k]);
+    out.intensity.push_back(from.intensity[k]);
+    out.node.push_back(from.node[k]);
+  }
+}
+
+}  // namespace
+
+RenderModel build_render_model(const Project& project, const RenderModelSettings& settings) {
+  RenderModel model;
+  const std::vector<StoredScanSummary> scans = project.scans();
+  if (!scans.empty()) {
+    const Eigen::Vector3d scanner = project.load_scan(scans.front().id).T_world_scan.translation();
+    model.origin = scanner.array().round();
+  }
+  const std::vector<ObjectNode> tree = project.object_nodes();
+  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
+  Gathered gathered;
+  for (const StoredScanSummary& stored : scans)
+    gather_scan(project, stored, settings, shown, model.origin, gathered, model.counts);
+
+  // The tree's nodes, then the root of the unassigned points.
+  std::map<std::int64_t, std::size_t> index_of;
+  for (const ObjectNode& n : tree) {
+    index_of[n.id] = model.nodes.size();
+    model.nodes.push_back({n, {}, {}, {}, shown.at(n.id)});
+  }
+  ObjectNode unassigned;
+  unassigned.name = "unassigned";
+  index_of[0] = model.nodes.size();
+  model.nodes.push_back({unassigned, {}, {}, {}, true});
+  for (std::size_t k = 0; k < model.nodes.size(); ++k) {
+    const std::optional<std::int64_t> parent = model.nodes[k].node.parent;
+    const auto found = parent ? index_of.find(*parent) : index_of.end();
+    if (found == index_of.end()) {
+      model.roots.push_back(k);
+    } else {
+      model.nodes[found->second].children.push_back(k);
+    }
+  }
+
+  const RenderPoints& from = gathered.points;
+  for (auto& [owner, indices] : gathered.by_node) {
+    RenderNode& node = model.nodes[index_of.at(owner)];
+    for (std::vector<std::uint32_t>& part :
+         split_into_tiles(from.position, std::move(indices), settings.tiles)) {
+      RenderTile tile;
+      tile.node = owner;
+      tile.first = static_cast<std::uint32_t>(model.points.size());
+      tile.count = static_cast<std::uint32_t>(part.size());
+      for (const std::uint32_t k : part) tile.box.extend(from.position[k]);
+      tile.cone = normal_cone(from.normal, part);
+      tile.level_ends = order_for_level_of_detail(from.position, part, tile.box);
+      for (std::uint32_t& end : tile.level_ends) end += tile.first;
+      tile.lod_cube_m = tile.box.sizes().maxCoeff();
+      append_points(from, part, model.points);
+      node.tiles.push_back(model.tiles.size());
+      node.box.extend(tile.box);
+      model.tiles.push_back(std::move(tile));
+    }
+  }
+  // A group's box holds its descendants': children before parents.
+  std::vector<std::size_t> post_order;
+  std::vector<std::pair<std::size_t, bool>> stack;
+  for (const std::size_t root : model.roots) stack.emplace_back(root, false);
+  while (!stack.empty()) {
+    const auto [at, expanded] = stack.back();
+    stack.pop_back();
+    if (expanded) {
+      post_order.push_back(at);
+      continue;
+    }
+    stack.emplace_back(at, true);
+    for (const std::size_t child : model.nodes[at].children) stack.emplace_back(child, false);
+  }
+  for (const std::size_t at : post_order) {
+    for (const std::size_t child : model.nodes[at].children) {
+      if (!model.nodes[child].box.isEmpty()) model.nodes[at].box.extend(model.nodes[child].box);
+    }
+  }
+  return model;
+}
+
+}  // namespace scanbench::modeling

@@ -1,0 +1,35 @@
+// The room of tests/segmentation/room_scene.hpp stored in a project with
+// its geometry, and its pixels by viewing direction: the scene the
+// segmentation's and the render model's project tests work on.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <utility>
+
+#include "modeling/project.hpp"
+#include "modeling/scan_layers.hpp"
+#include "project_test_support.hpp"
+#include "segmentation/room_scene.hpp"
+
+namespace scanbench::modeling {
+
+// A project holding the room of tests/segmentation/room_scene.hpp with its
+// geometry; returns the scan's id.
+inline std::int64_t store_room(Project& project) {
+  const test::RoomScan& room = test::shared_room();
+  const std::int64_t id = test::insert_committed(project, room.scan);
+  Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const EncodedLayer& layer : encode_geometry(room.geometry))
+    project.put_layer(edit, id, layer);
+  edit.commit("{}");
+  return id;
+}
+
+// The pixel of the room looking at azimuth / elevation [deg] (0.5° grid).
+inline std::pair<int, int> pixel_at(double azimuth_deg, double elevation_deg) {
+  return {static_cast<int>(std::lround((30.0 - elevation_deg) / 0.5)),
+          static_cast<int>(std::lround((azimuth_deg + 180.0) / 0.5 - 0.5)) % 720};
+}
+
+}  // namespace scanbench::modeling
