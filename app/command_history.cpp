@@ -67,6 +67,10 @@ std::string summary(const modeling::CommandRecord& c) {
   if ((c.name == "group" || c.name == "edit") && result.contains("node")) {
     return fmt::format("node {}", result.value("node", 0));
   }
+  if (c.name == "merge_objects" && result.contains("merged")) {
+    return fmt::format("{} object(s) merged into object {}", result.value("merged", 0),
+                       result.value("node", 0));
+  }
   if (c.name == "ungroup" && result.contains("children")) {
     return fmt::format("group {} dissolved, {} child(ren) moved up", result.value("node", 0),
                        result["children"].size());

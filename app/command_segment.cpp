@@ -42,7 +42,8 @@ void add_segment_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "segment",
       "Segment scans into the object tree from a script of the workbench's operations (lasso, "
-      "barrier, grow, add, subtract, commit, group, ungroup, rename, hide, show, reparent, delete, "
+      "barrier, grow, add, subtract, commit, group, ungroup, merge, rename, hide, show, reparent, "
+      "delete, "
       "separate, auto, undo, redo); each change is one undoable command. A refused script "
       "changes nothing.");
   command->add_option("project", options->project, "Project file (.sbproj)")

@@ -520,6 +520,47 @@ UngroupResult ungroup_node(Project& project, std::int64_t group) {
   return result;
 }
 
+NodeCommandResult merge_objects(Project& project, const MergeSettings& settings) {
+  const std::int64_t revision = project.revision();
+  Tree tree = load_tree(project);
+  if (settings.objects.size() < 2) refuse("merge", "needs two objects or more");
+  std::unordered_set<std::uint32_t> absorbed;
+  for (const std::int64_t id : settings.objects) {
+    if (require_node(tree, id).kind != NodeKind::kObject) {
+      refuse("node " + std::to_string(id), "is a group: only objects can be merged");
+    }
+    if (id != settings.objects.front() && !absorbed.insert(static_cast<std::uint32_t>(id)).second) {
+      refuse("node " + std::to_string(id), "is named twice");
+    }
+  }
+  const auto into = static_cast<std::uint32_t>(settings.objects.front());
+  if (absorbed.count(into)) refuse("node " + std::to_string(into), "cannot merge into itself");
+  std::map<std::int64_t, std::vector<std::uint32_t>> changed;
+  for (const StoredScanSummary& stored : project.scans()) {
+    auto membership =
+        project.load_layer<std::uint32_t>(stored.id, layer::kMembership, ElementType::kU32);
+    if (!membership) continue;
+    bool touched = false;
+    for (std::uint32_t& owner : *membership) {
+      if (owner == 0 || owner == kDeletedPoints || !absorbed.count(owner)) continue;
+      owner = into;
+      touched = true;
+    }
+    if (touched) changed.emplace(stored.id, std::move(*membership));
+  }
+  for (const std::uint32_t id : absorbed) tree.erase(id);
+  const auto figures = compute_figures(project, tree, changed);
+  Project::Edit edit =
+      project.begin_command("merge_objects", dump({{"objects", settings.objects}}), revision);
+  for (const std::uint32_t id : absorbed) project.remove_node(edit, id);
+  for (const auto& [scan_id, membership] : changed)
+    put_membership(project, edit, scan_id, membership);
+  refresh_figures(project, edit, tree, figures);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"node", into}, {"merged", settings.objects.size() - 1}}));
+  return {command_id, into};
+}
+
 NodeCommandResult delete_node(Project& project, const DeleteSettings& settings) {
   const std::int64_t revision = project.revision();
   Tree tree = load_tree(project);

@@ -112,6 +112,15 @@ struct DeleteSettings {
 // the pool or are marked deleted.
 NodeCommandResult delete_node(Project& project, const DeleteSettings& settings);
 
+struct MergeSettings {
+  std::vector<std::int64_t> objects;  // at least two; the first one takes the others' points
+};
+
+// Merges objects into the first: the others' pixels (in every scan) become
+// its pixels and the others are removed (the inverse of separate, and how a
+// user merges proposals).
+NodeCommandResult merge_objects(Project& project, const MergeSettings& settings);
+
 struct SeparateSettings {
   std::int64_t node = 0;     // an object
   std::int64_t scan_id = 0;  // the scan whose pixels are split
@@ -137,7 +146,7 @@ struct ProposeSettings {
 
 // Automatic proposals (segmentation/proposals.hpp) on the scan's pixels still
 // to be segmented, each committed as an object "proposal K" in a new group,
-// for the user to accept (rename, reparent), merge (group) or reject
+// for the user to accept (rename, reparent), merge (merge_objects) or reject
 // (delete back to the pool). One command: undo takes them all back.
 SeparateResult propose_objects(Project& project, const ProposeSettings& settings);
 

@@ -29,7 +29,7 @@ struct Op {
   std::string text;                                       // commit, group, rename: the name
   nlohmann::json node;                                    // a NODE reference
   std::optional<nlohmann::json> parent;                   // given: a NODE or null
-  std::vector<nlohmann::json> children;                   // group
+  std::vector<nlohmann::json> children;                   // group; merge: the objects
   DeletedPoints deleted_points = DeletedPoints::kToPool;  // delete
   std::size_t min_pixels = segmentation::ProposalSettings{}.min_pixels;  // auto
 };
@@ -126,6 +126,7 @@ const std::map<std::string, std::vector<std::string>>& op_keys() {
       {"reparent", {"node", "parent"}},
       {"delete", {"node", "points"}},
       {"ungroup", {"node"}},
+      {"merge", {"nodes"}},
       {"separate", {"node"}},
       {"auto", {"group", "parent", "channel", "tolerance", "min_pixels"}},
       {"undo", {}},
@@ -191,25 +192,29 @@ void read_pixel_op(const OpReader& in, Op& op) {
   }
 }
 
-// Ops on the tree: commit, group, ungroup, rename, hide, show, reparent,
-// delete, separate.
+// Ops on the tree: commit, group, ungroup, merge, rename, hide, show,
+// reparent, delete, separate.
 void read_tree_op(const OpReader& in, Op& op) {
   if (op.name == "commit" || op.name == "group" || op.name == "rename") op.text = read_name(in);
-  if (op.name != "commit" && op.name != "group") op.node = in.node("node", false);
+  if (op.name != "commit" && op.name != "group" && op.name != "merge")
+    op.node = in.node("node", false);
   if (op.name == "commit" || op.name == "group") {
     if (in.has("parent")) op.parent = in.node("parent", true);
   } else if (op.name == "reparent") {
     op.parent = in.node("parent", true);
   }
-  if (op.name == "group" && in.has("children")) {
-    const nlohmann::json& children = in.json()["children"];
-    if (!children.is_array()) in.bad("key \"children\" must be an array of nodes");
+  if ((op.name == "group" && in.has("children")) || op.name == "merge") {
+    const std::string key = op.name == "merge" ? "nodes" : "children";
+    if (!in.has(key.c_str())) in.bad("key \"" + key + "\" is missing");
+    const nlohmann::json& children = in.json()[key];
+    if (!children.is_array()) in.bad("key \"" + key + "\" must be an array of nodes");
     for (const nlohmann::json& child : children) {
       if (!child.is_number_integer() && !child.is_string()) {
-        in.bad("key \"children\" must hold node ids or names");
+        in.bad("key \"" + key + "\" must hold node ids or names");
       }
       op.children.push_back(child);
     }
+    if (op.name == "merge" && op.children.size() < 2) in.bad("merge needs two objects or more");
   }
   if (op.name == "delete") {
     const std::string points = in.has("points") ? in.text("points") : "pool";
@@ -421,6 +426,12 @@ nlohmann::json Runner::apply_tree(const Op& op, const std::string& at) {
   if (op.name == "separate") {
     const SeparateResult r = separate_object(project_, {node_of(op.node, at), scan_of(op, at).id});
     return made(r.command_id, {{"nodes", r.nodes}});
+  }
+  if (op.name == "merge") {
+    MergeSettings s;
+    for (const nlohmann::json& object : op.children) s.objects.push_back(node_of(object, at));
+    const NodeCommandResult r = merge_objects(project_, s);
+    return made(r.command_id, {{"node", r.node_id}});
   }
   if (op.name == "ungroup") {
     const UngroupResult r = ungroup_node(project_, node_of(op.node, at));

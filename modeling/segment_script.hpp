@@ -17,6 +17,7 @@
 //      {"op": "reparent", "node": NODE, "parent": NODE or null},
 //      {"op": "delete", "node": NODE, "points": "pool" or "deleted"},
 //      {"op": "ungroup", "node": NODE},           its children move up
+//      {"op": "merge", "nodes": [NODE, …]},       objects into the first
 //      {"op": "separate", "node": NODE},          an object's parts in the scan
 //      {"op": "auto", "group": "proposals", "parent": NODE,
 //       "channel": "normal", "tolerance": 6, "min_pixels": 200},

@@ -130,11 +130,16 @@ TEST(Cli, SegmentScriptBuildsTheTreeAndEachOpIsUndoable) {
   const std::filesystem::path more = write_script(dir, "more.json", R"json({"scan": 1, "ops": [
     {"op": "redo"}, {"op": "redo"},
     {"op": "group", "name": "building", "parent": "site", "children": ["wall south"]},
-    {"op": "ungroup", "node": "building"}]})json");
+    {"op": "ungroup", "node": "building"},
+    {"op": "lasso", "scan": 2, "points": [[-0.5, -0.5], [3.5, -0.5], [3.5, 2.5], [-0.5, 2.5]]},
+    {"op": "grow", "scan": 2, "seed": [0, 0], "channel": "range", "tolerance": 50},
+    {"op": "commit", "scan": 2, "name": "wall from scan 2", "parent": "site"},
+    {"op": "merge", "nodes": ["wall south", "wall from scan 2"]}]})json");
   ASSERT_EQ(run_cli(dir, {"segment", project.string(), "--script", more.string()}).exit_code, 0);
-  ASSERT_EQ(nodes().size(), 2u);
+  ASSERT_EQ(nodes().size(), 2u);  // the wall of scan 2 merged into scan 1's
   EXPECT_EQ(nodes()[1]["name"], "wall south");
   EXPECT_EQ(nodes()[1]["parent"], nodes()[0]["id"]);
+  EXPECT_GT(nodes()[1]["points"].get<int>(), 12);
 }
 
 TEST(Cli, ARefusedSegmentScriptLeavesTheTreeAsItWas) {

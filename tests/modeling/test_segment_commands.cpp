@@ -208,6 +208,13 @@ TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
   EXPECT_EQ(nodes[0].points + nodes[1].points, static_cast<std::int64_t>(both));
   EXPECT_TRUE(nodes[0].points == static_cast<std::int64_t>(pane) ||
               nodes[1].points == static_cast<std::int64_t>(pane));
+  // Merged back: one object with both parts, its figures whole again.
+  const NodeCommandResult merged = merge_objects(project, {{parts.nodes[1], parts.nodes[0]}});
+  EXPECT_EQ(merged.node_id, parts.nodes[1]);
+  ASSERT_EQ(project.object_nodes().size(), 1u);
+  EXPECT_EQ(project.object_nodes()[0].points, static_cast<std::int64_t>(both));
+  EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(parts.nodes[1])), both);
+  ASSERT_TRUE(project.undo().has_value());
   ASSERT_TRUE(project.undo().has_value());
   EXPECT_EQ(project.object_nodes().size(), 1u);
 }
@@ -261,6 +268,8 @@ TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
       },
       "below itself");
   refused([&] { delete_node(project, {42, DeletedPoints::kToPool}); }, "node 42");
+  refused([&] { merge_objects(project, {{site.node_id, hall.node_id}}); }, "is a group");
+  refused([&] { merge_objects(project, {{site.node_id}}); }, "two objects or more");
 }
 
 // What must hold after every command: each parent is a live group, and each
@@ -356,7 +365,11 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
           separate_object(project, {some_node(), scan});
           break;
         case 11:
-          ungroup_node(project, some_node());
+          if (pick(2)) {
+            ungroup_node(project, some_node());
+          } else {
+            merge_objects(project, {{some_node(), some_node(), some_node()}});
+          }
           break;
         case 10:
           if (pick(10) == 0) {  // a whole scan's proposals: now and then
