@@ -7,24 +7,18 @@
 #include <filesystem>
 #include <vector>
 
+#include "acquisition/camera_view.hpp"
 #include "acquisition/simulation/scene.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
 
 namespace scanbench::acquisition::sim {
 
-// Camera frame: x right, y down, z forward (the optical axis), as in OpenCV.
-struct CameraView {
-  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
-  double vertical_fov_deg = 60.0;
-  int width = 640;
-  int height = 480;
-};
+using acquisition::CameraView;
+using acquisition::read_camera_view;
 
-// Reads a view file: {"width", "height", "vertical_fov_deg", and either
-// "T_world_camera": [16 numbers, row-major] or "position": [x, y, z] with
-// "look_at": [x, y, z] (and optional "up", default [0, 0, 1])}. Throws
-// InputError naming the file, the key and the problem.
-CameraView read_camera_view(const std::filesystem::path& view_json);
+// The sky's colour in truth pictures (sRGB): the background a renderer
+// compared against them should draw.
+inline constexpr std::uint8_t kSkyRgb[3] = {170, 200, 235};
 
 struct TruthImage {
   int width = 0;
