@@ -25,5 +25,6 @@ void add_history_commands(CLI::App& app);
 void add_check_command(CLI::App& app);
 void add_objects_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
+void add_render_command(CLI::App& app);
 
 }  // namespace scanbench::app

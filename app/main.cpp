@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
   sb::add_export_command(app);
   sb::add_history_commands(app);
   sb::add_segment_command(app);
+  sb::add_render_command(app);
   sb::add_objects_command(app);
   sb::add_check_command(app);
   sb::add_simulate_command(app);

@@ -61,9 +61,18 @@ void write_triplet(const Project& project, const std::vector<acquisition::Scan>&
   acquisition::write_triplet(scans.front(), settings.output);
 }
 
-// Refuses (core::InputError, nothing written) an output that would replace
-// the project being exported or one of its files, by any path (a symlink, a
-// hard link, "./"). Any other project is refused by the output file itself.
+std::size_t count_points(const std::vector<acquisition::Scan>& scans,
+                         const std::vector<std::vector<std::uint8_t>>& keep) {
+  std::size_t points = 0;
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    const std::vector<std::uint8_t>& counted = keep.empty() ? scans[s].valid : keep[s];
+    for (const std::uint8_t flag : counted) points += flag != 0 ? 1 : 0;
+  }
+  return points;
+}
+
+}  // namespace
+
 void refuse_to_replace_the_project(const Project& project,
                                    std::span<const std::filesystem::path> outputs) {
   for (const std::filesystem::path& output : outputs) {
@@ -85,18 +94,6 @@ void refuse_to_replace_the_project(const Project& project,
     }
   }
 }
-
-std::size_t count_points(const std::vector<acquisition::Scan>& scans,
-                         const std::vector<std::vector<std::uint8_t>>& keep) {
-  std::size_t points = 0;
-  for (std::size_t s = 0; s < scans.size(); ++s) {
-    const std::vector<std::uint8_t>& counted = keep.empty() ? scans[s].valid : keep[s];
-    for (const std::uint8_t flag : counted) points += flag != 0 ? 1 : 0;
-  }
-  return points;
-}
-
-}  // namespace
 
 ExportResult export_project(const Project& project, const ExportSettings& settings) {
   // Masks, poses and channels from one state, whatever commits meanwhile.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 
 #include "modeling/project.hpp"
 
@@ -42,5 +43,13 @@ struct ExportResult {
 // is all-or-nothing (acquisition/output_file.hpp); write failures throw
 // std::runtime_error naming the file.
 ExportResult export_project(const Project& project, const ExportSettings& settings);
+
+// Refuses (core::InputError, nothing written) an output that would replace
+// the project being read or one of its files, by any path (a symlink, a
+// hard link, "./"). Any other project is refused by the output file itself
+// (acquisition/output_file.hpp). Every command that writes a file from a
+// project checks its outputs with it first.
+void refuse_to_replace_the_project(const Project& project,
+                                   std::span<const std::filesystem::path> outputs);
 
 }  // namespace scanbench::modeling

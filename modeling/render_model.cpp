@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
+#include <variant>
 
 #include "acquisition/scan_geometry.hpp"
 #include "core/errors.hpp"
@@ -11,12 +13,6 @@
 namespace scanbench::modeling {
 
 namespace {
-
-// The points to draw, before they are tiled: in scan and pixel order.
-struct Gathered {
-  RenderPoints points;
-  std::map<std::uint32_t, std::vector<std::uint32_t>> by_node;  // owner → indices
-};
 
 // For every node, whether it is shown: not hidden, nor any group above it.
 std::map<std::int64_t, bool> shown_nodes(const std::vector<ObjectNode>& nodes) {
@@ -35,9 +31,47 @@ std::map<std::int64_t, bool> shown_nodes(const std::vector<ObjectNode>& nodes) {
   return shown;
 }
 
+// Half the diagonal of pixel (row, col)'s cell [rad]: a sample's footprint
+// per metre of range seen head on. Per-pixel grids have no cell: none.
+std::optional<float> half_cell_rad(const acquisition::Scan& scan, int row) {
+  const auto* a = std::get_if<acquisition::SphericalAngles>(&scan.angles);
+  if (a == nullptr) return std::nullopt;
+  const double across =
+      a->azimuth_step_rad * std::cos(a->elevation_start_rad + row * a->elevation_step_rad);
+  return static_cast<float>(0.5 * std::hypot(across, a->elevation_step_rad));
+}
+
+// The splat of pixel (row, col): its normal, and radii and major axis from
+// the incidence of the scanner's beam (RenderPoints::radii_m).
+void append_splat(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry, int row,
+                  int col, const Eigen::Matrix3f& rotation, float max_stretch, RenderPoints& p) {
+  const std::size_t i = scan.index(row, col);
+  const float footprint = geometry.footprint_m[i];
+  if (!geometry.has_normal(i)) {
+    p.normal.push_back(Eigen::Vector3f::Zero());
+    p.radii_m.emplace_back(footprint, footprint);
+    p.major_axis.push_back(Eigen::Vector3f::Zero());
+    return;
+  }
+  const Eigen::Vector3f n = geometry.normal[i];
+  const Eigen::Vector3f beam = acquisition::direction(scan, row, col);  // scanner → point
+  const float cos_incidence = std::clamp(std::abs(n.dot(beam)), 1.0f / max_stretch, 1.0f);
+  const std::optional<float> half_cell = half_cell_rad(scan, row);
+  const float head_on = half_cell ? scan.range_m[i] * *half_cell : footprint * cos_incidence;
+  const Eigen::Vector3f slope = beam - n.dot(beam) * n;  // the beam's trace on the surface
+  p.normal.push_back(rotation * n);
+  if (slope.norm() < 1e-3f) {  // head on: round
+    p.radii_m.emplace_back(head_on, head_on);
+    p.major_axis.push_back(Eigen::Vector3f::Zero());
+    return;
+  }
+  p.radii_m.emplace_back(head_on, head_on / cos_incidence);
+  p.major_axis.push_back(rotation * slope.normalized());
+}
+
 void gather_scan(const Project& project, const StoredScanSummary& stored,
                  const RenderModelSettings& settings, const std::map<std::int64_t, bool>& shown,
-                 const Eigen::Vector3d& origin, Gathered& out, RenderModelCounts& counts) {
+                 const Eigen::Vector3d& origin, RenderPoints& p, RenderModelCounts& counts) {
   const acquisition::Scan scan = project.load_scan(stored.id);
   const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
   if (!geometry) {
@@ -57,7 +91,6 @@ void gather_scan(const Project& project, const StoredScanSummary& stored,
   const auto [low, high] = acquisition::intensity_range(scan, usable);
   const float spread = high > low ? high - low : 1.0f;
   const Eigen::Matrix3f rotation = scan.T_world_scan.linear().cast<float>();
-  RenderPoints& p = out.points;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.columns; ++col) {
       const std::size_t i = scan.index(row, col);
@@ -89,11 +122,8 @@ void gather_scan(const Project& project, const StoredScanSummary& stored,
         const auto grey = static_cast<std::uint8_t>(std::lround(255.0f * level));
         rgba = {grey, grey, grey, 255};
       }
-      out.by_node[owner].push_back(static_cast<std::uint32_t>(p.position.size()));
       p.position.push_back((acquisition::point_in_world(scan, row, col) - origin).cast<float>());
-      p.normal.push_back(geometry->has_normal(i) ? Eigen::Vector3f(rotation * geometry->normal[i])
-                                                 : Eigen::Vector3f::Zero());
-      p.footprint_m.push_back(geometry->footprint_m[i]);
+      append_splat(scan, *geometry, row, col, rotation, settings.max_stretch, p);
       p.rgba.push_back(rgba);
       p.intensity.push_back(level);
       p.node.push_back(owner);
@@ -107,7 +137,8 @@ void append_points(const RenderPoints& from, const std::vector<std::uint32_t>& o
   for (const std::uint32_t k : order) {
     out.position.push_back(from.position[k]);
     out.normal.push_back(from.normal[k]);
-    out.footprint_m.push_back(from.footprint_m[k]);
+    out.radii_m.push_back(from.radii_m[k]);
+    out.major_axis.push_back(from.major_axis[k]);
     out.rgba.push_back(from.rgba[k]);
     out.intensity.push_back(from.intensity[k]);
     out.node.push_back(from.node[k]);
@@ -117,18 +148,29 @@ void append_points(const RenderPoints& from, const std::vector<std::uint32_t>& o
 }  // namespace
 
 RenderModel build_render_model(const Project& project, const RenderModelSettings& settings) {
-  RenderModel model;
   const std::vector<StoredScanSummary> scans = project.scans();
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   if (!scans.empty()) {
     const Eigen::Vector3d scanner = project.load_scan(scans.front().id).T_world_scan.translation();
-    model.origin = scanner.array().round();
+    origin = scanner.array().round();
   }
   const std::vector<ObjectNode> tree = project.object_nodes();
   const std::map<std::int64_t, bool> shown = shown_nodes(tree);
-  Gathered gathered;
+  RenderModelCounts counts;
+  RenderPoints points;
   for (const StoredScanSummary& stored : scans)
-    gather_scan(project, stored, settings, shown, model.origin, gathered, model.counts);
+    gather_scan(project, stored, settings, shown, origin, points, counts);
+  RenderModel model = assemble_render_model(std::move(points), origin, tree, settings.tiles);
+  model.counts = counts;
+  return model;
+}
 
+RenderModel assemble_render_model(RenderPoints points, const Eigen::Vector3d& origin,
+                                  const std::vector<ObjectNode>& tree, const TileLimits& limits) {
+  RenderModel model;
+  model.origin = origin;
+  model.counts.in_model = points.size();
+  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
   // The tree's nodes, then the root of the unassigned points.
   std::map<std::int64_t, std::size_t> index_of;
   for (const ObjectNode& n : tree) {
@@ -149,11 +191,17 @@ RenderModel build_render_model(const Project& project, const RenderModelSettings
     }
   }
 
-  const RenderPoints& from = gathered.points;
-  for (auto& [owner, indices] : gathered.by_node) {
+  // Each node's points (a node not in the tree owns nothing), tiled.
+  std::map<std::int64_t, std::vector<std::uint32_t>> by_node;
+  for (std::uint32_t k = 0; k < points.size(); ++k) {
+    if (!index_of.count(points.node[k])) points.node[k] = 0;
+    by_node[points.node[k]].push_back(k);
+  }
+  const RenderPoints& from = points;
+  for (auto& [owner, indices] : by_node) {
     RenderNode& node = model.nodes[index_of.at(owner)];
     for (std::vector<std::uint32_t>& part :
-         split_into_tiles(from.position, std::move(indices), settings.tiles)) {
+         split_into_tiles(from.position, std::move(indices), limits)) {
       RenderTile tile;
       tile.node = owner;
       tile.first = static_cast<std::uint32_t>(model.points.size());

@@ -30,7 +30,13 @@ namespace scanbench::modeling {
 struct RenderPoints {
   std::vector<Eigen::Vector3f> position;  // [m] from the origin
   std::vector<Eigen::Vector3f> normal;    // world frame, towards its scanner; zero: unknown
-  std::vector<float> footprint_m;         // world-space splat radius
+  // The splat: an ellipse in the point's tangent plane covering its share of
+  // the surface. Seen at incidence θ, a sample's cell stretches by 1 / cos θ
+  // along the surface's slope away from the scanner (the major axis) and
+  // not across it, so the ground far from a scanner gets long thin splats
+  // instead of round ones that leave gaps between the scan's rows.
+  std::vector<Eigen::Vector2f> radii_m;     // (across, along the major axis) [m]
+  std::vector<Eigen::Vector3f> major_axis;  // unit, world frame; zero: round (radii equal)
   std::vector<std::array<std::uint8_t, 4>>
       rgba;                         // scan colour (grey from intensity without), alpha 255
   std::vector<float> intensity;     // [0, 1]: the scan's 2nd–98th percentile spread
@@ -81,11 +87,21 @@ struct RenderModel {
 
 struct RenderModelSettings {
   TileLimits tiles;
+  // The largest stretch of a splat along its major axis (1 / cos θ is
+  // capped here): beyond it the scan's samples are too sparse and too noisy
+  // to be a surface.
+  float max_stretch = 24.0f;
   bool merged_only = true;  // drop the points the merge dropped (where it ran)
 };
 
 // Reads every scan of the project (its geometry is required: a scan without
 // it is refused with core::InputError naming it) and builds the model.
 RenderModel build_render_model(const Project& project, const RenderModelSettings& settings);
+
+// The model of points gathered elsewhere (a test's, a bench's): `points`
+// relative to `origin`, each owned by points.node (0, or a node of `tree` not
+// in it: none), tiled with `limits`. Counts: in_model = points.size().
+RenderModel assemble_render_model(RenderPoints points, const Eigen::Vector3d& origin,
+                                  const std::vector<ObjectNode>& tree, const TileLimits& limits);
 
 }  // namespace scanbench::modeling

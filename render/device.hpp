@@ -1,0 +1,28 @@
+// The render device: whatever gives the renderer a current OpenGL 4.5 core
+// context. The renderer draws into its own offscreen target (frame_target.hpp)
+// either way, so the same code serves the headless device below and a
+// window backend (GLFW, which only that backend includes) that shows the
+// target on screen.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace scanbench::render {
+
+class RenderDevice {
+ public:
+  virtual ~RenderDevice() = default;
+  // Makes the device's context current on the calling thread.
+  virtual void make_current() = 0;
+  // "OpenGL 4.5 (Core Profile) Mesa … | llvmpipe …": what drew the frames.
+  virtual std::string describe() const = 0;
+};
+
+// A context without any surface, on EGL's surfaceless platform (Mesa;
+// llvmpipe on machines without a GPU), made current on return. Throws
+// core::RuntimeFailure naming what is missing (EGL, the platform, a 4.5
+// core context) when the machine cannot give one.
+std::unique_ptr<RenderDevice> make_headless_device();
+
+}  // namespace scanbench::render

@@ -1,0 +1,115 @@
+#include "render/frame_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace scanbench::render {
+
+namespace {
+
+float distance_to_box(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& eye) {
+  return std::sqrt(box.squaredExteriorDistance(eye));
+}
+
+// The tile's points of levels ≤ the first whose cells are at most
+// `pixels` wide on screen at `distance` (all of them when none is).
+std::uint32_t level_of_detail_count(const modeling::RenderTile& tile, float distance,
+                                    float focal_px, float pixels) {
+  if (distance <= 0.0f) return tile.count;
+  for (std::size_t level = 0; level < tile.level_ends.size(); ++level) {
+    const float cell = tile.lod_cube_m / static_cast<float>(1u << std::min<std::size_t>(level, 30));
+    if (cell * focal_px / distance <= pixels) return tile.level_ends[level] - tile.first;
+  }
+  return tile.count;
+}
+
+// The splat radius that keeps a prefix of `count` points closed: the cell of
+// the deepest level the prefix holds whole (0 when it holds them all).
+float min_radius_for(const modeling::RenderTile& tile, std::uint32_t count) {
+  if (count >= tile.count) return 0.0f;
+  float cell = tile.lod_cube_m;
+  for (std::size_t level = 0; level < tile.level_ends.size(); ++level) {
+    if (tile.level_ends[level] - tile.first > count) break;
+    cell = tile.lod_cube_m / static_cast<float>(1u << std::min<std::size_t>(level, 30));
+  }
+  return cell;
+}
+
+struct Walk {
+  const modeling::RenderModel& model;
+  const RenderView& view;
+  const CullSettings& settings;
+  std::array<Eigen::Vector4f, 6> planes;
+  FramePlan plan;
+
+  std::size_t points_below(std::size_t node) const {
+    std::size_t n = 0;
+    for (const std::size_t t : model.nodes[node].tiles) n += model.tiles[t].count;
+    for (const std::size_t child : model.nodes[node].children) n += points_below(child);
+    return n;
+  }
+
+  void visit(std::size_t index) {
+    const modeling::RenderNode& node = model.nodes[index];
+    if (!node.shown) {
+      plan.hidden += points_below(index);
+      return;
+    }
+    if (settings.frustum && !node.box.isEmpty() && outside_frustum(planes, node.box)) {
+      plan.culled_frustum += points_below(index);
+      return;
+    }
+    for (const std::size_t t : node.tiles) visit_tile(t);
+    for (const std::size_t child : node.children) visit(child);
+  }
+
+  void visit_tile(std::size_t t) {
+    const modeling::RenderTile& tile = model.tiles[t];
+    if (settings.frustum && outside_frustum(planes, tile.box)) {
+      plan.culled_frustum += tile.count;
+      return;
+    }
+    if (settings.backface && modeling::faces_away(tile.cone, tile.box, view.eye)) {
+      plan.culled_backface += tile.count;
+      return;
+    }
+    TileDraw draw{t, tile.count, 0.0f, distance_to_box(tile.box, view.eye)};
+    if (settings.level_of_detail) {
+      draw.count = level_of_detail_count(tile, draw.distance_m, view.focal_px, settings.lod_pixels);
+    }
+    plan.draws.push_back(draw);
+  }
+};
+
+}  // namespace
+
+FramePlan plan_frame(const modeling::RenderModel& model, const RenderView& view,
+                     const CullSettings& settings) {
+  Walk walk{model, view, settings, view.frustum_planes(), {}};
+  walk.plan.points = model.points.size();
+  for (const std::size_t root : model.roots) walk.visit(root);
+  FramePlan plan = std::move(walk.plan);
+  std::size_t wanted = 0;
+  for (const TileDraw& draw : plan.draws) wanted += draw.count;
+  // Over budget: every tile keeps the same share, so near and far thin alike.
+  const double share = settings.budget > 0 && wanted > settings.budget
+                           ? static_cast<double>(settings.budget) / static_cast<double>(wanted)
+                           : 1.0;
+  std::size_t visible = 0;
+  for (TileDraw& draw : plan.draws) {
+    const modeling::RenderTile& tile = model.tiles[draw.tile];
+    visible += tile.count;
+    draw.count = std::max<std::uint32_t>(
+        1, static_cast<std::uint32_t>(std::floor(share * static_cast<double>(draw.count))));
+    draw.min_radius_m = min_radius_for(tile, draw.count);
+    plan.submitted += draw.count;
+  }
+  plan.culled_budget = visible - plan.submitted;
+  plan.tiles_drawn = plan.draws.size();
+  std::stable_sort(plan.draws.begin(), plan.draws.end(), [](const TileDraw& a, const TileDraw& b) {
+    return a.distance_m < b.distance_m;
+  });
+  return plan;
+}
+
+}  // namespace scanbench::render

@@ -1,0 +1,249 @@
+#include "render/splat_renderer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+
+#include "render/gl_objects.hpp"
+#include "render/splat_shaders.hpp"
+
+namespace scanbench::render {
+
+namespace {
+
+constexpr std::array<std::string_view, 3> kDrawModeNames = {"points", "splats", "blended"};
+constexpr std::array<std::string_view, 3> kKernelNames = {"disk", "gaussian", "cosine"};
+constexpr std::array<std::string_view, 5> kColorModeNames = {"color", "intensity", "height",
+                                                             "normal", "object"};
+
+template <typename Enum, std::size_t N>
+std::optional<Enum> from_name(const std::array<std::string_view, N>& names, std::string_view name) {
+  const auto found = std::find(names.begin(), names.end(), name);
+  if (found == names.end()) return std::nullopt;
+  return static_cast<Enum>(found - names.begin());
+}
+
+// Uploads one attribute array as its own buffer (at least one element: GL
+// refuses empty storage).
+template <typename T>
+GlBuffer upload(const std::vector<T>& values) {
+  GlBuffer buffer = make_buffer();
+  const std::vector<T> one(1);
+  const std::vector<T>& data = values.empty() ? one : values;
+  glNamedBufferStorage(buffer.get(), static_cast<GLsizeiptr>(data.size() * sizeof(T)), data.data(),
+                       0);
+  return buffer;
+}
+
+}  // namespace
+
+std::string_view draw_mode_name(DrawMode mode) {
+  return kDrawModeNames[static_cast<int>(mode)];
+}
+std::string_view kernel_name(Kernel kernel) {
+  return kKernelNames[static_cast<int>(kernel)];
+}
+std::string_view color_mode_name(ColorMode mode) {
+  return kColorModeNames[static_cast<int>(mode)];
+}
+std::optional<DrawMode> draw_mode_from_name(std::string_view name) {
+  return from_name<DrawMode>(kDrawModeNames, name);
+}
+std::optional<Kernel> kernel_from_name(std::string_view name) {
+  return from_name<Kernel>(kKernelNames, name);
+}
+std::optional<ColorMode> color_mode_from_name(std::string_view name) {
+  return from_name<ColorMode>(kColorModeNames, name);
+}
+
+struct SplatRenderer::Gpu {
+  std::array<GlBuffer, 7> attributes;
+  GlVertexArray points;
+  GlVertexArray empty;  // the resolve's triangle needs no attributes
+  GlProgram splat;
+  GlProgram resolve;
+  // The frame's targets, made for one size.
+  int width = 0;
+  int height = 0;
+  GlTexture accumulated;  // RGBA32F: Σ w·colour, Σ w
+  GlTexture depth;        // DEPTH_COMPONENT32F, reversed Z
+  GlTexture picture;      // RGBA8: the resolved frame
+  GlFramebuffer splat_target;
+  GlFramebuffer picture_target;
+
+  void ensure_size(int w, int h) {
+    if (w == width && h == height) return;
+    width = w;
+    height = h;
+    accumulated = make_texture_2d(GL_RGBA32F, w, h);
+    depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+    picture = make_texture_2d(GL_RGBA8, w, h);
+    splat_target = make_framebuffer();
+    glNamedFramebufferTexture(splat_target.get(), GL_COLOR_ATTACHMENT0, accumulated.get(), 0);
+    glNamedFramebufferTexture(splat_target.get(), GL_DEPTH_ATTACHMENT, depth.get(), 0);
+    picture_target = make_framebuffer();
+    glNamedFramebufferTexture(picture_target.get(), GL_COLOR_ATTACHMENT0, picture.get(), 0);
+  }
+
+  void uniform(const char* name, int value) const {
+    glProgramUniform1i(splat.get(), glGetUniformLocation(splat.get(), name), value);
+  }
+  void uniform(const char* name, float value) const {
+    glProgramUniform1f(splat.get(), glGetUniformLocation(splat.get(), name), value);
+  }
+};
+
+SplatRenderer::SplatRenderer(const modeling::RenderModel& model)
+    : model_(model), gpu_(std::make_unique<Gpu>()) {
+  const modeling::RenderPoints& p = model.points;
+  gpu_->attributes = {upload(p.position),  upload(p.normal), upload(p.radii_m),   upload(p.rgba),
+                      upload(p.intensity), upload(p.node),   upload(p.major_axis)};
+  gpu_->points = make_vertex_array();
+  gpu_->empty = make_vertex_array();
+  const GLuint vao = gpu_->points.get();
+  struct Layout {
+    GLint size;
+    GLenum type;
+    GLboolean normalized;
+    GLsizei stride;
+    bool integer;
+  };
+  constexpr std::array<Layout, 7> kLayouts = {{{3, GL_FLOAT, GL_FALSE, 12, false},
+                                               {3, GL_FLOAT, GL_FALSE, 12, false},
+                                               {2, GL_FLOAT, GL_FALSE, 8, false},
+                                               {4, GL_UNSIGNED_BYTE, GL_TRUE, 4, false},
+                                               {1, GL_FLOAT, GL_FALSE, 4, false},
+                                               {1, GL_UNSIGNED_INT, GL_FALSE, 4, true},
+                                               {3, GL_FLOAT, GL_FALSE, 12, false}}};
+  for (GLuint k = 0; k < kLayouts.size(); ++k) {
+    const Layout& l = kLayouts[k];
+    glVertexArrayVertexBuffer(vao, k, gpu_->attributes[k].get(), 0, l.stride);
+    if (l.integer) {
+      glVertexArrayAttribIFormat(vao, k, l.size, l.type, 0);
+    } else {
+      glVertexArrayAttribFormat(vao, k, l.size, l.type, l.normalized, 0);
+    }
+    glVertexArrayAttribBinding(vao, k, k);
+    glEnableVertexArrayAttrib(vao, k);
+  }
+  gpu_->splat = build_program("splat shaders", shaders::kSplatVertex, shaders::kSplatFragment);
+  gpu_->resolve =
+      build_program("resolve shaders", shaders::kResolveVertex, shaders::kResolveFragment);
+  height_range_ = {0.0f, 1.0f};
+  if (!p.position.empty()) {
+    const auto [low, high] = std::minmax_element(
+        p.position.begin(), p.position.end(),
+        [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a.z() < b.z(); });
+    height_range_ = {low->z(), high->z()};
+  }
+}
+
+SplatRenderer::~SplatRenderer() = default;
+
+FrameResult SplatRenderer::draw(const RenderView& view, const RenderSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  FrameResult result;
+  result.plan = plan_frame(model_, view, settings.culling);
+  Gpu& gpu = *gpu_;
+  gpu.ensure_size(view.width, view.height);
+  const GLuint splat = gpu.splat.get();
+  glProgramUniformMatrix4fv(splat, glGetUniformLocation(splat, "u_view"), 1, GL_FALSE,
+                            view.view.data());
+  glProgramUniformMatrix4fv(splat, glGetUniformLocation(splat, "u_projection"), 1, GL_FALSE,
+                            view.projection.data());
+  glProgramUniform3fv(splat, glGetUniformLocation(splat, "u_eye"), 1, view.eye.data());
+  glProgramUniform2f(splat, glGetUniformLocation(splat, "u_viewport"),
+                     static_cast<float>(view.width), static_cast<float>(view.height));
+  glProgramUniform2fv(splat, glGetUniformLocation(splat, "u_height_range"), 1,
+                      height_range_.data());
+  gpu.uniform("u_focal", view.focal_px);
+  gpu.uniform("u_scale", settings.splat_scale);
+  gpu.uniform("u_points", settings.mode == DrawMode::kPoints ? 1 : 0);
+  gpu.uniform("u_backface", settings.culling.backface ? 1 : 0);
+  gpu.uniform("u_color_mode", static_cast<int>(settings.color));
+  gpu.uniform("u_lighting", settings.lighting ? 1 : 0);
+  gpu.uniform("u_kernel", static_cast<int>(settings.kernel));
+  gpu.uniform("u_oriented", settings.oriented ? 1 : 0);
+  gpu.uniform("u_depth_offset", settings.depth_offset);
+
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  glEnable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, gpu.splat_target.get());
+  glViewport(0, 0, view.width, view.height);
+  const float clear_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const float clear_depth = 0.0f;  // reversed Z: 0 is the far plane
+  glClearNamedFramebufferfv(gpu.splat_target.get(), GL_COLOR, 0, clear_color);
+  glClearNamedFramebufferfv(gpu.splat_target.get(), GL_DEPTH, 0, &clear_depth);
+  glUseProgram(splat);
+  glBindVertexArray(gpu.points.get());
+  const auto draw_tiles = [&] {
+    for (const TileDraw& draw : result.plan.draws) {
+      gpu.uniform("u_min_radius", draw.min_radius_m);
+      glDrawArrays(GL_POINTS, static_cast<GLint>(model_.tiles[draw.tile].first),
+                   static_cast<GLsizei>(draw.count));
+    }
+  };
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_GREATER);
+  if (settings.mode == DrawMode::kBlended) {
+    gpu.uniform("u_pass", shaders::kPassVisibility);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    draw_tiles();
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gpu.uniform("u_pass", shaders::kPassAccumulate);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_GEQUAL);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    draw_tiles();
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+  } else {
+    gpu.uniform("u_pass",
+                settings.mode == DrawMode::kPoints ? shaders::kPassPoints : shaders::kPassOpaque);
+    draw_tiles();
+  }
+
+  // Resolve into the picture.
+  const GLuint resolve = gpu.resolve.get();
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, gpu.picture_target.get());
+  glUseProgram(resolve);
+  glBindTextureUnit(0, gpu.accumulated.get());
+  glBindTextureUnit(1, gpu.depth.get());
+  glProgramUniform1i(resolve, glGetUniformLocation(resolve, "u_accumulated"), 0);
+  glProgramUniform1i(resolve, glGetUniformLocation(resolve, "u_depth"), 1);
+  glProgramUniform3f(resolve, glGetUniformLocation(resolve, "u_background"),
+                     settings.background[0] / 255.0f, settings.background[1] / 255.0f,
+                     settings.background[2] / 255.0f);
+  glProgramUniform1i(resolve, glGetUniformLocation(resolve, "u_eye_dome"),
+                     settings.eye_dome ? 1 : 0);
+  glProgramUniform2f(resolve, glGetUniformLocation(resolve, "u_depth_ab"), view.projection(2, 2),
+                     view.projection(2, 3));
+  glBindVertexArray(gpu.empty.get());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glFinish();
+  result.frame_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+RenderedImage SplatRenderer::read_image() const {
+  RenderedImage image;
+  image.width = gpu_->width;
+  image.height = gpu_->height;
+  const std::size_t row = 4 * static_cast<std::size_t>(image.width);
+  std::vector<std::uint8_t> bottom_up(row * image.height);
+  glGetTextureImage(gpu_->picture.get(), 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                    static_cast<GLsizei>(bottom_up.size()), bottom_up.data());
+  image.rgba.resize(bottom_up.size());
+  for (int y = 0; y < image.height; ++y) {
+    std::copy_n(bottom_up.begin() + static_cast<std::ptrdiff_t>(row * (image.height - 1 - y)), row,
+                image.rgba.begin() + static_cast<std::ptrdiff_t>(row * y));
+  }
+  return image;
+}
+
+}  // namespace scanbench::render

@@ -1,0 +1,189 @@
+#include "render/splat_shaders.hpp"
+
+namespace scanbench::render::shaders {
+
+// Per point: its centre, normal, major axis and radii in eye space for the
+// fragment stage, its colour by the colour mode, and a sprite wide enough
+// for the ellipse (2 r f / depth pixels for its major radius r, a little
+// more for perspective off axis). A
+// point whose normal faces away from the eye is moved outside the clip
+// volume (backface culling per point).
+const char* const kSplatVertex = R"glsl(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_radii;
+layout(location = 3) in vec4 a_color;
+layout(location = 4) in float a_intensity;
+layout(location = 5) in uint a_node;
+layout(location = 6) in vec3 a_major;
+
+uniform mat4 u_view;
+uniform mat4 u_projection;
+uniform vec3 u_eye;
+uniform float u_focal;
+uniform float u_scale;
+uniform float u_min_radius;
+uniform int u_points;
+uniform int u_backface;
+uniform int u_color_mode;
+uniform int u_lighting;
+uniform vec2 u_height_range;
+
+out vec3 v_color;
+flat out vec3 v_center;
+flat out vec3 v_normal;
+flat out vec3 v_major;
+flat out vec2 v_radii;
+
+vec3 ramp(float t) {  // blue, cyan, green, yellow, red
+  t = clamp(t, 0.0, 1.0);
+  return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)),
+               0.0, 1.0);
+}
+
+vec3 object_color(uint id) {
+  if (id == 0u) return vec3(0.55);
+  uint h = id * 2654435761u;
+  return 0.25 + 0.7 * vec3(float(h & 255u), float((h >> 8) & 255u), float((h >> 16) & 255u)) / 255.0;
+}
+
+void main() {
+  bool has_normal = dot(a_normal, a_normal) > 0.25;
+  if (u_backface == 1 && has_normal && dot(a_normal, u_eye - a_position) < 0.0) {
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+    gl_PointSize = 1.0;
+    return;
+  }
+  vec4 eye_position = u_view * vec4(a_position, 1.0);
+  vec2 radii = max(a_radii * u_scale, vec2(u_min_radius));
+  float depth = max(-eye_position.z, 1e-3);
+  gl_Position = u_projection * eye_position;
+  gl_PointSize = u_points == 1 ? 1.0 : clamp(2.2 * radii.y * u_focal / depth + 1.0, 1.0, 255.0);
+  v_center = eye_position.xyz;
+  v_normal = has_normal ? normalize(mat3(u_view) * a_normal) : vec3(0.0);
+  v_major = dot(a_major, a_major) > 0.25 ? normalize(mat3(u_view) * a_major) : vec3(0.0);
+  v_radii = radii;
+  vec3 color = a_color.rgb;
+  if (u_color_mode == 1) color = vec3(a_intensity);
+  if (u_color_mode == 2) color = ramp((a_position.z - u_height_range.x) /
+                                      max(u_height_range.y - u_height_range.x, 1e-3));
+  if (u_color_mode == 3) color = has_normal ? 0.5 + 0.5 * a_normal : vec3(0.5);
+  if (u_color_mode == 4) color = object_color(a_node);
+  if (u_lighting == 1 && has_normal) {
+    color *= 0.35 + 0.65 * abs(dot(v_normal, normalize(-v_center)));
+  }
+  v_color = color;
+}
+)glsl";
+
+// The fragment's view ray meets the splat's plane (its normal, or facing the
+// eye) at q; outside the ellipse (radii along the major axis and across it;
+// a disk of their geometric mean when facing the eye) it is discarded,
+// inside it weighs by the kernel of its elliptical distance and takes q's
+// depth (reversed Z).
+const char* const kSplatFragment = R"glsl(#version 450 core
+in vec3 v_color;
+flat in vec3 v_center;
+flat in vec3 v_normal;
+flat in vec3 v_major;
+flat in vec2 v_radii;
+
+uniform mat4 u_projection;
+uniform vec2 u_viewport;
+uniform int u_pass;
+uniform int u_kernel;
+uniform int u_oriented;
+uniform float u_depth_offset;
+
+layout(location = 0) out vec4 out_color;
+
+float kernel_weight(float d2) {
+  if (u_kernel == 1) return exp(-2.0 * d2);                   // Gaussian, σ = r / 2
+  if (u_kernel == 2) return cos(1.5707963 * sqrt(d2)) + 1e-3;  // cosine
+  return 1.0;                                                 // flat disk
+}
+
+void main() {
+  if (u_pass == 3) {
+    gl_FragDepth = gl_FragCoord.z;  // every path must write it, once one does
+    out_color = vec4(v_color, 1.0);
+    return;
+  }
+  vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
+  vec3 ray = vec3(ndc.x / u_projection[0][0], ndc.y / u_projection[1][1], -1.0);
+  vec3 facing = normalize(-v_center);
+  bool oriented = u_oriented == 1 && dot(v_normal, v_normal) > 0.25;
+  vec3 n = oriented ? v_normal : facing;
+  float along = dot(ray, n);
+  if (abs(along) < 0.05 * length(ray)) {  // seen edge on: face the eye instead
+    oriented = false;
+    n = facing;
+    along = dot(ray, n);
+  }
+  vec3 q = ray * (dot(v_center, n) / along);
+  vec3 offset = q - v_center;
+  float d2;
+  if (oriented && dot(v_major, v_major) > 0.25) {
+    vec2 e = vec2(dot(offset, cross(n, v_major)), dot(offset, v_major)) / v_radii;
+    d2 = dot(e, e);
+  } else {
+    d2 = dot(offset, offset) / (oriented ? v_radii.x * v_radii.x : v_radii.x * v_radii.y);
+  }
+  if (d2 > 1.0) discard;
+  float z = q.z;
+  if (u_pass == 0) z -= u_depth_offset * v_radii.y;
+  gl_FragDepth = (u_projection[2][2] * z + u_projection[3][2]) / -z;
+  float w = kernel_weight(d2);
+  out_color = u_pass == 1 ? vec4(v_color * w, w) : vec4(v_color, 1.0);
+}
+)glsl";
+
+// A triangle covering the screen.
+const char* const kResolveVertex = R"glsl(#version 450 core
+void main() {
+  vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+)glsl";
+
+// Weighted colour divided by weight; the background where nothing landed;
+// with eye-dome lighting, each pixel darkened by how far its neighbours
+// stand in front of it (log of eye distance).
+const char* const kResolveFragment = R"glsl(#version 450 core
+uniform sampler2D u_accumulated;
+uniform sampler2D u_depth;
+uniform vec3 u_background;
+uniform int u_eye_dome;
+uniform vec2 u_depth_ab;  // eye distance = b / (depth + a)
+
+layout(location = 0) out vec4 out_color;
+
+float log_distance(ivec2 p) {
+  float d = texelFetch(u_depth, p, 0).r;
+  return log2(u_depth_ab.y / (d + u_depth_ab.x));
+}
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  vec4 sum = texelFetch(u_accumulated, p, 0);
+  if (sum.a <= 0.0) {
+    out_color = vec4(u_background, 0.0);
+    return;
+  }
+  vec3 color = sum.rgb / sum.a;
+  if (u_eye_dome == 1) {
+    ivec2 size = textureSize(u_depth, 0);
+    float here = log_distance(p);
+    float response = 0.0;
+    for (int k = 0; k < 8; ++k) {
+      float angle = 0.7853982 * float(k);
+      ivec2 q = clamp(p + ivec2(round(2.0 * vec2(cos(angle), sin(angle)))), ivec2(0), size - 1);
+      response += max(0.0, here - log_distance(q));
+    }
+    color *= exp(-1.5 * response);
+  }
+  out_color = vec4(color, 1.0);
+}
+)glsl";
+
+}  // namespace scanbench::render::shaders

@@ -1,0 +1,18 @@
+// GLSL 4.50 sources of the splat renderer (splat_renderer.hpp): one vertex
+// and one fragment stage for every splat pass, and the resolve.
+#pragma once
+
+namespace scanbench::render::shaders {
+
+extern const char* const kSplatVertex;
+extern const char* const kSplatFragment;
+extern const char* const kResolveVertex;
+extern const char* const kResolveFragment;
+
+// u_pass of the splat fragment stage.
+inline constexpr int kPassVisibility = 0;
+inline constexpr int kPassAccumulate = 1;
+inline constexpr int kPassOpaque = 2;
+inline constexpr int kPassPoints = 3;
+
+}  // namespace scanbench::render::shaders

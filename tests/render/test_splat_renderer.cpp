@@ -1,0 +1,145 @@
+// The splat renderer on the headless device (llvmpipe in CI): raw points
+// leave holes that splats close, each half of the wall keeps its colour,
+// hidden objects are not drawn, and every kernel and colour mode draws.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "render/device.hpp"
+#include "render/splat_renderer.hpp"
+#include "wall_model.hpp"
+
+namespace scanbench::render {
+namespace {
+
+const Eigen::Vector3d kOrigin(1000.0, 2000.0, 0.0);
+
+// One device for the whole executable: creating contexts is slow on llvmpipe.
+RenderDevice& device() {
+  static const std::unique_ptr<RenderDevice> shared = make_headless_device();
+  shared->make_current();
+  return *shared;
+}
+
+// The wall covers x 141…499, y 106…374 of the 640 × 480 frame; a margin in.
+struct Inside {
+  double covered = 0.0;   // share of pixels drawn
+  double red_left = 0.0;  // share of drawn pixels of the left half that are red
+  double blue_right = 0.0;
+};
+
+Inside inside_the_wall(const RenderedImage& image) {
+  Inside out;
+  std::size_t pixels = 0, covered = 0, left = 0, red = 0, right = 0, blue = 0;
+  for (int y = 116; y < 364; ++y) {
+    for (int x = 151; x < 489; ++x) {
+      ++pixels;
+      if (!image.covered(x, y)) continue;
+      ++covered;
+      const std::uint8_t* p = &image.rgba[4 * (static_cast<std::size_t>(y) * image.width + x)];
+      if (x < 310) {
+        ++left;
+        red += p[0] > 150 && p[2] < 80;
+      } else if (x > 330) {
+        ++right;
+        blue += p[2] > 150 && p[0] < 80;
+      }
+    }
+  }
+  out.covered = static_cast<double>(covered) / static_cast<double>(pixels);
+  out.red_left = left ? static_cast<double>(red) / static_cast<double>(left) : 0.0;
+  out.blue_right = right ? static_cast<double>(blue) / static_cast<double>(right) : 0.0;
+  return out;
+}
+
+RenderedImage render(const modeling::RenderModel& model, const RenderSettings& settings,
+                     const Eigen::Vector3d& eye = {1000.0, 2000.0, 1.5}) {
+  device();
+  SplatRenderer renderer(model);
+  renderer.draw(make_render_view(test::camera_at(eye, 640, 480), kOrigin), settings);
+  return renderer.read_image();
+}
+
+TEST(SplatRenderer, TheHeadlessDeviceIsOpenGl45) {
+  EXPECT_NE(device().describe().find("4.5"), std::string::npos) << device().describe();
+}
+
+TEST(SplatRenderer, RawPointsLeaveHolesThatBlendedSplatsClose) {
+  const modeling::RenderModel model = test::wall_model();
+  RenderSettings points;
+  points.mode = DrawMode::kPoints;
+  const Inside raw = inside_the_wall(render(model, points));
+  EXPECT_GT(raw.covered, 0.03);  // a pixel every 4.5 pixels each way
+  EXPECT_LT(raw.covered, 0.1);
+  EXPECT_GT(raw.red_left, 0.99);
+  for (const DrawMode mode : {DrawMode::kSplats, DrawMode::kBlended}) {
+    RenderSettings splats;
+    splats.mode = mode;
+    const Inside closed = inside_the_wall(render(model, splats));
+    EXPECT_EQ(closed.covered, 1.0) << draw_mode_name(mode);
+    EXPECT_GT(closed.red_left, 0.99) << draw_mode_name(mode);
+    EXPECT_GT(closed.blue_right, 0.99) << draw_mode_name(mode);
+  }
+}
+
+TEST(SplatRenderer, EveryKernelClosesTheWallAndTheBackgroundStaysEmpty) {
+  const modeling::RenderModel model = test::wall_model();
+  for (const Kernel kernel : {Kernel::kDisk, Kernel::kGaussian, Kernel::kCosine}) {
+    RenderSettings settings;
+    settings.kernel = kernel;
+    settings.background = {10, 20, 30};
+    const RenderedImage image = render(model, settings);
+    EXPECT_EQ(inside_the_wall(image).covered, 1.0) << kernel_name(kernel);
+    EXPECT_FALSE(image.covered(5, 5));
+    EXPECT_EQ(image.rgba[0], 10);
+    EXPECT_EQ(image.rgba[2], 30);
+  }
+}
+
+TEST(SplatRenderer, HiddenObjectsAreNotDrawn) {
+  const RenderedImage image = render(test::wall_model(true), {});
+  std::size_t right = 0;
+  for (int y = 116; y < 364; ++y) {
+    for (int x = 340; x < 489; ++x) right += image.covered(x, y);
+  }
+  EXPECT_EQ(right, 0u);
+  EXPECT_GT(inside_the_wall(image).red_left, 0.99);
+}
+
+TEST(SplatRenderer, TheBackOfTheWallIsCulledUnlessAskedFor) {
+  const modeling::RenderModel model = test::wall_model();
+  const Eigen::Vector3d behind(1020.0, 2000.0, 1.5);
+  std::size_t drawn = 0;
+  const RenderedImage culled = render(model, {}, behind);
+  for (std::size_t i = 3; i < culled.rgba.size(); i += 4) drawn += culled.rgba[i] != 0;
+  EXPECT_EQ(drawn, 0u);
+  RenderSettings both_sides;
+  both_sides.culling.backface = false;
+  const RenderedImage seen = render(model, both_sides, behind);
+  EXPECT_TRUE(seen.covered(320, 240));
+}
+
+TEST(SplatRenderer, ColourModesDrawWhatTheyName) {
+  const modeling::RenderModel model = test::wall_model();
+  RenderSettings settings;
+  settings.color = ColorMode::kObject;
+  const RenderedImage objects = render(model, settings);
+  const auto pixel = [&](const RenderedImage& image, int x, int y) {
+    const std::uint8_t* p = &image.rgba[4 * (static_cast<std::size_t>(y) * image.width + x)];
+    return Eigen::Vector3i(p[0], p[1], p[2]);
+  };
+  EXPECT_NE(pixel(objects, 200, 240), pixel(objects, 440, 240));  // objects 1 and 2
+  settings.color = ColorMode::kIntensity;
+  EXPECT_EQ(pixel(render(model, settings), 200, 240), Eigen::Vector3i(128, 128, 128));
+  settings.color = ColorMode::kNormal;  // (−1, 0, 0) → (0, 0.5, 0.5)
+  EXPECT_EQ(pixel(render(model, settings), 200, 240), Eigen::Vector3i(0, 128, 128));
+  for (const ColorMode mode : {ColorMode::kHeight, ColorMode::kColor}) {
+    settings.color = mode;
+    settings.lighting = true;
+    settings.eye_dome = true;
+    EXPECT_EQ(inside_the_wall(render(model, settings)).covered, 1.0) << color_mode_name(mode);
+  }
+}
+
+}  // namespace
+}  // namespace scanbench::render
