@@ -1,4 +1,4 @@
-// scanbench bench SUITE [--json] [--smoke]
+// scanbench bench SUITE [--json] [--smoke] [--pictures DIR]
 #include <fmt/core.h>
 
 #include <memory>
@@ -49,6 +49,8 @@ void add_bench_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print one JSON object");
   command->add_flag("--smoke", options->bench.smoke,
                     "Tiny inputs: checks the suite runs; figures are not meaningful");
+  command->add_option("--pictures", options->bench.pictures,
+                      "render: also write each view's truth picture and renders (PNG) here");
   command->callback([options] { run_bench(*options); });
 }
 

@@ -136,7 +136,7 @@ void add_render_command(CLI::App& app) {
       ->default_str("color");
   command->add_option("--budget", s.culling.budget, "Points per frame (0: no budget)")
       ->capture_default_str();
-  command->add_option("--splat-scale", s.splat_scale, "Splat radius × the footprint")
+  command->add_option("--splat-scale", s.splat_scale, "Splat radii × the sample's cell")
       ->check(CLI::Range(0.1, 10.0))
       ->capture_default_str();
   command->add_flag("--lighting", s.lighting, "Shade by the normals, light at the eye");

@@ -16,6 +16,7 @@
 #include "acquisition/ptx_reader.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "bench/pcl_io.hpp"
+#include "bench/scratch_folder.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::bench {
@@ -111,31 +112,11 @@ nlohmann::json compare_pcd_readers(const std::filesystem::path& pcd, double poin
       {"speedup_vs_pcl_xyzi", pcl_xyzi / ours},     {"speedup_vs_pcl_blob", pcl_blob / ours}};
 }
 
-// A scratch folder removed with everything in it, also when the bench throws.
-class ScratchFolder {
- public:
-  ScratchFolder()
-      : path_(std::filesystem::temp_directory_path() /
-              ("scanbench-bench-io-" + std::to_string(::getpid()))) {
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchFolder() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  ScratchFolder(const ScratchFolder&) = delete;
-  ScratchFolder& operator=(const ScratchFolder&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
 }  // namespace
 
 nlohmann::json run_io_bench(const BenchOptions& options) {
   const int rows = options.smoke ? 90 : 900, columns = options.smoke ? 360 : 3600;
-  const ScratchFolder scratch;
+  const ScratchFolder scratch("io");
   const std::filesystem::path& dir = scratch.path();
   const Scan scan = synthetic_scan(rows, columns);
   const int repeats = options.smoke ? 1 : 3;

@@ -6,12 +6,13 @@
 #include "bench/bench_io.hpp"
 #include "bench/bench_merge.hpp"
 #include "bench/bench_registration.hpp"
+#include "bench/bench_render.hpp"
 #include "bench/bench_segmentation.hpp"
 
 namespace scanbench::bench {
 
 std::vector<std::string> suite_names() {
-  return {"io", "geometry", "registration", "merge", "segmentation"};
+  return {"io", "geometry", "registration", "merge", "segmentation", "render"};
 }
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
@@ -20,6 +21,7 @@ nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "registration") return run_registration_bench(options);
   if (name == "merge") return run_merge_bench(options);
   if (name == "segmentation") return run_segmentation_bench(options);
+  if (name == "render") return run_render_bench(options);
   assert(false && "unknown bench suite");
   return {};
 }

@@ -3,6 +3,7 @@
 // returns one JSON object with the field names its issue specifies.
 #pragma once
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@ struct BenchOptions {
   // Small inputs for the test suite's smoke run: same code paths, seconds
   // instead of minutes, figures not meaningful.
   bool smoke = false;
+  // Where a suite that draws pictures (render) writes them; empty: nowhere.
+  std::filesystem::path pictures;
 };
 
 std::vector<std::string> suite_names();

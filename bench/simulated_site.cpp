@@ -6,7 +6,7 @@
 namespace scanbench::bench {
 
 SimulatedSite simulate_site(const std::string& name, const acquisition::sim::ScannerModel& model,
-                            int scan_count) {
+                            int scan_count, SiteLighting lighting) {
   namespace sim = acquisition::sim;
   constexpr std::uint64_t kSiteSeed = 1;
   const sim::Site site = sim::make_site(name, kSiteSeed, scan_count);
@@ -18,7 +18,9 @@ SimulatedSite simulate_site(const std::string& name, const acquisition::sim::Sca
     const std::uint64_t seed = sim::hash_combine(kSiteSeed, static_cast<std::uint64_t>(k));
     sim::SimulatedScan simulated =
         sim::simulate_scan(site.scene, site.scan_poses[static_cast<std::size_t>(k)], model,
-                           sim::random_lighting(seed), seed);
+                           lighting == SiteLighting::kReference ? sim::reference_lighting()
+                                                                : sim::random_lighting(seed),
+                           seed);
     out.geometry.push_back(acquisition::compute_geometry(simulated.scan).geometry);
     out.scans.push_back(std::move(simulated.scan));
     out.truth.push_back(std::move(simulated.truth));

@@ -20,9 +20,15 @@ struct SimulatedSite {
   std::vector<acquisition::sim::ObjectInfo> objects;  // the truth's hierarchy; id k at k − 1
 };
 
+// How the scans' colours are lit.
+enum class SiteLighting {
+  kPerScan,    // each scan its own sun, exposure and white balance (a real campaign)
+  kReference,  // every scan under reference_lighting(), as the truth pictures are
+};
+
 // Scans the first `scan_count` positions of site `name` (seed 1) with `model`,
 // then computes every scan's geometry with the default settings.
 SimulatedSite simulate_site(const std::string& name, const acquisition::sim::ScannerModel& model,
-                            int scan_count);
+                            int scan_count, SiteLighting lighting = SiteLighting::kPerScan);
 
 }  // namespace scanbench::bench

@@ -41,6 +41,47 @@ std::optional<float> half_cell_rad(const acquisition::Scan& scan, int row) {
   return static_cast<float>(0.5 * std::hypot(across, a->elevation_step_rad));
 }
 
+// How far the pixel's samples reach along its surface: the largest distance
+// to one of its four neighbours, when it lies inside a surface its scan
+// sampled; none on a silhouette. Only inside may a splat stretch beyond the
+// edge-on limit, and never further than the samples beside it (normals of
+// small objects seen edge-on are too rough for 1 / cos θ). On a post's or a
+// wall's silhouette the beam grazes the surface too, but the next sample
+// along lies far behind it or there is none (the sky): each neighbour must
+// be a return (mixed pixels count: grazing ground is full of them) within
+// `reach` [m]. Ground seen from above (below the scanner, its normal within
+// 30° of `up`) may also have dropouts beside it, as far grazing ground loses
+// returns and there is no sky beyond the ground.
+std::optional<float> sample_reach(const acquisition::Scan& scan,
+                                  const acquisition::ScanGeometry& geometry, int row, int col,
+                                  float reach, const Eigen::Vector3f& up) {
+  const Eigen::Vector3f p = acquisition::point_in_scan(scan, row, col);
+  const Eigen::Vector3f& n = geometry.normal[scan.index(row, col)];
+  const bool ground_like = n.dot(up) > 0.866f && p.dot(up) < 0.0f;
+  constexpr int kSteps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  int returns = 0;
+  float widest = 0.0f;
+  for (const auto& step : kSteps) {
+    const int r = row + step[0];
+    int c = col + step[1];
+    if (c < 0 || c >= scan.columns) {
+      if (!acquisition::wraps_around(scan)) return std::nullopt;
+      c = (c + scan.columns) % scan.columns;
+    }
+    if (r < 0 || r >= scan.rows) return std::nullopt;
+    if (!scan.valid[scan.index(r, c)]) {
+      if (!ground_like) return std::nullopt;
+      continue;
+    }
+    ++returns;
+    const float distance = (acquisition::point_in_scan(scan, r, c) - p).norm();
+    if (distance > reach) return std::nullopt;
+    widest = std::max(widest, distance);
+  }
+  if (returns < 2) return std::nullopt;
+  return widest;
+}
+
 // The splat of pixel (row, col): its normal, and radii and major axis from
 // the incidence of the scanner's beam (RenderPoints::radii_m).
 void append_splat(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry, int row,
@@ -55,9 +96,17 @@ void append_splat(const acquisition::Scan& scan, const acquisition::ScanGeometry
   }
   const Eigen::Vector3f n = geometry.normal[i];
   const Eigen::Vector3f beam = acquisition::direction(scan, row, col);  // scanner → point
-  const float cos_incidence = std::clamp(std::abs(n.dot(beam)), 1.0f / max_stretch, 1.0f);
+  constexpr float kEdgeOnStretch = 4.0f;  // the geometry stage's footprint limit
+  float cos_incidence = std::clamp(std::abs(n.dot(beam)), 1.0f / max_stretch, 1.0f);
   const std::optional<float> half_cell = half_cell_rad(scan, row);
   const float head_on = half_cell ? scan.range_m[i] * *half_cell : footprint * cos_incidence;
+  if (cos_incidence < 1.0f / kEdgeOnStretch) {
+    const std::optional<float> along =
+        sample_reach(scan, geometry, row, col, 2.0f * head_on / cos_incidence,
+                     scan.T_world_scan.linear().transpose().col(2).cast<float>());
+    const float limit = along ? std::max(*along / head_on, kEdgeOnStretch) : kEdgeOnStretch;
+    cos_incidence = std::max(cos_incidence, 1.0f / limit);
+  }
   const Eigen::Vector3f slope = beam - n.dot(beam) * n;  // the beam's trace on the surface
   p.normal.push_back(rotation * n);
   if (slope.norm() < 1e-3f) {  // head on: round

@@ -51,10 +51,13 @@ class HeadlessDevice final : public RenderDevice {
     make_current();
   }
 
+  // The display stays initialised: EGL gives every device of the process
+  // the same surfaceless display, and terminating it would pull it from
+  // under the others (a bench's renderer beside a test's, the workbench's
+  // two views).
   ~HeadlessDevice() override {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(display_, context_);
-    eglTerminate(display_);
   }
 
   HeadlessDevice(const HeadlessDevice&) = delete;

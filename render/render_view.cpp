@@ -31,6 +31,15 @@ RenderView make_render_view(const acquisition::CameraView& camera, const Eigen::
   return out;
 }
 
+RenderView with_guard_band(const RenderView& view, int pixels) {
+  RenderView wider = view;
+  wider.width += 2 * pixels;
+  wider.height += 2 * pixels;
+  wider.projection(0, 0) = 2.0f * view.focal_px / static_cast<float>(wider.width);
+  wider.projection(1, 1) = 2.0f * view.focal_px / static_cast<float>(wider.height);
+  return wider;
+}
+
 std::array<Eigen::Vector4f, 6> RenderView::frustum_planes() const {
   // Rows of the clip matrix: −w ≤ x, y ≤ w and 0 ≤ z ≤ w (zero-to-one depth).
   const Eigen::Matrix4f clip = projection * view;

@@ -36,6 +36,12 @@ struct RenderView {
 RenderView make_render_view(const acquisition::CameraView& camera, const Eigen::Vector3d& origin,
                             float near_m = 0.5f, float far_m = 2000.0f);
 
+// The same camera with `pixels` more on every side (the principal point
+// stays the centre): GL drops a point sprite whose centre leaves the clip
+// volume, so splats straddling the picture's edge are drawn into a wider
+// target and the picture is cut from its middle.
+RenderView with_guard_band(const RenderView& view, int pixels);
+
 // True when the box lies wholly outside one of the planes.
 bool outside_frustum(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::AlignedBox3f& box);
 

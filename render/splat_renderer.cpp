@@ -140,12 +140,15 @@ SplatRenderer::SplatRenderer(const modeling::RenderModel& model)
 
 SplatRenderer::~SplatRenderer() = default;
 
-FrameResult SplatRenderer::draw(const RenderView& view, const RenderSettings& settings) {
+FrameResult SplatRenderer::draw(const RenderView& picture_view, const RenderSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
+  const RenderView view = with_guard_band(picture_view, kGuardBandPixels);
   FrameResult result;
   result.plan = plan_frame(model_, view, settings.culling);
   Gpu& gpu = *gpu_;
   gpu.ensure_size(view.width, view.height);
+  picture_width_ = picture_view.width;
+  picture_height_ = picture_view.height;
   const GLuint splat = gpu.splat.get();
   glProgramUniformMatrix4fv(splat, glGetUniformLocation(splat, "u_view"), 1, GL_FALSE,
                             view.view.data());
@@ -232,12 +235,13 @@ FrameResult SplatRenderer::draw(const RenderView& view, const RenderSettings& se
 
 RenderedImage SplatRenderer::read_image() const {
   RenderedImage image;
-  image.width = gpu_->width;
-  image.height = gpu_->height;
+  image.width = picture_width_;
+  image.height = picture_height_;
   const std::size_t row = 4 * static_cast<std::size_t>(image.width);
   std::vector<std::uint8_t> bottom_up(row * image.height);
-  glGetTextureImage(gpu_->picture.get(), 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                    static_cast<GLsizei>(bottom_up.size()), bottom_up.data());
+  glGetTextureSubImage(gpu_->picture.get(), 0, kGuardBandPixels, kGuardBandPixels, 0, image.width,
+                       image.height, 1, GL_RGBA, GL_UNSIGNED_BYTE,
+                       static_cast<GLsizei>(bottom_up.size()), bottom_up.data());
   image.rgba.resize(bottom_up.size());
   for (int y = 0; y < image.height; ++y) {
     std::copy_n(bottom_up.begin() + static_cast<std::ptrdiff_t>(row * (image.height - 1 - y)), row,

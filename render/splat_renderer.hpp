@@ -45,8 +45,11 @@ struct RenderSettings {
   DrawMode mode = DrawMode::kBlended;
   Kernel kernel = Kernel::kGaussian;
   ColorMode color = ColorMode::kColor;
-  bool oriented = true;       // disks in the plane of their normal (else facing the camera)
-  float splat_scale = 1.0f;   // × the footprint radius
+  bool oriented = true;  // disks in the plane of their normal (else facing the camera)
+  // × the splat radii. A sample's cell is covered by exactly its half
+  // diagonal on an ideal grid; 1.5 overlaps the neighbours, which closes the
+  // gaps noise and the merge leave and gives blending something to blend.
+  float splat_scale = 1.5f;
   float depth_offset = 1.0f;  // blended: the visibility pass's push back, × the splat radius
   bool lighting = false;      // diffuse shading from the normals, light at the eye
   bool eye_dome = false;      // eye-dome lighting: depth edges darkened (scans without colour)
@@ -79,16 +82,22 @@ class SplatRenderer {
   SplatRenderer(const SplatRenderer&) = delete;
   SplatRenderer& operator=(const SplatRenderer&) = delete;
 
-  // Draws a frame into the offscreen target (sized to the view).
+  // Draws a frame into the offscreen target (the view's size and a guard
+  // band round it).
   FrameResult draw(const RenderView& view, const RenderSettings& settings);
 
   // The last frame.
   RenderedImage read_image() const;
 
  private:
+  // Pixels drawn beyond each edge of the picture (render_view.hpp).
+  static constexpr int kGuardBandPixels = 64;
+
   struct Gpu;
   const modeling::RenderModel& model_;
   std::unique_ptr<Gpu> gpu_;
+  int picture_width_ = 0;
+  int picture_height_ = 0;
   Eigen::Vector2f height_range_;  // of the model's points [m, model frame z]
 };
 

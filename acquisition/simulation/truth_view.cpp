@@ -25,6 +25,7 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
   const std::size_t n = static_cast<std::size_t>(view.width) * view.height;
   image.rgb.assign(3 * n, 0);
   image.object_id.assign(n, 0);
+  image.distance_m.assign(n, 0.0f);
   const double focal = view.focal_px();
   const ScanLighting lighting = reference_lighting();
   const auto render_row = [&](int v) {
@@ -40,6 +41,7 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
         continue;
       }
       image.object_id[i] = hit->object;
+      image.distance_m[i] = static_cast<float>(hit->distance_m);
       const Eigen::Vector3d point = ray.origin + hit->distance_m * ray.direction;
       const double footprint =
           footprint_radius(hit->distance_m, 1.0 / focal, std::abs(hit->normal.dot(ray.direction)));

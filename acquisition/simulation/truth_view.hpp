@@ -25,6 +25,7 @@ struct TruthImage {
   int height = 0;
   std::vector<std::uint8_t> rgb;    // 8-bit sRGB, row-major, 3 per pixel; sky colour where no hit
   std::vector<ObjectId> object_id;  // 0 = sky
+  std::vector<float> distance_m;    // camera centre to the hit along the pixel's ray; 0 = sky
 };
 
 // Ray-casts the scene through every pixel centre under reference_lighting()

@@ -23,6 +23,7 @@ using test::ScratchDir;
 
 using test::CliResult;
 using test::run_cli;
+using ::testing::HasSubstr;
 
 nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& path) {
   const CliResult info = run_cli(dir, {"info", path.string(), "--json"});
@@ -140,6 +141,40 @@ TEST(Cli, SegmentScriptBuildsTheTreeAndEachOpIsUndoable) {
   EXPECT_EQ(nodes()[1]["name"], "wall south");
   EXPECT_EQ(nodes()[1]["parent"], nodes()[0]["id"]);
   EXPECT_GT(nodes()[1]["points"].get<int>(), 12);
+}
+
+TEST(Cli, RenderDrawsTheProjectHeadlessAndRefusesBadViewsAndOutputs) {
+  ScratchDir dir;
+  const std::filesystem::path project = segmentable_project(dir);
+  const std::filesystem::path view =
+      write_script(dir, "view.json",
+                   R"json({"width": 64, "height": 48, "vertical_fov_deg": 60,
+              "position": [0, 0, 0], "look_at": [1, 0, 0]})json");
+  const std::filesystem::path picture = dir / "picture.png";
+  const CliResult run = run_cli(
+      dir, {"render", project.string(), "--view", view.string(), "-o", picture.string(), "--json"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json out = nlohmann::json::parse(run.out);
+  EXPECT_EQ(out["width"], 64);
+  EXPECT_EQ(out["mode"], "blended");
+  for (const char* key : {"points", "points_submitted", "culled_frustum", "culled_backface",
+                          "culled_budget", "frame_ms"})
+    EXPECT_TRUE(out.contains(key)) << key;
+  EXPECT_GT(std::filesystem::file_size(picture), 0u);
+  // A view file without its camera, and a picture over the project: exit 2, nothing written.
+  const std::filesystem::path bad = write_script(dir, "bad.json", R"json({"width": 64})json");
+  const CliResult refused = run_cli(
+      dir, {"render", project.string(), "--view", bad.string(), "-o", (dir / "x.png").string()});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("bad.json"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+  const std::filesystem::path sneaky = dir / "segment.png";
+  std::filesystem::create_symlink(project, sneaky);
+  EXPECT_EQ(
+      run_cli(dir, {"render", project.string(), "--view", view.string(), "-o", sneaky.string()})
+          .exit_code,
+      2);
+  EXPECT_EQ(std::filesystem::read_symlink(sneaky), project);
 }
 
 TEST(Cli, ARefusedSegmentScriptLeavesTheTreeAsItWas) {

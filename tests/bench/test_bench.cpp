@@ -172,6 +172,31 @@ TEST(BenchSegmentation, SmokeRunReportsEveryField) {
   EXPECT_TRUE(bench["goals"]["click_latency_p95_at_most_16_ms"].is_boolean());
 }
 
+TEST(BenchRender, SmokeRunReportsEveryViewAndMode) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(
+      dir, {"bench", "render", "--json", "--smoke", "--pictures", (dir / "pictures").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "render");
+  for (const char* view : {"closeup", "street", "overview"}) {
+    for (const char* mode : {"points", "splats", "blended"}) {
+      const nlohmann::json& figures = bench["views"][view][mode];
+      for (const char* field : {"psnr_db", "ssim", "hole_fraction"})
+        EXPECT_TRUE(figures[field].is_number()) << view << "." << mode << "." << field;
+      EXPECT_GE(figures["hole_fraction"].get<double>(), 0.0);
+      EXPECT_LE(figures["hole_fraction"].get<double>(), 1.0);
+      EXPECT_TRUE(
+          std::filesystem::exists(dir / "pictures" / (std::string(view) + "_" + mode + ".png")));
+    }
+    EXPECT_GT(bench["views"][view]["sampled_pixels"].get<int>(), 0) << view;
+  }
+  for (const char* field :
+       {"frame_ms_culling_on", "frame_ms_culling_off", "culled_share", "culling_speedup"})
+    EXPECT_GT(bench[field].get<double>(), 0.0) << field;
+  for (const auto& [goal, met] : bench["goals"].items()) EXPECT_TRUE(met.is_boolean()) << goal;
+}
+
 TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
   test::ScratchDir dir;
   const test::CliResult result = test::run_cli(dir, {"bench", "io", "--json", "--smoke"});

@@ -21,6 +21,16 @@ RenderDevice& device() {
   return *shared;
 }
 
+TEST(SplatRenderer, DevicesComeAndGoWhileAnotherDraws) {
+  device();
+  { const std::unique_ptr<RenderDevice> second = make_headless_device(); }
+  const modeling::RenderModel model = test::wall_model();
+  device();
+  SplatRenderer renderer(model);
+  renderer.draw(make_render_view(test::camera_at({1000.0, 2000.0, 1.5}), kOrigin), {});
+  EXPECT_TRUE(renderer.read_image().covered(80, 60));
+}
+
 // The wall covers x 141…499, y 106…374 of the 640 × 480 frame; a margin in.
 struct Inside {
   double covered = 0.0;   // share of pixels drawn

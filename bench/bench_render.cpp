@@ -1,0 +1,264 @@
+// The protocol: the campus at seed 1, 4 scans at their true poses, lit as
+// the truth pictures are, their geometry and merge; the render model of the
+// merged points. For three
+// cameras ("closeup": Keller Hall's west façade from 9 m, scanned from
+// 20–35 m; "street": eye height across the quad; "overview": from 90 m up
+// and away) the simulator ray-casts the truth picture (reference lighting,
+// no noise), and each mode renders the same camera. Pixels count where the
+// truth's surface was sampled by some scan (sampled_mask): a roof no scanner
+// saw, or ground so far off that the scans' rows are more than 8 footprints
+// apart, is not a hole of the renderer. Frame times: the street view, blended, the median
+// of 5 frames after a warm-up, culling (frustum, normal cones, level of
+// detail) on and off.
+#include "bench/bench_render.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <optional>
+
+#include "acquisition/camera_view.hpp"
+#include "acquisition/picture_file.hpp"
+#include "acquisition/simulation/sites.hpp"
+#include "acquisition/simulation/truth_view.hpp"
+#include "acquisition/spherical_grid.hpp"
+#include "bench/image_metrics.hpp"
+#include "bench/scratch_folder.hpp"
+#include "bench/simulated_site.hpp"
+#include "modeling/layers.hpp"
+#include "modeling/render_model.hpp"
+#include "modeling/scan_layers.hpp"
+#include "registration/merge.hpp"
+#include "registration/prepared_scan.hpp"
+#include "render/device.hpp"
+#include "render/splat_renderer.hpp"
+
+namespace scanbench::bench {
+
+namespace {
+
+namespace sim = acquisition::sim;
+
+struct NamedView {
+  const char* name;
+  acquisition::CameraView camera;
+};
+
+acquisition::CameraView look(const Eigen::Vector3d& position, const Eigen::Vector3d& target,
+                             double fov_deg, int width, int height) {
+  acquisition::CameraView view;
+  view.width = width;
+  view.height = height;
+  view.vertical_fov_deg = fov_deg;
+  const Eigen::Vector3d z = (target - position).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  view.T_world_camera.linear().col(0) = x;
+  view.T_world_camera.linear().col(1) = z.cross(x);
+  view.T_world_camera.linear().col(2) = z;
+  view.T_world_camera.translation() = position;
+  return view;
+}
+
+// The same cameras as scripts/views/campus_*.json (the demo's pictures).
+std::vector<NamedView> campus_views(int width, int height) {
+  return {{"closeup", look({12.5, -15.0, 3.0}, {21.0, -11.0, 4.0}, 60.0, width, height)},
+          {"street", look({-22.0, -2.0, 1.7}, {30.0, 8.0, 3.0}, 60.0, width, height)},
+          {"overview", look({-55.0, -60.0, 55.0}, {0.0, 0.0, 0.0}, 50.0, width, height)}};
+}
+
+// 1 where the truth's surface was sampled by one of the scans: the beam
+// through it has an in-model return (not a mixed pixel) within two
+// footprints (the geometry stage's, stretched by at most 4 at grazing
+// incidence) and 2 cm of it.
+std::vector<std::uint8_t> sampled_mask(const sim::TruthImage& truth,
+                                       const acquisition::CameraView& camera,
+                                       const SimulatedSite& site) {
+  const std::vector<acquisition::Scan>& scans = site.scans;
+  std::vector<acquisition::SphericalGrid> grids;
+  for (const acquisition::Scan& scan : scans) grids.emplace_back(scan);
+  const double focal = camera.focal_px();
+  std::vector<std::uint8_t> mask(truth.distance_m.size(), 0);
+  for (int v = 0; v < truth.height; ++v) {
+    for (int u = 0; u < truth.width; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * truth.width + u;
+      if (truth.distance_m[i] <= 0.0f) continue;
+      const Eigen::Vector3d ray((u + 0.5 - 0.5 * truth.width) / focal,
+                                (v + 0.5 - 0.5 * truth.height) / focal, 1.0);
+      const Eigen::Vector3d p = camera.T_world_camera * (ray.normalized() * truth.distance_m[i]);
+      for (std::size_t s = 0; s < scans.size() && !mask[i]; ++s) {
+        const Eigen::Vector3d local = scans[s].T_world_scan.inverse() * p;
+        const std::int64_t pixel = grids[s].pixel_of(local);
+        if (pixel < 0 ||
+            !acquisition::in_model(scans[s], site.geometry[s], static_cast<std::size_t>(pixel)))
+          continue;
+        const auto k = static_cast<std::size_t>(pixel);
+        const Eigen::Vector3d sample =
+            scans[s].range_m[k] * local.normalized();  // on the beam p lies on
+        mask[i] = (sample - local).norm() <= 0.02 + 2.0 * site.geometry[s].footprint_m[k];
+      }
+    }
+  }
+  return mask;
+}
+
+// The campaign in a project (true poses, geometry, the merge's keep masks)
+// and its render model: the path `scanbench render` takes.
+modeling::RenderModel campus_model(const SimulatedSite& site, const ScratchFolder& scratch) {
+  std::vector<registration::PreparedScan> prepared;
+  for (std::size_t k = 0; k < site.scans.size(); ++k)
+    prepared.push_back(registration::prepare_scan(site.scans[k], site.geometry[k], 0));
+  const registration::MergeResult merged =
+      registration::merge_by_sampling_rate(prepared, site.true_poses, {});
+  modeling::Project project = modeling::Project::create(scratch.path() / "render.sbproj");
+  modeling::Project::Edit edit = project.begin_command("import", "{}");
+  for (std::size_t k = 0; k < site.scans.size(); ++k) {
+    const std::int64_t id = project.insert_scan(edit, modeling::encode_scan(site.scans[k]));
+    for (const modeling::EncodedLayer& layer : modeling::encode_geometry(site.geometry[k]))
+      project.put_layer(edit, id, layer);
+    project.put_layer(
+        edit, id,
+        modeling::encode_layer<std::uint8_t>(modeling::layer::kKeep, modeling::ElementType::kU8,
+                                             merged.scans[k].keep));
+  }
+  edit.commit("{}");
+  return modeling::build_render_model(project, {});
+}
+
+struct ViewFigures {
+  nlohmann::json modes = nlohmann::json::object();
+  double blended_minus_points_db = 0.0;
+};
+
+ViewFigures measure_view(render::SplatRenderer& renderer, const modeling::RenderModel& model,
+                         const sim::Scene& scene, const NamedView& view, const SimulatedSite& site,
+                         const std::filesystem::path& pictures) {
+  const sim::TruthImage truth = sim::render_truth_view(scene, view.camera);
+  const std::vector<std::uint8_t> mask = sampled_mask(truth, view.camera, site);
+  const auto picture = [&](const std::string& what, const std::vector<std::uint8_t>& rgb) {
+    if (pictures.empty()) return;
+    std::filesystem::create_directories(pictures);
+    acquisition::write_rgb_picture(pictures / (std::string(view.name) + "_" + what + ".png"),
+                                   truth.width, truth.height, rgb);
+  };
+  picture("truth", truth.rgb);
+  const render::RenderView camera = render::make_render_view(view.camera, model.origin);
+  ViewFigures out;
+  double points_db = 0.0;
+  for (const render::DrawMode mode :
+       {render::DrawMode::kPoints, render::DrawMode::kSplats, render::DrawMode::kBlended}) {
+    render::RenderSettings settings;
+    settings.mode = mode;
+    settings.background = {sim::kSkyRgb[0], sim::kSkyRgb[1], sim::kSkyRgb[2]};
+    const render::FrameResult frame = renderer.draw(camera, settings);
+    const render::RenderedImage image = renderer.read_image();
+    std::vector<std::uint8_t> rgb(truth.rgb.size()), covered(mask.size());
+    for (std::size_t i = 0; i < covered.size(); ++i) {
+      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image.rgba[4 * i + c];
+      covered[i] = image.rgba[4 * i + 3] != 0;
+    }
+    picture(std::string(render::draw_mode_name(mode)), rgb);
+    if (mode == render::DrawMode::kBlended) {  // the holes, magenta on the truth
+      std::vector<std::uint8_t> holes = truth.rgb;
+      for (std::size_t i = 0; i < mask.size(); ++i) {
+        if (mask[i] && !covered[i])
+          holes[3 * i] = 255, holes[3 * i + 1] = 0, holes[3 * i + 2] = 255;
+      }
+      picture("holes", holes);
+    }
+    const PictureComparison c =
+        compare_pictures(truth.width, truth.height, rgb, truth.rgb, covered, mask);
+    out.modes[std::string(render::draw_mode_name(mode))] = {
+        {"psnr_db", c.psnr_db},
+        {"ssim", c.ssim},
+        {"hole_fraction", c.hole_fraction},
+        {"points_submitted", frame.plan.submitted},
+        {"frame_ms", frame.frame_ms}};
+    out.modes["sampled_pixels"] = c.pixels;
+    if (mode == render::DrawMode::kPoints) points_db = c.psnr_db;
+    if (mode == render::DrawMode::kBlended) out.blended_minus_points_db = c.psnr_db - points_db;
+  }
+  return out;
+}
+
+// The median frame time of `frames` frames after one to warm up.
+double median_frame_ms(render::SplatRenderer& renderer, const render::RenderView& view,
+                       const render::RenderSettings& settings, int frames,
+                       render::FramePlan* plan) {
+  *plan = renderer.draw(view, settings).plan;
+  std::vector<double> times;
+  for (int k = 0; k < frames; ++k) times.push_back(renderer.draw(view, settings).frame_ms);
+  std::nth_element(times.begin(), times.begin() + frames / 2, times.end());
+  return times[static_cast<std::size_t>(frames / 2)];
+}
+
+}  // namespace
+
+nlohmann::json run_render_bench(const BenchOptions& options) {
+  sim::ScannerModel scanner;
+  if (options.smoke) {
+    scanner.columns = 900;
+    scanner.rows = 225;
+  }
+  const int scan_count = options.smoke ? 2 : 4;
+  const int width = options.smoke ? 240 : 960, height = options.smoke ? 135 : 540;
+  // The scans lit as the truth pictures are: what differs is the renderer's
+  // doing, not the campaign's exposures (the colour bench measures those).
+  const SimulatedSite site = simulate_site("campus", scanner, scan_count, SiteLighting::kReference);
+  const sim::Site scene_site = sim::make_site("campus", 1, scan_count);
+  const ScratchFolder scratch("render");
+  const auto build_start = std::chrono::steady_clock::now();
+  const modeling::RenderModel model = campus_model(site, scratch);
+  const double build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
+
+  const std::unique_ptr<render::RenderDevice> device = render::make_headless_device();
+  render::SplatRenderer renderer(model);
+  nlohmann::json views = nlohmann::json::object();
+  double closeup_gain_db = 0.0, worst_hole = 0.0;
+  for (const NamedView& view : campus_views(width, height)) {
+    const ViewFigures figures =
+        measure_view(renderer, model, scene_site.scene, view, site, options.pictures);
+    views[view.name] = figures.modes;
+    worst_hole = std::max(worst_hole, figures.modes["blended"]["hole_fraction"].get<double>());
+    if (std::string(view.name) == "closeup") closeup_gain_db = figures.blended_minus_points_db;
+  }
+
+  const NamedView street = campus_views(width, height)[1];
+  const render::RenderView street_view = render::make_render_view(street.camera, model.origin);
+  render::RenderSettings culled, unculled;
+  unculled.culling.frustum = unculled.culling.backface = unculled.culling.level_of_detail = false;
+  const int frames = options.smoke ? 1 : 5;
+  render::FramePlan plan_on, plan_off;
+  const double on_ms = median_frame_ms(renderer, street_view, culled, frames, &plan_on);
+  const double off_ms = median_frame_ms(renderer, street_view, unculled, frames, &plan_off);
+  const double culled_share =
+      1.0 - static_cast<double>(plan_on.submitted) / static_cast<double>(plan_on.points);
+
+  return {{"suite", "render"},
+          {"site", "campus"},
+          {"scans", scan_count},
+          {"points", model.points.size()},
+          {"tiles", model.tiles.size()},
+          {"model_build_seconds", build_seconds},
+          {"width", width},
+          {"height", height},
+          {"device", device->describe()},
+          {"views", views},
+          {"frame_ms_culling_on", on_ms},
+          {"frame_ms_culling_off", off_ms},
+          {"culling_speedup", off_ms / on_ms},
+          {"culled_share", culled_share},
+          {"street_culled",
+           {{"frustum", plan_on.culled_frustum},
+            {"backface", plan_on.culled_backface},
+            {"level_of_detail", plan_on.culled_budget},
+            {"submitted", plan_on.submitted}}},
+          {"closeup_blended_minus_points_db", closeup_gain_db},
+          {"blended_hole_fraction_worst", worst_hole},
+          {"goals",
+           {{"blended_hole_fraction_at_most_0_005", worst_hole <= 0.005},
+            {"closeup_blended_beats_points_by_6_db", closeup_gain_db >= 6.0},
+            {"culling_at_least_halves_street_frame_time", off_ms >= 2.0 * on_ms}}}};
+}
+
+}  // namespace scanbench::bench
