@@ -41,23 +41,23 @@ std::optional<float> half_cell_rad(const acquisition::Scan& scan, int row) {
   return static_cast<float>(0.5 * std::hypot(across, a->elevation_step_rad));
 }
 
-// How far the pixel's samples reach along its surface: the largest distance
-// to one of its four neighbours, when it lies inside a surface its scan
-// sampled; none on a silhouette. Only inside may a splat stretch beyond the
-// edge-on limit, and never further than the samples beside it (normals of
-// small objects seen edge-on are too rough for 1 / cos θ). On a post's or a
-// wall's silhouette the beam grazes the surface too, but the next sample
-// along lies far behind it or there is none (the sky): each neighbour must
-// be a return (mixed pixels count: grazing ground is full of them) within
-// `reach` [m]. Ground seen from above (below the scanner, its normal within
-// 30° of `up`) may also have dropouts beside it, as far grazing ground loses
-// returns and there is no sky beyond the ground.
+// How far the pixel's samples reach along its surface, when the pixel lies
+// inside ground its scan sampled; none elsewhere. Only there may a splat
+// stretch beyond the edge-on limit, and never further than the samples
+// beside it. Ground (facing up within 30°, below the scanner) is what a
+// terrestrial scanner sees at grazing incidence over tens of metres, its
+// rows far apart. Elsewhere a beam that grazes a surface is mostly on a
+// silhouette (a post, a lamp's head, a wall's edge), and the normals of
+// small objects seen edge on are too rough for 1 / cos θ. Each neighbour
+// must be a return within `reach` [m] and within 20° of the tangent plane,
+// or a dropout (far grazing ground loses returns; beyond ground there is no
+// sky); at least two must be returns.
 std::optional<float> sample_reach(const acquisition::Scan& scan,
                                   const acquisition::ScanGeometry& geometry, int row, int col,
                                   float reach, const Eigen::Vector3f& up) {
   const Eigen::Vector3f p = acquisition::point_in_scan(scan, row, col);
   const Eigen::Vector3f& n = geometry.normal[scan.index(row, col)];
-  const bool ground_like = n.dot(up) > 0.866f && p.dot(up) < 0.0f;
+  if (n.dot(up) < 0.866f || p.dot(up) >= 0.0f) return std::nullopt;  // not ground seen from above
   constexpr int kSteps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
   int returns = 0;
   float widest = 0.0f;
@@ -69,13 +69,12 @@ std::optional<float> sample_reach(const acquisition::Scan& scan,
       c = (c + scan.columns) % scan.columns;
     }
     if (r < 0 || r >= scan.rows) return std::nullopt;
-    if (!scan.valid[scan.index(r, c)]) {
-      if (!ground_like) return std::nullopt;
-      continue;
-    }
+    if (!scan.valid[scan.index(r, c)]) continue;  // far grazing ground loses returns
     ++returns;
-    const float distance = (acquisition::point_in_scan(scan, r, c) - p).norm();
-    if (distance > reach) return std::nullopt;
+    const Eigen::Vector3f step_to = acquisition::point_in_scan(scan, r, c) - p;
+    const float distance = step_to.norm();
+    // Too far, or off the tangent plane by more than 20°: another surface.
+    if (distance > reach || std::abs(n.dot(step_to)) > 0.35f * distance) return std::nullopt;
     widest = std::max(widest, distance);
   }
   if (returns < 2) return std::nullopt;

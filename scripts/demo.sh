@@ -12,11 +12,12 @@
 #             doors, a roof, a sign; trees → crowns, trunks) from the clicks,
 #             lassos and channels in scripts/campus_segment.json
 #   history   the journal of those commands; undo and redo of the merge
+#   render    the merged model as splats (headless OpenGL) from three cameras,
+#             beside the simulator's truth pictures (out/demo/render/)
 #   info      table and JSON
 #   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as PLY
 #   bench     raw-scan I/O throughput against PCL's reader
-# Output goes to DEMO_OUT (default: out/demo/). Later stages (render) join
-# this script as they land.
+# Output goes to DEMO_OUT (default: out/demo/).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/build.sh"
@@ -60,6 +61,22 @@ phase "history"
 "$scanbench" history "$project"
 "$scanbench" undo "$project"
 "$scanbench" redo "$project"
+
+phase "render"
+# The merged model as blended splats from the three cameras of
+# `bench render` (scripts/views), beside the simulator's truth pictures; the
+# close-up also as raw points, and the street coloured by object.
+mkdir -p "$out/render"
+for view in closeup street overview; do
+  "$scanbench" simulate --site campus --seed 1 --render-view "$root/scripts/views/campus_$view.json" \
+    -o "$out/render/${view}_truth.png"
+  "$scanbench" render "$project" --view "$root/scripts/views/campus_$view.json" \
+    -o "$out/render/${view}_blended.png"
+done
+"$scanbench" render "$project" --view "$root/scripts/views/campus_closeup.json" --mode points \
+  -o "$out/render/closeup_points.png"
+"$scanbench" render "$project" --view "$root/scripts/views/campus_street.json" --color object \
+  --lighting -o "$out/render/street_objects.png" --json
 
 phase "info"
 "$scanbench" info "$project"
