@@ -89,8 +89,9 @@ struct RenderModelSettings {
   TileLimits tiles;
   // The largest stretch of a splat along its major axis (1 / cos θ is
   // capped here): beyond it the scan's samples are too sparse and too noisy
-  // to be a surface. Beyond 4, only inside a smooth surface (its four
-  // neighbours on it), never on a silhouette.
+  // to be a surface. Beyond 4 (the geometry stage's limit) only on ground
+  // seen from above, and never past its neighbouring samples (sample_reach
+  // in render_model.cpp): never on a silhouette.
   float max_stretch = 64.0f;
   bool merged_only = true;  // drop the points the merge dropped (where it ran)
 };
