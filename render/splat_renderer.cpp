@@ -85,6 +85,93 @@ struct SplatRenderer::Gpu {
     glNamedFramebufferTexture(picture_target.get(), GL_COLOR_ATTACHMENT0, picture.get(), 0);
   }
 
+  void set_splat_uniforms(const RenderView& view, const RenderSettings& settings,
+                          const Eigen::Vector2f& height_range) const {
+    const GLuint program = splat.get();
+    glProgramUniformMatrix4fv(program, glGetUniformLocation(program, "u_view"), 1, GL_FALSE,
+                              view.view.data());
+    glProgramUniformMatrix4fv(program, glGetUniformLocation(program, "u_projection"), 1, GL_FALSE,
+                              view.projection.data());
+    glProgramUniform3fv(program, glGetUniformLocation(program, "u_eye"), 1, view.eye.data());
+    glProgramUniform2f(program, glGetUniformLocation(program, "u_viewport"),
+                       static_cast<float>(view.width), static_cast<float>(view.height));
+    glProgramUniform2fv(program, glGetUniformLocation(program, "u_height_range"), 1,
+                        height_range.data());
+    uniform("u_focal", view.focal_px);
+    uniform("u_scale", settings.splat_scale);
+    uniform("u_points", settings.mode == DrawMode::kPoints ? 1 : 0);
+    uniform("u_backface", settings.culling.backface ? 1 : 0);
+    uniform("u_color_mode", static_cast<int>(settings.color));
+    uniform("u_lighting", settings.lighting ? 1 : 0);
+    uniform("u_kernel", static_cast<int>(settings.kernel));
+    uniform("u_oriented", settings.oriented ? 1 : 0);
+    uniform("u_depth_offset", settings.depth_offset);
+  }
+
+  // The planned tiles into the splat target: one opaque pass, or the
+  // visibility and accumulation passes of blending.
+  void draw_splats(const modeling::RenderModel& model, const FramePlan& plan, DrawMode mode) const {
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glEnable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, splat_target.get());
+    glViewport(0, 0, width, height);
+    const float clear_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    const float clear_depth = 0.0f;  // reversed Z: 0 is the far plane
+    glClearNamedFramebufferfv(splat_target.get(), GL_COLOR, 0, clear_color);
+    glClearNamedFramebufferfv(splat_target.get(), GL_DEPTH, 0, &clear_depth);
+    glUseProgram(splat.get());
+    glBindVertexArray(points.get());
+    const auto draw_tiles = [&] {
+      for (const TileDraw& draw : plan.draws) {
+        uniform("u_min_radius", draw.min_radius_m);
+        glDrawArrays(GL_POINTS, static_cast<GLint>(model.tiles[draw.tile].first),
+                     static_cast<GLsizei>(draw.count));
+      }
+    };
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_GREATER);
+    if (mode != DrawMode::kBlended) {
+      uniform("u_pass", mode == DrawMode::kPoints ? shaders::kPassPoints : shaders::kPassOpaque);
+      draw_tiles();
+      return;
+    }
+    uniform("u_pass", shaders::kPassVisibility);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    draw_tiles();
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    uniform("u_pass", shaders::kPassAccumulate);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_GEQUAL);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    draw_tiles();
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+  }
+
+  // Weighted colours divided into the picture, the background where none.
+  void resolve_picture(const RenderView& view, const RenderSettings& settings) const {
+    const GLuint program = resolve.get();
+    glDisable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, picture_target.get());
+    glUseProgram(program);
+    glBindTextureUnit(0, accumulated.get());
+    glBindTextureUnit(1, depth.get());
+    glProgramUniform1i(program, glGetUniformLocation(program, "u_accumulated"), 0);
+    glProgramUniform1i(program, glGetUniformLocation(program, "u_depth"), 1);
+    glProgramUniform3f(program, glGetUniformLocation(program, "u_background"),
+                       settings.background[0] / 255.0f, settings.background[1] / 255.0f,
+                       settings.background[2] / 255.0f);
+    glProgramUniform1i(program, glGetUniformLocation(program, "u_eye_dome"),
+                       settings.eye_dome ? 1 : 0);
+    glProgramUniform2f(program, glGetUniformLocation(program, "u_depth_ab"), view.projection(2, 2),
+                       view.projection(2, 3));
+    glBindVertexArray(empty.get());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+
   void uniform(const char* name, int value) const {
     glProgramUniform1i(splat.get(), glGetUniformLocation(splat.get(), name), value);
   }
@@ -149,84 +236,9 @@ FrameResult SplatRenderer::draw(const RenderView& picture_view, const RenderSett
   gpu.ensure_size(view.width, view.height);
   picture_width_ = picture_view.width;
   picture_height_ = picture_view.height;
-  const GLuint splat = gpu.splat.get();
-  glProgramUniformMatrix4fv(splat, glGetUniformLocation(splat, "u_view"), 1, GL_FALSE,
-                            view.view.data());
-  glProgramUniformMatrix4fv(splat, glGetUniformLocation(splat, "u_projection"), 1, GL_FALSE,
-                            view.projection.data());
-  glProgramUniform3fv(splat, glGetUniformLocation(splat, "u_eye"), 1, view.eye.data());
-  glProgramUniform2f(splat, glGetUniformLocation(splat, "u_viewport"),
-                     static_cast<float>(view.width), static_cast<float>(view.height));
-  glProgramUniform2fv(splat, glGetUniformLocation(splat, "u_height_range"), 1,
-                      height_range_.data());
-  gpu.uniform("u_focal", view.focal_px);
-  gpu.uniform("u_scale", settings.splat_scale);
-  gpu.uniform("u_points", settings.mode == DrawMode::kPoints ? 1 : 0);
-  gpu.uniform("u_backface", settings.culling.backface ? 1 : 0);
-  gpu.uniform("u_color_mode", static_cast<int>(settings.color));
-  gpu.uniform("u_lighting", settings.lighting ? 1 : 0);
-  gpu.uniform("u_kernel", static_cast<int>(settings.kernel));
-  gpu.uniform("u_oriented", settings.oriented ? 1 : 0);
-  gpu.uniform("u_depth_offset", settings.depth_offset);
-
-  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glEnable(GL_PROGRAM_POINT_SIZE);
-  glEnable(GL_DEPTH_TEST);
-  glBindFramebuffer(GL_FRAMEBUFFER, gpu.splat_target.get());
-  glViewport(0, 0, view.width, view.height);
-  const float clear_color[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  const float clear_depth = 0.0f;  // reversed Z: 0 is the far plane
-  glClearNamedFramebufferfv(gpu.splat_target.get(), GL_COLOR, 0, clear_color);
-  glClearNamedFramebufferfv(gpu.splat_target.get(), GL_DEPTH, 0, &clear_depth);
-  glUseProgram(splat);
-  glBindVertexArray(gpu.points.get());
-  const auto draw_tiles = [&] {
-    for (const TileDraw& draw : result.plan.draws) {
-      gpu.uniform("u_min_radius", draw.min_radius_m);
-      glDrawArrays(GL_POINTS, static_cast<GLint>(model_.tiles[draw.tile].first),
-                   static_cast<GLsizei>(draw.count));
-    }
-  };
-  glDepthMask(GL_TRUE);
-  glDepthFunc(GL_GREATER);
-  if (settings.mode == DrawMode::kBlended) {
-    gpu.uniform("u_pass", shaders::kPassVisibility);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    draw_tiles();
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    gpu.uniform("u_pass", shaders::kPassAccumulate);
-    glDepthMask(GL_FALSE);
-    glDepthFunc(GL_GEQUAL);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    draw_tiles();
-    glDisable(GL_BLEND);
-    glDepthMask(GL_TRUE);
-  } else {
-    gpu.uniform("u_pass",
-                settings.mode == DrawMode::kPoints ? shaders::kPassPoints : shaders::kPassOpaque);
-    draw_tiles();
-  }
-
-  // Resolve into the picture.
-  const GLuint resolve = gpu.resolve.get();
-  glDisable(GL_DEPTH_TEST);
-  glBindFramebuffer(GL_FRAMEBUFFER, gpu.picture_target.get());
-  glUseProgram(resolve);
-  glBindTextureUnit(0, gpu.accumulated.get());
-  glBindTextureUnit(1, gpu.depth.get());
-  glProgramUniform1i(resolve, glGetUniformLocation(resolve, "u_accumulated"), 0);
-  glProgramUniform1i(resolve, glGetUniformLocation(resolve, "u_depth"), 1);
-  glProgramUniform3f(resolve, glGetUniformLocation(resolve, "u_background"),
-                     settings.background[0] / 255.0f, settings.background[1] / 255.0f,
-                     settings.background[2] / 255.0f);
-  glProgramUniform1i(resolve, glGetUniformLocation(resolve, "u_eye_dome"),
-                     settings.eye_dome ? 1 : 0);
-  glProgramUniform2f(resolve, glGetUniformLocation(resolve, "u_depth_ab"), view.projection(2, 2),
-                     view.projection(2, 3));
-  glBindVertexArray(gpu.empty.get());
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  gpu.set_splat_uniforms(view, settings, height_range_);
+  gpu.draw_splats(model_, result.plan, settings.mode);
+  gpu.resolve_picture(view, settings);
   glFinish();
   result.frame_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
