@@ -2,6 +2,8 @@
 //                  [--kernel disk|gaussian|cosine] [--color MODE] [--budget N] [--json]
 #include <fmt/core.h>
 
+#include <chrono>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>

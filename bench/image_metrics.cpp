@@ -1,5 +1,6 @@
 #include "bench/image_metrics.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>

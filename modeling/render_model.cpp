@@ -193,6 +193,71 @@ void append_points(const RenderPoints& from, const std::vector<std::uint32_t>& o
   }
 }
 
+// The tree's nodes into `model` (nodes, children, roots), then the root of
+// the points no object owns; returns each node id's index (0: that root).
+std::map<std::int64_t, std::size_t> link_tree(const std::vector<ObjectNode>& tree,
+                                              RenderModel& model) {
+  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
+  std::map<std::int64_t, std::size_t> index_of;
+  for (const ObjectNode& n : tree) {
+    index_of[n.id] = model.nodes.size();
+    model.nodes.push_back({n, {}, {}, {}, shown.at(n.id)});
+  }
+  ObjectNode unassigned;
+  unassigned.name = "unassigned";
+  index_of[0] = model.nodes.size();
+  model.nodes.push_back({unassigned, {}, {}, {}, true});
+  for (std::size_t k = 0; k < model.nodes.size(); ++k) {
+    const std::optional<std::int64_t> parent = model.nodes[k].node.parent;
+    const auto found = parent ? index_of.find(*parent) : index_of.end();
+    if (found == index_of.end()) {
+      model.roots.push_back(k);
+    } else {
+      model.nodes[found->second].children.push_back(k);
+    }
+  }
+  return index_of;
+}
+
+// One tile of `owner`: the points `part` (indices into `from`) appended to
+// `out` in level-of-detail order, with their box and normal cone.
+RenderTile make_tile(std::int64_t owner, const RenderPoints& from, std::vector<std::uint32_t>& part,
+                     RenderPoints& out) {
+  RenderTile tile;
+  tile.node = owner;
+  tile.first = static_cast<std::uint32_t>(out.size());
+  tile.count = static_cast<std::uint32_t>(part.size());
+  for (const std::uint32_t k : part) tile.box.extend(from.position[k]);
+  tile.cone = normal_cone(from.normal, part);
+  tile.level_ends = order_for_level_of_detail(from.position, part, tile.box);
+  for (std::uint32_t& end : tile.level_ends) end += tile.first;
+  tile.lod_cube_m = tile.box.sizes().maxCoeff();
+  append_points(from, part, out);
+  return tile;
+}
+
+// A group's box holds its descendants': children before parents.
+void extend_group_boxes(RenderModel& model) {
+  std::vector<std::size_t> post_order;
+  std::vector<std::pair<std::size_t, bool>> stack;
+  for (const std::size_t root : model.roots) stack.emplace_back(root, false);
+  while (!stack.empty()) {
+    const auto [at, expanded] = stack.back();
+    stack.pop_back();
+    if (expanded) {
+      post_order.push_back(at);
+      continue;
+    }
+    stack.emplace_back(at, true);
+    for (const std::size_t child : model.nodes[at].children) stack.emplace_back(child, false);
+  }
+  for (const std::size_t at : post_order) {
+    for (const std::size_t child : model.nodes[at].children) {
+      if (!model.nodes[child].box.isEmpty()) model.nodes[at].box.extend(model.nodes[child].box);
+    }
+  }
+}
+
 }  // namespace
 
 RenderModel build_render_model(const Project& project, const RenderModelSettings& settings) {
@@ -218,72 +283,23 @@ RenderModel assemble_render_model(RenderPoints points, const Eigen::Vector3d& or
   RenderModel model;
   model.origin = origin;
   model.counts.in_model = points.size();
-  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
-  // The tree's nodes, then the root of the unassigned points.
-  std::map<std::int64_t, std::size_t> index_of;
-  for (const ObjectNode& n : tree) {
-    index_of[n.id] = model.nodes.size();
-    model.nodes.push_back({n, {}, {}, {}, shown.at(n.id)});
-  }
-  ObjectNode unassigned;
-  unassigned.name = "unassigned";
-  index_of[0] = model.nodes.size();
-  model.nodes.push_back({unassigned, {}, {}, {}, true});
-  for (std::size_t k = 0; k < model.nodes.size(); ++k) {
-    const std::optional<std::int64_t> parent = model.nodes[k].node.parent;
-    const auto found = parent ? index_of.find(*parent) : index_of.end();
-    if (found == index_of.end()) {
-      model.roots.push_back(k);
-    } else {
-      model.nodes[found->second].children.push_back(k);
-    }
-  }
-
+  const std::map<std::int64_t, std::size_t> index_of = link_tree(tree, model);
   // Each node's points (a node not in the tree owns nothing), tiled.
   std::map<std::int64_t, std::vector<std::uint32_t>> by_node;
   for (std::uint32_t k = 0; k < points.size(); ++k) {
     if (!index_of.count(points.node[k])) points.node[k] = 0;
     by_node[points.node[k]].push_back(k);
   }
-  const RenderPoints& from = points;
   for (auto& [owner, indices] : by_node) {
     RenderNode& node = model.nodes[index_of.at(owner)];
     for (std::vector<std::uint32_t>& part :
-         split_into_tiles(from.position, std::move(indices), limits)) {
-      RenderTile tile;
-      tile.node = owner;
-      tile.first = static_cast<std::uint32_t>(model.points.size());
-      tile.count = static_cast<std::uint32_t>(part.size());
-      for (const std::uint32_t k : part) tile.box.extend(from.position[k]);
-      tile.cone = normal_cone(from.normal, part);
-      tile.level_ends = order_for_level_of_detail(from.position, part, tile.box);
-      for (std::uint32_t& end : tile.level_ends) end += tile.first;
-      tile.lod_cube_m = tile.box.sizes().maxCoeff();
-      append_points(from, part, model.points);
+         split_into_tiles(points.position, std::move(indices), limits)) {
       node.tiles.push_back(model.tiles.size());
-      node.box.extend(tile.box);
-      model.tiles.push_back(std::move(tile));
+      model.tiles.push_back(make_tile(owner, points, part, model.points));
+      node.box.extend(model.tiles.back().box);
     }
   }
-  // A group's box holds its descendants': children before parents.
-  std::vector<std::size_t> post_order;
-  std::vector<std::pair<std::size_t, bool>> stack;
-  for (const std::size_t root : model.roots) stack.emplace_back(root, false);
-  while (!stack.empty()) {
-    const auto [at, expanded] = stack.back();
-    stack.pop_back();
-    if (expanded) {
-      post_order.push_back(at);
-      continue;
-    }
-    stack.emplace_back(at, true);
-    for (const std::size_t child : model.nodes[at].children) stack.emplace_back(child, false);
-  }
-  for (const std::size_t at : post_order) {
-    for (const std::size_t child : model.nodes[at].children) {
-      if (!model.nodes[child].box.isEmpty()) model.nodes[at].box.extend(model.nodes[child].box);
-    }
-  }
+  extend_group_boxes(model);
   return model;
 }
 

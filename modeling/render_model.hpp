@@ -57,8 +57,10 @@ struct RenderTile {
   float lod_cube_m = 0.0f;
 };
 
-// A node of the tree with what culling needs: its box over the points it
-// shows (its tiles' and its descendants'), its tiles, and its children.
+// A node of the tree with what culling needs: its box over its tiles and its
+// descendants' (hidden ones included, so that showing one needs no
+// rebuild: a box at most too large, never too small), its tiles, and its
+// children.
 struct RenderNode {
   ObjectNode node;
   Eigen::AlignedBox3f box;            // empty when it shows nothing

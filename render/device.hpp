@@ -15,8 +15,9 @@ class RenderDevice {
   virtual ~RenderDevice() = default;
   // Makes the device's context current on the calling thread.
   virtual void make_current() = 0;
-  // "OpenGL 4.5 (Core Profile) Mesa … | llvmpipe …": what drew the frames.
-  virtual std::string describe() const = 0;
+  // "OpenGL 4.5 (Core Profile) Mesa … | llvmpipe …": what draws the frames.
+  // Makes the device's context current.
+  virtual std::string describe() = 0;
 };
 
 // A context without any surface, on EGL's surfaceless platform (Mesa;

@@ -41,6 +41,10 @@ struct FramePlan {
   std::size_t tiles_drawn = 0;
 };
 
+// The frame of `model` through `view` (the model's frame, metres): every
+// tile of a shown node either drawn (a prefix of its points, never empty) or
+// counted as culled; points of hidden nodes counted as hidden. An empty
+// model gives an empty plan.
 FramePlan plan_frame(const modeling::RenderModel& model, const RenderView& view,
                      const CullSettings& settings);
 

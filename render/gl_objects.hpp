@@ -53,9 +53,9 @@ GlTexture make_texture_2d(GLenum internal_format, int width, int height);
 GlFramebuffer make_framebuffer();
 
 // Compiles and links a program from GLSL 4.50 sources (the `#version` line
-// included). A shader that does not compile or link is a programmer error
-// here (our sources are compiled in): throws core::RuntimeFailure with the
-// driver's log, naming `label`.
+// included). Our sources are compiled in and tested on Mesa; a driver that
+// refuses them is this machine's failure: throws core::RuntimeFailure with
+// the driver's log, naming `label`.
 GlProgram build_program(const std::string& label, const char* vertex_source,
                         const char* fragment_source);
 

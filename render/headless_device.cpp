@@ -10,9 +10,9 @@ namespace scanbench::render {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& what) {
+[[noreturn]] void fail(const std::string& what, EGLint error = eglGetError()) {
   char code[32];
-  std::snprintf(code, sizeof code, " (EGL error 0x%04x)", static_cast<unsigned>(eglGetError()));
+  std::snprintf(code, sizeof code, " (EGL error 0x%04x)", static_cast<unsigned>(error));
   std::string problem = what;
   problem.append(code);
   throw core::RuntimeFailure("EGL", {}, problem);
@@ -44,11 +44,12 @@ class HeadlessDevice final : public RenderDevice {
                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                  EGL_NONE};
     context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
-    if (context_ == EGL_NO_CONTEXT) {
-      eglTerminate(display_);
-      fail("no OpenGL 4.5 core context");
+    if (context_ == EGL_NO_CONTEXT) fail("no OpenGL 4.5 core context");
+    if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
+      const EGLint error = eglGetError();
+      eglDestroyContext(display_, context_);
+      fail("cannot make the context current", error);
     }
-    make_current();
   }
 
   // The display stays initialised: EGL gives every device of the process
@@ -68,9 +69,15 @@ class HeadlessDevice final : public RenderDevice {
       fail("cannot make the context current");
   }
 
-  std::string describe() const override {
-    return std::string("OpenGL ") + reinterpret_cast<const char*>(glGetString(GL_VERSION)) + " | " +
-           reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  std::string describe() override {
+    make_current();
+    const auto text = [](GLenum name) {
+      const auto* value = reinterpret_cast<const char*>(glGetString(name));
+      return std::string(value != nullptr ? value : "unknown");
+    };
+    std::string out = "OpenGL ";
+    out.append(text(GL_VERSION)).append(" | ").append(text(GL_RENDERER));
+    return out;
   }
 
  private:

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <chrono>
 
 #include "render/gl_objects.hpp"
@@ -246,6 +247,7 @@ FrameResult SplatRenderer::draw(const RenderView& picture_view, const RenderSett
 }
 
 RenderedImage SplatRenderer::read_image() const {
+  assert(picture_width_ > 0 && "read_image before the first draw");
   RenderedImage image;
   image.width = picture_width_;
   image.height = picture_height_;

@@ -83,15 +83,20 @@ class SplatRenderer {
   SplatRenderer& operator=(const SplatRenderer&) = delete;
 
   // Draws a frame into the offscreen target (the view's size and a guard
-  // band round it).
+  // band round it). Leaves the context's GL state as drawing needs it
+  // (zero-to-one clip control, program point size, this renderer's program
+  // and vertex arrays bound): a caller drawing more (the workbench's UI)
+  // sets its own state.
   FrameResult draw(const RenderView& view, const RenderSettings& settings);
 
-  // The last frame.
+  // The last frame, without its guard band. Asserts that a frame was drawn.
   RenderedImage read_image() const;
 
  private:
-  // Pixels drawn beyond each edge of the picture (render_view.hpp).
-  static constexpr int kGuardBandPixels = 64;
+  // Pixels drawn beyond each edge of the picture (render_view.hpp): half
+  // the widest sprite GL draws (255 pixels), so no splat that reaches into
+  // the picture is dropped.
+  static constexpr int kGuardBandPixels = 128;
 
   struct Gpu;
   const modeling::RenderModel& model_;

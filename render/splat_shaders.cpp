@@ -4,8 +4,7 @@ namespace scanbench::render::shaders {
 
 // Per point: its centre, normal, major axis and radii in eye space for the
 // fragment stage, its colour by the colour mode, and a sprite wide enough
-// for the ellipse (2 r f / depth pixels for its major radius r, a little
-// more for perspective off axis). A
+// for the ellipse (the screen extent of the sphere of its major radius). A
 // point whose normal faces away from the eye is moved outside the clip
 // volume (backface culling per point).
 const char* const kSplatVertex = R"glsl(#version 450 core
@@ -58,7 +57,10 @@ void main() {
   vec2 radii = max(a_radii * u_scale, vec2(u_min_radius));
   float depth = max(-eye_position.z, 1e-3);
   gl_Position = u_projection * eye_position;
-  gl_PointSize = u_points == 1 ? 1.0 : clamp(2.2 * radii.y * u_focal / depth + 1.0, 1.0, 255.0);
+  // A sphere of radius r at distance L spans r f L / depth² pixels either
+  // side of its centre: 1 / cos θ more than on the axis.
+  float reach = radii.y * u_focal * length(eye_position.xyz) / (depth * depth);
+  gl_PointSize = u_points == 1 ? 1.0 : clamp(2.0 * reach + 2.0, 1.0, 255.0);
   v_center = eye_position.xyz;
   v_normal = has_normal ? normalize(mat3(u_view) * a_normal) : vec3(0.0);
   v_major = dot(a_major, a_major) > 0.25 ? normalize(mat3(u_view) * a_major) : vec3(0.0);
