@@ -1,6 +1,7 @@
 #include "acquisition/camera_view.hpp"
 
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -41,14 +42,10 @@ Eigen::Isometry3d look_at_pose(const fs::path& file, const json& root) {
       root.contains("up") ? vector_at(file, root, "up") : Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d z = target - position;
   if (z.norm() < 1e-9) fail(file, "look_at", "equals the position");
-  const Eigen::Vector3d x = z.cross(up);
-  if (x.norm() < 1e-9 * z.norm()) fail(file, "up", "is parallel to the viewing direction");
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear().col(0) = x.normalized();
-  pose.linear().col(2) = z.normalized();
-  pose.linear().col(1) = pose.linear().col(2).cross(pose.linear().col(0));
-  pose.translation() = position;
-  return pose;
+  if (z.cross(up).norm() < 1e-9 * z.norm()) {
+    fail(file, "up", "is parallel to the viewing direction");
+  }
+  return look_at(position, target, up);
 }
 
 Eigen::Isometry3d matrix_pose(const fs::path& file, const json& root) {
@@ -74,6 +71,19 @@ T number_at(const fs::path& file, const json& root, const std::string& key, T lo
 }
 
 }  // namespace
+
+Eigen::Isometry3d look_at(const Eigen::Vector3d& position, const Eigen::Vector3d& target,
+                          const Eigen::Vector3d& up) {
+  const Eigen::Vector3d z = target - position;
+  const Eigen::Vector3d x = z.cross(up);
+  assert(z.norm() >= 1e-9 && x.norm() >= 1e-9 * z.norm() && "a degenerate look-at");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear().col(0) = x.normalized();
+  pose.linear().col(2) = z.normalized();
+  pose.linear().col(1) = pose.linear().col(2).cross(pose.linear().col(0));
+  pose.translation() = position;
+  return pose;
+}
 
 double CameraView::focal_px() const {
   return 0.5 * height / std::tan(0.5 * vertical_fov_deg * std::numbers::pi / 180.0);

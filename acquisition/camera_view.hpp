@@ -22,6 +22,12 @@ struct CameraView {
   double focal_px() const;
 };
 
+// The pose of a camera at `position` looking at `target` [m, world], its
+// image's up (−y) towards `up`. Asserts target ≠ position and `up` not
+// parallel to the viewing direction.
+Eigen::Isometry3d look_at(const Eigen::Vector3d& position, const Eigen::Vector3d& target,
+                          const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
+
 // Reads a view file: {"width", "height", "vertical_fov_deg", and either
 // "T_world_camera": [16 numbers, row-major] or "position": [x, y, z] with
 // "look_at": [x, y, z] (and optional "up", default [0, 0, 1])}. Throws

@@ -50,12 +50,7 @@ acquisition::CameraView look(const Eigen::Vector3d& position, const Eigen::Vecto
   view.width = width;
   view.height = height;
   view.vertical_fov_deg = fov_deg;
-  const Eigen::Vector3d z = (target - position).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  view.T_world_camera.linear().col(0) = x;
-  view.T_world_camera.linear().col(1) = z.cross(x);
-  view.T_world_camera.linear().col(2) = z;
-  view.T_world_camera.translation() = position;
+  view.T_world_camera = acquisition::look_at(position, target);
   return view;
 }
 

@@ -222,6 +222,28 @@ StoredScanSummary require_scan(const Project& project, std::int64_t scan_id) {
   refuse("scan " + std::to_string(scan_id), "no such scan");
 }
 
+// The membership layers of every scan in which a pixel of one of `owners`
+// now goes to `replacement` (an object, the pool or kDeletedPoints), with
+// those pixels rewritten; scans without such pixels are left out.
+std::map<std::int64_t, std::vector<std::uint32_t>> reassign_pixels(
+    const Project& project, const std::unordered_set<std::uint32_t>& owners,
+    std::uint32_t replacement) {
+  std::map<std::int64_t, std::vector<std::uint32_t>> changed;
+  for (const StoredScanSummary& stored : project.scans()) {
+    auto membership =
+        project.load_layer<std::uint32_t>(stored.id, layer::kMembership, ElementType::kU32);
+    if (!membership) continue;
+    bool touched = false;
+    for (std::uint32_t& owner : *membership) {
+      if (owner == 0 || owner == kDeletedPoints || !owners.count(owner)) continue;
+      owner = replacement;
+      touched = true;
+    }
+    if (touched) changed.emplace(stored.id, std::move(*membership));
+  }
+  return changed;
+}
+
 // 1 where an object owns the pixel or it is deleted: closed to growing.
 std::vector<std::uint8_t> taken_mask(const std::vector<std::uint32_t>& membership) {
   std::vector<std::uint8_t> taken(membership.size());
@@ -535,19 +557,8 @@ NodeCommandResult merge_objects(Project& project, const MergeSettings& settings)
   }
   const auto into = static_cast<std::uint32_t>(settings.objects.front());
   if (absorbed.count(into)) refuse("node " + std::to_string(into), "cannot merge into itself");
-  std::map<std::int64_t, std::vector<std::uint32_t>> changed;
-  for (const StoredScanSummary& stored : project.scans()) {
-    auto membership =
-        project.load_layer<std::uint32_t>(stored.id, layer::kMembership, ElementType::kU32);
-    if (!membership) continue;
-    bool touched = false;
-    for (std::uint32_t& owner : *membership) {
-      if (owner == 0 || owner == kDeletedPoints || !absorbed.count(owner)) continue;
-      owner = into;
-      touched = true;
-    }
-    if (touched) changed.emplace(stored.id, std::move(*membership));
-  }
+  const std::map<std::int64_t, std::vector<std::uint32_t>> changed =
+      reassign_pixels(project, absorbed, into);
   for (const std::uint32_t id : absorbed) tree.erase(id);
   const auto figures = compute_figures(project, tree, changed);
   Project::Edit edit =
@@ -571,20 +582,8 @@ NodeCommandResult delete_node(Project& project, const DeleteSettings& settings) 
   }
   const std::uint32_t replacement = settings.points == DeletedPoints::kToPool ? 0 : kDeletedPoints;
   const std::unordered_set<std::uint32_t> gone_ids(gone.begin(), gone.end());
-  std::map<std::int64_t, std::vector<std::uint32_t>> changed;
-  for (const StoredScanSummary& stored : project.scans()) {
-    auto membership =
-        project.load_layer<std::uint32_t>(stored.id, layer::kMembership, ElementType::kU32);
-    if (!membership) continue;
-    bool touched = false;
-    for (std::uint32_t& owner : *membership) {
-      if (owner == 0 || owner == kDeletedPoints) continue;
-      if (!gone_ids.count(owner)) continue;
-      owner = replacement;
-      touched = true;
-    }
-    if (touched) changed.emplace(stored.id, std::move(*membership));
-  }
+  const std::map<std::int64_t, std::vector<std::uint32_t>> changed =
+      reassign_pixels(project, gone_ids, replacement);
   for (const std::int64_t id : gone) tree.erase(id);
   const auto figures = compute_figures(project, tree, changed);
   Project::Edit edit = project.begin_command(

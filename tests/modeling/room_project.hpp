@@ -5,10 +5,12 @@
 
 #include <cmath>
 #include <cstdint>
+#include <tuple>
 #include <utility>
 
 #include "modeling/project.hpp"
 #include "modeling/scan_layers.hpp"
+#include "modeling/segment_commands.hpp"
 #include "project_test_support.hpp"
 #include "segmentation/room_scene.hpp"
 
@@ -30,6 +32,18 @@ inline std::int64_t store_room(Project& project) {
 inline std::pair<int, int> pixel_at(double azimuth_deg, double elevation_deg) {
   return {static_cast<int>(std::lround((30.0 - elevation_deg) / 0.5)),
           static_cast<int>(std::lround((azimuth_deg + 180.0) / 0.5 - 0.5)) % 720};
+}
+
+// A click of `channel` at azimuth / elevation [deg] of the room's scan.
+inline SelectSettings select_at(std::int64_t scan, double azimuth_deg, double elevation_deg,
+                                SelectMode mode = SelectMode::kReplace,
+                                segmentation::Channel channel = segmentation::Channel::kNormal) {
+  SelectSettings settings;
+  settings.scan_id = scan;
+  std::tie(settings.seed_row, settings.seed_col) = pixel_at(azimuth_deg, elevation_deg);
+  settings.mode = mode;
+  settings.grow = segmentation::default_grow_settings(channel);
+  return settings;
 }
 
 }  // namespace scanbench::modeling

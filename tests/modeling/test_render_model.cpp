@@ -23,14 +23,6 @@ std::size_t usable_points() {
   return n;
 }
 
-SelectSettings select_at(std::int64_t scan, double azimuth_deg, double elevation_deg) {
-  SelectSettings settings;
-  settings.scan_id = scan;
-  std::tie(settings.seed_row, settings.seed_col) = pixel_at(azimuth_deg, elevation_deg);
-  settings.grow = segmentation::default_grow_settings(segmentation::Channel::kNormal);
-  return settings;
-}
-
 TEST(RenderModel, AnUnsegmentedScanIsTiledWhole) {
   const ScratchDir dir;
   Project project = Project::create(dir / "p.sbproj");

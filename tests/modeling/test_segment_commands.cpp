@@ -22,17 +22,6 @@ namespace {
 using test::ScratchDir;
 using ::testing::HasSubstr;
 
-SelectSettings select_at(std::int64_t scan, double azimuth_deg, double elevation_deg,
-                         SelectMode mode = SelectMode::kReplace,
-                         segmentation::Channel channel = segmentation::Channel::kNormal) {
-  SelectSettings settings;
-  settings.scan_id = scan;
-  std::tie(settings.seed_row, settings.seed_col) = pixel_at(azimuth_deg, elevation_deg);
-  settings.mode = mode;
-  settings.grow = segmentation::default_grow_settings(channel);
-  return settings;
-}
-
 std::size_t count_owned(const Project& project, std::int64_t scan, std::uint32_t owner) {
   const auto membership =
       project.load_layer<std::uint32_t>(scan, layer::kMembership, ElementType::kU32);

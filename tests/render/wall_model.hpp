@@ -48,13 +48,7 @@ inline acquisition::CameraView camera_at(const Eigen::Vector3d& position, int wi
   view.width = width;
   view.height = height;
   view.vertical_fov_deg = fov_deg;
-  const Eigen::Vector3d target(1010.0, 2000.0, 1.5);
-  const Eigen::Vector3d z = (target - position).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  view.T_world_camera.linear().col(0) = x;
-  view.T_world_camera.linear().col(1) = z.cross(x);
-  view.T_world_camera.linear().col(2) = z;
-  view.T_world_camera.translation() = position;
+  view.T_world_camera = acquisition::look_at(position, {1010.0, 2000.0, 1.5});
   return view;
 }
 
