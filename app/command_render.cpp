@@ -141,6 +141,10 @@ void add_render_command(CLI::App& app) {
   command->add_option("--splat-scale", s.splat_scale, "Splat radii × the sample's cell")
       ->check(CLI::Range(0.1, 10.0))
       ->capture_default_str();
+  command->add_option("--fill", s.fill_reach_px,
+                      "Fill holes ringed by splats within this many pixels (0: off)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   command->add_flag("--lighting", s.lighting, "Shade by the normals, light at the eye");
   command->add_flag("--eye-dome", s.eye_dome, "Eye-dome lighting (for scans without colour)");
   command->add_flag("!--no-culling", options->culling,

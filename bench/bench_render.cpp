@@ -169,6 +169,15 @@ ViewFigures measure_view(render::SplatRenderer& renderer, const modeling::Render
         {"points_submitted", frame.plan.submitted},
         {"frame_ms", frame.frame_ms}};
     out.modes["sampled_pixels"] = c.pixels;
+    if (mode == render::DrawMode::kBlended) {  // what the splats alone leave open
+      settings.fill_reach_px = 0;
+      renderer.draw(camera, settings);
+      const render::RenderedImage unfilled = renderer.read_image();
+      std::size_t open = 0;
+      for (std::size_t i = 0; i < mask.size(); ++i) open += mask[i] && unfilled.rgba[4 * i + 3] == 0;
+      out.modes["blended"]["hole_fraction_unfilled"] =
+          c.pixels == 0 ? 0.0 : static_cast<double>(open) / static_cast<double>(c.pixels);
+    }
     if (mode == render::DrawMode::kPoints) points_db = c.psnr_db;
     if (mode == render::DrawMode::kBlended) out.blended_minus_points_db = c.psnr_db - points_db;
   }

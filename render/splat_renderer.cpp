@@ -166,6 +166,8 @@ struct SplatRenderer::Gpu {
                        settings.background[2] / 255.0f);
     glProgramUniform1i(program, glGetUniformLocation(program, "u_eye_dome"),
                        settings.eye_dome ? 1 : 0);
+    glProgramUniform1i(program, glGetUniformLocation(program, "u_fill_reach"),
+                       settings.mode == DrawMode::kPoints ? 0 : settings.fill_reach_px);
     glProgramUniform2f(program, glGetUniformLocation(program, "u_depth_ab"), view.projection(2, 2),
                        view.projection(2, 3));
     glBindVertexArray(empty.get());

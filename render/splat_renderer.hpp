@@ -53,6 +53,10 @@ struct RenderSettings {
   float depth_offset = 1.0f;  // blended: the visibility pass's push back, × the splat radius
   bool lighting = false;      // diffuse shading from the normals, light at the eye
   bool eye_dome = false;      // eye-dome lighting: depth edges darkened (scans without colour)
+  // Splats and blended: a pixel nothing landed on but with splats of one
+  // surface in all 8 directions within this many pixels takes their colour
+  // (0: off). Points mode never fills: it shows the raw samples.
+  int fill_reach_px = 3;
   std::array<std::uint8_t, 3> background = {0, 0, 0};  // sRGB
   CullSettings culling;
 };

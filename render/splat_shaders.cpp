@@ -151,25 +151,72 @@ void main() {
 // Weighted colour divided by weight; the background where nothing landed;
 // with eye-dome lighting, each pixel darkened by how far its neighbours
 // stand in front of it (log of eye distance).
+//
+// Hole filling (u_fill_reach > 0): a pixel nothing landed on looks along the
+// 8 compass directions for the first covered pixel within the reach. Only
+// when all 8 find one is it a hole in a surface (a pixel at a silhouette
+// sees background on one side at least); it then takes the mean of the
+// finds on the nearest surface (eye distance within 5 % of the nearest),
+// each weighed by 1 / its distance, so a gap in a wall never takes the
+// colour of what stands behind it.
 const char* const kResolveFragment = R"glsl(#version 450 core
 uniform sampler2D u_accumulated;
 uniform sampler2D u_depth;
 uniform vec3 u_background;
 uniform int u_eye_dome;
+uniform int u_fill_reach;
 uniform vec2 u_depth_ab;  // eye distance = b / (depth + a)
 
 layout(location = 0) out vec4 out_color;
 
-float log_distance(ivec2 p) {
+float eye_distance(ivec2 p) {
   float d = texelFetch(u_depth, p, 0).r;
-  return log2(u_depth_ab.y / (d + u_depth_ab.x));
+  return u_depth_ab.y / (d + u_depth_ab.x);
+}
+
+float log_distance(ivec2 p) {
+  return log2(eye_distance(p));
+}
+
+const ivec2 kCompass[8] = ivec2[8](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
+                                   ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
+
+// The colour a hole at p takes, or alpha 0 when p is not a hole.
+vec4 fill_hole(ivec2 p) {
+  ivec2 size = textureSize(u_accumulated, 0);
+  vec3 colors[8];
+  float distances[8];
+  float steps[8];
+  float nearest = 1e30;
+  for (int k = 0; k < 8; ++k) {
+    steps[k] = 0.0;
+    for (int s = 1; s <= u_fill_reach; ++s) {
+      ivec2 q = p + s * kCompass[k];
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) break;
+      vec4 found = texelFetch(u_accumulated, q, 0);
+      if (found.a > 0.0) {
+        colors[k] = found.rgb / found.a;
+        distances[k] = eye_distance(q);
+        steps[k] = float(s) * length(vec2(kCompass[k]));
+        nearest = min(nearest, distances[k]);
+        break;
+      }
+    }
+    if (steps[k] == 0.0) return vec4(0.0);
+  }
+  vec4 sum = vec4(0.0);
+  for (int k = 0; k < 8; ++k) {
+    if (distances[k] <= 1.05 * nearest) sum += vec4(colors[k], 1.0) / steps[k];
+  }
+  return vec4(sum.rgb / sum.a, 1.0);
 }
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec4 sum = texelFetch(u_accumulated, p, 0);
   if (sum.a <= 0.0) {
-    out_color = vec4(u_background, 0.0);
+    vec4 filled = u_fill_reach > 0 ? fill_hole(p) : vec4(0.0);
+    out_color = filled.a > 0.0 ? filled : vec4(u_background, 0.0);
     return;
   }
   vec3 color = sum.rgb / sum.a;

@@ -106,6 +106,30 @@ TEST(SplatRenderer, EveryKernelClosesTheWallAndTheBackgroundStaysEmpty) {
   }
 }
 
+// Splats at 0.8 × their radii leave a pinhole at every cell's centre; the
+// resolve fills each from the splats round it, and nothing beyond the
+// wall's edges, where background lies on one side.
+TEST(SplatRenderer, PinholesRingedBySplatsAreFilledAndTheSilhouetteStays) {
+  const modeling::RenderModel model = test::wall_model();
+  RenderSettings thin;
+  thin.splat_scale = 0.8f;
+  thin.fill_reach_px = 0;
+  const RenderedImage open = render(model, thin);
+  EXPECT_LT(inside_the_wall(open).covered, 0.995);
+  thin.fill_reach_px = 3;
+  const RenderedImage filled = render(model, thin);
+  const Inside inside = inside_the_wall(filled);
+  EXPECT_EQ(inside.covered, 1.0);
+  EXPECT_GT(inside.red_left, 0.99);
+  EXPECT_GT(inside.blue_right, 0.99);
+  for (int y = 0; y < 480; ++y) {
+    for (const int x : {120, 136, 504, 520}) EXPECT_FALSE(filled.covered(x, y)) << x << ", " << y;
+  }
+  for (int x = 0; x < 640; ++x) {
+    for (const int y : {90, 101, 379, 390}) EXPECT_FALSE(filled.covered(x, y)) << x << ", " << y;
+  }
+}
+
 TEST(SplatRenderer, HiddenObjectsAreNotDrawn) {
   const RenderedImage image = render(test::wall_model(true), {});
   std::size_t right = 0;
