@@ -25,7 +25,7 @@ nlohmann::json to_json(const modeling::ObjectNode& node) {
     const Eigen::Vector3d lo = node.bbox_world->min(), hi = node.bbox_world->max();
     bbox = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
   }
-  return {{"id", node.id},
+  nlohmann::json out = {{"id", node.id},
           {"name", node.name},
           {"kind", node.kind == modeling::NodeKind::kGroup ? "group" : "object"},
           {"parent", node.parent ? nlohmann::json(*node.parent) : nlohmann::json(nullptr)},
@@ -34,6 +34,10 @@ nlohmann::json to_json(const modeling::ObjectNode& node) {
           {"mean_footprint_m",
            node.mean_footprint_m ? nlohmann::json(*node.mean_footprint_m) : nlohmann::json()},
           {"bbox_world", bbox}};
+  // The node's own colour edit (what it inherits is not repeated).
+  if (const std::string color = modeling::to_json(node.color); !color.empty())
+    out["color"] = nlohmann::json::parse(color);
+  return out;
 }
 
 // The tree depth first, children by id, each level indented by two spaces.
@@ -53,10 +57,10 @@ void print_tree(const std::vector<modeling::ObjectNode>& nodes) {
   fmt::print("{:>5}  {:<7} {:>10}  {}\n", "id", "kind", "points", "name");
   const std::function<void(const modeling::ObjectNode&, int)> print = [&](const auto& node,
                                                                           int depth) {
-    fmt::print("{:>5}  {:<7} {:>10}  {}{}{}\n", node.id,
+    fmt::print("{:>5}  {:<7} {:>10}  {}{}{}{}\n", node.id,
                node.kind == modeling::NodeKind::kGroup ? "group" : "object", node.points,
                std::string(static_cast<std::size_t>(2 * depth), ' '), node.name,
-               node.hidden ? " (hidden)" : "");
+               node.hidden ? " (hidden)" : "", node.color.empty() ? "" : " (recoloured)");
     for (const modeling::ObjectNode* child : children[node.id]) print(*child, depth + 1);
   };
   for (const modeling::ObjectNode* root : roots) print(*root, 0);

@@ -26,5 +26,7 @@ void add_check_command(CLI::App& app);
 void add_objects_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
 void add_render_command(CLI::App& app);
+void add_recolor_command(CLI::App& app);
+void add_harmonize_command(CLI::App& app);
 
 }  // namespace scanbench::app

@@ -68,9 +68,11 @@ int main(int argc, char** argv) {
   sb::add_geometry_command(app);
   sb::add_register_command(app);
   sb::add_merge_command(app);
+  sb::add_harmonize_command(app);
   sb::add_export_command(app);
   sb::add_history_commands(app);
   sb::add_segment_command(app);
+  sb::add_recolor_command(app);
   sb::add_render_command(app);
   sb::add_objects_command(app);
   sb::add_check_command(app);

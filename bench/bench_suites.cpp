@@ -2,6 +2,7 @@
 
 #include <cassert>
 
+#include "bench/bench_color.hpp"
 #include "bench/bench_geometry.hpp"
 #include "bench/bench_io.hpp"
 #include "bench/bench_merge.hpp"
@@ -12,7 +13,7 @@
 namespace scanbench::bench {
 
 std::vector<std::string> suite_names() {
-  return {"io", "geometry", "registration", "merge", "segmentation", "render"};
+  return {"io", "geometry", "registration", "merge", "segmentation", "render", "color"};
 }
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
@@ -22,6 +23,7 @@ nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "merge") return run_merge_bench(options);
   if (name == "segmentation") return run_segmentation_bench(options);
   if (name == "render") return run_render_bench(options);
+  if (name == "color") return run_color_bench(options);
   assert(false && "unknown bench suite");
   return {};
 }

@@ -5,22 +5,44 @@
 
 namespace scanbench::bench {
 
+namespace {
+constexpr std::uint64_t kSiteSeed = 1;
+}  // namespace
+
+std::uint64_t scan_seed(int k) {
+  return acquisition::sim::hash_combine(kSiteSeed, static_cast<std::uint64_t>(k));
+}
+
+acquisition::sim::ScanLighting scan_lighting(SiteLighting lighting, int k) {
+  namespace sim = acquisition::sim;
+  switch (lighting) {
+    case SiteLighting::kReference:
+      return sim::reference_lighting();
+    case SiteLighting::kExposureOnly: {
+      sim::ScanLighting out = sim::reference_lighting();
+      const sim::ScanLighting own = sim::random_lighting(scan_seed(k));
+      out.exposure = own.exposure;
+      out.white_balance = own.white_balance;
+      return out;
+    }
+    case SiteLighting::kPerScan:
+      break;
+  }
+  return sim::random_lighting(scan_seed(k));
+}
+
 SimulatedSite simulate_site(const std::string& name, const acquisition::sim::ScannerModel& model,
                             int scan_count, SiteLighting lighting) {
   namespace sim = acquisition::sim;
-  constexpr std::uint64_t kSiteSeed = 1;
   const sim::Site site = sim::make_site(name, kSiteSeed, scan_count);
   SimulatedSite out;
   out.name = name;
   out.true_poses = site.scan_poses;
   out.objects = site.scene.objects();
   for (int k = 0; k < scan_count; ++k) {
-    const std::uint64_t seed = sim::hash_combine(kSiteSeed, static_cast<std::uint64_t>(k));
     sim::SimulatedScan simulated =
         sim::simulate_scan(site.scene, site.scan_poses[static_cast<std::size_t>(k)], model,
-                           lighting == SiteLighting::kReference ? sim::reference_lighting()
-                                                                : sim::random_lighting(seed),
-                           seed);
+                           scan_lighting(lighting, k), scan_seed(k));
     out.geometry.push_back(acquisition::compute_geometry(simulated.scan).geometry);
     out.scans.push_back(std::move(simulated.scan));
     out.truth.push_back(std::move(simulated.truth));

@@ -24,7 +24,17 @@ struct SimulatedSite {
 enum class SiteLighting {
   kPerScan,    // each scan its own sun, exposure and white balance (a real campaign)
   kReference,  // every scan under reference_lighting(), as the truth pictures are
+  // The reference sun for every scan, each with its own exposure and white
+  // balance: colours differ between scans by per-channel gains only.
+  kExposureOnly,
 };
+
+// The simulation seed of scan k (0-based): simulating it again with another
+// lighting gives the same geometry and noise, other colours.
+std::uint64_t scan_seed(int k);
+
+// The lighting of scan k (0-based) of a site simulated with `lighting`.
+acquisition::sim::ScanLighting scan_lighting(SiteLighting lighting, int k);
 
 // Scans the first `scan_count` positions of site `name` (seed 1) with `model`,
 // then computes every scan's geometry with the default settings.

@@ -5,6 +5,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
@@ -26,8 +27,8 @@ ORDER BY n.node_id)sql"});
 constexpr const char* kInsert = R"sql(
 INSERT OR REPLACE INTO object_nodes (node_id, command_id, live, name, kind, parent, hidden, points,
                                      mean_footprint_m, bbox_min_x, bbox_min_y, bbox_min_z,
-                                     bbox_max_x, bbox_max_y, bbox_max_z, checksum)
-VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16))sql";
+                                     bbox_max_x, bbox_max_y, bbox_max_z, color_edit, checksum)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17))sql";
 
 NodeRecord record_of(const ObjectNode& node, std::int64_t command_id, bool live) {
   NodeRecord r;
@@ -46,6 +47,7 @@ NodeRecord record_of(const ObjectNode& node, std::int64_t command_id, bool live)
       r.bbox[static_cast<std::size_t>(k + 3)] = node.bbox_world->max()[k];
     }
   }
+  r.color_edit = to_json(node.color);
   return r;
 }
 
@@ -76,6 +78,11 @@ ObjectNode node_of(const NodeRecord& r, const std::string& file) {
     }
     node.bbox_world = box;
   }
+  try {
+    node.color = color_edit_from_json(r.color_edit);
+  } catch (const std::invalid_argument& e) {
+    damaged(file, r.node_id, std::string("bad colour edit: ") + e.what());
+  }
   return node;
 }
 
@@ -91,7 +98,7 @@ void write(sqlite3* db, const std::string& file, const NodeRecord& r) {
   insert.bind_int(7, r.hidden).bind_int(8, r.points).bind_optional_double(9, r.mean_footprint_m);
   for (int k = 0; k < 6; ++k)
     insert.bind_optional_double(10 + k, r.bbox[static_cast<std::size_t>(k)]);
-  insert.bind_int(16, checksum(r)).run();
+  insert.bind_text(16, r.color_edit).bind_int(17, checksum(r)).run();
 }
 
 }  // namespace
@@ -122,6 +129,7 @@ void Project::put_node(Edit& edit, const ObjectNode& node) {
   assert(node.parent != node.id && "a node is not its own parent");
   assert(node.points >= 0 && "a point count is not negative");
   assert((!node.mean_footprint_m || std::isfinite(*node.mean_footprint_m)) && "finite footprint");
+  assert(check_color_edit(node.color).empty() && "a sound colour edit");
   assert((!node.bbox_world ||
           (node.bbox_world->min().allFinite() && node.bbox_world->max().allFinite())) &&
          "finite bounding box");

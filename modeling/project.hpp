@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -45,6 +46,7 @@
 #include "acquisition/scan.hpp"
 #include "acquisition/scan_summary.hpp"
 #include "core/project_file.hpp"
+#include "modeling/color_edits.hpp"
 #include "modeling/layers.hpp"
 
 struct sqlite3;
@@ -58,8 +60,9 @@ inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplication
 // PRAGMA user_version written by this build. Older projects are migrated on
 // open; newer ones are refused.
 // 2: scan_geometry; 3: registration_runs, merge_masks; 4: the command journal,
-// versioned poses and the per-scan layer store; 5: the object tree.
-inline constexpr int kProjectSchemaVersion = 5;
+// versioned poses and the per-scan layer store; 5: the object tree; 6: colour
+// edits of objects and colour corrections of scans.
+inline constexpr int kProjectSchemaVersion = 6;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
@@ -78,6 +81,7 @@ struct ObjectNode {
   std::int64_t points = 0;
   std::optional<double> mean_footprint_m;         // [m]; none without points
   std::optional<Eigen::AlignedBox3d> bbox_world;  // [m]; none without points
+  ColorEdit color;  // what the node itself sets (color_edits.hpp); the rest it inherits
 };
 
 struct StoredScanSummary {
@@ -263,6 +267,18 @@ class Project {
   // Deletes node `id` as part of `edit` (a version saying "deleted": undo
   // brings it back). No effect on a node that is not live.
   void remove_node(Edit& edit, std::int64_t id);
+
+  // ---- Colour corrections of scans (color_edits.hpp) -----------------------
+
+  // The current correction of every live scan that has one, by scan id.
+  // Throws core::InputError naming the scan when its row is damaged.
+  std::map<std::int64_t, ScanColorCorrection> scan_color_corrections() const;
+
+  // Writes a new version of scan `id`'s correction as part of `edit` (the
+  // identity removes it in effect). Throws core::InputError when there is
+  // no such scan.
+  void put_scan_color_correction(Edit& edit, std::int64_t id,
+                                 const ScanColorCorrection& correction);
 
   // ---- Commands and the journal ------------------------------------------
 

@@ -109,6 +109,22 @@ std::size_t check_nodes(sqlite3* db, const std::string& file, std::vector<std::s
   return checked;
 }
 
+std::size_t check_scan_colors(sqlite3* db, const std::string& file,
+                              std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  for (sqlite::Statement rows(
+           db, "SELECT scan_id, command_id, correction, checksum FROM scan_colors", file);
+       rows.step(); ++checked) {
+    const ScanColorRecord record{rows.column_int(0), rows.column_int(1), rows.column_text(2)};
+    if (checksum(record) != rows.column_int(3)) {
+      damage.push_back("colour correction of scan " + std::to_string(record.scan_id) +
+                       ": its version of command " + std::to_string(record.command_id) +
+                       " fails its checksum");
+    }
+  }
+  return checked;
+}
+
 }  // namespace
 
 Project::CheckReport Project::check() const {
@@ -117,6 +133,7 @@ Project::CheckReport Project::check() const {
   report.records += check_scan_records(db(), file_name(), report.damage);
   report.records += check_commands(db(), file_name(), report.damage);
   report.records += check_nodes(db(), file_name(), report.damage);
+  report.records += check_scan_colors(db(), file_name(), report.damage);
   report.layers = check_layers(db(), file_name(), report.damage);
   return report;
 }

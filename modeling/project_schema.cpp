@@ -76,8 +76,8 @@ INSERT INTO meta (key, value) VALUES
 // Tables every version has (checked before migrating) and those of the
 // current version (checked after).
 constexpr std::array<const char*, 2> kEveryVersionTables = {"meta", "scans"};
-constexpr std::array<const char*, 6> kCurrentTables = {"meta",       "scans",       "commands",
-                                                       "scan_poses", "scan_layers", "object_nodes"};
+constexpr std::array<const char*, 7> kCurrentTables = {
+    "meta", "scans", "commands", "scan_poses", "scan_layers", "object_nodes", "scan_colors"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
   throw core::InputError(file, {}, problem);
@@ -337,6 +337,21 @@ CREATE TABLE object_nodes (
 CREATE INDEX object_nodes_by_command ON object_nodes (command_id);
 )sql";
 
+// Version 6: each node's own colour edit (JSON, "" for none; old rows keep
+// their checksums, which an empty edit does not change), and the versioned
+// colour corrections of scans (`harmonize`).
+constexpr const char* kMigrate5To6 = R"sql(
+ALTER TABLE object_nodes ADD COLUMN color_edit TEXT NOT NULL DEFAULT '';
+CREATE TABLE scan_colors (
+  scan_id INTEGER NOT NULL REFERENCES scans (id) ON DELETE CASCADE,
+  command_id INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
+  correction TEXT NOT NULL,
+  checksum INTEGER NOT NULL,
+  PRIMARY KEY (scan_id, command_id)
+);
+CREATE INDEX scan_colors_by_command ON scan_colors (command_id);
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction; `original_version` is the version the file had when opened.
 void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
@@ -353,6 +368,9 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
       return;
     case 4:
       sqlite::execute(db, kMigrate4To5, file);
+      return;
+    case 5:
+      sqlite::execute(db, kMigrate5To6, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

@@ -42,6 +42,15 @@ std::int64_t checksum(const NodeRecord& r) {
   sum.add(r.parent ? std::optional<double>(static_cast<double>(*r.parent)) : std::nullopt);
   sum.add(r.hidden).add(r.points).add(r.mean_footprint_m);
   for (const std::optional<double>& v : r.bbox) sum.add(v);
+  // Rows of schema 5 have no edit: an empty one adds nothing, so their
+  // checksums still hold.
+  if (!r.color_edit.empty()) sum.add(r.color_edit);
+  return sum.value();
+}
+
+std::int64_t checksum(const ScanColorRecord& r) {
+  RowChecksum sum;
+  sum.add(r.scan_id).add(r.command_id).add(r.correction);
   return sum.value();
 }
 
@@ -135,7 +144,8 @@ std::pair<NodeRecord, std::int64_t> read_node_record(const sqlite::Statement& ro
   r.points = row.column_int(7);
   r.mean_footprint_m = optional_double(row, 8);
   for (int k = 0; k < 6; ++k) r.bbox[static_cast<std::size_t>(k)] = optional_double(row, 9 + k);
-  return {std::move(r), row.column_int(15)};
+  r.color_edit = row.column_text(15);
+  return {std::move(r), row.column_int(16)};
 }
 
 void fill_migrated_checksums(sqlite3* db, const std::string& file) {

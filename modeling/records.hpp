@@ -68,7 +68,16 @@ struct NodeRecord {
   std::int64_t points = 0;
   std::optional<double> mean_footprint_m;
   std::array<std::optional<double>, 6> bbox;  // min x y z, max x y z
+  std::string color_edit;                     // JSON; "" for none
 };
+
+// A version of a scan's colour correction.
+struct ScanColorRecord {
+  std::int64_t scan_id = 0;
+  std::int64_t command_id = 0;
+  std::string correction;  // JSON
+};
+
 
 // A layer version's row without its data (whose zstd frame checks itself).
 struct LayerFields {
@@ -87,6 +96,7 @@ std::int64_t checksum(const PoseRecord& record);
 std::int64_t checksum(const CommandFields& record);
 std::int64_t checksum(const LayerFields& record);
 std::int64_t checksum(const NodeRecord& record);
+std::int64_t checksum(const ScanColorRecord& record);
 
 // What identifies a scan's data whatever its name or pose (the same file
 // imported twice has the same): CRC-32 of its grid size, angle model and
@@ -114,7 +124,7 @@ inline constexpr const char* kLayerColumns =
 inline constexpr const char* kNodeColumns =
     "n.node_id, n.command_id, n.live, n.name, n.kind, n.parent, n.hidden, n.points, "
     "n.mean_footprint_m, n.bbox_min_x, n.bbox_min_y, n.bbox_min_z, n.bbox_max_x, n.bbox_max_y, "
-    "n.bbox_max_z, n.checksum";
+    "n.bbox_max_z, n.color_edit, n.checksum";
 
 // The parts of an SQL statement put together (plain appends: GCC 12 warns
 // falsely on chains of std::string operator+ at -O3).

@@ -5,11 +5,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "core/progress.hpp"
 #include "modeling/project.hpp"
+#include "registration/color_harmonization.hpp"
 #include "registration/merge.hpp"
 #include "registration/register_scans.hpp"
 
@@ -72,5 +74,50 @@ MergeStageResult merge_project(Project& project, const registration::MergeSettin
 // merge --json` prints: {"scans":[{"id","name","in_model","kept","redundant"}],
 // "points","kept","seconds"}.
 std::string merge_result_json(const MergeStageResult& result);
+
+struct HarmonizeStageSettings {
+  registration::ColorPairSettings pairs;
+  registration::HarmonizeSettings solve;
+};
+
+struct HarmonizeStageScan {
+  std::int64_t id = 0;
+  std::string name;
+  ScanColorCorrection correction;
+  bool connected = false;  // linked to the first scan through overlaps
+  std::size_t pairs = 0;   // colour pairs it takes part in
+  // Mean CIE76 ΔE to the other scan of its pairs, before and after.
+  double delta_e_before = 0.0;
+  double delta_e_after = 0.0;
+};
+
+struct HarmonizeStageResult {
+  std::int64_t command_id = 0;
+  std::vector<HarmonizeStageScan> scans;  // by id
+  std::size_t pairs = 0;
+  double delta_e_before = 0.0;  // mean over every pair
+  double delta_e_after = 0.0;
+  int iterations = 0;
+  bool converged = false;
+  double seconds = 0.0;
+};
+
+// Mean CIE76 ΔE between the two colours of each pair, each corrected by its
+// scan's correction (by index into `corrections`; empty: none).
+double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
+                         std::span<const ScanColorCorrection> corrections);
+
+// Harmonises the colours of the project's scans at their current poses
+// (seed 004 §4.5; registration/color_harmonization.hpp): colour pairs from
+// the overlaps, one correction per scan with the first scan (by id) fixed,
+// stored as one command ("harmonize") whose undo restores the earlier
+// corrections. Scans with no chain of overlaps to the first keep theirs.
+// Throws as merge_project (no scans, a scan without geometry, a project
+// changed meanwhile, cancelled), and core::InputError when no two scans
+// with colour overlap. The project is then unchanged.
+HarmonizeStageResult harmonize_project(Project& project, const HarmonizeStageSettings& settings,
+                                       core::Progress& progress);
+
+std::string harmonize_result_json(const HarmonizeStageResult& result);
 
 }  // namespace scanbench::modeling

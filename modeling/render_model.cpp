@@ -119,7 +119,8 @@ void append_splat(const acquisition::Scan& scan, const acquisition::ScanGeometry
 
 void gather_scan(const Project& project, const StoredScanSummary& stored,
                  const RenderModelSettings& settings, const std::map<std::int64_t, bool>& shown,
-                 const Eigen::Vector3d& origin, RenderPoints& p, RenderModelCounts& counts) {
+                 const ColorPipeline& colors, const Eigen::Vector3d& origin, RenderPoints& p,
+                 RenderModelCounts& counts) {
   const acquisition::Scan scan = project.load_scan(stored.id);
   const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
   if (!geometry) {
@@ -165,7 +166,9 @@ void gather_scan(const Project& project, const StoredScanSummary& stored,
           scan.has_intensity() ? std::clamp((scan.intensity[i] - low) / spread, 0.0f, 1.0f) : 0.5f;
       std::array<std::uint8_t, 4> rgba{};
       if (scan.has_color()) {
-        rgba = {scan.rgb[3 * i], scan.rgb[3 * i + 1], scan.rgb[3 * i + 2], 255};
+        const std::array<std::uint8_t, 3> rgb = colors.shown(
+            stored.id, owner, {scan.rgb[3 * i], scan.rgb[3 * i + 1], scan.rgb[3 * i + 2]});
+        rgba = {rgb[0], rgb[1], rgb[2], 255};
       } else {
         const auto grey = static_cast<std::uint8_t>(std::lround(255.0f * level));
         rgba = {grey, grey, grey, 255};
@@ -271,8 +274,9 @@ RenderModel build_render_model(const Project& project, const RenderModelSettings
   const std::map<std::int64_t, bool> shown = shown_nodes(tree);
   RenderModelCounts counts;
   RenderPoints points;
+  const ColorPipeline colors(project.scan_color_corrections(), resolve_color_edits(tree));
   for (const StoredScanSummary& stored : scans)
-    gather_scan(project, stored, settings, shown, origin, points, counts);
+    gather_scan(project, stored, settings, shown, colors, origin, points, counts);
   RenderModel model = assemble_render_model(std::move(points), origin, tree, settings.tiles);
   model.counts = counts;
   return model;

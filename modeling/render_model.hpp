@@ -38,7 +38,8 @@ struct RenderPoints {
   std::vector<Eigen::Vector2f> radii_m;     // (across, along the major axis) [m]
   std::vector<Eigen::Vector3f> major_axis;  // unit, world frame; zero: round (radii equal)
   std::vector<std::array<std::uint8_t, 4>>
-      rgba;                         // scan colour (grey from intensity without), alpha 255
+      rgba;  // shown colour: the scan's, its correction and its object's edit
+             // applied (color_edits.hpp); grey from intensity without; alpha 255
   std::vector<float> intensity;     // [0, 1]: the scan's 2nd–98th percentile spread
   std::vector<std::uint32_t> node;  // the owning object, 0 for none
 

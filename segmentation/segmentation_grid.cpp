@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "acquisition/color_space.hpp"
 #include "core/parallel.hpp"
 
 namespace scanbench::segmentation {
@@ -12,22 +13,6 @@ namespace scanbench::segmentation {
 namespace {
 
 constexpr std::array<std::string_view, 4> kChannelNames = {"range", "color", "intensity", "normal"};
-
-// sRGB decoding (IEC 61966-2-1) of every 8-bit value.
-std::array<float, 256> make_linear_table() {
-  std::array<float, 256> table{};
-  for (int v = 0; v < 256; ++v) {
-    const double c = v / 255.0;
-    table[v] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-  }
-  return table;
-}
-
-// CIE 1976 L*a*b* companding of a tristimulus ratio.
-float lab_f(float t) {
-  constexpr float kDelta = 6.0f / 29.0f;
-  return t > kDelta * kDelta * kDelta ? std::cbrt(t) : t / (3.0f * kDelta * kDelta) + 4.0f / 29.0f;
-}
 
 float intensity_spread(const acquisition::Scan& scan, const std::vector<std::uint8_t>& usable) {
   const auto [low, high] = acquisition::intensity_range(scan, usable);
@@ -59,14 +44,8 @@ GridShape grid_shape(const acquisition::Scan& scan) {
 }
 
 std::array<float, 3> srgb_to_lab(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
-  static const std::array<float, 256> linear = make_linear_table();
-  const float R = linear[r], G = linear[g], B = linear[b];
-  // Linear sRGB to XYZ, divided by the D65 white point.
-  const float x = (0.4124f * R + 0.3576f * G + 0.1805f * B) / 0.95047f;
-  const float y = 0.2126f * R + 0.7152f * G + 0.0722f * B;
-  const float z = (0.0193f * R + 0.1192f * G + 0.9505f * B) / 1.08883f;
-  const float fx = lab_f(x), fy = lab_f(y), fz = lab_f(z);
-  return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
+  const Eigen::Vector3d lab = acquisition::srgb_to_lab({r, g, b});
+  return {static_cast<float>(lab.x()), static_cast<float>(lab.y()), static_cast<float>(lab.z())};
 }
 
 SegmentationGrid prepare_grid(const acquisition::Scan& scan,

@@ -34,7 +34,8 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
   for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry",
-                              "register", "merge", "history", "undo", "redo", "check", "objects"}) {
+                              "register", "merge", "history", "undo", "redo", "check", "objects",
+                              "segment", "render", "recolor", "harmonize"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
@@ -141,6 +142,53 @@ TEST(Cli, SegmentScriptBuildsTheTreeAndEachOpIsUndoable) {
   EXPECT_EQ(nodes()[1]["name"], "wall south");
   EXPECT_EQ(nodes()[1]["parent"], nodes()[0]["id"]);
   EXPECT_GT(nodes()[1]["points"].get<int>(), 12);
+}
+
+TEST(Cli, RecolorEditsAnObjectUndoablyAndRefusesWhatItCannotDo) {
+  ScratchDir dir;
+  const std::filesystem::path project = segmentable_project(dir);
+  const std::filesystem::path script = write_script(dir, "ops.json", R"json({"scan": 1, "ops": [
+    {"op": "group", "name": "site"},
+    {"op": "grow", "seed": [0, 0], "channel": "range", "tolerance": 50},
+    {"op": "commit", "name": "wall", "parent": "site"}]})json");
+  ASSERT_EQ(run_cli(dir, {"segment", project.string(), "--script", script.string()}).exit_code, 0);
+  const CliResult edited = run_cli(dir, {"recolor", project.string(), "--object", "2",
+                                         "--brightness", "12.5", "--hue", "30", "--json"});
+  ASSERT_EQ(edited.exit_code, 0) << edited.err;
+  const nlohmann::json color = nlohmann::json::parse(edited.out)["color"];
+  EXPECT_EQ(color["brightness"], 12.5);
+  EXPECT_EQ(color["hue_deg"], 30.0);
+  const auto history_size = [&] {
+    return nlohmann::json::parse(run_cli(dir, {"history", project.string(), "--json"}).out)
+        ["commands"]
+        .size();
+  };
+  const std::size_t commands = history_size();
+  // No such node, a value out of range, an edit mixed with a clone, a
+  // clone without a source, a scan without colour: exit 2, nothing written.
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"--object", "99", "--brightness", "1"},
+        {"--object", "2", "--contrast", "-1"},
+        {"--object", "2", "--brightness", "1", "--clone", "1"},
+        {"--to", "2"},
+        {"--to", "2", "--paint-color", "#12345"},
+        {"--to", "2", "--clone-region", "1:0:0:2:2"}}) {
+    std::vector<std::string> args = {"recolor", project.string()};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const CliResult refused = run_cli(dir, args);
+    EXPECT_EQ(refused.exit_code, 2) << bad.front() << " " << bad.back();
+    EXPECT_FALSE(refused.err.empty());
+  }
+  EXPECT_EQ(history_size(), commands);
+  const CliResult harmonize = run_cli(dir, {"harmonize", project.string()});
+  EXPECT_EQ(harmonize.exit_code, 2);  // the fixture's scans have no colour
+  EXPECT_THAT(harmonize.err, HasSubstr("colour overlap"));
+  ASSERT_EQ(run_cli(dir, {"undo", project.string()}).exit_code, 0);
+  const nlohmann::json nodes =
+      nlohmann::json::parse(run_cli(dir, {"objects", project.string(), "--json"}).out)["nodes"];
+  EXPECT_FALSE(nodes[1].contains("color"));
+  ASSERT_EQ(run_cli(dir, {"redo", project.string()}).exit_code, 0);
+  EXPECT_THAT(run_cli(dir, {"objects", project.string()}).out, HasSubstr("wall (recoloured)"));
 }
 
 TEST(Cli, RenderDrawsTheProjectHeadlessAndRefusesBadViewsAndOutputs) {

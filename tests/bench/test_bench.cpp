@@ -197,6 +197,23 @@ TEST(BenchRender, SmokeRunReportsEveryViewAndMode) {
   for (const auto& [goal, met] : bench["goals"].items()) EXPECT_TRUE(met.is_boolean()) << goal;
 }
 
+TEST(BenchColor, SmokeRunReportsTheIssuesFields) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "color", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "color");
+  for (const char* field :
+       {"before_delta_e", "after_delta_e", "after_delta_e_to_albedo", "reduction"})
+    EXPECT_TRUE(bench[field].is_number()) << field;
+  EXPECT_GT(bench["held_out_pairs"].get<int>(), 1000);
+  // Even the smoke run's two small scans differ by exposure and white
+  // balance only, which the fit undoes.
+  EXPECT_LT(bench["after_delta_e"].get<double>(), bench["before_delta_e"].get<double>());
+  EXPECT_EQ(bench["gain_offset"]["scans"].size(), 2u);
+  EXPECT_TRUE(bench["goals"]["reduction_at_least_0_8"].is_boolean());
+}
+
 TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
   test::ScratchDir dir;
   const test::CliResult result = test::run_cli(dir, {"bench", "io", "--json", "--smoke"});

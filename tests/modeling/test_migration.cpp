@@ -36,36 +36,64 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
-// fixtures/projects/version5.sbproj: version4.sbproj (below) opened by the
-// build that introduced version 5, then the nodes "north hall" (a group) and
-// "wall south" (an object in it) created, and a rename of the wall undone.
+// fixtures/projects/version6.sbproj: version5.sbproj (below) opened by the
+// build that introduced version 6 (the undone rename is discarded by the
+// next command), then "wall south" recoloured (brightness 12, saturation
+// 0.8) and a hue edit of "north hall" undone.
 TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournal) {
-  static_assert(kProjectSchemaVersion == 5, "add fixtures/projects/version6.sbproj");
+  static_assert(kProjectSchemaVersion == 6, "add fixtures/projects/version7.sbproj");
   const ScratchDir dir;
-  const auto file = migrated_copy(dir, 5);
+  const auto file = migrated_copy(dir, 6);
   const std::string before = test::read_file_bytes(file);
   {
     Project project = Project::open(file);
     EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
     const std::vector<CommandRecord> history = project.history();
-    ASSERT_EQ(history.size(), 3u);
-    EXPECT_EQ(history[1].name, "objects");
-    EXPECT_EQ(history[2].name, "rename");
-    EXPECT_EQ(history[2].state, CommandState::kUndone);
+    ASSERT_EQ(history.size(), 4u);
+    EXPECT_EQ(history[2].name, "recolor");
+    EXPECT_EQ(history[3].name, "recolor");
+    EXPECT_EQ(history[3].state, CommandState::kUndone);
     const std::vector<ObjectNode> nodes = project.object_nodes();
     ASSERT_EQ(nodes.size(), 2u);
-    EXPECT_EQ(nodes[0].name, "north hall");
-    EXPECT_EQ(nodes[0].kind, NodeKind::kGroup);
-    EXPECT_EQ(nodes[1].name, "wall south");
-    EXPECT_EQ(nodes[1].parent, 1);
-    EXPECT_EQ(nodes[1].points, 5);
-    ASSERT_TRUE(nodes[1].bbox_world.has_value());
-    EXPECT_EQ(nodes[1].bbox_world->max(), Eigen::Vector3d(1.5, 2.0, 0.75));
+    EXPECT_TRUE(nodes[0].color.empty());
+    EXPECT_EQ(nodes[1].color.brightness, 12.0);
+    EXPECT_EQ(nodes[1].color.saturation, 0.8);
+    EXPECT_FALSE(nodes[1].color.hue_deg.has_value());
+    EXPECT_TRUE(project.scan_color_corrections().empty());
   }
   EXPECT_EQ(test::read_file_bytes(file), before);
   Project project = Project::open(file);
   ASSERT_TRUE(project.redo().has_value());
-  EXPECT_EQ(project.object_nodes()[1].name, "wall west");
+  EXPECT_EQ(project.object_nodes()[0].color.hue_deg, 20.0);
+  EXPECT_TRUE(project.check().damage.empty());
+}
+
+// fixtures/projects/version5.sbproj: version4.sbproj (below) opened by the
+// build that introduced version 5, then the nodes "north hall" (a group) and
+// "wall south" (an object in it) created, and a rename of the wall undone.
+// Its nodes keep their checksums and have no colour edits.
+TEST(Migration, VersionFiveKeepsItsTreeAndTakesColourEdits) {
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 5);
+  Project project = Project::open(file);
+  EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
+  const std::vector<CommandRecord> history = project.history();
+  ASSERT_EQ(history.size(), 3u);
+  EXPECT_EQ(history[2].state, CommandState::kUndone);
+  std::vector<ObjectNode> nodes = project.object_nodes();
+  ASSERT_EQ(nodes.size(), 2u);
+  EXPECT_EQ(nodes[1].name, "wall south");
+  EXPECT_EQ(nodes[1].points, 5);
+  EXPECT_TRUE(nodes[1].color.empty());
+  EXPECT_TRUE(project.check().damage.empty());
+  ASSERT_TRUE(project.redo().has_value());
+  nodes = project.object_nodes();
+  EXPECT_EQ(nodes[1].name, "wall west");
+  nodes[1].color.hue_deg = 45.0;
+  Project::Edit edit = project.begin_command("recolor", "{}");
+  project.put_node(edit, nodes[1]);
+  edit.commit("{}");
+  EXPECT_EQ(project.object_nodes()[1].color.hue_deg, 45.0);
   EXPECT_TRUE(project.check().damage.empty());
 }
 

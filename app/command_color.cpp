@@ -1,0 +1,210 @@
+// scanbench recolor PROJECT --object ID [--brightness B] [--contrast C] [--gamma G] [--hue DEG]
+//                           [--saturation S] [--reset] [--json]
+// scanbench recolor PROJECT --to ID (--clone SRC_ID | --clone-region SCAN:ROW0:COL0:ROW1:COL1 |
+//                           --paint-color '#RRGGBB') [--paint] [--json]
+// scanbench harmonize PROJECT [--model gain-offset|matrix] [--threads N] [--json]
+#include <fmt/core.h>
+
+#include <charconv>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/progress_bar.hpp"
+#include "modeling/color_commands.hpp"
+#include "modeling/registration_stage.hpp"
+
+namespace scanbench::app {
+namespace {
+
+struct RecolorOptions {
+  std::string project;
+  std::optional<std::int64_t> object;
+  modeling::ColorEdit set;
+  bool reset = false;
+  std::optional<std::int64_t> target;
+  std::optional<std::int64_t> clone;
+  std::string clone_region;
+  std::string paint_color;
+  bool paint = false;
+  bool json = false;
+};
+
+// "SCAN:ROW0:COL0:ROW1:COL1".
+modeling::PixelRect parse_region(const std::string& text) {
+  std::array<long long, 5> v{};
+  const char* at = text.data();
+  const char* end = text.data() + text.size();
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const auto [next, error] = std::from_chars(at, end, v[k]);
+    const bool last = k + 1 == v.size();
+    if (error != std::errc() || (last ? next != end : (next == end || *next != ':')))
+      throw CLI::ValidationError("--clone-region", "expected SCAN:ROW0:COL0:ROW1:COL1, got " + text);
+    at = next + 1;
+  }
+  return {v[0], static_cast<int>(v[1]), static_cast<int>(v[3]), static_cast<int>(v[2]),
+          static_cast<int>(v[4])};
+}
+
+// "#RRGGBB" or "RRGGBB".
+std::array<std::uint8_t, 3> parse_color(const std::string& text) {
+  const std::string hex = !text.empty() && text[0] == '#' ? text.substr(1) : text;
+  unsigned value = 0;
+  const auto [next, error] = std::from_chars(hex.data(), hex.data() + hex.size(), value, 16);
+  if (hex.size() != 6 || error != std::errc() || next != hex.data() + hex.size())
+    throw CLI::ValidationError("--paint-color", "expected #RRGGBB, got " + text);
+  return {static_cast<std::uint8_t>(value >> 16), static_cast<std::uint8_t>(value >> 8),
+          static_cast<std::uint8_t>(value)};
+}
+
+void print_edit(const modeling::ObjectNode& node) {
+  const std::string json = modeling::to_json(node.color);
+  fmt::print("node {} ({}): colour edit {}\n", node.id, node.name,
+             json.empty() ? "none (inherits its parent's)" : json);
+}
+
+void run_recolor(const RecolorOptions& options) {
+  const bool editing = options.object.has_value();
+  const bool cloning = options.target.has_value();
+  if (editing == cloning)
+    throw CLI::ValidationError("recolor", "give --object ID (an edit) or --to ID (a clone)");
+  const bool sources = options.clone || !options.clone_region.empty() ||
+                       !options.paint_color.empty() || options.paint;
+  if (editing && sources)
+    throw CLI::ValidationError("--object", "edits an object; a clone names its target with --to");
+  if (cloning && (!options.set.empty() || options.reset))
+    throw CLI::ValidationError("--to", "clones colours; edit parameters go with --object");
+  modeling::Project project = modeling::Project::open(options.project);
+  std::int64_t node_id = 0;
+  std::string result;
+  if (editing) {
+    if (options.set.empty() && !options.reset)
+      throw CLI::ValidationError("--object", "give at least one of --brightness, --contrast, "
+                                             "--gamma, --hue, --saturation or --reset");
+    const modeling::NodeCommandResult out =
+        modeling::recolor_object(project, {*options.object, options.set, options.reset});
+    node_id = out.node_id;
+  } else {
+    modeling::CloneSettings settings;
+    settings.target = *options.target;
+    settings.source_node = options.clone;
+    if (!options.clone_region.empty()) settings.source_region = parse_region(options.clone_region);
+    if (!options.paint_color.empty()) settings.source_color = parse_color(options.paint_color);
+    settings.paint = options.paint;
+    const modeling::CloneResult out = modeling::clone_color(project, settings);
+    node_id = out.node_id;
+    if (!options.json) {
+      fmt::print("matched {} target points to {} source points\n", out.target_points,
+                 out.source_points);
+    }
+  }
+  for (const modeling::ObjectNode& node : project.object_nodes()) {
+    if (node.id != node_id) continue;
+    if (options.json) {
+      const std::string json = modeling::to_json(node.color);
+      fmt::print("{{\"node\":{},\"color\":{}}}\n", node.id, json.empty() ? "{}" : json);
+    } else {
+      print_edit(node);
+    }
+  }
+}
+
+struct HarmonizeOptions {
+  std::string project;
+  modeling::HarmonizeStageSettings settings;
+  bool json = false;
+};
+
+void run_harmonize(const HarmonizeOptions& options) {
+  modeling::Project project = modeling::Project::open(options.project);
+  ProgressBar progress;
+  const modeling::HarmonizeStageResult out =
+      modeling::harmonize_project(project, options.settings, progress);
+  if (options.json) {
+    fmt::print("{}\n", modeling::harmonize_result_json(out));
+    return;
+  }
+  fmt::print("{:>4}  {:<24} {:>9} {:>10} {:>9}  {}\n", "id", "name", "pairs", "ΔE before",
+             "ΔE after", "gains (R G B), offsets");
+  for (const modeling::HarmonizeStageScan& s : out.scans) {
+    fmt::print("{:>4}  {:<24} {:>9} {:>10.2f} {:>9.2f}  ", s.id, s.name, s.pairs,
+               s.delta_e_before, s.delta_e_after);
+    if (!s.connected) {
+      fmt::print("no overlap with the first scan: unchanged\n");
+      continue;
+    }
+    fmt::print("{:.3f} {:.3f} {:.3f}, {:+.4f} {:+.4f} {:+.4f}\n", s.correction.matrix(0, 0),
+               s.correction.matrix(1, 1), s.correction.matrix(2, 2), s.correction.offset.x(),
+               s.correction.offset.y(), s.correction.offset.z());
+  }
+  fmt::print("{} colour pairs: mean ΔE {:.2f} → {:.2f} ({} iterations, {:.2f} s); corrections "
+             "stored in {}\n",
+             out.pairs, out.delta_e_before, out.delta_e_after, out.iterations, out.seconds,
+             options.project);
+}
+
+}  // namespace
+
+void add_recolor_command(CLI::App& app) {
+  auto options = std::make_shared<RecolorOptions>();
+  CLI::App* command = app.add_subcommand(
+      "recolor",
+      "Edit an object's colours without changing the scans (one command, undoable): set its "
+      "brightness, contrast, gamma, hue or saturation (in CIE L*a*b*; parameters it does not set "
+      "it inherits from its group), or make its colours match another object, a region of a "
+      "scan, or one colour.");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--object", options->object, "The node to edit");
+  command->add_option("--brightness", options->set.brightness, "Added to L* (-100…100)");
+  command->add_option("--contrast", options->set.contrast, "L* scaled about 50 (1: none)");
+  command->add_option("--gamma", options->set.gamma, "L*/100 raised to 1/gamma (1: none)");
+  command->add_option("--hue", options->set.hue_deg, "a*b* rotated by this many degrees");
+  command->add_option("--saturation", options->set.saturation, "Chroma × this (1: none)");
+  command->add_flag("--reset", options->reset,
+                    "Drop the node's own parameters first (it inherits them again)");
+  command->add_option("--to", options->target, "The node whose colours a clone changes");
+  command->add_option("--clone", options->clone, "Clone from this node's colours as shown");
+  command->add_option("--clone-region", options->clone_region,
+                      "Clone from a region of a scan: SCAN:ROW0:COL0:ROW1:COL1 (ends excluded)");
+  command->add_option("--paint-color", options->paint_color,
+                      "Paint this colour (#RRGGBB), keeping the target's lightness detail");
+  command->add_flag("--paint", options->paint,
+                    "Paint the source's mean colour instead of matching its spread");
+  command->add_flag("--json", options->json, "Print the node's colour edit as JSON");
+  command->callback([options] { run_recolor(*options); });
+}
+
+void add_harmonize_command(CLI::App& app) {
+  auto options = std::make_shared<HarmonizeOptions>();
+  CLI::App* command = app.add_subcommand(
+      "harmonize",
+      "Make the same surface look the same from every scan: corresponding points in the "
+      "overlaps of the registered scans give colour pairs, and a robust least-squares solve "
+      "(Ceres) gives each scan a colour correction in linear RGB, the first scan fixed. Stored as "
+      "one command, undoable; the scans' colours are never changed.");
+  command->add_option("project", options->project, "Project file (.sbproj)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--model", options->settings.solve.model,
+                   "gain-offset (per channel) or matrix (3 × 3 and offset)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, registration::ColorModel>{
+              {"gain-offset", registration::ColorModel::kGainOffset},
+              {"matrix", registration::ColorModel::kMatrix}},
+          CLI::ignore_case))
+      ->default_str("gain-offset");
+  command->add_option("--threads", options->settings.pairs.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_flag("--json", options->json, "Print one JSON object");
+  command->callback([options] {
+    HarmonizeOptions run = *options;
+    run.settings.solve.threads = run.settings.pairs.threads;
+    run_harmonize(run);
+  });
+}
+
+}  // namespace scanbench::app

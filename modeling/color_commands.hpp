@@ -1,0 +1,70 @@
+// The colour commands (issue 15, seed 004 §4.5): an object's colour edit set
+// or reset (`recolor`), and an object's colours made to match another
+// object, a region of a scan, or one colour (`clone`). Each is one journaled
+// command writing a new version of the target node, so undo restores the
+// earlier edit exactly. The scans' colours are never changed
+// (color_edits.hpp); scan-level corrections are the harmonize stage's
+// (registration_stage.hpp).
+//
+// Errors: a node or scan that does not exist, parameters out of range, a
+// region outside the scan, a source or target without coloured points:
+// core::InputError naming it, and nothing written.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "modeling/color_edits.hpp"
+#include "modeling/project.hpp"
+#include "modeling/segment_commands.hpp"
+
+namespace scanbench::modeling {
+
+struct RecolorSettings {
+  std::int64_t node = 0;
+  ColorEdit set;       // the parameters to set; the others stay as they are
+  bool reset = false;  // first drop every parameter the node sets (it inherits them again)
+};
+
+NodeCommandResult recolor_object(Project& project, const RecolorSettings& settings);
+
+// A rectangle of a scan's grid: rows [row_begin, row_end), columns
+// [col_begin, col_end).
+struct PixelRect {
+  std::int64_t scan_id = 0;
+  int row_begin = 0;
+  int row_end = 0;
+  int col_begin = 0;
+  int col_end = 0;
+};
+
+struct CloneSettings {
+  std::int64_t target = 0;
+  // Exactly one source: an object (or group: its descendants' points), a
+  // region, or a colour (8-bit sRGB).
+  std::optional<std::int64_t> source_node;
+  std::optional<PixelRect> source_region;
+  std::optional<std::array<std::uint8_t, 3>> source_color;
+  // Paint: the target takes the source's mean colour, keeping its own
+  // lightness detail (always so for a colour source); otherwise it takes
+  // the source's mean and spread in each of L*, a*, b*.
+  bool paint = false;
+};
+
+struct CloneResult {
+  std::int64_t command_id = 0;
+  std::int64_t node_id = 0;
+  std::size_t source_points = 0;  // 1 for a colour source
+  std::size_t target_points = 0;
+  LabTransfer transfer;  // now the target's own
+};
+
+// Statistics transfer in L*a*b* (Reinhard et al.'s idea, in CIELAB): the
+// source's colours as shown (its scans' corrections and its edits), the
+// target's as its scans' corrections leave them; the target gets the
+// transfer and neutral adjustments of its own, so nothing it inherits
+// bends the match.
+CloneResult clone_color(Project& project, const CloneSettings& settings);
+
+}  // namespace scanbench::modeling

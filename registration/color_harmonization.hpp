@@ -1,0 +1,112 @@
+// Colour harmonisation of registered scans (seed 004 §4.5): outdoor scans
+// are taken over hours under other exposures and white balances, so one
+// wall gets another colour in each scan. Corresponding points in the
+// overlaps (the same surface sampled by two scans) give colour pairs; a
+// robust least-squares problem (Ceres) solves for each scan's correction in
+// linear RGB, where exposure and white balance act as per-channel gains:
+//   gain-offset  rgb' = diag(g) · rgb + o   (6 parameters per scan)
+//   matrix       rgb' = M · rgb + o         (12: also cross-talk between channels)
+// The first scan is fixed (identity): the others are brought to it.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "registration/prepared_scan.hpp"
+
+namespace scanbench::registration {
+
+enum class ColorModel { kGainOffset, kMatrix };
+std::string_view color_model_name(ColorModel model);
+
+struct ColorPairSettings {
+  // Sample every stride-th pixel of every stride-th row of each scan,
+  // from row and column `phase` (a phase other than the fit's samples
+  // pixels the fit never saw: a held-out set).
+  int stride = 2;
+  int phase = 0;
+  // Same surface: the point lies within this distance plus two footprints
+  // of the other scan's point on its beam, and the normals (where both
+  // have one) agree within max_normal_angle_deg.
+  double max_distance_m = 0.02;
+  double max_normal_angle_deg = 25.0;
+  // Colours with a channel at or below `dark` or at or above `bright` (8-bit)
+  // are left out: clipped or lost in noise, they follow no gain.
+  int dark = 4;
+  int bright = 250;
+  // Only points whose colour differs from each of their 4 grid neighbours'
+  // by at most this much (8-bit, any channel) in both scans: on texture,
+  // shadow edges and object borders two scans' samples of "the same point"
+  // see different colours through their different footprints, which no
+  // correction should try to explain.
+  int max_local_step = 8;
+  // At most this many pairs per pair of scans, spread evenly over the
+  // candidates (0: all).
+  std::size_t max_pairs_per_overlap = 40000;
+  int threads = 0;  // 0 = all cores; results do not depend on it
+};
+
+// One corresponding point: its colour in two scans, linear RGB.
+struct ColorPair {
+  std::uint32_t scan_a = 0;
+  std::uint32_t scan_b = 0;
+  std::int64_t pixel_a = 0;  // row-major, in scan a
+  std::int64_t pixel_b = 0;
+  Eigen::Vector3f rgb_a = Eigen::Vector3f::Zero();
+  Eigen::Vector3f rgb_b = Eigen::Vector3f::Zero();
+};
+
+// Pairs of every two scans, scan a < scan b, found by projecting a's
+// sampled points into b's grid (registration/prepared_scan.hpp's
+// association). Deterministic for any thread count. Scans without colour
+// take part in none.
+std::vector<ColorPair> find_color_pairs(std::span<const PreparedScan> scans,
+                                        std::span<const Eigen::Isometry3d> T_world_scan,
+                                        const ColorPairSettings& settings);
+
+struct ColorCorrection {
+  Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  Eigen::Vector3d apply(const Eigen::Vector3d& rgb) const { return matrix * rgb + offset; }
+};
+
+struct HarmonizeSettings {
+  ColorModel model = ColorModel::kGainOffset;
+  // Cauchy loss scale on the residual, in cube-root units of linear RGB
+  // (the companding of L*: 0.01 there is about 1 ΔE at mid grey).
+  double loss_scale = 0.05;
+  // Weight of each scan's pull towards the identity, × √(its pairs): a
+  // gentle tie for scans the pairs constrain poorly.
+  double prior_weight = 0.002;
+  // Bounds: gains within [1 / max_gain_ratio, max_gain_ratio] (exposure 2
+  // stops either way), cross-talk of the matrix model within
+  // ±max_cross_talk, offsets within ±max_offset (linear RGB: flare and
+  // black level are small).
+  double max_gain_ratio = 4.0;
+  double max_cross_talk = 0.1;
+  double max_offset = 0.005;
+  int max_iterations = 100;
+  int threads = 0;
+};
+
+struct HarmonizeResult {
+  std::vector<ColorCorrection> corrections;  // one per scan; the first is the identity
+  // Per scan: linked to the first scan through pairs (else left at the identity).
+  std::vector<std::uint8_t> connected;
+  std::size_t pairs = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Solves the corrections of `scan_count` scans from `pairs` (residual: the
+// cube roots of both corrected colours, per channel, under a Cauchy loss).
+HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t scan_count,
+                                 const HarmonizeSettings& settings);
+
+}  // namespace scanbench::registration

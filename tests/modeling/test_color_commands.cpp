@@ -1,0 +1,273 @@
+// The colour commands on a project: an edit changes only its own object's
+// shown colours and never the scans', undo restores them bit for bit, edits
+// and corrections survive reopening, clones match their source, and
+// harmonize recovers gains applied to a copy of a scan.
+#include <gtest/gtest.h>
+
+#include "acquisition/color_space.hpp"
+#include "core/errors.hpp"
+#include "core/progress.hpp"
+#include "modeling/color_commands.hpp"
+#include "modeling/registration_stage.hpp"
+#include "modeling/render_model.hpp"
+#include "room_project.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::ScratchDir;
+
+// The room with its floor and the wall ahead as objects, both in the group
+// "room".
+struct RoomObjects {
+  std::int64_t scan = 0;
+  std::int64_t room = 0;
+  std::int64_t floor = 0;
+  std::int64_t wall = 0;
+};
+
+RoomObjects segment_room(Project& project) {
+  RoomObjects out;
+  out.scan = store_room(project);
+  out.room = group_nodes(project, {"room", std::nullopt, {}}).node_id;
+  select_region(project, select_at(out.scan, 0, -45));
+  out.floor = commit_selection(project, {out.scan, "floor", out.room}).node_id;
+  select_region(project, select_at(out.scan, -20, 0));
+  out.wall = commit_selection(project, {out.scan, "wall", out.room}).node_id;
+  return out;
+}
+
+RenderModel model_of(const Project& project) {
+  RenderModelSettings settings;
+  settings.merged_only = false;
+  return build_render_model(project, settings);
+}
+
+// The render model's colours point by point, in its order (the same
+// project state gives the same order).
+using Colours = std::vector<std::array<std::uint8_t, 4>>;
+
+Eigen::Vector3d mean_lab(const RenderModel& model, std::uint32_t node) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < model.points.size(); ++k) {
+    if (model.points.node[k] != node) continue;
+    const auto& c = model.points.rgba[k];
+    sum += acquisition::srgb_to_lab({c[0], c[1], c[2]});
+    ++n;
+  }
+  return sum / static_cast<double>(std::max<std::size_t>(n, 1));
+}
+
+TEST(Recolor, AnEditChangesOnlyItsObjectAndUndoRestoresItBitExactly) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const RoomObjects room = segment_room(project);
+  const RenderModel before = model_of(project);
+  const acquisition::Scan scan_before = project.load_scan(room.scan);
+
+  RecolorSettings settings;
+  settings.node = room.wall;
+  settings.set.hue_deg = 120.0;
+  settings.set.brightness = -10.0;
+  recolor_object(project, settings);
+  const RenderModel after = model_of(project);
+  ASSERT_EQ(after.points.size(), before.points.size());
+  std::size_t changed = 0, wall = 0;
+  for (std::size_t k = 0; k < after.points.size(); ++k) {
+    const bool on_wall = after.points.node[k] == static_cast<std::uint32_t>(room.wall);
+    wall += on_wall;
+    if (on_wall) {
+      changed += after.points.rgba[k] != before.points.rgba[k];
+    } else {
+      EXPECT_EQ(after.points.rgba[k], before.points.rgba[k]) << "point " << k;
+    }
+  }
+  EXPECT_GT(wall, 1000u);
+  EXPECT_EQ(changed, wall);
+  EXPECT_NEAR(mean_lab(after, room.wall).x(), mean_lab(before, room.wall).x() - 10.0, 0.5);
+  test::expect_identical(project.load_scan(room.scan), scan_before);  // the scan never changes
+
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(model_of(project).points.rgba, before.points.rgba);
+  ASSERT_TRUE(project.redo().has_value());
+  EXPECT_EQ(model_of(project).points.rgba, after.points.rgba);
+}
+
+TEST(Recolor, AGroupsEditReachesChildrenThatDoNotOverrideIt) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const RoomObjects room = segment_room(project);
+  const RenderModel before = model_of(project);
+  RecolorSettings group;
+  group.node = room.room;
+  group.set.brightness = 10.0;
+  recolor_object(project, group);
+  RecolorSettings floor;
+  floor.node = room.floor;
+  floor.set.brightness = 0.0;  // the floor keeps its lightness
+  recolor_object(project, floor);
+  const RenderModel after = model_of(project);
+  const auto wall = static_cast<std::uint32_t>(room.wall);
+  const auto floor_id = static_cast<std::uint32_t>(room.floor);
+  EXPECT_NEAR(mean_lab(after, wall).x(), mean_lab(before, wall).x() + 10.0, 0.5);
+  EXPECT_NEAR(mean_lab(after, floor_id).x(), mean_lab(before, floor_id).x(), 0.5);
+  // --reset: the floor inherits the group's brightness again.
+  RecolorSettings reset;
+  reset.node = room.floor;
+  reset.reset = true;
+  recolor_object(project, reset);
+  EXPECT_NEAR(mean_lab(model_of(project), floor_id).x(), mean_lab(before, floor_id).x() + 10.0,
+              0.5);
+}
+
+TEST(Recolor, EditsSurviveReopeningTheProject) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  Colours shown;
+  ColorEdit expected;
+  {
+    Project project = Project::create(file);
+    const RoomObjects room = segment_room(project);
+    RecolorSettings settings;
+    settings.node = room.wall;
+    settings.set.saturation = 0.3;
+    settings.set.gamma = 1.4;
+    recolor_object(project, settings);
+    expected.saturation = 0.3;
+    expected.gamma = 1.4;
+    shown = model_of(project).points.rgba;
+  }
+  Project project = Project::open(file);
+  EXPECT_EQ(project.object_nodes().back().color, expected);
+  EXPECT_EQ(model_of(project).points.rgba, shown);
+  EXPECT_TRUE(project.check().damage.empty());
+}
+
+TEST(Recolor, BadRequestsAreRefusedAndChangeNothing) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const RoomObjects room = segment_room(project);
+  const std::int64_t revision = project.revision();
+  RecolorSettings missing;
+  missing.node = 99;
+  missing.set.brightness = 5.0;
+  EXPECT_THROW(recolor_object(project, missing), core::InputError);
+  RecolorSettings too_bright;
+  too_bright.node = room.wall;
+  too_bright.set.brightness = 250.0;
+  EXPECT_THROW(recolor_object(project, too_bright), core::InputError);
+  CloneSettings two_sources;
+  two_sources.target = room.wall;
+  two_sources.source_node = room.floor;
+  two_sources.source_color = std::array<std::uint8_t, 3>{1, 2, 3};
+  EXPECT_THROW(clone_color(project, two_sources), core::InputError);
+  CloneSettings outside;
+  outside.target = room.wall;
+  outside.source_region = PixelRect{room.scan, 0, 5, 700, 800};
+  EXPECT_THROW(clone_color(project, outside), core::InputError);
+  CloneSettings into_itself;
+  into_itself.target = room.room;
+  into_itself.source_node = room.wall;
+  EXPECT_THROW(clone_color(project, into_itself), core::InputError);
+  EXPECT_EQ(project.revision(), revision);
+}
+
+TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  const RoomObjects room = segment_room(project);
+  RecolorSettings warm;
+  warm.node = room.floor;
+  warm.set.hue_deg = 40.0;
+  warm.set.saturation = 3.0;
+  recolor_object(project, warm);
+  CloneSettings clone;
+  clone.target = room.wall;
+  clone.source_node = room.floor;
+  const CloneResult out = clone_color(project, clone);
+  EXPECT_GT(out.source_points, 1000u);
+  EXPECT_GT(out.target_points, 1000u);
+  const RenderModel model = model_of(project);
+  const Eigen::Vector3d floor = mean_lab(model, static_cast<std::uint32_t>(room.floor));
+  const Eigen::Vector3d wall = mean_lab(model, static_cast<std::uint32_t>(room.wall));
+  EXPECT_LT(acquisition::delta_e(floor, wall), 1.0) << floor.transpose() << " / "
+                                                      << wall.transpose();
+  // Painting one colour (its lightness detail kept: what leaves the sRGB
+  // gamut is clipped, so the mean lands within a little of the paint).
+  CloneSettings paint;
+  paint.target = room.wall;
+  paint.source_color = std::array<std::uint8_t, 3>{30, 120, 60};
+  clone_color(project, paint);
+  const Eigen::Vector3d green = acquisition::srgb_to_lab({30, 120, 60});
+  EXPECT_LT(acquisition::delta_e(mean_lab(model_of(project), static_cast<std::uint32_t>(room.wall)),
+                                 green),
+            2.0);
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(model_of(project).points.rgba, model.points.rgba);
+}
+
+// The room scanned twice from the same place, the second copy's colours
+// through gains in linear RGB: harmonising must find their inverse.
+TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  const Eigen::Vector3d gains(1.25, 0.9, 1.1);
+  Colours first_scan;
+  {
+    Project project = Project::create(file);
+    store_room(project);
+    first_scan = model_of(project).points.rgba;
+    test::RoomScan copy = test::shared_room();
+    for (std::size_t i = 0; i < copy.scan.pixel_count(); ++i) {
+      for (std::size_t c = 0; c < 3; ++c) {
+        copy.scan.rgb[3 * i + c] = acquisition::linear_to_srgb(
+            gains[static_cast<int>(c)] * acquisition::srgb_to_linear(copy.scan.rgb[3 * i + c]));
+      }
+    }
+    const std::int64_t second = test::insert_committed(project, copy.scan);
+    Project::Edit edit = project.begin_command("geometry", "{}");
+    for (const EncodedLayer& layer : encode_geometry(copy.geometry))
+      project.put_layer(edit, second, layer);
+    edit.commit("{}");
+
+    core::Progress quiet;
+    const HarmonizeStageResult out = harmonize_project(project, {}, quiet);
+    ASSERT_EQ(out.scans.size(), 2u);
+    EXPECT_TRUE(out.scans[1].connected);
+    EXPECT_GT(out.pairs, 1000u);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(out.scans[1].correction.matrix(c, c) * gains[c], 1.0, 0.01) << "channel " << c;
+      EXPECT_NEAR(out.scans[1].correction.offset[c], 0.0, 0.002);
+    }
+    EXPECT_GT(out.delta_e_before, 3.0);
+    EXPECT_LT(out.delta_e_after, 0.5);
+  }
+  Project project = Project::open(file);
+  const std::map<std::int64_t, ScanColorCorrection> stored = project.scan_color_corrections();
+  ASSERT_EQ(stored.size(), 2u);
+  EXPECT_TRUE(stored.begin()->second.identity());
+  // The copy now shows the first scan's colours.
+  const RenderModel model = model_of(project);
+  ASSERT_EQ(model.points.size(), 2 * first_scan.size());
+  std::size_t off = 0;
+  for (std::size_t k = 0; k < model.points.size(); ++k) {
+    const auto& c = model.points.rgba[k];
+    const Eigen::Vector3d lab = acquisition::srgb_to_lab({c[0], c[1], c[2]});
+    double nearest = 1e9;
+    for (const auto& f : {std::array<std::uint8_t, 3>{120, 120, 120},
+                          std::array<std::uint8_t, 3>{40, 60, 90},
+                          std::array<std::uint8_t, 3>{200, 30, 30},
+                          std::array<std::uint8_t, 3>{200, 200, 190}})
+      nearest = std::min(nearest, acquisition::delta_e(lab, acquisition::srgb_to_lab(f)));
+    off += nearest > 1.5;
+  }
+  EXPECT_EQ(off, 0u);
+  EXPECT_TRUE(project.check().damage.empty());
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_TRUE(project.scan_color_corrections().empty());
+}
+
+}  // namespace
+}  // namespace scanbench::modeling

@@ -1,0 +1,92 @@
+// The colour harmonisation solver on synthetic pairs: known gains and
+// offsets come back with outliers among the pairs, the first scan stays
+// fixed, and a scan no chain of pairs reaches is left alone.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "registration/color_harmonization.hpp"
+
+namespace scanbench::registration {
+namespace {
+
+struct Truth {
+  Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+};
+
+// Pairs among `truth.size()` scans (each scan's colour is truth⁻¹ of the
+// surface's, so the correction `truth` brings it back), a share of them
+// outliers (unrelated colours: a shadow in one scan, a wrong match).
+std::vector<ColorPair> synthetic_pairs(const std::vector<Truth>& truth, double outliers,
+                                       std::uint32_t skip_scan = 99) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(0.03, 0.7);
+  std::uniform_real_distribution<double> coin(0.0, 1.0);
+  std::vector<ColorPair> pairs;
+  for (std::uint32_t a = 0; a < truth.size(); ++a) {
+    for (std::uint32_t b = a + 1; b < truth.size(); ++b) {
+      if (a == skip_scan || b == skip_scan) continue;
+      for (int k = 0; k < 3000; ++k) {
+        const Eigen::Vector3d surface(unit(random), unit(random), unit(random));
+        const auto seen = [&](std::uint32_t s) {
+          return Eigen::Vector3d(truth[s].matrix.inverse() * (surface - truth[s].offset))
+              .cast<float>()
+              .eval();
+        };
+        ColorPair pair{a, b, 0, 0, seen(a), seen(b)};
+        if (coin(random) < outliers)
+          pair.rgb_b = Eigen::Vector3d(unit(random), unit(random), unit(random)).cast<float>();
+        pairs.push_back(pair);
+      }
+    }
+  }
+  return pairs;
+}
+
+TEST(ColorHarmonization, GainsAndOffsetsComeBackDespiteOutliers) {
+  std::vector<Truth> truth(3);
+  truth[1].matrix.diagonal() << 1.3, 0.85, 1.1;
+  truth[1].offset << 0.004, -0.002, 0.0;
+  truth[2].matrix.diagonal() << 0.7, 0.75, 0.9;
+  const std::vector<ColorPair> pairs = synthetic_pairs(truth, 0.2);
+  const HarmonizeResult out = harmonize_colors(pairs, 3, {});
+  EXPECT_EQ(out.pairs, pairs.size());
+  EXPECT_TRUE(out.corrections[0].matrix.isIdentity());
+  for (std::size_t s = 1; s < 3; ++s) {
+    EXPECT_TRUE(out.connected[s]);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(out.corrections[s].matrix(c, c), truth[s].matrix(c, c), 0.01) << s << "," << c;
+      EXPECT_NEAR(out.corrections[s].offset[c], truth[s].offset[c], 0.002) << s << "," << c;
+    }
+  }
+}
+
+TEST(ColorHarmonization, TheMatrixModelFindsCrossTalk) {
+  std::vector<Truth> truth(2);
+  truth[1].matrix << 1.1, 0.05, 0.0,  //
+      0.0, 0.95, 0.04,                //
+      -0.03, 0.0, 1.2;
+  const std::vector<ColorPair> pairs = synthetic_pairs(truth, 0.1);
+  HarmonizeSettings settings;
+  settings.model = ColorModel::kMatrix;
+  const HarmonizeResult out = harmonize_colors(pairs, 2, settings);
+  EXPECT_LT((out.corrections[1].matrix - truth[1].matrix).cwiseAbs().maxCoeff(), 0.01)
+      << out.corrections[1].matrix;
+  EXPECT_LT(out.corrections[1].offset.cwiseAbs().maxCoeff(), 0.002);
+}
+
+TEST(ColorHarmonization, AScanWithoutOverlapsIsLeftAlone) {
+  std::vector<Truth> truth(3);
+  truth[1].matrix.diagonal() << 1.2, 1.2, 1.2;
+  truth[2].matrix.diagonal() << 0.5, 0.5, 0.5;
+  const HarmonizeResult out = harmonize_colors(synthetic_pairs(truth, 0.0, 2), 3, {});
+  EXPECT_TRUE(out.connected[1]);
+  EXPECT_FALSE(out.connected[2]);
+  EXPECT_TRUE(out.corrections[2].matrix.isIdentity());
+  EXPECT_NEAR(out.corrections[1].matrix(0, 0), 1.2, 0.005);
+  EXPECT_TRUE(harmonize_colors({}, 1, {}).corrections[0].matrix.isIdentity());
+}
+
+}  // namespace
+}  // namespace scanbench::registration
