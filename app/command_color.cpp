@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "app/progress_bar.hpp"
@@ -20,16 +21,31 @@ namespace {
 
 struct RecolorOptions {
   std::string project;
-  std::optional<std::int64_t> object;
+  std::string object;  // an id or a unique name
   modeling::ColorEdit set;
   bool reset = false;
-  std::optional<std::int64_t> target;
-  std::optional<std::int64_t> clone;
+  std::string target;
+  std::string clone;
   std::string clone_region;
   std::string paint_color;
   bool paint = false;
   bool json = false;
 };
+
+// A node named by its id or by its name (which must be unique).
+std::int64_t node_named(const modeling::Project& project, const std::string& option,
+                        const std::string& text) {
+  std::int64_t id = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), id);
+  if (error == std::errc() && end == text.data() + text.size()) return id;
+  std::vector<std::int64_t> found;
+  for (const modeling::ObjectNode& node : project.object_nodes())
+    if (node.name == text) found.push_back(node.id);
+  if (found.size() == 1) return found.front();
+  throw CLI::ValidationError(option, found.empty() ? "no node is named \"" + text + "\""
+                                                   : "several nodes are named \"" + text +
+                                                         "\": give the id");
+}
 
 // "SCAN:ROW0:COL0:ROW1:COL1".
 modeling::PixelRect parse_region(const std::string& text) {
@@ -65,11 +81,11 @@ void print_edit(const modeling::ObjectNode& node) {
 }
 
 void run_recolor(const RecolorOptions& options) {
-  const bool editing = options.object.has_value();
-  const bool cloning = options.target.has_value();
+  const bool editing = !options.object.empty();
+  const bool cloning = !options.target.empty();
   if (editing == cloning)
     throw CLI::ValidationError("recolor", "give --object ID (an edit) or --to ID (a clone)");
-  const bool sources = options.clone || !options.clone_region.empty() ||
+  const bool sources = !options.clone.empty() || !options.clone_region.empty() ||
                        !options.paint_color.empty() || options.paint;
   if (editing && sources)
     throw CLI::ValidationError("--object", "edits an object; a clone names its target with --to");
@@ -83,12 +99,13 @@ void run_recolor(const RecolorOptions& options) {
       throw CLI::ValidationError("--object", "give at least one of --brightness, --contrast, "
                                              "--gamma, --hue, --saturation or --reset");
     const modeling::NodeCommandResult out =
-        modeling::recolor_object(project, {*options.object, options.set, options.reset});
+        modeling::recolor_object(project, {node_named(project, "--object", options.object),
+                                           options.set, options.reset});
     node_id = out.node_id;
   } else {
     modeling::CloneSettings settings;
-    settings.target = *options.target;
-    settings.source_node = options.clone;
+    settings.target = node_named(project, "--to", options.target);
+    if (!options.clone.empty()) settings.source_node = node_named(project, "--clone", options.clone);
     if (!options.clone_region.empty()) settings.source_region = parse_region(options.clone_region);
     if (!options.paint_color.empty()) settings.source_color = parse_color(options.paint_color);
     settings.paint = options.paint;
@@ -157,7 +174,7 @@ void add_recolor_command(CLI::App& app) {
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--object", options->object, "The node to edit");
+  command->add_option("--object", options->object, "The node to edit (id or unique name)");
   command->add_option("--brightness", options->set.brightness, "Added to L* (-100…100)");
   command->add_option("--contrast", options->set.contrast, "L* scaled about 50 (1: none)");
   command->add_option("--gamma", options->set.gamma, "L*/100 raised to 1/gamma (1: none)");
@@ -165,8 +182,10 @@ void add_recolor_command(CLI::App& app) {
   command->add_option("--saturation", options->set.saturation, "Chroma × this (1: none)");
   command->add_flag("--reset", options->reset,
                     "Drop the node's own parameters first (it inherits them again)");
-  command->add_option("--to", options->target, "The node whose colours a clone changes");
-  command->add_option("--clone", options->clone, "Clone from this node's colours as shown");
+  command->add_option("--to", options->target,
+                      "The node whose colours a clone changes (id or unique name)");
+  command->add_option("--clone", options->clone,
+                      "Clone from this node's colours as shown (id or unique name)");
   command->add_option("--clone-region", options->clone_region,
                       "Clone from a region of a scan: SCAN:ROW0:COL0:ROW1:COL1 (ends excluded)");
   command->add_option("--paint-color", options->paint_color,

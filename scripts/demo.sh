@@ -12,8 +12,11 @@
 #             doors, a roof, a sign; trees → crowns, trunks) from the clicks,
 #             lassos and channels in scripts/campus_segment.json
 #   history   the journal of those commands; undo and redo of the merge
+#   harmonize one colour correction per scan (exposure and white balance) so
+#             the same wall looks the same from every scan
 #   render    the merged model as splats (headless OpenGL) from three cameras,
 #             beside the simulator's truth pictures (out/demo/render/)
+#   recolor   the trees recoloured through their group, rendered, and undone
 #   info      table and JSON
 #   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as PLY
 #   bench     raw-scan I/O throughput against PCL's reader
@@ -62,11 +65,18 @@ phase "history"
 "$scanbench" undo "$project"
 "$scanbench" redo "$project"
 
+phase "harmonize"
+# Each scan was taken under its own sun, exposure and white balance; the
+# street view before harmonising, then one correction per scan.
+mkdir -p "$out/render"
+"$scanbench" render "$project" --view "$root/scripts/views/campus_street.json" \
+  -o "$out/render/street_unharmonized.png"
+"$scanbench" harmonize "$project"
+
 phase "render"
 # The merged model as blended splats from the three cameras of
 # `bench render` (scripts/views), beside the simulator's truth pictures; the
 # close-up also as raw points, and the street coloured by object.
-mkdir -p "$out/render"
 for view in closeup street overview; do
   "$scanbench" simulate --site campus --seed 1 --render-view "$root/scripts/views/campus_$view.json" \
     -o "$out/render/${view}_truth.png"
@@ -77,6 +87,18 @@ done
   -o "$out/render/closeup_points.png"
 "$scanbench" render "$project" --view "$root/scripts/views/campus_street.json" --color object \
   --lighting -o "$out/render/street_objects.png" --json
+
+phase "recolor"
+# Non-destructive edits of objects (the scans keep their colours): the trees
+# group turned autumnal (its crowns and trunks inherit the edit), tree 1's
+# trunk keeping its own hue; rendered, then both undone.
+"$scanbench" recolor "$project" --object trees --hue -55 --saturation 1.6 --brightness 4
+"$scanbench" recolor "$project" --object "tree 1 trunk" --hue 0 --saturation 1
+"$scanbench" objects "$project"
+"$scanbench" render "$project" --view "$root/scripts/views/campus_street.json" \
+  -o "$out/render/street_recolored.png"
+"$scanbench" undo "$project"
+"$scanbench" undo "$project"
 
 phase "info"
 "$scanbench" info "$project"

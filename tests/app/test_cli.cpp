@@ -152,7 +152,7 @@ TEST(Cli, RecolorEditsAnObjectUndoablyAndRefusesWhatItCannotDo) {
     {"op": "grow", "seed": [0, 0], "channel": "range", "tolerance": 50},
     {"op": "commit", "name": "wall", "parent": "site"}]})json");
   ASSERT_EQ(run_cli(dir, {"segment", project.string(), "--script", script.string()}).exit_code, 0);
-  const CliResult edited = run_cli(dir, {"recolor", project.string(), "--object", "2",
+  const CliResult edited = run_cli(dir, {"recolor", project.string(), "--object", "wall",
                                          "--brightness", "12.5", "--hue", "30", "--json"});
   ASSERT_EQ(edited.exit_code, 0) << edited.err;
   const nlohmann::json color = nlohmann::json::parse(edited.out)["color"];
@@ -168,6 +168,7 @@ TEST(Cli, RecolorEditsAnObjectUndoablyAndRefusesWhatItCannotDo) {
   // clone without a source, a scan without colour: exit 2, nothing written.
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--object", "99", "--brightness", "1"},
+        {"--object", "no such wall", "--brightness", "1"},
         {"--object", "2", "--contrast", "-1"},
         {"--object", "2", "--brightness", "1", "--clone", "1"},
         {"--to", "2"},
