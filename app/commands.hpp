@@ -28,5 +28,6 @@ void add_segment_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_recolor_command(CLI::App& app);
 void add_harmonize_command(CLI::App& app);
+void add_workbench_command(CLI::App& app);
 
 }  // namespace scanbench::app

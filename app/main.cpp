@@ -74,6 +74,7 @@ int main(int argc, char** argv) {
   sb::add_segment_command(app);
   sb::add_recolor_command(app);
   sb::add_render_command(app);
+  sb::add_workbench_command(app);
   sb::add_objects_command(app);
   sb::add_check_command(app);
   sb::add_simulate_command(app);

@@ -20,6 +20,9 @@ class RenderDevice {
   virtual std::string describe() = 0;
 };
 
+// describe() of the context current on the calling thread.
+std::string describe_current_context();
+
 // A context without any surface, on EGL's surfaceless platform (Mesa;
 // llvmpipe on machines without a GPU), made current on return. Throws
 // core::RuntimeFailure naming what is missing (EGL, the platform, a 4.5

@@ -71,13 +71,7 @@ class HeadlessDevice final : public RenderDevice {
 
   std::string describe() override {
     make_current();
-    const auto text = [](GLenum name) {
-      const auto* value = reinterpret_cast<const char*>(glGetString(name));
-      return std::string(value != nullptr ? value : "unknown");
-    };
-    std::string out = "OpenGL ";
-    out.append(text(GL_VERSION)).append(" | ").append(text(GL_RENDERER));
-    return out;
+    return describe_current_context();
   }
 
  private:

@@ -248,6 +248,15 @@ FrameResult SplatRenderer::draw(const RenderView& picture_view, const RenderSett
   return result;
 }
 
+SplatRenderer::PictureTexture SplatRenderer::picture_texture() const {
+  assert(picture_width_ > 0 && "picture_texture before the first draw");
+  const auto w = static_cast<float>(gpu_->width), h = static_cast<float>(gpu_->height);
+  const auto band = static_cast<float>(kGuardBandPixels);
+  return {gpu_->picture.get(),
+          {band / w, band / h, (band + static_cast<float>(picture_width_)) / w,
+           (band + static_cast<float>(picture_height_)) / h}};
+}
+
 RenderedImage SplatRenderer::read_image() const {
   assert(picture_width_ > 0 && "read_image before the first draw");
   RenderedImage image;

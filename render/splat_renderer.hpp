@@ -96,6 +96,16 @@ class SplatRenderer {
   // The last frame, without its guard band. Asserts that a frame was drawn.
   RenderedImage read_image() const;
 
+  // The last frame on the device, for a window to show without reading it
+  // back: the OpenGL name of its RGBA8 texture (bottom row first) and the
+  // picture's rectangle in it, without the guard band, as texture
+  // coordinates (u0, v0, u1, v1). Asserts that a frame was drawn.
+  struct PictureTexture {
+    unsigned texture = 0;
+    std::array<float, 4> uv{};
+  };
+  PictureTexture picture_texture() const;
+
  private:
   // Pixels drawn beyond each edge of the picture (render_view.hpp): half
   // the widest sprite GL draws (255 pixels), so no splat that reaches into

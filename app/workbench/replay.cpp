@@ -1,0 +1,214 @@
+#include "app/workbench/replay.hpp"
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "render/window/window_device.hpp"
+
+namespace scanbench::app::workbench {
+
+namespace {
+
+using Kind = ReplayEvent::Kind;
+using nlohmann::json;
+
+struct Reader {
+  std::filesystem::path file;
+  std::string where;
+
+  [[noreturn]] void refuse(const std::string& problem) const {
+    core::FilePosition position;
+    position.detail = where;
+    throw core::InputError(file.string(), position, problem);
+  }
+
+  std::array<double, 2> point(const json& j) const {
+    if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
+      refuse("expected a point [x, y] in window pixels");
+    return {j[0].get<double>(), j[1].get<double>()};
+  }
+
+  int button(const json& j) const {
+    static const std::map<std::string, int> names = {{"left", 0}, {"right", 1}, {"middle", 2}};
+    if (!j.is_string() || !names.count(j.get<std::string>()))
+      refuse("a button is \"left\", \"right\" or \"middle\"");
+    return names.at(j.get<std::string>());
+  }
+
+  int key(const json& j) const {
+    namespace k = render::keys;
+    static const std::map<std::string, int> names = {
+        {"Enter", k::kEnter}, {"Escape", k::kEscape}, {"Tab", k::kTab},
+        {"Backspace", k::kBackspace}, {"Delete", k::kDelete}, {"Left", k::kLeft},
+        {"Right", k::kRight}, {"Up", k::kUp}, {"Down", k::kDown}, {"Home", k::kHome},
+        {"End", k::kEnd}, {"Space", k::kSpace}};
+    if (!j.is_string()) refuse("a key is a name such as \"Z\" or \"Enter\"");
+    const std::string name = j.get<std::string>();
+    if (name.size() == 1 && ((name[0] >= 'A' && name[0] <= 'Z') || (name[0] >= '0' && name[0] <= '9')))
+      return name[0];
+    if (!names.count(name)) refuse("unknown key \"" + name + "\"");
+    return names.at(name);
+  }
+
+  int mods(const json& event) const {
+    if (!event.contains("mods")) return 0;
+    if (!event["mods"].is_array()) refuse("mods is a list of \"ctrl\", \"shift\", \"alt\"");
+    int out = 0;
+    for (const json& m : event["mods"]) {
+      const std::string name = m.is_string() ? m.get<std::string>() : "";
+      if (name == "ctrl") {
+        out |= render::keys::kModControl;
+      } else if (name == "shift") {
+        out |= render::keys::kModShift;
+      } else if (name == "alt") {
+        out |= render::keys::kModAlt;
+      } else {
+        refuse("mods is a list of \"ctrl\", \"shift\", \"alt\"");
+      }
+    }
+    return out;
+  }
+
+  int count(const json& j, const char* what) const {
+    if (!j.is_number_integer() || j.get<int>() < 0 || j.get<int>() > 100000)
+      refuse(std::string(what) + " must be a whole number from 0 to 100000");
+    return j.get<int>();
+  }
+};
+
+void add_key(std::vector<ReplayEvent>& out, int key, bool pressed, int mods) {
+  ReplayEvent e;
+  e.kind = Kind::kKey;
+  e.key = key;
+  e.pressed = pressed;
+  e.mods = mods;
+  out.push_back(e);
+}
+
+void add_button(std::vector<ReplayEvent>& out, int button, bool pressed, int mods) {
+  ReplayEvent e;
+  e.kind = Kind::kButton;
+  e.button = button;
+  e.pressed = pressed;
+  e.mods = mods;
+  out.push_back(e);
+}
+
+void add_move(std::vector<ReplayEvent>& out, double x, double y) {
+  ReplayEvent e;
+  e.kind = Kind::kMove;
+  e.x = x;
+  e.y = y;
+  out.push_back(e);
+}
+
+void add_waits(std::vector<ReplayEvent>& out, int frames) {
+  for (int k = 0; k < frames; ++k) out.push_back(ReplayEvent{});
+}
+
+// UTF-8 to code points (ASCII and 2–4 byte sequences).
+std::vector<unsigned> codepoints(const std::string& text, const Reader& reader) {
+  std::vector<unsigned> out;
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const int length = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
+    if (length == 0 || i + static_cast<std::size_t>(length) > text.size())
+      reader.refuse("text is not valid UTF-8");
+    unsigned value = length == 1 ? c : c & (0xFFu >> (length + 1));
+    for (int k = 1; k < length; ++k)
+      value = (value << 6) | (static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]) & 0x3Fu);
+    out.push_back(value);
+    i += static_cast<std::size_t>(length);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  Reader reader{file, ""};
+  if (!in) reader.refuse("cannot read the file");
+  const json root = json::parse(in, nullptr, false);
+  if (root.is_discarded()) reader.refuse("not valid JSON");
+  if (!root.is_object() || !root.contains("events") || !root["events"].is_array())
+    reader.refuse("expected {\"events\": [...]}");
+  std::vector<ReplayEvent> out;
+  const json& events = root["events"];
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    reader.where = "events[" + std::to_string(k) + "]";
+    const json& e = events[k];
+    if (!e.is_object() || e.empty()) reader.refuse("an event is an object such as {\"key\": \"Z\"}");
+    const int mods = reader.mods(e);
+    if (e.contains("move")) {
+      const auto [x, y] = reader.point(e["move"]);
+      add_move(out, x, y);
+    } else if (e.contains("press") || e.contains("release")) {
+      const bool press = e.contains("press");
+      add_button(out, reader.button(press ? e["press"] : e["release"]), press, mods);
+    } else if (e.contains("click")) {
+      const auto [x, y] = reader.point(e["click"]);
+      const int button = e.contains("button") ? reader.button(e["button"]) : 0;
+      add_move(out, x, y);
+      add_button(out, button, true, mods);
+      add_button(out, button, false, mods);
+    } else if (e.contains("drag")) {
+      if (!e["drag"].is_array() || e["drag"].size() != 2) reader.refuse("drag is [[x0, y0], [x1, y1]]");
+      const auto [x0, y0] = reader.point(e["drag"][0]);
+      const auto [x1, y1] = reader.point(e["drag"][1]);
+      const int button = e.contains("button") ? reader.button(e["button"]) : 0;
+      const int steps = std::max(1, e.contains("steps") ? reader.count(e["steps"], "steps") : 10);
+      add_move(out, x0, y0);
+      add_button(out, button, true, mods);
+      for (int s = 1; s <= steps; ++s) {
+        const double t = static_cast<double>(s) / steps;
+        add_move(out, x0 + t * (x1 - x0), y0 + t * (y1 - y0));
+      }
+      add_button(out, button, false, mods);
+    } else if (e.contains("scroll")) {
+      if (!e["scroll"].is_number()) reader.refuse("scroll is a number of wheel steps");
+      if (e.contains("at")) {
+        const auto [x, y] = reader.point(e["at"]);
+        add_move(out, x, y);
+      }
+      ReplayEvent s;
+      s.kind = Kind::kScroll;
+      s.scroll = e["scroll"].get<double>();
+      out.push_back(s);
+    } else if (e.contains("key")) {
+      const int key = reader.key(e["key"]);
+      add_key(out, key, true, mods);
+      add_key(out, key, false, mods);
+    } else if (e.contains("hold")) {
+      const int key = reader.key(e["hold"]);
+      add_key(out, key, true, mods);
+      add_waits(out, e.contains("frames") ? reader.count(e["frames"], "frames") : 10);
+      add_key(out, key, false, mods);
+    } else if (e.contains("text")) {
+      if (!e["text"].is_string()) reader.refuse("text is a string");
+      for (const unsigned c : codepoints(e["text"].get<std::string>(), reader)) {
+        ReplayEvent t;
+        t.kind = Kind::kText;
+        t.codepoint = c;
+        out.push_back(t);
+      }
+    } else if (e.contains("wait")) {
+      add_waits(out, reader.count(e["wait"], "wait"));
+    } else if (e.contains("screenshot")) {
+      if (!e["screenshot"].is_string() || e["screenshot"].get<std::string>().empty())
+        reader.refuse("screenshot names a .png file");
+      ReplayEvent s;
+      s.kind = Kind::kScreenshot;
+      s.file = std::filesystem::path(e["screenshot"].get<std::string>());
+      if (s.file.is_relative()) s.file = file.parent_path() / s.file;
+      out.push_back(s);
+    } else {
+      reader.refuse("unknown event: " + e.begin().key());
+    }
+  }
+  return out;
+}
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,115 @@
+// The workbench's state apart from its window: the open project, the scan in
+// the panoramic view with its layers, the tools (seed, lasso, barrier), and
+// the actions, each through the same commands the CLI's segment script and
+// recolor issue (modeling/segment_commands.hpp, modeling/color_commands.hpp),
+// so every action is one journal entry that Ctrl+Z takes back. No ImGui here.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "acquisition/scan.hpp"
+#include "modeling/color_commands.hpp"
+#include "modeling/project.hpp"
+#include "modeling/render_model.hpp"
+#include "modeling/segment_commands.hpp"
+#include "segmentation/constraints.hpp"
+#include "segmentation/segmentation_grid.hpp"
+
+namespace scanbench::app::workbench {
+
+enum class Tool { kSeed, kLasso, kBarrier };
+enum class PanoramaChannel { kColor, kRange, kIntensity, kNormal };
+
+// An RGBA8 picture, top row first.
+struct Picture {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;
+};
+
+class Session {
+ public:
+  // Opens the project (Project::open: throws as it does) and its first scan.
+  explicit Session(const std::filesystem::path& project);
+
+  modeling::Project& project() { return project_; }
+  const std::vector<modeling::StoredScanSummary>& scans() const { return scans_; }
+  std::int64_t scan_id() const { return scan_id_; }
+  const acquisition::Scan& scan() const { return scan_; }
+  void open_scan(std::int64_t id);
+
+  // ---- Tools (image coordinates: x = column, y = row) -------------------
+  Tool tool = Tool::kSeed;
+  segmentation::Channel channel = segmentation::Channel::kNormal;
+  double tolerance = segmentation::default_grow_settings(segmentation::Channel::kNormal).tolerance;
+  modeling::SelectMode mode = modeling::SelectMode::kReplace;
+  const segmentation::Polyline& lasso() const { return lasso_; }
+  bool lasso_closed() const { return lasso_closed_; }
+  const std::vector<segmentation::Polyline>& barriers() const { return barriers_; }
+  // A click of the current tool at (x, y): a seed grows a region, a lasso
+  // or barrier gets a vertex.
+  void click(double x, double y);
+  // Closes the lasso (≥ 3 vertices) or ends the barrier being drawn.
+  void finish_polyline();
+  void clear_constraints();
+  std::size_t selected_pixels() const { return selected_; }
+
+  // ---- Commands: each one journal entry; false (and status()) when refused
+  bool commit(const std::string& name, std::optional<std::int64_t> parent);
+  bool group(const std::string& name, const std::vector<std::int64_t>& children);
+  bool rename(std::int64_t node, const std::string& name);
+  bool set_hidden(std::int64_t node, bool hidden);
+  bool reparent(std::int64_t node, std::optional<std::int64_t> parent);
+  bool remove(std::int64_t node);
+  bool separate(std::int64_t node);
+  bool propose();
+  bool recolor(std::int64_t node, const modeling::ColorEdit& set, bool reset);
+  bool clone(std::int64_t source, std::int64_t target);
+  bool undo();
+  bool redo();
+
+  const std::vector<modeling::ObjectNode>& nodes() const { return nodes_; }
+  // What the last action did or why it was refused.
+  const std::string& status() const { return status_; }
+  // Changes with every change of the project the views show.
+  std::int64_t revision() const { return revision_; }
+
+  // The scan's channel with the objects and the selection laid over it.
+  Picture panorama(PanoramaChannel channel) const;
+  // The model as the 3D view draws it, rebuilt after changes to it (not
+  // after a selection, which it does not show).
+  const modeling::RenderModel& render_model();
+  bool render_model_stale() const { return !model_ || model_revision_ != model_changes_; }
+
+ private:
+  // Runs a command; a refusal becomes status() and false. After it, the
+  // layers and the tree are read again.
+  template <typename Action>
+  bool act(const std::string& what, Action&& action, bool changes_model = true);
+  void reload();
+
+  modeling::Project project_;
+  std::vector<modeling::StoredScanSummary> scans_;
+  std::int64_t scan_id_ = 0;
+  acquisition::Scan scan_;
+  std::vector<Eigen::Vector3f> normal_;     // scan frame; zero where none
+  std::vector<std::uint32_t> membership_;   // empty: none
+  std::vector<std::uint8_t> selection_;     // empty: none
+  std::size_t selected_ = 0;
+  segmentation::Polyline lasso_;
+  bool lasso_closed_ = false;
+  std::vector<segmentation::Polyline> barriers_;
+  bool drawing_barrier_ = false;
+  std::vector<modeling::ObjectNode> nodes_;
+  std::string status_;
+  std::int64_t revision_ = 0;
+  std::optional<modeling::RenderModel> model_;
+  std::int64_t model_revision_ = -1;
+  std::int64_t model_changes_ = 0;  // commands that changed what the 3D view shows
+};
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,26 @@
+// `scanbench workbench [PROJECT]`: the interactive workbench (seed 004
+// Fig. 2(i)) in one window: scans, the panoramic image view with the
+// segmentation tools, the object manager, the colour editor and the 3D
+// view, drawn with Dear ImGui over GLFW (render/window). Every action goes
+// through the project's commands; Ctrl+Z and Ctrl+Y undo and redo.
+#pragma once
+
+#include <filesystem>
+
+namespace scanbench::app::workbench {
+
+struct WorkbenchOptions {
+  std::filesystem::path project;
+  std::filesystem::path replay;      // events to feed, then exit (replay.hpp); empty: live
+  std::filesystem::path screenshot;  // the window after the replay (.png); empty: none
+  std::filesystem::path layout;      // where to write the widgets' centres (JSON); empty: none
+  int width = 1280;
+  int height = 800;
+};
+
+// Runs the workbench until its window closes or the replay ends. Throws
+// core::InputError for a bad project or events file, core::RuntimeFailure
+// without a display or an OpenGL 4.5 context.
+void run_workbench(const WorkbenchOptions& options);
+
+}  // namespace scanbench::app::workbench
