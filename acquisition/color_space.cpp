@@ -10,9 +10,9 @@ namespace {
 // Linear sRGB → CIE XYZ (D65), and its inverse.
 const Eigen::Matrix3d& rgb_to_xyz() {
   static const Eigen::Matrix3d m = (Eigen::Matrix3d() << 0.4124564, 0.3575761, 0.1804375,  //
-                                     0.2126729, 0.7151522, 0.0721750,                       //
-                                     0.0193339, 0.1191920, 0.9503041)
-                                        .finished();
+                                    0.2126729, 0.7151522, 0.0721750,                       //
+                                    0.0193339, 0.1191920, 0.9503041)
+                                       .finished();
   return m;
 }
 

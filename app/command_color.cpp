@@ -42,25 +42,30 @@ std::int64_t node_named(const modeling::Project& project, const std::string& opt
   for (const modeling::ObjectNode& node : project.object_nodes())
     if (node.name == text) found.push_back(node.id);
   if (found.size() == 1) return found.front();
-  throw CLI::ValidationError(option, found.empty() ? "no node is named \"" + text + "\""
-                                                   : "several nodes are named \"" + text +
-                                                         "\": give the id");
+  throw CLI::ValidationError(option, found.empty()
+                                         ? "no node is named \"" + text + "\""
+                                         : "several nodes are named \"" + text + "\": give the id");
 }
 
 // "SCAN:ROW0:COL0:ROW1:COL1".
 modeling::PixelRect parse_region(const std::string& text) {
-  std::array<long long, 5> v{};
-  const char* at = text.data();
+  std::int64_t scan = 0;
+  std::array<int, 4> v{};
   const char* end = text.data() + text.size();
+  const auto bad = [&] {
+    return CLI::ValidationError("--clone-region",
+                                "expected SCAN:ROW0:COL0:ROW1:COL1 (whole numbers), got " + text);
+  };
+  std::from_chars_result read = std::from_chars(text.data(), end, scan);
+  if (read.ec != std::errc() || read.ptr == end || *read.ptr != ':') throw bad();
   for (std::size_t k = 0; k < v.size(); ++k) {
-    const auto [next, error] = std::from_chars(at, end, v[k]);
+    // Into int directly: a value out of its range is an error, not a wrap.
+    read = std::from_chars(read.ptr + 1, end, v[k]);
     const bool last = k + 1 == v.size();
-    if (error != std::errc() || (last ? next != end : (next == end || *next != ':')))
-      throw CLI::ValidationError("--clone-region", "expected SCAN:ROW0:COL0:ROW1:COL1, got " + text);
-    at = next + 1;
+    if (read.ec != std::errc() || (last ? read.ptr != end : (read.ptr == end || *read.ptr != ':')))
+      throw bad();
   }
-  return {v[0], static_cast<int>(v[1]), static_cast<int>(v[3]), static_cast<int>(v[2]),
-          static_cast<int>(v[4])};
+  return {scan, v[0], v[2], v[1], v[3]};
 }
 
 // "#RRGGBB" or "RRGGBB".
@@ -96,16 +101,17 @@ void run_recolor(const RecolorOptions& options) {
   std::string result;
   if (editing) {
     if (options.set.empty() && !options.reset)
-      throw CLI::ValidationError("--object", "give at least one of --brightness, --contrast, "
-                                             "--gamma, --hue, --saturation or --reset");
-    const modeling::NodeCommandResult out =
-        modeling::recolor_object(project, {node_named(project, "--object", options.object),
-                                           options.set, options.reset});
+      throw CLI::ValidationError("--object",
+                                 "give at least one of --brightness, --contrast, "
+                                 "--gamma, --hue, --saturation or --reset");
+    const modeling::NodeCommandResult out = modeling::recolor_object(
+        project, {node_named(project, "--object", options.object), options.set, options.reset});
     node_id = out.node_id;
   } else {
     modeling::CloneSettings settings;
     settings.target = node_named(project, "--to", options.target);
-    if (!options.clone.empty()) settings.source_node = node_named(project, "--clone", options.clone);
+    if (!options.clone.empty())
+      settings.source_node = node_named(project, "--clone", options.clone);
     if (!options.clone_region.empty()) settings.source_region = parse_region(options.clone_region);
     if (!options.paint_color.empty()) settings.source_color = parse_color(options.paint_color);
     settings.paint = options.paint;
@@ -145,20 +151,25 @@ void run_harmonize(const HarmonizeOptions& options) {
   fmt::print("{:>4}  {:<24} {:>9} {:>10} {:>9}  {}\n", "id", "name", "pairs", "ΔE before",
              "ΔE after", "gains (R G B), offsets");
   for (const modeling::HarmonizeStageScan& s : out.scans) {
-    fmt::print("{:>4}  {:<24} {:>9} {:>10.2f} {:>9.2f}  ", s.id, s.name, s.pairs,
-               s.delta_e_before, s.delta_e_after);
-    if (!s.connected) {
-      fmt::print("no overlap with the first scan: unchanged\n");
+    fmt::print("{:>4}  {:<24} {:>9} {:>10.2f} {:>9.2f}  ", s.id, s.name, s.pairs, s.delta_e_before,
+               s.delta_e_after);
+    if (!s.reference) {
+      fmt::print("overlaps no other scan: unchanged\n");
+      continue;
+    }
+    if (*s.reference == s.id) {
+      fmt::print("fixed: the others are brought to it\n");
       continue;
     }
     fmt::print("{:.3f} {:.3f} {:.3f}, {:+.4f} {:+.4f} {:+.4f}\n", s.correction.matrix(0, 0),
                s.correction.matrix(1, 1), s.correction.matrix(2, 2), s.correction.offset.x(),
                s.correction.offset.y(), s.correction.offset.z());
   }
-  fmt::print("{} colour pairs: mean ΔE {:.2f} → {:.2f} ({} iterations, {:.2f} s); corrections "
-             "stored in {}\n",
-             out.pairs, out.delta_e_before, out.delta_e_after, out.iterations, out.seconds,
-             options.project);
+  fmt::print(
+      "{} colour pairs: mean ΔE {:.2f} → {:.2f} ({} iterations, {:.2f} s); corrections "
+      "stored in {}\n",
+      out.pairs, out.delta_e_before, out.delta_e_after, out.iterations, out.seconds,
+      options.project);
 }
 
 }  // namespace
@@ -216,7 +227,8 @@ void add_harmonize_command(CLI::App& app) {
               {"matrix", registration::ColorModel::kMatrix}},
           CLI::ignore_case))
       ->default_str("gain-offset");
-  command->add_option("--threads", options->settings.pairs.threads, "Worker threads (0 = all cores)")
+  command
+      ->add_option("--threads", options->settings.pairs.threads, "Worker threads (0 = all cores)")
       ->check(CLI::NonNegativeNumber);
   command->add_flag("--json", options->json, "Print one JSON object");
   command->callback([options] {

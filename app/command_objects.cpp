@@ -25,15 +25,16 @@ nlohmann::json to_json(const modeling::ObjectNode& node) {
     const Eigen::Vector3d lo = node.bbox_world->min(), hi = node.bbox_world->max();
     bbox = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
   }
-  nlohmann::json out = {{"id", node.id},
-          {"name", node.name},
-          {"kind", node.kind == modeling::NodeKind::kGroup ? "group" : "object"},
-          {"parent", node.parent ? nlohmann::json(*node.parent) : nlohmann::json(nullptr)},
-          {"hidden", node.hidden},
-          {"points", node.points},
-          {"mean_footprint_m",
-           node.mean_footprint_m ? nlohmann::json(*node.mean_footprint_m) : nlohmann::json()},
-          {"bbox_world", bbox}};
+  nlohmann::json out = {
+      {"id", node.id},
+      {"name", node.name},
+      {"kind", node.kind == modeling::NodeKind::kGroup ? "group" : "object"},
+      {"parent", node.parent ? nlohmann::json(*node.parent) : nlohmann::json(nullptr)},
+      {"hidden", node.hidden},
+      {"points", node.points},
+      {"mean_footprint_m",
+       node.mean_footprint_m ? nlohmann::json(*node.mean_footprint_m) : nlohmann::json()},
+      {"bbox_world", bbox}};
   // The node's own colour edit (what it inherits is not repeated).
   if (const std::string color = modeling::to_json(node.color); !color.empty())
     out["color"] = nlohmann::json::parse(color);

@@ -18,8 +18,9 @@ void add_workbench_command(CLI::App& app) {
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--replay", options->replay,
-                      "Feed the recorded mouse and key events of this file (JSON), then exit")
+  command
+      ->add_option("--replay", options->replay,
+                   "Feed the recorded mouse and key events of this file (JSON), then exit")
       ->check(CLI::ExistingFile);
   command->add_option("--screenshot", options->screenshot,
                       "Save the window as PNG: after the replay, or after the first frame");

@@ -52,7 +52,8 @@ Campaign scan_campaign(const sim::ScannerModel& scanner, int scan_count, SiteLig
 std::vector<modeling::ScanColorCorrection> as_scan_corrections(
     const registration::HarmonizeResult& solved) {
   std::vector<modeling::ScanColorCorrection> out;
-  for (const registration::ColorCorrection& c : solved.corrections) out.push_back({c.matrix, c.offset});
+  for (const registration::ColorCorrection& c : solved.corrections)
+    out.push_back({c.matrix, c.offset});
   return out;
 }
 
@@ -114,15 +115,15 @@ nlohmann::json solve_and_measure(const Campaign& c, registration::ColorModel mod
   const std::vector<modeling::ScanColorCorrection> corrections = as_scan_corrections(solved);
   const double before = modeling::mean_pair_delta_e(c.held_out, {});
   const double after = modeling::mean_pair_delta_e(c.held_out, corrections);
-  nlohmann::json out = {{"before_delta_e", before},
-                        {"after_delta_e", after},
-                        {"reduction", before > 0.0 ? 1.0 - after / before : 0.0},
-                        {"solve_seconds", seconds},
-                        {"all_points_before_delta_e", modeling::mean_pair_delta_e(c.held_out_all, {})},
-                        {"all_points_after_delta_e",
-                         modeling::mean_pair_delta_e(c.held_out_all, corrections)},
-                        {"iterations", solved.iterations},
-                        {"converged", solved.converged}};
+  nlohmann::json out = {
+      {"before_delta_e", before},
+      {"after_delta_e", after},
+      {"reduction", before > 0.0 ? 1.0 - after / before : 0.0},
+      {"solve_seconds", seconds},
+      {"all_points_before_delta_e", modeling::mean_pair_delta_e(c.held_out_all, {})},
+      {"all_points_after_delta_e", modeling::mean_pair_delta_e(c.held_out_all, corrections)},
+      {"iterations", solved.iterations},
+      {"converged", solved.converged}};
   if (truth_rgb) {
     out["before_delta_e_to_albedo"] = delta_e_to_truth(c.held_out, {}, *truth_rgb);
     out["after_delta_e_to_albedo"] = delta_e_to_truth(c.held_out, corrections, *truth_rgb);
@@ -147,7 +148,7 @@ nlohmann::json run_color_bench(const BenchOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const Campaign campaign = scan_campaign(scanner, scan_count, SiteLighting::kExposureOnly);
   // Every scan again under the first scan's lighting: the truth colours.
-  const sim::Site scene_site = sim::make_site("campus", 1, scan_count);
+  const sim::Site scene_site = sim::make_site("campus", kSiteSeed, scan_count);
   const sim::ScanLighting first = scan_lighting(SiteLighting::kExposureOnly, 0);
   std::vector<std::vector<std::uint8_t>> truth_rgb;
   for (int k = 0; k < scan_count; ++k) {

@@ -174,7 +174,8 @@ ViewFigures measure_view(render::SplatRenderer& renderer, const modeling::Render
       renderer.draw(camera, settings);
       const render::RenderedImage unfilled = renderer.read_image();
       std::size_t open = 0;
-      for (std::size_t i = 0; i < mask.size(); ++i) open += mask[i] && unfilled.rgba[4 * i + 3] == 0;
+      for (std::size_t i = 0; i < mask.size(); ++i)
+        open += mask[i] && unfilled.rgba[4 * i + 3] == 0;
       out.modes["blended"]["hole_fraction_unfilled"] =
           c.pixels == 0 ? 0.0 : static_cast<double>(open) / static_cast<double>(c.pixels);
     }
@@ -208,7 +209,7 @@ nlohmann::json run_render_bench(const BenchOptions& options) {
   // The scans lit as the truth pictures are: what differs is the renderer's
   // doing, not the campaign's exposures (the colour bench measures those).
   const SimulatedSite site = simulate_site("campus", scanner, scan_count, SiteLighting::kReference);
-  const sim::Site scene_site = sim::make_site("campus", 1, scan_count);
+  const sim::Site scene_site = sim::make_site("campus", kSiteSeed, scan_count);
   const ScratchFolder scratch("render");
   const auto build_start = std::chrono::steady_clock::now();
   const modeling::RenderModel model = campus_model(site, scratch);

@@ -5,10 +5,6 @@
 
 namespace scanbench::bench {
 
-namespace {
-constexpr std::uint64_t kSiteSeed = 1;
-}  // namespace
-
 std::uint64_t scan_seed(int k) {
   return acquisition::sim::hash_combine(kSiteSeed, static_cast<std::uint64_t>(k));
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,9 @@ enum class SiteLighting {
   // balance: colours differ between scans by per-channel gains only.
   kExposureOnly,
 };
+
+// The seed of the site every bench simulates (its layout, trees, textures).
+inline constexpr std::uint64_t kSiteSeed = 1;
 
 // The simulation seed of scan k (0-based): simulating it again with another
 // lighting gives the same geometry and noise, other colours.

@@ -17,6 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const Project project = Project::open(path);
     static_cast<void>(project.history());
     static_cast<void>(project.object_nodes());
+    static_cast<void>(project.scan_color_corrections());
     for (const auto& stored : project.scans()) {
       static_cast<void>(project.load_scan(stored.id));
       static_cast<void>(scanbench::modeling::load_geometry(project, stored.id));

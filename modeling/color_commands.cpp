@@ -8,6 +8,7 @@
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
 #include "modeling/layers.hpp"
+#include "modeling/scan_layers.hpp"
 
 namespace scanbench::modeling {
 
@@ -19,7 +20,9 @@ namespace {
   throw core::InputError("", position, problem);
 }
 
-std::string node_name(std::int64_t id) { return "node " + std::to_string(id); }
+std::string node_name(std::int64_t id) {
+  return "node " + std::to_string(id);
+}
 
 const ObjectNode& require_node(const std::vector<ObjectNode>& nodes, std::int64_t id) {
   for (const ObjectNode& n : nodes) {
@@ -35,6 +38,22 @@ std::set<std::int64_t> subtree(const std::vector<ObjectNode>& nodes, std::int64_
     grown = false;
     for (const ObjectNode& n : nodes) {
       if (n.parent && out.count(*n.parent) && out.insert(n.id).second) grown = true;
+    }
+  }
+  return out;
+}
+
+// `target` and the nodes below it that take their transfer from it (none
+// on the way up to it sets its own): the points a transfer set on the
+// target reaches.
+std::set<std::int64_t> inheriting_transfer(const std::vector<ObjectNode>& nodes,
+                                           std::int64_t target) {
+  std::set<std::int64_t> out{target};
+  for (bool grown = true; grown;) {
+    grown = false;
+    for (const ObjectNode& n : nodes) {
+      if (n.parent && out.count(*n.parent) && !n.color.transfer && out.insert(n.id).second)
+        grown = true;
     }
   }
   return out;
@@ -66,9 +85,8 @@ std::optional<ColorLayers> color_layers(const Project& project, std::int64_t sca
   std::optional<std::vector<std::uint8_t>> rgb =
       project.load_layer<std::uint8_t>(scan_id, layer::kRgb, ElementType::kU8x3);
   if (!rgb) return std::nullopt;
-  return ColorLayers{std::move(*rgb),
-                     project.load_layer<std::uint32_t>(scan_id, layer::kMembership,
-                                                       ElementType::kU32)};
+  return ColorLayers{std::move(*rgb), project.load_layer<std::uint32_t>(scan_id, layer::kMembership,
+                                                                        ElementType::kU32)};
 }
 
 std::array<std::uint8_t, 3> pixel_rgb(const ColorLayers& layers, std::size_t i) {
@@ -110,14 +128,16 @@ LabStats region_colors(const Project& project, const ColorPipeline& pipeline,
   if (!scan.has_color()) refuse(where, "the scan has no colour");
   const std::optional<std::vector<std::uint32_t>> membership =
       project.load_layer<std::uint32_t>(region.scan_id, layer::kMembership, ElementType::kU32);
+  const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, region.scan_id);
   LabStats stats;
   for (int row = region.row_begin; row < region.row_end; ++row) {
     for (int col = region.col_begin; col < region.col_end; ++col) {
+      // Only what the model shows: in the model (valid, not a mixed pixel)
+      // and not deleted.
       const std::size_t i = scan.index(row, col);
-      if (!scan.valid[i]) continue;
-      const std::uint32_t owner = membership && (*membership)[i] != kDeletedPoints
-                                      ? (*membership)[i]
-                                      : 0;
+      if (!scan.valid[i] || (geometry && !acquisition::in_model(scan, *geometry, i))) continue;
+      const std::uint32_t owner = membership ? (*membership)[i] : 0;
+      if (owner == kDeletedPoints) continue;
       const std::array<std::uint8_t, 3> rgb = {scan.rgb[3 * i], scan.rgb[3 * i + 1],
                                                scan.rgb[3 * i + 2]};
       stats.add(acquisition::srgb_to_lab(pipeline.shown(region.scan_id, owner, rgb)));
@@ -185,7 +205,8 @@ CloneResult clone_color(Project& project, const CloneSettings& settings) {
   } else if (settings.source_region) {
     const PixelRect& r = *settings.source_region;
     source = region_colors(project, pipeline, r);
-    json["source_region"] = {{"scan", r.scan_id}, {"rows", {r.row_begin, r.row_end}},
+    json["source_region"] = {{"scan", r.scan_id},
+                             {"rows", {r.row_begin, r.row_end}},
                              {"columns", {r.col_begin, r.col_end}}};
   } else {
     const std::array<std::uint8_t, 3>& c = *settings.source_color;
@@ -193,7 +214,8 @@ CloneResult clone_color(Project& project, const CloneSettings& settings) {
     json["source_color"] = {c[0], c[1], c[2]};
   }
   if (source.count == 0) refuse("clone", "the source has no coloured points");
-  const LabStats own = node_colors(project, pipeline, subtree(nodes, settings.target), false);
+  const LabStats own =
+      node_colors(project, pipeline, inheriting_transfer(nodes, settings.target), false);
   if (own.count == 0) refuse(node_name(settings.target), "the target has no coloured points");
 
   // Per channel: the target's mean onto the source's, its spread scaled to

@@ -61,10 +61,13 @@ struct CloneResult {
 };
 
 // Statistics transfer in L*a*b* (Reinhard et al.'s idea, in CIELAB): the
-// source's colours as shown (its scans' corrections and its edits), the
-// target's as its scans' corrections leave them; the target gets the
-// transfer and neutral adjustments of its own, so nothing it inherits
-// bends the match.
+// source's colours as shown (its scans' corrections and its edits; for a
+// region, its points in the model, deleted ones left out), the target's as
+// its scans' corrections leave them, over the points the transfer reaches
+// (a group's descendants that set their own transfer keep it and are left
+// out). The target gets the transfer and neutral adjustments of its own,
+// so nothing it inherits bends the match. The transfer is fixed when
+// cloned: a later harmonize changes the target's colours under it.
 CloneResult clone_color(Project& project, const CloneSettings& settings);
 
 }  // namespace scanbench::modeling

@@ -14,7 +14,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+nlohmann::json vector_json(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 Eigen::Vector3d vector_of(const nlohmann::json& j, const char* what) {
   if (!j.is_array() || j.size() != 3)
@@ -52,7 +54,8 @@ ResolvedColorEdit resolve(const ColorEdit& own, const ResolvedColorEdit& inherit
   return out;
 }
 
-std::map<std::int64_t, ResolvedColorEdit> resolve_color_edits(const std::vector<ObjectNode>& nodes) {
+std::map<std::int64_t, ResolvedColorEdit> resolve_color_edits(
+    const std::vector<ObjectNode>& nodes) {
   std::map<std::int64_t, const ObjectNode*> by_id;
   for (const ObjectNode& n : nodes) by_id[n.id] = &n;
   std::map<std::int64_t, ResolvedColorEdit> resolved;
@@ -99,9 +102,8 @@ std::string check_color_edit(const ColorEdit& edit) {
     return "gamma must be above 0.05 and at most 20";
   if (edit.saturation && (*edit.saturation < 0.0 || *edit.saturation > 10.0))
     return "saturation must be within 0 and 10";
-  if (edit.transfer &&
-      (!edit.transfer->scale.allFinite() || !edit.transfer->offset.allFinite() ||
-       (edit.transfer->scale.array() < 0.0).any()))
+  if (edit.transfer && (!edit.transfer->scale.allFinite() || !edit.transfer->offset.allFinite() ||
+                        (edit.transfer->scale.array() < 0.0).any()))
     return "a colour transfer must have finite, non-negative scales and finite offsets";
   return {};
 }

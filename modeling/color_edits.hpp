@@ -33,7 +33,7 @@ struct LabTransfer {
 struct ColorEdit {
   std::optional<double> brightness;  // added to L* [L* units, −100…100]
   std::optional<double> contrast;    // L* scaled about 50 (> 0; 1: none)
-  std::optional<double> gamma;       // L*/100 raised to 1 / gamma (> 0; > 1 lightens mid-tones)
+  std::optional<double> gamma;       // L*/100 raised to 1 / gamma (> 0.05; > 1 lightens mid-tones)
   std::optional<double> hue_deg;     // a*b* rotated [°]
   std::optional<double> saturation;  // a*b* scaled (≥ 0; 0: grey)
   std::optional<LabTransfer> transfer;
@@ -88,7 +88,8 @@ ScanColorCorrection scan_color_correction_from_json(const std::string& json);
 std::string check_color_edit(const ColorEdit& edit);
 
 // Colours as the model shows them: per scan its correction, per object its
-// resolved edit. Cheap to copy-free share; built once per render model.
+// resolved edit. Built once per render model (or clone) and read for every
+// point.
 class ColorPipeline {
  public:
   ColorPipeline(std::map<std::int64_t, ScanColorCorrection> corrections,

@@ -78,7 +78,6 @@ struct ScanColorRecord {
   std::string correction;  // JSON
 };
 
-
 // A layer version's row without its data (whose zstd frame checks itself).
 struct LayerFields {
   std::int64_t scan_id = 0;

@@ -1,6 +1,7 @@
 #include "modeling/registration_stage.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <nlohmann/json.hpp>
 
@@ -234,6 +235,12 @@ std::string merge_result_json(const MergeStageResult& out) {
 double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
                          std::span<const ScanColorCorrection> corrections) {
   if (pairs.empty()) return 0.0;
+  assert((corrections.empty() || std::all_of(pairs.begin(), pairs.end(),
+                                             [&](const auto& p) {
+                                               return std::max(p.scan_a, p.scan_b) <
+                                                      corrections.size();
+                                             })) &&
+         "a correction for every scan of the pairs");
   const auto lab = [&](std::uint32_t scan, const Eigen::Vector3f& rgb) {
     Eigen::Vector3d linear = rgb.cast<double>();
     if (!corrections.empty()) {
@@ -247,6 +254,59 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
     sum += acquisition::delta_e(lab(p.scan_a, p.rgb_a), lab(p.scan_b, p.rgb_b));
   return sum / static_cast<double>(pairs.size());
 }
+
+namespace {
+
+// The stage's result from the solver's: each scan's new correction (the
+// stored one kept for scans in no pair), its reference, and ΔE before and
+// after over all pairs and over each scan's own.
+HarmonizeStageResult harmonize_outcome(const LoadedScans& loaded,
+                                       std::span<const registration::ColorPair> pairs,
+                                       const registration::HarmonizeResult& solved,
+                                       const std::map<std::int64_t, ScanColorCorrection>& stored) {
+  HarmonizeStageResult out;
+  out.pairs = pairs.size();
+  out.iterations = solved.iterations;
+  out.converged = solved.converged;
+  std::vector<ScanColorCorrection> corrections;
+  for (std::size_t k = 0; k < loaded.ids.size(); ++k) {
+    HarmonizeStageScan scan;
+    scan.id = loaded.ids[k];
+    scan.name = loaded.scans[k].name;
+    if (solved.reference[k] >= 0) {
+      scan.reference = loaded.ids[static_cast<std::size_t>(solved.reference[k])];
+      scan.correction = {solved.corrections[k].matrix, solved.corrections[k].offset};
+    } else if (const auto kept = stored.find(scan.id); kept != stored.end()) {
+      scan.correction = kept->second;
+    }
+    corrections.push_back(scan.correction);
+    out.scans.push_back(std::move(scan));
+  }
+  out.delta_e_before = mean_pair_delta_e(pairs, {});
+  out.delta_e_after = mean_pair_delta_e(pairs, corrections);
+  for (std::size_t k = 0; k < out.scans.size(); ++k) {
+    std::vector<registration::ColorPair> own;
+    for (const registration::ColorPair& p : pairs)
+      if (p.scan_a == k || p.scan_b == k) own.push_back(p);
+    out.scans[k].pairs = own.size();
+    out.scans[k].delta_e_before = mean_pair_delta_e(own, {});
+    out.scans[k].delta_e_after = mean_pair_delta_e(own, corrections);
+  }
+  return out;
+}
+
+std::string harmonize_settings_json(const HarmonizeStageSettings& settings) {
+  return nlohmann::json{{"model", registration::color_model_name(settings.solve.model)},
+                        {"loss_scale", settings.solve.loss_scale},
+                        {"stride", settings.pairs.stride},
+                        {"max_distance_m", settings.pairs.max_distance_m},
+                        {"max_normal_angle_deg", settings.pairs.max_normal_angle_deg},
+                        {"max_local_step", settings.pairs.max_local_step},
+                        {"max_pairs_per_overlap", settings.pairs.max_pairs_per_overlap}}
+      .dump();
+}
+
+}  // namespace
 
 HarmonizeStageResult harmonize_project(Project& project, const HarmonizeStageSettings& settings,
                                        core::Progress& progress) {
@@ -265,46 +325,12 @@ HarmonizeStageResult harmonize_project(Project& project, const HarmonizeStageSet
   progress.throw_if_cancelled(kStage);
   const registration::HarmonizeResult solved =
       registration::harmonize_colors(pairs, loaded.scans.size(), settings.solve);
-  HarmonizeStageResult out;
-  out.pairs = pairs.size();
-  out.iterations = solved.iterations;
-  out.converged = solved.converged;
-  const std::map<std::int64_t, ScanColorCorrection> stored = project.scan_color_corrections();
-  std::vector<ScanColorCorrection> corrections;
-  for (std::size_t k = 0; k < loaded.ids.size(); ++k) {
-    HarmonizeStageScan scan;
-    scan.id = loaded.ids[k];
-    scan.name = loaded.scans[k].name;
-    scan.connected = solved.connected[k] != 0;
-    if (scan.connected) {
-      scan.correction = {solved.corrections[k].matrix, solved.corrections[k].offset};
-    } else if (const auto kept = stored.find(scan.id); kept != stored.end()) {
-      scan.correction = kept->second;
-    }
-    corrections.push_back(scan.correction);
-    out.scans.push_back(std::move(scan));
-  }
-  out.delta_e_before = mean_pair_delta_e(pairs, {});
-  out.delta_e_after = mean_pair_delta_e(pairs, corrections);
-  for (std::size_t k = 0; k < out.scans.size(); ++k) {
-    std::vector<registration::ColorPair> own;
-    for (const registration::ColorPair& p : pairs)
-      if (p.scan_a == k || p.scan_b == k) own.push_back(p);
-    out.scans[k].pairs = own.size();
-    out.scans[k].delta_e_before = mean_pair_delta_e(own, {});
-    out.scans[k].delta_e_after = mean_pair_delta_e(own, corrections);
-  }
+  HarmonizeStageResult out =
+      harmonize_outcome(loaded, pairs, solved, project.scan_color_corrections());
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.throw_if_cancelled(kStage);
 
-  const nlohmann::json settings_json = {
-      {"model", registration::color_model_name(settings.solve.model)},
-      {"loss_scale", settings.solve.loss_scale},
-      {"stride", settings.pairs.stride},
-      {"max_distance_m", settings.pairs.max_distance_m},
-      {"max_normal_angle_deg", settings.pairs.max_normal_angle_deg},
-      {"max_pairs_per_overlap", settings.pairs.max_pairs_per_overlap}};
-  Project::Edit edit = project.begin_command(kStage, settings_json.dump(), revision);
+  Project::Edit edit = project.begin_command(kStage, harmonize_settings_json(settings), revision);
   out.command_id = edit.command_id();
   for (const HarmonizeStageScan& scan : out.scans)
     project.put_scan_color_correction(edit, scan.id, scan.correction);
@@ -317,17 +343,17 @@ std::string harmonize_result_json(const HarmonizeStageResult& out) {
   for (const HarmonizeStageScan& s : out.scans) {
     nlohmann::json matrix = nlohmann::json::array();
     for (int r = 0; r < 3; ++r)
-      matrix.push_back({s.correction.matrix(r, 0), s.correction.matrix(r, 1),
-                        s.correction.matrix(r, 2)});
-    scans.push_back({{"id", s.id},
-                     {"name", s.name},
-                     {"connected", s.connected},
-                     {"pairs", s.pairs},
-                     {"delta_e_before", s.delta_e_before},
-                     {"delta_e_after", s.delta_e_after},
-                     {"matrix", matrix},
-                     {"offset", {s.correction.offset.x(), s.correction.offset.y(),
-                                 s.correction.offset.z()}}});
+      matrix.push_back(
+          {s.correction.matrix(r, 0), s.correction.matrix(r, 1), s.correction.matrix(r, 2)});
+    scans.push_back(
+        {{"id", s.id},
+         {"name", s.name},
+         {"reference", s.reference ? nlohmann::json(*s.reference) : nlohmann::json()},
+         {"pairs", s.pairs},
+         {"delta_e_before", s.delta_e_before},
+         {"delta_e_after", s.delta_e_after},
+         {"matrix", matrix},
+         {"offset", {s.correction.offset.x(), s.correction.offset.y(), s.correction.offset.z()}}});
   }
   return nlohmann::json{{"scans", scans},
                         {"pairs", out.pairs},

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -84,8 +85,10 @@ struct HarmonizeStageScan {
   std::int64_t id = 0;
   std::string name;
   ScanColorCorrection correction;
-  bool connected = false;  // linked to the first scan through overlaps
-  std::size_t pairs = 0;   // colour pairs it takes part in
+  // The fixed scan of its group of overlapping scans (itself for that one);
+  // none: it overlaps no scan and keeps its correction.
+  std::optional<std::int64_t> reference;
+  std::size_t pairs = 0;  // colour pairs it takes part in
   // Mean CIE76 ΔE to the other scan of its pairs, before and after.
   double delta_e_before = 0.0;
   double delta_e_after = 0.0;
@@ -109,9 +112,10 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
 
 // Harmonises the colours of the project's scans at their current poses
 // (seed 004 §4.5; registration/color_harmonization.hpp): colour pairs from
-// the overlaps, one correction per scan with the first scan (by id) fixed,
-// stored as one command ("harmonize") whose undo restores the earlier
-// corrections. Scans with no chain of overlaps to the first keep theirs.
+// the overlaps, one correction per scan with the first scan (by id) of each
+// group of overlapping scans fixed, stored as one command ("harmonize")
+// whose undo restores the earlier corrections. Scans that overlap no other
+// keep theirs.
 // Throws as merge_project (no scans, a scan without geometry, a project
 // changed meanwhile, cancelled), and core::InputError when no two scans
 // with colour overlap. The project is then unchanged.

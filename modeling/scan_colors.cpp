@@ -41,7 +41,8 @@ std::map<std::int64_t, ScanColorCorrection> Project::scan_color_corrections() co
     record.command_id = select.column_int(1);
     record.correction = select.column_text(2);
     if (checksum(record) != select.column_int(3))
-      damaged(file_name(), record.scan_id, "the row fails its checksum (changed outside scanbench?)");
+      damaged(file_name(), record.scan_id,
+              "the row fails its checksum (changed outside scanbench?)");
     try {
       out[record.scan_id] = scan_color_correction_from_json(record.correction);
     } catch (const std::invalid_argument& e) {

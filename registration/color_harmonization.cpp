@@ -10,6 +10,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/parallel.hpp"
+#include "registration/color_costs.hpp"
 
 namespace scanbench::registration {
 
@@ -80,9 +81,9 @@ std::vector<ColorPair> pairs_between(const PreparedScan& a, const PreparedScan& 
       if (na.squaredNorm() > 0.25f && nb.squaredNorm() > 0.25f &&
           (T_b_a.linear() * na).dot(nb) < min_cos)
         continue;
-      by_row[static_cast<std::size_t>(k)].push_back(
-          {ia, ib, static_cast<std::int64_t>(i), found, linear_color(scan_a, i),
-           linear_color(scan_b, j)});
+      by_row[static_cast<std::size_t>(k)].push_back({ia, ib, static_cast<std::int64_t>(i), found,
+                                                     linear_color(scan_a, i),
+                                                     linear_color(scan_b, j)});
     }
   });
   std::vector<ColorPair> out;
@@ -90,78 +91,75 @@ std::vector<ColorPair> pairs_between(const PreparedScan& a, const PreparedScan& 
   return out;
 }
 
-// The corrected colour under a scan's parameters (gain-offset: g, o;
-// matrix: M row-major, o).
-template <ColorModel Model, typename T>
-void correct(const T* p, const Eigen::Vector3f& rgb, T* out) {
-  for (int c = 0; c < 3; ++c) {
-    if constexpr (Model == ColorModel::kGainOffset) {
-      out[c] = p[c] * T(rgb[c]) + p[3 + c];
-    } else {
-      out[c] = p[3 * c] * T(rgb[0]) + p[3 * c + 1] * T(rgb[1]) + p[3 * c + 2] * T(rgb[2]) +
-               p[9 + c];
-    }
-  }
-}
-
-constexpr double kSoftLogEpsilon = 0.01;
-
-template <ColorModel Model>
-struct PairCost {
-  Eigen::Vector3f a, b;
-  template <typename T>
-  bool operator()(const T* pa, const T* pb, T* residual) const {
-    using std::log;
-    T ca[3], cb[3];
-    correct<Model>(pa, a, ca);
-    correct<Model>(pb, b, cb);
-    // A soft logarithm: relative differences for bright colours (a gain is
-    // a shift there, so shrinking every colour towards one never pays),
-    // absolute ones near black, where noise would dominate a true log.
-    const T floor(0.0);
-    const T soft(kSoftLogEpsilon);
-    for (int c = 0; c < 3; ++c) {
-      residual[c] = log((ca[c] < floor ? floor : ca[c]) + soft) -
-                    log((cb[c] < floor ? floor : cb[c]) + soft);
-    }
-    return true;
-  }
-};
-
 template <ColorModel Model>
 ceres::CostFunction* pair_cost(const ColorPair& pair) {
-  constexpr int kParameters = Model == ColorModel::kGainOffset ? 6 : 12;
-  return new ceres::AutoDiffCostFunction<PairCost<Model>, 3, kParameters, kParameters>(
-      new PairCost<Model>{pair.rgb_a, pair.rgb_b});
+  constexpr int kParameters = costs::kColorParameters<Model>;
+  return new ceres::AutoDiffCostFunction<costs::ColorPairCost<Model>, 3, kParameters, kParameters>(
+      new costs::ColorPairCost<Model>{pair.rgb_a, pair.rgb_b});
 }
 
-// Pulls a scan's parameters towards the identity, weighted by
-// `weight`: without it, scans that no correction can make agree (sunlit in
-// one, shaded in another) would collapse towards one flat colour, which
-// agrees with itself and gives up only the pairs with the fixed scan.
-struct IdentityPrior {
-  std::vector<double> identity;
-  double weight = 0.0;
-  template <typename T>
-  bool operator()(const T* const* parameters, T* residual) const {
-    for (std::size_t k = 0; k < identity.size(); ++k)
-      residual[k] = T(weight) * (parameters[0][k] - T(identity[k]));
-    return true;
-  }
-};
-
-// Which scans a chain of pairs links to scan 0.
-std::vector<std::uint8_t> linked_to_first(std::span<const ColorPair> pairs, std::size_t count) {
+// Per scan, the fixed scan of its group of scans linked by pairs (the one
+// with the lowest index), or -1 for a scan in no pair.
+std::vector<std::int32_t> group_references(std::span<const ColorPair> pairs, std::size_t count) {
   std::vector<std::size_t> root(count);
   std::iota(root.begin(), root.end(), 0);
   const auto find = [&](std::size_t x) {
     while (root[x] != x) x = root[x] = root[root[x]];
     return x;
   };
-  for (const ColorPair& p : pairs) root[find(p.scan_a)] = find(p.scan_b);
-  std::vector<std::uint8_t> out(count, 0);
-  for (std::size_t k = 0; k < count; ++k) out[k] = count > 0 && find(k) == find(0) ? 1 : 0;
+  std::vector<std::uint8_t> paired(count, 0);
+  for (const ColorPair& p : pairs) {
+    paired[p.scan_a] = paired[p.scan_b] = 1;
+    // The smaller root wins, so every group's root is its lowest index.
+    const std::size_t a = find(p.scan_a), b = find(p.scan_b);
+    root[std::max(a, b)] = std::min(a, b);
+  }
+  std::vector<std::int32_t> out(count, -1);
+  for (std::size_t k = 0; k < count; ++k)
+    if (paired[k]) out[k] = static_cast<std::int32_t>(find(k));
   return out;
+}
+
+// The identity correction's parameters.
+std::vector<double> identity_parameters(bool matrix) {
+  std::vector<double> p(matrix ? 12 : 6, 0.0);
+  for (std::size_t c = 0; c < 3; ++c) p[matrix ? 4 * c : c] = 1.0;
+  return p;
+}
+
+// Bounds of what exposure, white balance and flare can do: gains within
+// max_gain_ratio either way, channel cross-talk and offsets small.
+void bound_parameters(ceres::Problem& problem, double* p, bool matrix,
+                      const HarmonizeSettings& settings) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < (matrix ? 3 : 1); ++c) {
+      const int at = matrix ? 3 * r + c : r;
+      const bool diagonal = !matrix || r == c;
+      problem.SetParameterLowerBound(
+          p, at, diagonal ? 1.0 / settings.max_gain_ratio : -settings.max_cross_talk);
+      problem.SetParameterUpperBound(p, at,
+                                     diagonal ? settings.max_gain_ratio : settings.max_cross_talk);
+    }
+    const int offset = (matrix ? 9 : 3) + r;
+    problem.SetParameterLowerBound(p, offset, -settings.max_offset);
+    problem.SetParameterUpperBound(p, offset, settings.max_offset);
+  }
+}
+
+ColorCorrection correction_of(const std::vector<double>& p, bool matrix) {
+  ColorCorrection c;
+  for (int r = 0; r < 3; ++r) {
+    const auto ur = static_cast<std::size_t>(r);
+    if (matrix) {
+      for (int col = 0; col < 3; ++col)
+        c.matrix(r, col) = p[3 * ur + static_cast<std::size_t>(col)];
+      c.offset[r] = p[9 + ur];
+    } else {
+      c.matrix(r, r) = p[ur];
+      c.offset[r] = p[3 + ur];
+    }
+  }
+  return c;
 }
 
 }  // namespace
@@ -199,61 +197,37 @@ HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t s
                                  const HarmonizeSettings& settings) {
   HarmonizeResult result;
   result.corrections.resize(scan_count);
-  result.connected = linked_to_first(pairs, scan_count);
-  if (scan_count < 2) return result;
+  result.reference = group_references(pairs, scan_count);
+  if (pairs.empty()) return result;
   const bool matrix = settings.model == ColorModel::kMatrix;
-  const std::size_t size = matrix ? 12 : 6;
-  std::vector<std::vector<double>> parameters(scan_count, std::vector<double>(size, 0.0));
-  for (std::vector<double>& p : parameters) {
-    for (int c = 0; c < 3; ++c) p[static_cast<std::size_t>(matrix ? 4 * c : c)] = 1.0;
-  }
+  const std::vector<double> identity = identity_parameters(matrix);
+  std::vector<std::vector<double>> parameters(scan_count, identity);
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   ceres::CauchyLoss loss(settings.loss_scale);
+  std::vector<std::size_t> pairs_of(scan_count, 0);
   for (const ColorPair& pair : pairs) {
-    if (!result.connected[pair.scan_a]) continue;  // both or neither: a pair links them
     problem.AddResidualBlock(
         matrix ? pair_cost<ColorModel::kMatrix>(pair) : pair_cost<ColorModel::kGainOffset>(pair),
         &loss, parameters[pair.scan_a].data(), parameters[pair.scan_b].data());
-    ++result.pairs;
-  }
-  if (result.pairs == 0) return result;
-  problem.SetParameterBlockConstant(parameters[0].data());
-  std::vector<std::size_t> pairs_of(scan_count, 0);
-  for (const ColorPair& pair : pairs) {
-    if (!result.connected[pair.scan_a]) continue;
     ++pairs_of[pair.scan_a];
     ++pairs_of[pair.scan_b];
   }
-  const std::vector<double> identity = parameters[0];
-  for (std::size_t k = 1; k < scan_count; ++k) {
+  result.pairs = pairs.size();
+  for (std::size_t k = 0; k < scan_count; ++k) {
     if (pairs_of[k] == 0) continue;
-    auto* prior = new ceres::DynamicAutoDiffCostFunction<IdentityPrior>(new IdentityPrior{
-        identity, settings.prior_weight * std::sqrt(static_cast<double>(pairs_of[k]))});
-    prior->AddParameterBlock(static_cast<int>(size));
-    prior->SetNumResiduals(static_cast<int>(size));
-    problem.AddResidualBlock(prior, nullptr, parameters[k].data());
-  }
-  // Bounds of what exposure, white balance and flare can do: gains within
-  // max_gain_ratio either way, channel cross-talk and offsets small. They
-  // also keep scans that cannot agree from collapsing to one flat colour.
-  for (std::size_t k = 1; k < scan_count; ++k) {
-    if (pairs_of[k] == 0) continue;
-    double* p = parameters[k].data();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < (matrix ? 3 : 1); ++c) {
-        const int at = matrix ? 3 * r + c : r;
-        const bool diagonal = !matrix || r == c;
-        problem.SetParameterLowerBound(p, at, diagonal ? 1.0 / settings.max_gain_ratio
-                                                       : -settings.max_cross_talk);
-        problem.SetParameterUpperBound(p, at, diagonal ? settings.max_gain_ratio
-                                                       : settings.max_cross_talk);
-      }
-      const int offset = (matrix ? 9 : 3) + r;
-      problem.SetParameterLowerBound(p, offset, -settings.max_offset);
-      problem.SetParameterUpperBound(p, offset, settings.max_offset);
+    if (result.reference[k] == static_cast<std::int32_t>(k)) {
+      problem.SetParameterBlockConstant(parameters[k].data());
+      continue;
     }
+    auto* prior =
+        new ceres::DynamicAutoDiffCostFunction<costs::IdentityPrior>(new costs::IdentityPrior{
+            identity, settings.prior_weight * std::sqrt(static_cast<double>(pairs_of[k]))});
+    prior->AddParameterBlock(static_cast<int>(identity.size()));
+    prior->SetNumResiduals(static_cast<int>(identity.size()));
+    problem.AddResidualBlock(prior, nullptr, parameters[k].data());
+    bound_parameters(problem, parameters[k].data(), matrix, settings);
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -266,20 +240,9 @@ HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t s
   result.final_cost = summary.final_cost;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;
-  for (std::size_t k = 1; k < scan_count; ++k) {
-    if (!result.connected[k]) continue;
-    const std::vector<double>& p = parameters[k];
-    ColorCorrection& c = result.corrections[k];
-    for (int r = 0; r < 3; ++r) {
-      const auto ur = static_cast<std::size_t>(r);
-      if (matrix) {
-        for (int col = 0; col < 3; ++col) c.matrix(r, col) = p[3 * ur + static_cast<std::size_t>(col)];
-        c.offset[r] = p[9 + ur];
-      } else {
-        c.matrix(r, r) = p[ur];
-        c.offset[r] = p[3 + ur];
-      }
-    }
+  for (std::size_t k = 0; k < scan_count; ++k) {
+    if (result.reference[k] >= 0 && result.reference[k] != static_cast<std::int32_t>(k))
+      result.corrections[k] = correction_of(parameters[k], matrix);
   }
   return result;
 }

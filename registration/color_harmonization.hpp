@@ -6,7 +6,9 @@
 // linear RGB, where exposure and white balance act as per-channel gains:
 //   gain-offset  rgb' = diag(g) · rgb + o   (6 parameters per scan)
 //   matrix       rgb' = M · rgb + o         (12: also cross-talk between channels)
-// The first scan is fixed (identity): the others are brought to it.
+// In each group of scans linked by overlaps, the first scan (lowest index)
+// is fixed (identity) and the others are brought to it. The residual and
+// its loss are in color_costs.hpp.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -76,8 +78,8 @@ struct ColorCorrection {
 
 struct HarmonizeSettings {
   ColorModel model = ColorModel::kGainOffset;
-  // Cauchy loss scale on the residual, in cube-root units of linear RGB
-  // (the companding of L*: 0.01 there is about 1 ΔE at mid grey).
+  // Cauchy loss scale on the residual (color_costs.hpp), a difference of
+  // soft logarithms: a relative colour difference (0.05: about 5 %).
   double loss_scale = 0.05;
   // Weight of each scan's pull towards the identity, × √(its pairs): a
   // gentle tie for scans the pairs constrain poorly.
@@ -94,9 +96,12 @@ struct HarmonizeSettings {
 };
 
 struct HarmonizeResult {
-  std::vector<ColorCorrection> corrections;  // one per scan; the first is the identity
-  // Per scan: linked to the first scan through pairs (else left at the identity).
-  std::vector<std::uint8_t> connected;
+  // One per scan: the identity for each group's fixed scan and for scans in
+  // no pair.
+  std::vector<ColorCorrection> corrections;
+  // Per scan, the index of the fixed scan of its group of scans linked by
+  // pairs (itself for that scan); -1 for a scan in no pair.
+  std::vector<std::int32_t> reference;
   std::size_t pairs = 0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
@@ -104,8 +109,9 @@ struct HarmonizeResult {
   bool converged = false;
 };
 
-// Solves the corrections of `scan_count` scans from `pairs` (residual: the
-// cube roots of both corrected colours, per channel, under a Cauchy loss).
+// Solves the corrections of `scan_count` scans from `pairs`: Levenberg–
+// Marquardt on the costs of color_costs.hpp under a Cauchy loss, within the
+// settings' bounds.
 HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t scan_count,
                                  const HarmonizeSettings& settings);
 

@@ -46,8 +46,7 @@ void Navigation::zoom(double steps) {
   eye_ = target_ - distance_ * forward();
 }
 
-void Navigation::fly(double forward_amount, double right_amount, double up_amount,
-                     double seconds) {
+void Navigation::fly(double forward_amount, double right_amount, double up_amount, double seconds) {
   const Eigen::Vector3d f = forward();
   const Eigen::Vector3d right = f.cross(Eigen::Vector3d::UnitZ()).normalized();
   const Eigen::Vector3d shift =

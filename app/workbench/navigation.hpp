@@ -33,7 +33,7 @@ class Navigation {
   Eigen::Vector3d forward() const;
   Eigen::Vector3d target_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d eye_ = Eigen::Vector3d(-30.0, 0.0, 15.0);
-  double yaw_ = 0.0;    // of the view direction, about +z [rad]
+  double yaw_ = 0.0;      // of the view direction, about +z [rad]
   double pitch_ = -0.45;  // of the view direction above the horizon [rad]
   double distance_ = 33.0;
   double speed_ = 10.0;

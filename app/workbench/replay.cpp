@@ -40,13 +40,14 @@ struct Reader {
   int key(const json& j) const {
     namespace k = render::keys;
     static const std::map<std::string, int> names = {
-        {"Enter", k::kEnter}, {"Escape", k::kEscape}, {"Tab", k::kTab},
+        {"Enter", k::kEnter},         {"Escape", k::kEscape}, {"Tab", k::kTab},
         {"Backspace", k::kBackspace}, {"Delete", k::kDelete}, {"Left", k::kLeft},
-        {"Right", k::kRight}, {"Up", k::kUp}, {"Down", k::kDown}, {"Home", k::kHome},
-        {"End", k::kEnd}, {"Space", k::kSpace}};
+        {"Right", k::kRight},         {"Up", k::kUp},         {"Down", k::kDown},
+        {"Home", k::kHome},           {"End", k::kEnd},       {"Space", k::kSpace}};
     if (!j.is_string()) refuse("a key is a name such as \"Z\" or \"Enter\"");
     const std::string name = j.get<std::string>();
-    if (name.size() == 1 && ((name[0] >= 'A' && name[0] <= 'Z') || (name[0] >= '0' && name[0] <= '9')))
+    if (name.size() == 1 &&
+        ((name[0] >= 'A' && name[0] <= 'Z') || (name[0] >= '0' && name[0] <= '9')))
       return name[0];
     if (!names.count(name)) refuse("unknown key \"" + name + "\"");
     return names.at(name);
@@ -113,12 +114,17 @@ std::vector<unsigned> codepoints(const std::string& text, const Reader& reader) 
   std::vector<unsigned> out;
   for (std::size_t i = 0; i < text.size();) {
     const auto c = static_cast<unsigned char>(text[i]);
-    const int length = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
+    const int length = c < 0x80         ? 1
+                       : (c >> 5) == 6  ? 2
+                       : (c >> 4) == 14 ? 3
+                       : (c >> 3) == 30 ? 4
+                                        : 0;
     if (length == 0 || i + static_cast<std::size_t>(length) > text.size())
       reader.refuse("text is not valid UTF-8");
     unsigned value = length == 1 ? c : c & (0xFFu >> (length + 1));
     for (int k = 1; k < length; ++k)
-      value = (value << 6) | (static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]) & 0x3Fu);
+      value = (value << 6) |
+              (static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]) & 0x3Fu);
     out.push_back(value);
     i += static_cast<std::size_t>(length);
   }
@@ -140,7 +146,8 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
   for (std::size_t k = 0; k < events.size(); ++k) {
     reader.where = "events[" + std::to_string(k) + "]";
     const json& e = events[k];
-    if (!e.is_object() || e.empty()) reader.refuse("an event is an object such as {\"key\": \"Z\"}");
+    if (!e.is_object() || e.empty())
+      reader.refuse("an event is an object such as {\"key\": \"Z\"}");
     const int mods = reader.mods(e);
     if (e.contains("move")) {
       const auto [x, y] = reader.point(e["move"]);
@@ -155,7 +162,8 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
       add_button(out, button, true, mods);
       add_button(out, button, false, mods);
     } else if (e.contains("drag")) {
-      if (!e["drag"].is_array() || e["drag"].size() != 2) reader.refuse("drag is [[x0, y0], [x1, y1]]");
+      if (!e["drag"].is_array() || e["drag"].size() != 2)
+        reader.refuse("drag is [[x0, y0], [x1, y1]]");
       const auto [x0, y0] = reader.point(e["drag"][0]);
       const auto [x1, y1] = reader.point(e["drag"][1]);
       const int button = e.contains("button") ? reader.button(e["button"]) : 0;

@@ -21,8 +21,8 @@ std::array<std::uint8_t, 3> object_color(std::uint32_t id) {
 }
 
 std::uint8_t blend(std::uint8_t a, std::uint8_t b, float t) {
-  return static_cast<std::uint8_t>(std::lround((1.0f - t) * static_cast<float>(a) +
-                                               t * static_cast<float>(b)));
+  return static_cast<std::uint8_t>(
+      std::lround((1.0f - t) * static_cast<float>(a) + t * static_cast<float>(b)));
 }
 
 }  // namespace
@@ -107,12 +107,13 @@ void Session::click(double x, double y) {
   if (lasso_closed_) settings.constraints.lasso = lasso_;
   settings.constraints.barriers = barriers_;
   modeling::SelectResult result;
-  act("", [&] { result = modeling::select_region(project_, settings); }, false);
+  act(
+      "", [&] { result = modeling::select_region(project_, settings); }, false);
   if (status_.empty()) {
-    status_ = result.seed_open ? "grew " + std::to_string(result.region_pixels) +
-                                     " pixels; selection " +
-                                     std::to_string(result.selected_pixels)
-                               : "the seed cannot grow there (no normal, taken, or outside the lasso)";
+    status_ = result.seed_open
+                  ? "grew " + std::to_string(result.region_pixels) + " pixels; selection " +
+                        std::to_string(result.selected_pixels)
+                  : "the seed cannot grow there (no normal, taken, or outside the lasso)";
   }
 }
 
@@ -132,8 +133,9 @@ void Session::clear_constraints() {
 }
 
 bool Session::commit(const std::string& name, std::optional<std::int64_t> parent) {
-  return act("committed \"" + name + "\"",
-             [&] { modeling::commit_selection(project_, {scan_id_, name, parent}); });
+  return act("committed \"" + name + "\"", [&] {
+    modeling::commit_selection(project_, {scan_id_, name, parent});
+  });
 }
 
 bool Session::group(const std::string& name, const std::vector<std::int64_t>& children) {
@@ -141,18 +143,21 @@ bool Session::group(const std::string& name, const std::vector<std::int64_t>& ch
   for (const modeling::ObjectNode& n : nodes_) {
     if (!children.empty() && n.id == children.front()) parent = n.parent;
   }
-  return act("grouped " + std::to_string(children.size()) + " node(s) as \"" + name + "\"",
-             [&] { modeling::group_nodes(project_, {name, parent, children}); });
+  return act("grouped " + std::to_string(children.size()) + " node(s) as \"" + name + "\"", [&] {
+    modeling::group_nodes(project_, {name, parent, children});
+  });
 }
 
 bool Session::rename(std::int64_t node, const std::string& name) {
-  return act("renamed to \"" + name + "\"",
-             [&] { modeling::edit_node(project_, {node, name, std::nullopt, std::nullopt}); });
+  return act("renamed to \"" + name + "\"", [&] {
+    modeling::edit_node(project_, {node, name, std::nullopt, std::nullopt});
+  });
 }
 
 bool Session::set_hidden(std::int64_t node, bool hidden) {
-  return act(hidden ? "hidden" : "shown",
-             [&] { modeling::edit_node(project_, {node, std::nullopt, hidden, std::nullopt}); });
+  return act(hidden ? "hidden" : "shown", [&] {
+    modeling::edit_node(project_, {node, std::nullopt, hidden, std::nullopt});
+  });
 }
 
 bool Session::reparent(std::int64_t node, std::optional<std::int64_t> parent) {
@@ -168,8 +173,9 @@ bool Session::remove(std::int64_t node) {
 }
 
 bool Session::separate(std::int64_t node) {
-  return act("separated into its connected parts",
-             [&] { modeling::separate_object(project_, {node, scan_id_}); });
+  return act("separated into its connected parts", [&] {
+    modeling::separate_object(project_, {node, scan_id_});
+  });
 }
 
 bool Session::propose() {

@@ -96,9 +96,9 @@ class Session {
   std::vector<modeling::StoredScanSummary> scans_;
   std::int64_t scan_id_ = 0;
   acquisition::Scan scan_;
-  std::vector<Eigen::Vector3f> normal_;     // scan frame; zero where none
-  std::vector<std::uint32_t> membership_;   // empty: none
-  std::vector<std::uint8_t> selection_;     // empty: none
+  std::vector<Eigen::Vector3f> normal_;    // scan frame; zero where none
+  std::vector<std::uint32_t> membership_;  // empty: none
+  std::vector<std::uint8_t> selection_;    // empty: none
   std::size_t selected_ = 0;
   segmentation::Polyline lasso_;
   bool lasso_closed_ = false;

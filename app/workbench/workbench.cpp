@@ -1,14 +1,14 @@
 #include "app/workbench/workbench.hpp"
 
+#include <backends/imgui_impl_opengl3.h>
 #include <epoxy/gl.h>
 #include <imgui.h>
-#include <backends/imgui_impl_opengl3.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -42,7 +42,9 @@ constexpr double kReplayFrameSeconds = 1.0 / 30.0;
 
 struct Rect {
   float x = 0, y = 0, w = 0, h = 0;
-  bool contains(double px, double py) const { return px >= x && py >= y && px < x + w && py < y + h; }
+  bool contains(double px, double py) const {
+    return px >= x && py >= y && px < x + w && py < y + h;
+  }
 };
 
 std::string node_label(const modeling::ObjectNode& node) {
@@ -60,24 +62,24 @@ class Workbench final : public render::WindowInput {
     ImGuiIO& io = ImGui::GetIO();
     io.IniFilename = nullptr;
     const std::array<std::pair<ImGuiKey, int>, 19> map = {{{ImGuiKey_Tab, keys::kTab},
-                                                          {ImGuiKey_LeftArrow, keys::kLeft},
-                                                          {ImGuiKey_RightArrow, keys::kRight},
-                                                          {ImGuiKey_UpArrow, keys::kUp},
-                                                          {ImGuiKey_DownArrow, keys::kDown},
-                                                          {ImGuiKey_Home, keys::kHome},
-                                                          {ImGuiKey_End, keys::kEnd},
-                                                          {ImGuiKey_Delete, keys::kDelete},
-                                                          {ImGuiKey_Backspace, keys::kBackspace},
-                                                          {ImGuiKey_Space, keys::kSpace},
-                                                          {ImGuiKey_Enter, keys::kEnter},
-                                                          {ImGuiKey_Escape, keys::kEscape},
-                                                          {ImGuiKey_KeyPadEnter, keys::kEnter},
-                                                          {ImGuiKey_A, 'A'},
-                                                          {ImGuiKey_C, 'C'},
-                                                          {ImGuiKey_V, 'V'},
-                                                          {ImGuiKey_X, 'X'},
-                                                          {ImGuiKey_Y, 'Y'},
-                                                          {ImGuiKey_Z, 'Z'}}};
+                                                           {ImGuiKey_LeftArrow, keys::kLeft},
+                                                           {ImGuiKey_RightArrow, keys::kRight},
+                                                           {ImGuiKey_UpArrow, keys::kUp},
+                                                           {ImGuiKey_DownArrow, keys::kDown},
+                                                           {ImGuiKey_Home, keys::kHome},
+                                                           {ImGuiKey_End, keys::kEnd},
+                                                           {ImGuiKey_Delete, keys::kDelete},
+                                                           {ImGuiKey_Backspace, keys::kBackspace},
+                                                           {ImGuiKey_Space, keys::kSpace},
+                                                           {ImGuiKey_Enter, keys::kEnter},
+                                                           {ImGuiKey_Escape, keys::kEscape},
+                                                           {ImGuiKey_KeyPadEnter, keys::kEnter},
+                                                           {ImGuiKey_A, 'A'},
+                                                           {ImGuiKey_C, 'C'},
+                                                           {ImGuiKey_V, 'V'},
+                                                           {ImGuiKey_X, 'X'},
+                                                           {ImGuiKey_Y, 'Y'},
+                                                           {ImGuiKey_Z, 'Z'}}};
     for (const auto& [imgui_key, code] : map) io.KeyMap[imgui_key] = code;
     glGenTextures(1, &panorama_texture_);
     frame_whole_model();
@@ -255,12 +257,14 @@ class Workbench final : public render::WindowInput {
   void write_layout(const std::filesystem::path& file) const {
     nlohmann::json widgets = nlohmann::json::object();
     for (const auto& [name, at] : probes_) widgets[name] = {at[0], at[1]};
-    const nlohmann::json out = {
-        {"widgets", widgets},
-        {"panorama",
-         {{"x", panorama_.x + pan_[0]}, {"y", panorama_.y + pan_[1]}, {"scale", panorama_scale()},
-          {"columns", session_.scan().columns}, {"rows", session_.scan().rows}}},
-        {"view3d", {view3d_.x, view3d_.y, view3d_.w, view3d_.h}}};
+    const nlohmann::json out = {{"widgets", widgets},
+                                {"panorama",
+                                 {{"x", panorama_.x + pan_[0]},
+                                  {"y", panorama_.y + pan_[1]},
+                                  {"scale", panorama_scale()},
+                                  {"columns", session_.scan().columns},
+                                  {"rows", session_.scan().rows}}},
+                                {"view3d", {view3d_.x, view3d_.y, view3d_.w, view3d_.h}}};
     std::ofstream(file) << out.dump(1) << "\n";
   }
 
@@ -280,8 +284,7 @@ class Workbench final : public render::WindowInput {
     const float w = static_cast<float>(width), h = static_cast<float>(height);
     const float views_height = h - kToolbarHeight - kStatusHeight;
     panorama_ = {kPanelWidth, kToolbarHeight, w - kPanelWidth, std::round(0.45f * views_height)};
-    view3d_ = {kPanelWidth, panorama_.y + panorama_.h, w - kPanelWidth,
-               views_height - panorama_.h};
+    view3d_ = {kPanelWidth, panorama_.y + panorama_.h, w - kPanelWidth, views_height - panorama_.h};
   }
 
   float panorama_scale() const {
@@ -316,8 +319,9 @@ class Workbench final : public render::WindowInput {
   }
 
   void after_command() {
-    if (selected_.size() == 1 && !std::any_of(session_.nodes().begin(), session_.nodes().end(),
-                                              [&](const auto& n) { return n.id == *selected_.begin(); }))
+    if (selected_.size() == 1 &&
+        !std::any_of(session_.nodes().begin(), session_.nodes().end(),
+                     [&](const auto& n) { return n.id == *selected_.begin(); }))
       selected_.clear();
     load_color_editor();
   }
@@ -379,7 +383,8 @@ class Workbench final : public render::WindowInput {
     const std::size_t step = std::max<std::size_t>(1, n / 20000);
     std::array<std::vector<float>, 3> axes;
     for (std::size_t k = 0; k < n; k += step)
-      for (int a = 0; a < 3; ++a) axes[static_cast<std::size_t>(a)].push_back(model.points.position[k][a]);
+      for (int a = 0; a < 3; ++a)
+        axes[static_cast<std::size_t>(a)].push_back(model.points.position[k][a]);
     Eigen::AlignedBox3d box;
     for (int a = 0; a < 3; ++a) {
       std::vector<float>& v = axes[static_cast<std::size_t>(a)];
@@ -522,7 +527,8 @@ class Workbench final : public render::WindowInput {
     probe("rename");
     ImGui::SameLine();
     const modeling::ObjectNode* n = p ? node(*p) : nullptr;
-    if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n) session_.set_hidden(n->id, !n->hidden);
+    if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n)
+      session_.set_hidden(n->id, !n->hidden);
     probe("hide");
     ImGui::SameLine();
     if (ImGui::Button("Delete") && p) {
@@ -578,7 +584,8 @@ class Workbench final : public render::WindowInput {
     const bool two = n && selected_.size() == 2;
     ImGui::BeginDisabled(!two);
     if (ImGui::Button("Clone from other") && two) {
-      const std::int64_t source = *selected_.begin() == n->id ? *selected_.rbegin() : *selected_.begin();
+      const std::int64_t source =
+          *selected_.begin() == n->id ? *selected_.rbegin() : *selected_.begin();
       session_.clone(source, n->id);
     }
     probe("clone colour");
@@ -681,13 +688,15 @@ class Workbench final : public render::WindowInput {
   void status_bar() {
     const ImVec2 size = ImGui::GetIO().DisplaySize;
     place(0, size.y - kStatusHeight, size.x, kStatusHeight);
-    ImGui::Begin("Status", nullptr, kFixed | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar);
+    ImGui::Begin("Status", nullptr,
+                 kFixed | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar);
     const render::FramePlan& plan = last_plan_;
-    ImGui::Text("%s | selection %zu px | %zu of %zu points drawn (frustum %zu, backface %zu, "
-                "detail/budget %zu) in %.0f ms | %.1f fps",
-                session_.status().c_str(), session_.selected_pixels(), plan.submitted, plan.points,
-                plan.culled_frustum, plan.culled_backface, plan.culled_budget, last_draw_ms_,
-                frame_seconds_ > 0 ? 1.0 / frame_seconds_ : 0.0);
+    ImGui::Text(
+        "%s | selection %zu px | %zu of %zu points drawn (frustum %zu, backface %zu, "
+        "detail/budget %zu) in %.0f ms | %.1f fps",
+        session_.status().c_str(), session_.selected_pixels(), plan.submitted, plan.points,
+        plan.culled_frustum, plan.culled_backface, plan.culled_budget, last_draw_ms_,
+        frame_seconds_ > 0 ? 1.0 / frame_seconds_ : 0.0);
     ImGui::End();
   }
 
@@ -708,13 +717,15 @@ class Workbench final : public render::WindowInput {
       panorama_key_ = key;
     }
     ImDrawList* draw = ImGui::GetBackgroundDrawList();
-    const ImVec2 low(panorama_.x, panorama_.y), high(panorama_.x + panorama_.w, panorama_.y + panorama_.h);
+    const ImVec2 low(panorama_.x, panorama_.y),
+        high(panorama_.x + panorama_.w, panorama_.y + panorama_.h);
     draw->PushClipRect(low, high, true);
     draw->AddRectFilled(low, high, IM_COL32(20, 20, 24, 255));
     const acquisition::Scan& scan = session_.scan();
-    draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(panorama_texture_)),
-                   panorama_screen({0.0, 0.0}),
-                   panorama_screen({static_cast<double>(scan.columns), static_cast<double>(scan.rows)}));
+    draw->AddImage(
+        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(panorama_texture_)),
+        panorama_screen({0.0, 0.0}),
+        panorama_screen({static_cast<double>(scan.columns), static_cast<double>(scan.rows)}));
     const auto polyline = [&](const segmentation::Polyline& line, ImU32 colour, bool closed) {
       std::vector<ImVec2> points;
       for (const Eigen::Vector2d& v : line) points.push_back(panorama_screen(v));
@@ -724,7 +735,8 @@ class Workbench final : public render::WindowInput {
       for (const ImVec2& p : points) draw->AddCircleFilled(p, 3.0f, colour);
     };
     polyline(session_.lasso(), IM_COL32(80, 220, 255, 255), session_.lasso_closed());
-    for (const segmentation::Polyline& b : session_.barriers()) polyline(b, IM_COL32(255, 70, 70, 255), false);
+    for (const segmentation::Polyline& b : session_.barriers())
+      polyline(b, IM_COL32(255, 70, 70, 255), false);
     draw->PopClipRect();
   }
 
@@ -737,8 +749,8 @@ class Workbench final : public render::WindowInput {
       view_dirty_ = true;
     }
     if (view_dirty_) {
-      const render::RenderView view = render::make_render_view(navigation_.camera(w, h),
-                                                               session_.render_model().origin);
+      const render::RenderView view =
+          render::make_render_view(navigation_.camera(w, h), session_.render_model().origin);
       const render::FrameResult frame = renderer_->draw(view, settings_);
       last_plan_ = frame.plan;
       last_draw_ms_ = frame.frame_ms;
@@ -753,10 +765,12 @@ class Workbench final : public render::WindowInput {
     ImDrawList* draw = ImGui::GetBackgroundDrawList();
     // The texture's bottom row first: flipped.
     draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(picture.texture)),
-                   ImVec2(view3d_.x, view3d_.y), ImVec2(view3d_.x + view3d_.w, view3d_.y + view3d_.h),
+                   ImVec2(view3d_.x, view3d_.y),
+                   ImVec2(view3d_.x + view3d_.w, view3d_.y + view3d_.h),
                    ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
     draw->AddText(ImVec2(view3d_.x + 8, view3d_.y + 6), IM_COL32(255, 255, 255, 200),
-                  fly_ ? "walk/fly: W A S D Q E, drag to look" : "orbit: drag to turn, right-drag to pan, wheel to zoom");
+                  fly_ ? "walk/fly: W A S D Q E, drag to look"
+                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
   }
 
   const WorkbenchOptions& options_;

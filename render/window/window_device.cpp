@@ -75,7 +75,9 @@ WindowDevice::~WindowDevice() {
   glfwTerminate();
 }
 
-void WindowDevice::make_current() { glfwMakeContextCurrent(window_->handle); }
+void WindowDevice::make_current() {
+  glfwMakeContextCurrent(window_->handle);
+}
 
 std::string WindowDevice::describe() {
   make_current();
@@ -90,9 +92,13 @@ bool WindowDevice::close_requested() const {
   return glfwWindowShouldClose(window_->handle) == GLFW_TRUE;
 }
 
-void WindowDevice::poll_events() { glfwPollEvents(); }
+void WindowDevice::poll_events() {
+  glfwPollEvents();
+}
 
-void WindowDevice::swap_buffers() { glfwSwapBuffers(window_->handle); }
+void WindowDevice::swap_buffers() {
+  glfwSwapBuffers(window_->handle);
+}
 
 std::array<int, 2> WindowDevice::framebuffer_size() const {
   std::array<int, 2> size{};

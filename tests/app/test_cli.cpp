@@ -33,9 +33,9 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
 
 TEST(Cli, HelpSucceedsForEverySubcommand) {
   ScratchDir dir;
-  for (const char* command : {"import", "info", "export", "bench", "simulate", "geometry",
-                              "register", "merge", "history", "undo", "redo", "check", "objects",
-                              "segment", "render", "recolor", "harmonize"}) {
+  for (const char* command :
+       {"import", "info", "export", "bench", "simulate", "geometry", "register", "merge", "history",
+        "undo", "redo", "check", "objects", "segment", "render", "recolor", "harmonize"}) {
     const CliResult help = run_cli(dir, {command, "--help"});
     EXPECT_EQ(help.exit_code, 0) << command;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << command;
@@ -159,8 +159,8 @@ TEST(Cli, RecolorEditsAnObjectUndoablyAndRefusesWhatItCannotDo) {
   EXPECT_EQ(color["brightness"], 12.5);
   EXPECT_EQ(color["hue_deg"], 30.0);
   const auto history_size = [&] {
-    return nlohmann::json::parse(run_cli(dir, {"history", project.string(), "--json"}).out)
-        ["commands"]
+    return nlohmann::json::parse(
+               run_cli(dir, {"history", project.string(), "--json"}).out)["commands"]
         .size();
   };
   const std::size_t commands = history_size();
@@ -173,7 +173,10 @@ TEST(Cli, RecolorEditsAnObjectUndoablyAndRefusesWhatItCannotDo) {
         {"--object", "2", "--brightness", "1", "--clone", "1"},
         {"--to", "2"},
         {"--to", "2", "--paint-color", "#12345"},
-        {"--to", "2", "--clone-region", "1:0:0:2:2"}}) {
+        {"--to", "2", "--clone-region", "1:0:0:2:2"},
+        {"--to", "2", "--clone-region", "1:4294967296:0:4294967306:10"},
+        {"--to", "2", "--clone-region", "1:0:0:2"},
+        {"--to", "2", "--clone-region", "1:0:0:2:2:"}}) {
     std::vector<std::string> args = {"recolor", project.string()};
     args.insert(args.end(), bad.begin(), bad.end());
     const CliResult refused = run_cli(dir, args);

@@ -108,9 +108,9 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   const auto run = [&](const std::string& stage, const json& list) {
     const std::filesystem::path layout = dir / ("layout_" + stage + ".json");
     const std::filesystem::path shot = dir / ("workbench_" + stage + ".png");
-    const CliResult result =
-        run_on_display(dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
-                             "--screenshot", shot.string(), "--layout", layout.string()});
+    const CliResult result = run_on_display(
+        dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
+              "--screenshot", shot.string(), "--layout", layout.string()});
     EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
     EXPECT_TRUE(std::filesystem::exists(shot)) << stage;
     keep_screenshot(shot);
@@ -122,12 +122,16 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_EQ(start.data["panorama"]["columns"], 1800);
 
   // Two walls: a seed click each, named in the name field, Enter commits.
-  const Layout segmented = run(
-      "segment",
-      {{{"click", start.pixel(1309, 232)}}, {{"wait", 2}},
-       {{"click", start.widget("name")}}, {{"text", "wall west"}}, {{"key", "Enter"}},
-       {{"click", start.pixel(1235, 165)}}, {{"wait", 2}},
-       {{"click", start.widget("name")}}, {{"text", "wall south"}}, {{"key", "Enter"}}});
+  const Layout segmented = run("segment", {{{"click", start.pixel(1309, 232)}},
+                                           {{"wait", 2}},
+                                           {{"click", start.widget("name")}},
+                                           {{"text", "wall west"}},
+                                           {{"key", "Enter"}},
+                                           {{"click", start.pixel(1235, 165)}},
+                                           {{"wait", 2}},
+                                           {{"click", start.widget("name")}},
+                                           {{"text", "wall south"}},
+                                           {{"key", "Enter"}}});
   json tree = nodes(dir, project);
   ASSERT_EQ(tree.size(), 2u);
   EXPECT_EQ(tree[0]["name"], "wall west");
@@ -139,8 +143,10 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   const Layout grouped =
       run("group", {{{"click", segmented.widget("node wall west")}},
                     {{"click", segmented.widget("node wall south")}, {"mods", {"ctrl"}}},
-                    {{"click", segmented.widget("name")}}, {{"text", "keller hall"}},
-                    {{"click", segmented.widget("group")}}, {{"wait", 2}}});
+                    {{"click", segmented.widget("name")}},
+                    {{"text", "keller hall"}},
+                    {{"click", segmented.widget("group")}},
+                    {{"wait", 2}}});
   tree = nodes(dir, project);
   ASSERT_EQ(tree.size(), 3u);
   EXPECT_EQ(tree[2]["name"], "keller hall");
@@ -195,8 +201,8 @@ TEST(Workbench, BadEventsAndProjectsAreRefusedByName) {
   std::ofstream(not_json) << "{\"events\": [";
   EXPECT_EQ(run_on_display(dir, {project.string(), "--replay", not_json.string()}).exit_code, 2);
   // Without a display at all: a runtime failure that says what to do.
-  const CliResult no_display =
-      run_cli(dir, {"workbench", project.string(), "--replay", events(dir, "ok.json", json::array()).string()});
+  const CliResult no_display = run_cli(dir, {"workbench", project.string(), "--replay",
+                                             events(dir, "ok.json", json::array()).string()});
   if (std::getenv("DISPLAY") == nullptr) {
     EXPECT_EQ(no_display.exit_code, 1);
     EXPECT_THAT(no_display.err, HasSubstr("xvfb-run"));

@@ -192,8 +192,8 @@ TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
   const RenderModel model = model_of(project);
   const Eigen::Vector3d floor = mean_lab(model, static_cast<std::uint32_t>(room.floor));
   const Eigen::Vector3d wall = mean_lab(model, static_cast<std::uint32_t>(room.wall));
-  EXPECT_LT(acquisition::delta_e(floor, wall), 1.0) << floor.transpose() << " / "
-                                                      << wall.transpose();
+  EXPECT_LT(acquisition::delta_e(floor, wall), 1.0)
+      << floor.transpose() << " / " << wall.transpose();
   // Painting one colour (its lightness detail kept: what leaves the sRGB
   // gamut is clipped, so the mean lands within a little of the paint).
   CloneSettings paint;
@@ -206,6 +206,57 @@ TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
             2.0);
   ASSERT_TRUE(project.undo().has_value());
   EXPECT_EQ(model_of(project).points.rgba, model.points.rgba);
+}
+
+// Mean and standard deviation of the shown L* of a node's points.
+std::pair<double, double> lightness(const RenderModel& model, std::uint32_t node) {
+  double sum = 0.0, squares = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < model.points.size(); ++k) {
+    if (model.points.node[k] != node) continue;
+    const auto& c = model.points.rgba[k];
+    const double l = acquisition::srgb_to_lab({c[0], c[1], c[2]}).x();
+    sum += l;
+    squares += l * l;
+    ++n;
+  }
+  const double mean = sum / static_cast<double>(n);
+  return {mean, std::sqrt(std::max(0.0, squares / static_cast<double>(n) - mean * mean))};
+}
+
+// A textured room: every other column 40 levels darker, so each object
+// has a spread of lightness. A clone maps the target's mean and spread
+// onto the source's: an inverted ratio or a wrong offset shows.
+TEST(Clone, TheTargetTakesTheSourcesMeanAndSpread) {
+  const ScratchDir dir;
+  Project project = Project::create(dir / "p.sbproj");
+  test::RoomScan room = test::shared_room();
+  for (std::size_t i = 0; i < room.scan.pixel_count(); ++i) {
+    if ((i % static_cast<std::size_t>(room.scan.columns)) % 2 != 0) continue;
+    for (std::size_t c = 0; c < 3; ++c)
+      room.scan.rgb[3 * i + c] =
+          static_cast<std::uint8_t>(std::max(0, room.scan.rgb[3 * i + c] - 40));
+  }
+  const std::int64_t scan = test::insert_committed(project, room.scan);
+  Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const EncodedLayer& layer : encode_geometry(room.geometry))
+    project.put_layer(edit, scan, layer);
+  edit.commit("{}");
+  select_region(project, select_at(scan, 0, -45));
+  const std::int64_t floor = commit_selection(project, {scan, "floor", std::nullopt}).node_id;
+  select_region(project, select_at(scan, -20, 0));
+  const std::int64_t wall = commit_selection(project, {scan, "wall", std::nullopt}).node_id;
+  const auto source = lightness(model_of(project), static_cast<std::uint32_t>(wall));
+  const auto before = lightness(model_of(project), static_cast<std::uint32_t>(floor));
+  ASSERT_GT(std::abs(source.second - before.second), 1.0);  // the spreads differ
+  CloneSettings clone;
+  clone.target = floor;
+  clone.source_node = wall;
+  const CloneResult out = clone_color(project, clone);
+  EXPECT_NEAR(out.transfer.scale.x(), source.second / before.second, 1e-6);
+  const auto after = lightness(model_of(project), static_cast<std::uint32_t>(floor));
+  EXPECT_NEAR(after.first, source.first, 0.5);
+  EXPECT_NEAR(after.second, source.second, 0.5);
 }
 
 // The room scanned twice from the same place, the second copy's colours
@@ -235,7 +286,8 @@ TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
     core::Progress quiet;
     const HarmonizeStageResult out = harmonize_project(project, {}, quiet);
     ASSERT_EQ(out.scans.size(), 2u);
-    EXPECT_TRUE(out.scans[1].connected);
+    EXPECT_EQ(out.scans[1].reference, out.scans[0].id);
+    EXPECT_EQ(out.scans[0].reference, out.scans[0].id);
     EXPECT_GT(out.pairs, 1000u);
     for (int c = 0; c < 3; ++c) {
       EXPECT_NEAR(out.scans[1].correction.matrix(c, c) * gains[c], 1.0, 0.01) << "channel " << c;
@@ -256,10 +308,9 @@ TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
     const auto& c = model.points.rgba[k];
     const Eigen::Vector3d lab = acquisition::srgb_to_lab({c[0], c[1], c[2]});
     double nearest = 1e9;
-    for (const auto& f : {std::array<std::uint8_t, 3>{120, 120, 120},
-                          std::array<std::uint8_t, 3>{40, 60, 90},
-                          std::array<std::uint8_t, 3>{200, 30, 30},
-                          std::array<std::uint8_t, 3>{200, 200, 190}})
+    for (const auto& f :
+         {std::array<std::uint8_t, 3>{120, 120, 120}, std::array<std::uint8_t, 3>{40, 60, 90},
+          std::array<std::uint8_t, 3>{200, 30, 30}, std::array<std::uint8_t, 3>{200, 200, 190}})
       nearest = std::min(nearest, acquisition::delta_e(lab, acquisition::srgb_to_lab(f)));
     off += nearest > 1.5;
   }

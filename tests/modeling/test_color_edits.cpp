@@ -58,6 +58,16 @@ TEST(ColorEdit, EachParameterActsInLab) {
   EXPECT_EQ(apply(transfer, lab), Eigen::Vector3d(50.0, 11.0, -3.0));
 }
 
+// Gamma, then contrast, then brightness: L* 16 → 40 → 30 → 35 (contrast
+// first would give 50 + 2 · (16 − 50) < 0, clamped, and another result).
+TEST(ColorEdit, LightnessStepsApplyInTheirOrder) {
+  ResolvedColorEdit edit;
+  edit.gamma = 2.0;
+  edit.contrast = 2.0;
+  edit.brightness = 5.0;
+  EXPECT_NEAR(apply(edit, Eigen::Vector3d(16.0, 0.0, 0.0)).x(), 35.0, 1e-9);
+}
+
 TEST(ColorEdit, ChildrenInheritWhatTheyDoNotSet) {
   std::vector<ObjectNode> nodes(3);
   nodes[0].id = 1;

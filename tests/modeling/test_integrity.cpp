@@ -96,6 +96,45 @@ TEST(Integrity, ChangedSettingsInTheJournalAreFound) {
   EXPECT_THAT(joined(project.check().damage), HasSubstr("command 1 (import)"));
 }
 
+TEST(Integrity, ChangedColourEditsAndCorrectionsAreFound) {
+  const ScratchDir dir;
+  const auto file = sound_project(dir);
+  {
+    Project project = Project::open(file);
+    ObjectNode node;
+    node.id = project.new_node_id();
+    node.name = "wall";
+    node.color.hue_deg = 30.0;
+    Project::Edit edit = project.begin_command("recolor", "{}");
+    project.put_node(edit, node);
+    ScanColorCorrection gains;
+    gains.matrix.diagonal() << 1.1, 1.0, 0.9;
+    project.put_scan_color_correction(edit, project.scans().front().id, gains);
+    edit.commit("{}");
+  }
+  RawDatabase(file).execute("UPDATE object_nodes SET color_edit = '{\"hue_deg\": 90.0}'");
+  RawDatabase(file).execute(
+      "UPDATE scan_colors SET correction = replace(correction, '1.1', '1.2')");
+  const Project project = Project::open(file);
+  try {
+    project.object_nodes();
+    ADD_FAILURE() << "a changed colour edit was read";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.problem(), HasSubstr("checksum"));
+    EXPECT_THAT(error.position().detail, HasSubstr("object node"));
+  }
+  try {
+    project.scan_color_corrections();
+    ADD_FAILURE() << "a changed colour correction was read";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.problem(), HasSubstr("checksum"));
+    EXPECT_THAT(error.position().detail, HasSubstr("colour correction of scan 1"));
+  }
+  const std::string damage = joined(project.check().damage);
+  EXPECT_THAT(damage, HasSubstr("object node"));
+  EXPECT_THAT(damage, HasSubstr("colour correction of scan 1"));
+}
+
 TEST(Integrity, ADamagedLayerIsNamedByTheCheck) {
   const ScratchDir dir;
   const auto file = sound_project(dir);

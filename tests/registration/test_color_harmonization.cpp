@@ -1,6 +1,7 @@
 // The colour harmonisation solver on synthetic pairs: known gains and
-// offsets come back with outliers among the pairs, the first scan stays
-// fixed, and a scan no chain of pairs reaches is left alone.
+// offsets come back with outliers among the pairs, the first scan of each
+// group of overlapping scans stays fixed, and a scan in no pair is left
+// alone.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -54,7 +55,7 @@ TEST(ColorHarmonization, GainsAndOffsetsComeBackDespiteOutliers) {
   EXPECT_EQ(out.pairs, pairs.size());
   EXPECT_TRUE(out.corrections[0].matrix.isIdentity());
   for (std::size_t s = 1; s < 3; ++s) {
-    EXPECT_TRUE(out.connected[s]);
+    EXPECT_EQ(out.reference[s], 0);
     for (int c = 0; c < 3; ++c) {
       EXPECT_NEAR(out.corrections[s].matrix(c, c), truth[s].matrix(c, c), 0.01) << s << "," << c;
       EXPECT_NEAR(out.corrections[s].offset[c], truth[s].offset[c], 0.002) << s << "," << c;
@@ -81,11 +82,26 @@ TEST(ColorHarmonization, AScanWithoutOverlapsIsLeftAlone) {
   truth[1].matrix.diagonal() << 1.2, 1.2, 1.2;
   truth[2].matrix.diagonal() << 0.5, 0.5, 0.5;
   const HarmonizeResult out = harmonize_colors(synthetic_pairs(truth, 0.0, 2), 3, {});
-  EXPECT_TRUE(out.connected[1]);
-  EXPECT_FALSE(out.connected[2]);
+  EXPECT_EQ(out.reference[1], 0);
+  EXPECT_EQ(out.reference[2], -1);
   EXPECT_TRUE(out.corrections[2].matrix.isIdentity());
   EXPECT_NEAR(out.corrections[1].matrix(0, 0), 1.2, 0.005);
   EXPECT_TRUE(harmonize_colors({}, 1, {}).corrections[0].matrix.isIdentity());
+}
+
+// Scans 1 and 2 overlap each other but not scan 0 (which may have no
+// colour): scan 1 is their reference, and scan 2 is brought to it.
+TEST(ColorHarmonization, EachGroupOfOverlappingScansHasItsOwnReference) {
+  std::vector<Truth> truth(3);
+  truth[2].matrix.diagonal() << 1.3, 1.1, 0.9;
+  std::vector<ColorPair> pairs = synthetic_pairs(truth, 0.0, 0);
+  const HarmonizeResult out = harmonize_colors(pairs, 3, {});
+  EXPECT_EQ(out.reference[0], -1);
+  EXPECT_EQ(out.reference[1], 1);
+  EXPECT_EQ(out.reference[2], 1);
+  EXPECT_TRUE(out.corrections[1].matrix.isIdentity());
+  EXPECT_NEAR(out.corrections[2].matrix(0, 0), 1.3, 0.005);
+  EXPECT_NEAR(out.corrections[2].matrix(2, 2), 0.9, 0.005);
 }
 
 }  // namespace
