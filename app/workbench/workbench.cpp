@@ -307,6 +307,12 @@ class Workbench final : public render::WindowInput {
     probes_[name] = {0.5f * (low.x + high.x), 0.5f * (low.y + high.y)};
   }
 
+  // A slider's probe: the centre of its frame, not of frame and label.
+  void probe_slider(const std::string& name) {
+    const ImVec2 low = ImGui::GetItemRectMin(), high = ImGui::GetItemRectMax();
+    probes_[name] = {low.x + 0.5f * ImGui::CalcItemWidth(), 0.5f * (low.y + high.y)};
+  }
+
   void fly_keys(double seconds) {
     if (!fly_ || ImGui::GetIO().WantCaptureKeyboard) return;
     const auto held = [&](int key) { return held_.count(key) ? 1.0 : 0.0; };
@@ -554,15 +560,15 @@ class Workbench final : public render::WindowInput {
     // its place.
     ImGui::BeginDisabled(n == nullptr);
     ImGui::SliderFloat("brightness", &color_.brightness, -50.0f, 50.0f, "%.1f");
-    probe("brightness");
+    probe_slider("brightness");
     ImGui::SliderFloat("contrast", &color_.contrast, 0.2f, 3.0f, "%.2f");
-    probe("contrast");
+    probe_slider("contrast");
     ImGui::SliderFloat("gamma", &color_.gamma, 0.2f, 5.0f, "%.2f");
-    probe("gamma");
+    probe_slider("gamma");
     ImGui::SliderFloat("hue", &color_.hue, -180.0f, 180.0f, "%.0f°");
-    probe("hue");
+    probe_slider("hue");
     ImGui::SliderFloat("saturation", &color_.saturation, 0.0f, 3.0f, "%.2f");
-    probe("saturation");
+    probe_slider("saturation");
     if (ImGui::Button("Apply") && n) {
       modeling::ColorEdit set;
       set.brightness = color_.brightness;

@@ -7,6 +7,11 @@
 
 #include <string>
 
+#if defined(__SANITIZE_ADDRESS__)
+#include <dlfcn.h>
+#include <link.h>
+#endif
+
 #include "core/errors.hpp"
 
 namespace scanbench::render {
@@ -20,6 +25,24 @@ std::string glfw_error() {
   out.append(" (GLFW error ").append(std::to_string(code)).append(")");
   return out;
 }
+
+#if defined(__SANITIZE_ADDRESS__)
+// Under AddressSanitizer: pins every library loaded so far (the GL driver
+// that GLFW and ImGui's loader open, and close again at exit), so that
+// LeakSanitizer can still name them at exit and tests/lsan.supp applies to
+// the allocations the driver keeps for the process's life.
+void pin_loaded_libraries() {
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void*) {
+        if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0')
+          dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        return 0;
+      },
+      nullptr);
+}
+#else
+void pin_loaded_libraries() {}
+#endif
 
 WindowInput* input_of(GLFWwindow* window) {
   return static_cast<WindowInput*>(glfwGetWindowUserPointer(window));
@@ -51,6 +74,7 @@ WindowDevice::WindowDevice(int width, int height, const std::string& title)
   }
   glfwMakeContextCurrent(window_->handle);
   glfwSwapInterval(0);
+  pin_loaded_libraries();
   GLFWwindow* w = window_->handle;
   glfwSetCursorPosCallback(w, [](GLFWwindow* window, double x, double y) {
     if (WindowInput* in = input_of(window)) in->cursor_moved(x, y);

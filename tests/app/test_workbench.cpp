@@ -154,12 +154,15 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_EQ(tree[0]["parent"], tree[2]["id"]);
   EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
 
-  // The west wall recoloured: its hue slider clicked three quarters along,
-  // Apply; the screenshot shows it; then Ctrl+Z.
+  // The west wall recoloured: its hue slider clicked three quarters along
+  // and its saturation raised, Apply; the screenshot shows it; then Ctrl+Z.
   json hue = grouped.widget("hue");
   hue[0] = hue[0].get<double>() + 55.0;
+  json saturation = grouped.widget("saturation");
+  saturation[0] = saturation[0].get<double>() + 80.0;
   run("recolor", {{{"click", grouped.widget("node wall west")}},
                   {{"click", hue}},
+                  {{"click", saturation}},
                   {{"click", grouped.widget("apply colour")}},
                   {{"wait", 2}},
                   {{"screenshot", "workbench_recolored.png"}}});
@@ -167,6 +170,7 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   tree = nodes(dir, project);
   ASSERT_TRUE(tree[0].contains("color"));
   EXPECT_GT(tree[0]["color"]["hue_deg"].get<double>(), 30.0);
+  EXPECT_GT(tree[0]["color"]["saturation"].get<double>(), 1.5);
 
   // Undo, then fly: V, forward for a second, a look to the side.
   const json centre = grouped.view3d_centre();
