@@ -451,6 +451,18 @@ class Workbench final : public render::WindowInput {
                           s.summary.columns, s.summary.valid_points, t.x(), t.y(), t.z());
       }
     }
+    // The shown scan's pose: its scanner's position and heading in the world.
+    for (const modeling::StoredScanSummary& s : session_.scans()) {
+      if (s.id != session_.scan_id()) continue;
+      const Eigen::Isometry3d& pose = s.summary.T_world_scan;
+      const Eigen::Vector3d t = pose.translation();
+      const Eigen::Vector3d x = pose.linear().col(0);
+      const double heading = std::atan2(x.y(), x.x()) * 180.0 / 3.14159265358979323846;
+      const double tilt = std::acos(std::clamp(pose.linear()(2, 2), -1.0, 1.0)) * 180.0 /
+                          3.14159265358979323846;
+      ImGui::TextWrapped("pose: at %.3f, %.3f, %.3f m; heading %.2f°, tilt %.2f°", t.x(), t.y(),
+                         t.z(), heading, tilt);
+    }
     if (const auto report = session_.project().latest_result("register")) {
       if (ImGui::TreeNode("Registration report")) {
         const nlohmann::json j = nlohmann::json::parse(*report, nullptr, false);
