@@ -131,6 +131,87 @@ std::vector<unsigned> codepoints(const std::string& text, const Reader& reader) 
   return out;
 }
 
+// A mouse entry's events, appended to `out`; false when `e` is none.
+bool add_pointer_event(const json& e, const Reader& reader, int mods,
+                       std::vector<ReplayEvent>& out) {
+  if (e.contains("move")) {
+    const auto [x, y] = reader.point(e["move"]);
+    add_move(out, x, y);
+  } else if (e.contains("press") || e.contains("release")) {
+    const bool press = e.contains("press");
+    add_button(out, reader.button(press ? e["press"] : e["release"]), press, mods);
+  } else if (e.contains("click")) {
+    const auto [x, y] = reader.point(e["click"]);
+    const int button = e.contains("button") ? reader.button(e["button"]) : 0;
+    add_move(out, x, y);
+    add_button(out, button, true, mods);
+    add_button(out, button, false, mods);
+  } else if (e.contains("drag")) {
+    if (!e["drag"].is_array() || e["drag"].size() != 2)
+      reader.refuse("drag is [[x0, y0], [x1, y1]]");
+    const auto [x0, y0] = reader.point(e["drag"][0]);
+    const auto [x1, y1] = reader.point(e["drag"][1]);
+    const int button = e.contains("button") ? reader.button(e["button"]) : 0;
+    const int steps = std::max(1, e.contains("steps") ? reader.count(e["steps"], "steps") : 10);
+    add_move(out, x0, y0);
+    add_button(out, button, true, mods);
+    for (int s = 1; s <= steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      add_move(out, x0 + t * (x1 - x0), y0 + t * (y1 - y0));
+    }
+    add_button(out, button, false, mods);
+  } else if (e.contains("scroll")) {
+    if (!e["scroll"].is_number()) reader.refuse("scroll is a number of wheel steps");
+    if (e.contains("at")) {
+      const auto [x, y] = reader.point(e["at"]);
+      add_move(out, x, y);
+    }
+    ReplayEvent s;
+    s.kind = Kind::kScroll;
+    s.scroll = e["scroll"].get<double>();
+    out.push_back(s);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The events one entry of the file stands for, appended to `out`.
+void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& out) {
+  const int mods = reader.mods(e);
+  if (add_pointer_event(e, reader, mods, out)) return;
+  if (e.contains("key")) {
+    const int key = reader.key(e["key"]);
+    add_key(out, key, true, mods);
+    add_key(out, key, false, mods);
+  } else if (e.contains("hold")) {
+    const int key = reader.key(e["hold"]);
+    add_key(out, key, true, mods);
+    add_waits(out, e.contains("frames") ? reader.count(e["frames"], "frames") : 10);
+    add_key(out, key, false, mods);
+  } else if (e.contains("text")) {
+    if (!e["text"].is_string()) reader.refuse("text is a string");
+    for (const unsigned c : codepoints(e["text"].get<std::string>(), reader)) {
+      ReplayEvent t;
+      t.kind = Kind::kText;
+      t.codepoint = c;
+      out.push_back(t);
+    }
+  } else if (e.contains("wait")) {
+    add_waits(out, reader.count(e["wait"], "wait"));
+  } else if (e.contains("screenshot")) {
+    if (!e["screenshot"].is_string() || e["screenshot"].get<std::string>().empty())
+      reader.refuse("screenshot names a .png file");
+    ReplayEvent s;
+    s.kind = Kind::kScreenshot;
+    s.file = std::filesystem::path(e["screenshot"].get<std::string>());
+    if (s.file.is_relative()) s.file = reader.file.parent_path() / s.file;
+    out.push_back(s);
+  } else {
+    reader.refuse("unknown event: " + e.begin().key());
+  }
+}
+
 }  // namespace
 
 std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
@@ -148,73 +229,7 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
     const json& e = events[k];
     if (!e.is_object() || e.empty())
       reader.refuse("an event is an object such as {\"key\": \"Z\"}");
-    const int mods = reader.mods(e);
-    if (e.contains("move")) {
-      const auto [x, y] = reader.point(e["move"]);
-      add_move(out, x, y);
-    } else if (e.contains("press") || e.contains("release")) {
-      const bool press = e.contains("press");
-      add_button(out, reader.button(press ? e["press"] : e["release"]), press, mods);
-    } else if (e.contains("click")) {
-      const auto [x, y] = reader.point(e["click"]);
-      const int button = e.contains("button") ? reader.button(e["button"]) : 0;
-      add_move(out, x, y);
-      add_button(out, button, true, mods);
-      add_button(out, button, false, mods);
-    } else if (e.contains("drag")) {
-      if (!e["drag"].is_array() || e["drag"].size() != 2)
-        reader.refuse("drag is [[x0, y0], [x1, y1]]");
-      const auto [x0, y0] = reader.point(e["drag"][0]);
-      const auto [x1, y1] = reader.point(e["drag"][1]);
-      const int button = e.contains("button") ? reader.button(e["button"]) : 0;
-      const int steps = std::max(1, e.contains("steps") ? reader.count(e["steps"], "steps") : 10);
-      add_move(out, x0, y0);
-      add_button(out, button, true, mods);
-      for (int s = 1; s <= steps; ++s) {
-        const double t = static_cast<double>(s) / steps;
-        add_move(out, x0 + t * (x1 - x0), y0 + t * (y1 - y0));
-      }
-      add_button(out, button, false, mods);
-    } else if (e.contains("scroll")) {
-      if (!e["scroll"].is_number()) reader.refuse("scroll is a number of wheel steps");
-      if (e.contains("at")) {
-        const auto [x, y] = reader.point(e["at"]);
-        add_move(out, x, y);
-      }
-      ReplayEvent s;
-      s.kind = Kind::kScroll;
-      s.scroll = e["scroll"].get<double>();
-      out.push_back(s);
-    } else if (e.contains("key")) {
-      const int key = reader.key(e["key"]);
-      add_key(out, key, true, mods);
-      add_key(out, key, false, mods);
-    } else if (e.contains("hold")) {
-      const int key = reader.key(e["hold"]);
-      add_key(out, key, true, mods);
-      add_waits(out, e.contains("frames") ? reader.count(e["frames"], "frames") : 10);
-      add_key(out, key, false, mods);
-    } else if (e.contains("text")) {
-      if (!e["text"].is_string()) reader.refuse("text is a string");
-      for (const unsigned c : codepoints(e["text"].get<std::string>(), reader)) {
-        ReplayEvent t;
-        t.kind = Kind::kText;
-        t.codepoint = c;
-        out.push_back(t);
-      }
-    } else if (e.contains("wait")) {
-      add_waits(out, reader.count(e["wait"], "wait"));
-    } else if (e.contains("screenshot")) {
-      if (!e["screenshot"].is_string() || e["screenshot"].get<std::string>().empty())
-        reader.refuse("screenshot names a .png file");
-      ReplayEvent s;
-      s.kind = Kind::kScreenshot;
-      s.file = std::filesystem::path(e["screenshot"].get<std::string>());
-      if (s.file.is_relative()) s.file = file.parent_path() / s.file;
-      out.push_back(s);
-    } else {
-      reader.refuse("unknown event: " + e.begin().key());
-    }
+    add_event(e, reader, out);
   }
   return out;
 }

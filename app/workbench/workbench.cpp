@@ -676,7 +676,13 @@ class Workbench final : public render::WindowInput {
     session_.mode = static_cast<modeling::SelectMode>(mode);
     ImGui::SameLine();
     if (ImGui::Button("Clear lasso")) session_.clear_constraints();
-    // Second row: the name for commits, groups and renames, and commit.
+    commands_row();
+    ImGui::End();
+  }
+
+  // The toolbar's second row: the name for commits, groups and renames,
+  // commit, proposals, the panoramic view's channel, undo and redo.
+  void commands_row() {
     ImGui::SetNextItemWidth(220);
     if (ImGui::InputText("name", name_.data(), name_.size(),
                          ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll))
@@ -695,12 +701,17 @@ class Workbench final : public render::WindowInput {
     ImGui::Combo("view", &panorama_channel_, "colour\0range\0intensity\0normals\0");
     probe("panorama channel");
     ImGui::SameLine();
-    if (ImGui::Button("Undo")) session_.undo(), after_command();
+    if (ImGui::Button("Undo")) {
+      session_.undo();
+      after_command();
+    }
     probe("undo");
     ImGui::SameLine();
-    if (ImGui::Button("Redo")) session_.redo(), after_command();
+    if (ImGui::Button("Redo")) {
+      session_.redo();
+      after_command();
+    }
     probe("redo");
-    ImGui::End();
   }
 
   void status_bar() {
