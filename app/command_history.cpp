@@ -82,6 +82,14 @@ std::string summary(const modeling::CommandRecord& c) {
     return fmt::format("{} proposal(s), {} points", result.value("proposals", 0),
                        result.value("pixels", 0));
   }
+  if ((c.name == "recolor" || c.name == "clone") && result.contains("node")) {
+    const std::string color = result.contains("color") ? result["color"].dump() : "{}";
+    return fmt::format("node {}: {}", result.value("node", 0), color);
+  }
+  if (c.name == "harmonize" && result.contains("pairs")) {
+    return fmt::format("{} colour pairs, mean ΔE {:.2f} → {:.2f}", result.value("pairs", 0),
+                       result.value("delta_e_before", 0.0), result.value("delta_e_after", 0.0));
+  }
   if (c.name == "delete" && result.contains("nodes")) {
     return fmt::format("{} node(s), points to the {}", result["nodes"].size(),
                        settings.value("points", "pool") == "pool" ? "pool" : "deleted");

@@ -1,6 +1,8 @@
 // scanbench workbench PROJECT [--replay EVENTS.json] [--screenshot OUT.png] [--layout OUT.json]
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "app/commands.hpp"
 #include "app/workbench/workbench.hpp"
@@ -32,6 +34,12 @@ void add_workbench_command(CLI::App& app) {
   command->callback([options] {
     if (!options->screenshot.empty() && options->screenshot.extension() != ".png")
       throw CLI::ValidationError("--screenshot", "must name a .png file");
+    for (const auto& [option, file] :
+         {std::pair{"--screenshot", options->screenshot}, std::pair{"--layout", options->layout}}) {
+      const std::filesystem::path folder = file.parent_path().empty() ? "." : file.parent_path();
+      if (!file.empty() && !std::filesystem::is_directory(folder))
+        throw CLI::ValidationError(option, "the folder " + folder.string() + " does not exist");
+    }
     options->height = options->width * 5 / 8;
     workbench::run_workbench(*options);
   });

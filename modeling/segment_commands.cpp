@@ -44,7 +44,8 @@ void require_group(const Tree& tree, std::optional<std::int64_t> parent) {
 }
 
 void require_name(const std::string& name) {
-  if (name.empty()) refuse("name", "a node needs a name");
+  if (name.find_first_not_of(" \t\r\n") == std::string::npos)
+    refuse("name", "a node needs a name (not only spaces)");
 }
 
 // True when `ancestor` is `node` or above it.

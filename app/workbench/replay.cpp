@@ -206,6 +206,11 @@ void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& ou
     s.kind = Kind::kScreenshot;
     s.file = std::filesystem::path(e["screenshot"].get<std::string>());
     if (s.file.is_relative()) s.file = reader.file.parent_path() / s.file;
+    // Checked now, so that a replay never stops half-way for a bad path.
+    if (s.file.extension() != ".png") reader.refuse("screenshot names a .png file");
+    const std::filesystem::path folder = s.file.parent_path().empty() ? "." : s.file.parent_path();
+    if (!std::filesystem::is_directory(folder))
+      reader.refuse("the screenshot's folder " + folder.string() + " does not exist");
     out.push_back(s);
   } else {
     reader.refuse("unknown event: " + e.begin().key());

@@ -121,6 +121,8 @@ void Session::finish_polyline() {
   if (tool == Tool::kLasso && lasso_.size() >= 3) {
     lasso_closed_ = true;
     status_ = "lasso closed: grows stay inside it";
+  } else if (tool == Tool::kLasso) {
+    status_ = "a lasso needs at least 3 vertices; it has " + std::to_string(lasso_.size());
   }
   if (tool == Tool::kBarrier) drawing_barrier_ = false;
 }

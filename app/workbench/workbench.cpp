@@ -111,7 +111,7 @@ class Workbench final : public render::WindowInput {
 
   void button(int button, bool pressed, int mods) override {
     ImGuiIO& io = ImGui::GetIO();
-    set_mods(mods);
+    set_mods(pressed ? mods : 0);
     if (button >= 0 && button < 5) io.MouseDown[button] = pressed;
     if (!pressed) {
       drag_ = Drag::kNone;
@@ -151,15 +151,15 @@ class Workbench final : public render::WindowInput {
 
   void key(int key, bool pressed, int mods) override {
     ImGuiIO& io = ImGui::GetIO();
-    set_mods(mods);
-    if (key == keys::kLeftControl) io.KeyCtrl = pressed;
-    if (key == keys::kLeftShift) io.KeyShift = pressed;
     if (key >= 0 && key < 512) io.KeysDown[key] = pressed;
     if (pressed) {
       held_.insert(key);
     } else {
       held_.erase(key);
     }
+    // A key's modifiers hold while it is down; after that only the
+    // modifier keys still held count (a replayed Ctrl+Z lets Ctrl go).
+    set_mods(pressed ? mods : 0);
     if (!pressed || io.WantTextInput) return;
     // Undo and redo work wherever the keyboard is, text fields excepted
     // (they have their own).
@@ -174,7 +174,9 @@ class Workbench final : public render::WindowInput {
       after_command();
       return;
     }
-    if (io.WantCaptureKeyboard || control) return;
+    // Letter shortcuts act unless a text field has the keyboard (not "any
+    // widget": a click on a tree node would otherwise swallow the next key).
+    if (control) return;
     switch (key) {
       case 'S':
         session_.tool = Tool::kSeed;
@@ -217,7 +219,7 @@ class Workbench final : public render::WindowInput {
     const auto [width, height] = window_.framebuffer_size();
     io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
     io.DeltaTime = static_cast<float>(std::max(seconds, 1e-4));
-    frame_seconds_ = 0.9 * frame_seconds_ + 0.1 * seconds;
+    frame_seconds_ = frames_ == 0 ? seconds : 0.9 * frame_seconds_ + 0.1 * seconds;
     layout(width, height);
     fly_keys(seconds);
     ImGui_ImplOpenGL3_NewFrame();
@@ -265,7 +267,9 @@ class Workbench final : public render::WindowInput {
                                   {"columns", session_.scan().columns},
                                   {"rows", session_.scan().rows}}},
                                 {"view3d", {view3d_.x, view3d_.y, view3d_.w, view3d_.h}}};
-    std::ofstream(file) << out.dump(1) << "\n";
+    std::ofstream stream(file);
+    stream << out.dump(1) << "\n";
+    if (!stream.flush()) throw core::RuntimeFailure(file.string(), {}, "cannot write the layout");
   }
 
  private:
@@ -273,11 +277,15 @@ class Workbench final : public render::WindowInput {
 
   std::string name() const { return std::string(name_.data()); }
 
+  // ImGui's modifier state: the modifier keys held, and `mods` of the event.
   void set_mods(int mods) {
     ImGuiIO& io = ImGui::GetIO();
-    io.KeyCtrl = (mods & keys::kModControl) != 0;
-    io.KeyShift = (mods & keys::kModShift) != 0;
-    io.KeyAlt = (mods & keys::kModAlt) != 0;
+    const auto held = [&](int left, int right) {
+      return held_.count(left) != 0 || held_.count(right) != 0;
+    };
+    io.KeyCtrl = held(keys::kLeftControl, keys::kRightControl) || (mods & keys::kModControl) != 0;
+    io.KeyShift = held(keys::kLeftShift, keys::kRightShift) || (mods & keys::kModShift) != 0;
+    io.KeyAlt = held(keys::kLeftAlt, keys::kRightAlt) || (mods & keys::kModAlt) != 0;
   }
 
   void layout(int width, int height) {
@@ -314,7 +322,7 @@ class Workbench final : public render::WindowInput {
   }
 
   void fly_keys(double seconds) {
-    if (!fly_ || ImGui::GetIO().WantCaptureKeyboard) return;
+    if (!fly_ || ImGui::GetIO().WantTextInput) return;
     const auto held = [&](int key) { return held_.count(key) ? 1.0 : 0.0; };
     const double forward = held('W') - held('S');
     const double right = held('D') - held('A');
@@ -337,17 +345,19 @@ class Workbench final : public render::WindowInput {
     return primary_;
   }
 
-  const modeling::ObjectNode* node(std::int64_t id) const {
+  // A copy of node `id`: a command reloads the tree, so pointers into it do
+  // not outlive one.
+  std::optional<modeling::ObjectNode> node(std::int64_t id) const {
     for (const modeling::ObjectNode& n : session_.nodes())
-      if (n.id == id) return &n;
-    return nullptr;
+      if (n.id == id) return n;
+    return std::nullopt;
   }
 
   // A new object from the selection, in the selected group if one is.
   void commit() {
     std::optional<std::int64_t> parent;
     if (const auto p = primary(); p && node(*p)) {
-      const modeling::ObjectNode& n = *node(*p);
+      const modeling::ObjectNode n = *node(*p);
       parent = n.kind == modeling::NodeKind::kGroup ? std::optional(n.id) : n.parent;
     }
     if (session_.commit(name(), parent)) {
@@ -369,9 +379,10 @@ class Workbench final : public render::WindowInput {
 
   void load_color_editor() {
     color_ = {};
+    touched_ = {};
     const auto p = primary();
     if (!p || !node(*p)) return;
-    const modeling::ColorEdit& own = node(*p)->color;
+    const modeling::ColorEdit own = node(*p)->color;
     color_.brightness = static_cast<float>(own.brightness.value_or(0.0));
     color_.contrast = static_cast<float>(own.contrast.value_or(1.0));
     color_.gamma = static_cast<float>(own.gamma.value_or(1.0));
@@ -404,7 +415,7 @@ class Workbench final : public render::WindowInput {
 
   void frame_selection() {
     const auto p = primary();
-    const modeling::ObjectNode* n = p ? node(*p) : nullptr;
+    const std::optional<modeling::ObjectNode> n = p ? node(*p) : std::nullopt;
     if (n && n->bbox_world) {
       navigation_.frame(*n->bbox_world);
       view_dirty_ = true;
@@ -458,8 +469,8 @@ class Workbench final : public render::WindowInput {
       const Eigen::Vector3d t = pose.translation();
       const Eigen::Vector3d x = pose.linear().col(0);
       const double heading = std::atan2(x.y(), x.x()) * 180.0 / 3.14159265358979323846;
-      const double tilt = std::acos(std::clamp(pose.linear()(2, 2), -1.0, 1.0)) * 180.0 /
-                          3.14159265358979323846;
+      const double tilt =
+          std::acos(std::clamp(pose.linear()(2, 2), -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
       ImGui::TextWrapped("pose: at %.3f, %.3f, %.3f m; heading %.2f°, tilt %.2f°", t.x(), t.y(),
                          t.z(), heading, tilt);
     }
@@ -499,7 +510,7 @@ class Workbench final : public render::WindowInput {
       if (const ImGuiPayload* payload = ImGui::AcceptDragDropPayload("scanbench-node")) {
         std::int64_t moved = 0;
         std::memcpy(&moved, payload->Data, sizeof moved);
-        if (moved != n.id) session_.reparent(moved, n.id);
+        if (moved != n.id) pending_reparent_ = {moved, n.id};
       }
       ImGui::EndDragDropTarget();
     }
@@ -532,9 +543,13 @@ class Workbench final : public render::WindowInput {
       if (const ImGuiPayload* payload = ImGui::AcceptDragDropPayload("scanbench-node")) {
         std::int64_t moved = 0;
         std::memcpy(&moved, payload->Data, sizeof moved);
-        session_.reparent(moved, std::nullopt);
+        pending_reparent_ = {moved, std::nullopt};
       }
       ImGui::EndDragDropTarget();
+    }
+    if (pending_reparent_) {
+      session_.reparent(pending_reparent_->first, pending_reparent_->second);
+      pending_reparent_.reset();
     }
     const auto p = primary();
     ImGui::BeginDisabled(selected_.empty());
@@ -544,7 +559,7 @@ class Workbench final : public render::WindowInput {
     if (ImGui::Button("Rename") && p) session_.rename(*p, name());
     probe("rename");
     ImGui::SameLine();
-    const modeling::ObjectNode* n = p ? node(*p) : nullptr;
+    const std::optional<modeling::ObjectNode> n = p ? node(*p) : std::nullopt;
     if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n)
       session_.set_hidden(n->id, !n->hidden);
     probe("hide");
@@ -566,29 +581,32 @@ class Workbench final : public render::WindowInput {
   void color_section() {
     if (!ImGui::CollapsingHeader("Colour", ImGuiTreeNodeFlags_DefaultOpen)) return;
     const auto p = primary();
-    const modeling::ObjectNode* n = p ? node(*p) : nullptr;
+    const std::optional<modeling::ObjectNode> n = p ? node(*p) : std::nullopt;
     ImGui::Text("%s", n ? n->name.c_str() : "select an object to edit its colours");
     // Present without a selection too (disabled), so the panel below keeps
     // its place.
-    ImGui::BeginDisabled(n == nullptr);
-    ImGui::SliderFloat("brightness", &color_.brightness, -50.0f, 50.0f, "%.1f");
+    ImGui::BeginDisabled(!n);
+    touched_[0] |= ImGui::SliderFloat("brightness", &color_.brightness, -50.0f, 50.0f, "%.1f");
     probe_slider("brightness");
-    ImGui::SliderFloat("contrast", &color_.contrast, 0.2f, 3.0f, "%.2f");
+    touched_[1] |= ImGui::SliderFloat("contrast", &color_.contrast, 0.2f, 3.0f, "%.2f");
     probe_slider("contrast");
-    ImGui::SliderFloat("gamma", &color_.gamma, 0.2f, 5.0f, "%.2f");
+    touched_[2] |= ImGui::SliderFloat("gamma", &color_.gamma, 0.2f, 5.0f, "%.2f");
     probe_slider("gamma");
-    ImGui::SliderFloat("hue", &color_.hue, -180.0f, 180.0f, "%.0f°");
+    touched_[3] |= ImGui::SliderFloat("hue", &color_.hue, -180.0f, 180.0f, "%.0f°");
     probe_slider("hue");
-    ImGui::SliderFloat("saturation", &color_.saturation, 0.0f, 3.0f, "%.2f");
+    touched_[4] |= ImGui::SliderFloat("saturation", &color_.saturation, 0.0f, 3.0f, "%.2f");
     probe_slider("saturation");
+    // Apply sets what was moved (and keeps what the node set before); the
+    // rest it goes on inheriting.
     if (ImGui::Button("Apply") && n) {
       modeling::ColorEdit set;
-      set.brightness = color_.brightness;
-      set.contrast = color_.contrast;
-      set.gamma = color_.gamma;
-      set.hue_deg = color_.hue;
-      set.saturation = color_.saturation;
-      session_.recolor(n->id, set, false);
+      if (touched_[0]) set.brightness = color_.brightness;
+      if (touched_[1]) set.contrast = color_.contrast;
+      if (touched_[2]) set.gamma = color_.gamma;
+      if (touched_[3]) set.hue_deg = color_.hue;
+      if (touched_[4]) set.saturation = color_.saturation;
+      if (!set.empty()) session_.recolor(n->id, set, false);
+      load_color_editor();
     }
     probe("apply colour");
     ImGui::SameLine();
@@ -605,6 +623,7 @@ class Workbench final : public render::WindowInput {
       const std::int64_t source =
           *selected_.begin() == n->id ? *selected_.rbegin() : *selected_.begin();
       session_.clone(source, n->id);
+      load_color_editor();
     }
     probe("clone colour");
     ImGui::EndDisabled();
@@ -622,7 +641,7 @@ class Workbench final : public render::WindowInput {
     changed |= ImGui::Checkbox("two-pass blending", &blended);
     settings_.mode = blended ? render::DrawMode::kBlended : render::DrawMode::kSplats;
     int budget = static_cast<int>(settings_.culling.budget / 1000);
-    changed |= ImGui::SliderInt("budget [k points]", &budget, 50, 8000);
+    changed |= ImGui::SliderInt("budget (k)", &budget, 50, 8000);
     settings_.culling.budget = static_cast<std::size_t>(budget) * 1000;
     int color = static_cast<int>(settings_.color);
     changed |= ImGui::Combo("colour", &color, "colour\0intensity\0height\0normal\0object\0");
@@ -655,7 +674,7 @@ class Workbench final : public render::WindowInput {
     ImGui::SameLine();
     ImGui::SetNextItemWidth(100);
     int channel = static_cast<int>(session_.channel);
-    if (ImGui::Combo("##channel", &channel, "range\0color\0intensity\0normal\0")) {
+    if (ImGui::Combo("##channel", &channel, "range\0colour\0intensity\0normal\0")) {
       session_.channel = static_cast<segmentation::Channel>(channel);
       session_.tolerance = segmentation::default_grow_settings(session_.channel).tolerance;
     }
@@ -663,7 +682,10 @@ class Workbench final : public render::WindowInput {
     ImGui::SameLine();
     ImGui::SetNextItemWidth(90);
     float tolerance = static_cast<float>(session_.tolerance);
-    if (ImGui::DragFloat("tolerance", &tolerance, 0.1f, 0.1f, 100.0f, "%.1f"))
+    // Units by channel (region_grow.hpp): range in footprints, colour in
+    // ΔE, intensity in shares of the scan's spread, normal in degrees.
+    if (ImGui::DragFloat("tolerance", &tolerance, 0.01f * std::max(tolerance, 0.01f), 0.001f,
+                         100.0f, "%.3g"))
       session_.tolerance = tolerance;
     ImGui::SameLine();
     int mode = static_cast<int>(session_.mode);
@@ -721,11 +743,11 @@ class Workbench final : public render::WindowInput {
                  kFixed | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar);
     const render::FramePlan& plan = last_plan_;
     ImGui::Text(
-        "%s | selection %zu px | %zu of %zu points drawn (frustum %zu, backface %zu, "
-        "detail/budget %zu) in %.0f ms | %.1f fps",
-        session_.status().c_str(), session_.selected_pixels(), plan.submitted, plan.points,
-        plan.culled_frustum, plan.culled_backface, plan.culled_budget, last_draw_ms_,
-        frame_seconds_ > 0 ? 1.0 / frame_seconds_ : 0.0);
+        "%s | selection %zu px | 3D: %zu of %zu points drawn (frustum %zu, backface %zu, "
+        "detail/budget %zu) in %.0f ms | %.1f frames/s",
+        session_.status().empty() ? "ready" : session_.status().c_str(), session_.selected_pixels(),
+        plan.submitted, plan.points, plan.culled_frustum, plan.culled_backface, plan.culled_budget,
+        last_draw_ms_, frame_seconds_ > 0 ? 1.0 / frame_seconds_ : 0.0);
     ImGui::End();
   }
 
@@ -832,6 +854,10 @@ class Workbench final : public render::WindowInput {
   struct {
     float brightness = 0.0f, contrast = 1.0f, gamma = 1.0f, hue = 0.0f, saturation = 1.0f;
   } color_;
+  std::array<bool, 5> touched_{};  // the colour sliders moved since the node was selected
+  // A drop in the object tree, made after the tree is drawn (the move
+  // reloads the nodes the tree is walking): the node and its new parent.
+  std::optional<std::pair<std::int64_t, std::optional<std::int64_t>>> pending_reparent_;
   std::map<std::string, std::array<float, 2>> probes_;
   double frame_seconds_ = 0.0;
   std::int64_t frames_ = 0;

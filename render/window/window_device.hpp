@@ -31,6 +31,10 @@ inline constexpr int kHome = 268;
 inline constexpr int kEnd = 269;
 inline constexpr int kLeftShift = 340;
 inline constexpr int kLeftControl = 341;
+inline constexpr int kLeftAlt = 342;
+inline constexpr int kRightShift = 344;
+inline constexpr int kRightControl = 345;
+inline constexpr int kRightAlt = 346;
 // Letters and digits are their ASCII upper-case codes ('A' = 65, '0' = 48).
 }  // namespace keys
 

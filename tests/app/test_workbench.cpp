@@ -125,6 +125,7 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   const Layout segmented = run("segment", {{{"click", start.pixel(1309, 232)}},
                                            {{"wait", 2}},
                                            {{"click", start.widget("name")}},
+                                           {{"key", "A"}, {"mods", {"ctrl"}}},
                                            {{"text", "wall west"}},
                                            {{"key", "Enter"}},
                                            {{"click", start.pixel(1235, 165)}},
@@ -186,6 +187,19 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   ASSERT_FALSE(history.empty());
   EXPECT_EQ(history.back()["name"], "recolor");
   EXPECT_EQ(history.back()["state"], "undone");
+
+  // Drag and drop in the object tree: the south wall out of the group to
+  // the roots (the panel's empty part), then back onto the group.
+  json empty = grouped.widget("node wall south");
+  empty[1] = empty[1].get<double>() + 100.0;
+  const Layout out =
+      run("reparent_out", {{{"drag", {grouped.widget("node wall south"), empty}}}, {{"wait", 2}}});
+  tree = nodes(dir, project);
+  EXPECT_TRUE(tree[1]["parent"].is_null());
+  run("reparent_in", {{{"drag", {out.widget("node wall south"), out.widget("node keller hall")}}},
+                      {{"wait", 2}}});
+  tree = nodes(dir, project);
+  EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
 }
 
 TEST(Workbench, BadEventsAndProjectsAreRefusedByName) {
