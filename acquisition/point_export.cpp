@@ -1,12 +1,18 @@
 #include "acquisition/point_export.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
+#include <cmath>
 #include <cstring>
+#include <ctime>
+#include <limits>
+#include <string_view>
 
 #include "acquisition/number_format.hpp"
 #include "acquisition/output_file.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -74,6 +80,93 @@ std::string ply_header(std::size_t vertices, Channels channels) {
   return header + "end_header\n";
 }
 
+// ---- LAS 1.4 -------------------------------------------------------------
+
+constexpr double kLasScale = 1e-4;  // 0.1 mm
+constexpr std::uint16_t kLasHeaderSize = 375;
+constexpr std::uint16_t kVlrHeaderSize = 54;
+constexpr std::uint16_t kExtraBytesDescriptorSize = 192;
+constexpr std::uint16_t kPointFormat7Size = 36;
+
+// A fixed-size, zero-padded character field.
+void append_text(std::string& out, std::string_view text, std::size_t size) {
+  std::string field(size, '\0');
+  std::copy_n(text.begin(), std::min(text.size(), size), field.begin());
+  out += field;
+}
+
+struct LasExtent {
+  std::size_t points = 0;
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
+};
+
+// The four extra bytes fields of the geometry: one descriptor each.
+std::string extra_bytes_vlr() {
+  std::string out;
+  append_binary(out, std::uint16_t{0});  // reserved
+  append_text(out, "LASF_Spec", 16);
+  append_binary(out, std::uint16_t{4});  // the extra bytes record
+  append_binary(out, static_cast<std::uint16_t>(4 * kExtraBytesDescriptorSize));
+  append_text(out, "normal and footprint", 32);
+  const std::array<std::pair<const char*, const char*>, 4> fields = {
+      {{"NormalX", "unit normal, world x"},
+       {"NormalY", "unit normal, world y"},
+       {"NormalZ", "unit normal, world z"},
+       {"Footprint", "footprint radius [m]"}}};
+  for (const auto& [name, description] : fields) {
+    std::string d(kExtraBytesDescriptorSize, '\0');
+    d[2] = 9;  // data type: float
+    std::copy_n(name, std::strlen(name), d.begin() + 4);
+    std::copy_n(description, std::strlen(description), d.begin() + 160);
+    out += d;
+  }
+  return out;
+}
+
+std::string las_header(const LasExtent& extent, bool extra_bytes, const Eigen::Vector3d& offset) {
+  std::string h;
+  h += "LASF";
+  append_binary(h, std::uint16_t{0});       // file source id
+  append_binary(h, std::uint16_t{1 << 4});  // global encoding: WKT (required for formats 6–10)
+  append_text(h, "", 16);                   // project GUID
+  h += '\x01';
+  h += '\x04';  // version 1.4
+  append_text(h, "scanbench", 32);
+  append_text(h, "scanbench export", 32);
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  append_binary(h, static_cast<std::uint16_t>(utc.tm_yday + 1));
+  append_binary(h, static_cast<std::uint16_t>(utc.tm_year + 1900));
+  append_binary(h, kLasHeaderSize);
+  const std::uint32_t vlr_bytes =
+      extra_bytes ? kVlrHeaderSize + 4u * kExtraBytesDescriptorSize : 0u;
+  append_binary(h, static_cast<std::uint32_t>(kLasHeaderSize + vlr_bytes));  // offset to points
+  append_binary(h, static_cast<std::uint32_t>(extra_bytes ? 1 : 0));         // VLRs
+  h += '\x07';  // point data record format 7
+  append_binary(h, static_cast<std::uint16_t>(kPointFormat7Size + (extra_bytes ? 16 : 0)));
+  for (int k = 0; k < 6; ++k) append_binary(h, std::uint32_t{0});  // legacy counts: 0 for 6–10
+  for (int axis = 0; axis < 3; ++axis) append_binary(h, kLasScale);
+  for (int axis = 0; axis < 3; ++axis) append_binary(h, offset[axis]);
+  for (int axis = 0; axis < 3; ++axis) {
+    append_binary(h, extent.max[axis]);
+    append_binary(h, extent.min[axis]);
+  }
+  append_binary(h, std::uint64_t{0});  // waveform data
+  append_binary(h, std::uint64_t{0});  // first extended VLR
+  append_binary(h, std::uint32_t{0});  // extended VLRs
+  append_binary(h, static_cast<std::uint64_t>(extent.points));
+  append_binary(h, static_cast<std::uint64_t>(extent.points));  // by return: all are first
+  for (int k = 1; k < 15; ++k) append_binary(h, std::uint64_t{0});
+  assert(h.size() == kLasHeaderSize && "the LAS 1.4 header is 375 bytes");
+  return h;
+}
+
+std::uint16_t to_u16(double unit) {
+  return static_cast<std::uint16_t>(std::lround(std::clamp(unit, 0.0, 1.0) * 65535.0));
+}
+
 }  // namespace
 
 void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
@@ -130,6 +223,68 @@ void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
                    out += '\n';
                    file.flush_if_full();
                  });
+  file.commit();
+}
+
+void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const std::uint16_t> source_ids,
+               std::span<const ScanGeometry* const> geometry,
+               std::span<const std::vector<std::uint8_t>* const> keep) {
+  assert(source_ids.size() == scans.size() && "a point source id per scan");
+  const Channels channels = common_channels(scans, geometry);
+  LasExtent extent;
+  extent.min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  extent.max = -extent.min;
+  for_each_point(scans, geometry, keep, channels,
+                 [&](std::size_t, std::size_t, const Eigen::Vector3d& p) {
+                   ++extent.points;
+                   extent.min = extent.min.cwiseMin(p);
+                   extent.max = extent.max.cwiseMax(p);
+                 });
+  if (extent.points == 0) extent.min = extent.max = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d offset = extent.min;
+  // The largest quantised coordinate must fit a signed 32-bit integer.
+  const Eigen::Vector3d span = (extent.max - offset) / kLasScale;
+  if (span.maxCoeff() > static_cast<double>(std::numeric_limits<std::int32_t>::max())) {
+    throw core::InputError(path.string(), {},
+                           "the points span " + std::to_string(span.maxCoeff() * kLasScale) +
+                               " m on an axis: more than LAS can hold at 0.1 mm");
+  }
+  // The header's bounds are those of the quantised coordinates.
+  for (int axis = 0; axis < 3; ++axis)
+    extent.max[axis] = offset[axis] + std::round(span[axis]) * kLasScale;
+  OutputFile file(path);
+  file.write(las_header(extent, channels.geometry, offset));
+  if (channels.geometry) file.write(extra_bytes_vlr());
+  for_each_point(
+      scans, geometry, keep, channels, [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
+        const Scan& scan = scans[s];
+        std::string& out = file.buffer();
+        for (int axis = 0; axis < 3; ++axis) {
+          append_binary(
+              out, static_cast<std::int32_t>(std::lround((p[axis] - offset[axis]) / kLasScale)));
+        }
+        append_binary(out, channels.intensity ? to_u16(scan.intensity[i]) : std::uint16_t{0});
+        out += '\x11';                        // return 1 of 1
+        out += '\0';                          // classification flags, channel, direction, edge
+        out += '\0';                          // classification: never classified
+        out += '\0';                          // user data
+        append_binary(out, std::int16_t{0});  // scan angle
+        append_binary(out, source_ids[s]);
+        append_binary(out, 0.0);  // GPS time
+        for (int c = 0; c < 3; ++c) {
+          const std::uint16_t v =
+              channels.color ? static_cast<std::uint16_t>(scan.rgb[3 * i + c] * 257) : 0;
+          append_binary(out, v);
+        }
+        if (channels.geometry) {
+          const Eigen::Vector3f n =
+              (scan.T_world_scan.linear().cast<float>() * geometry[s]->normal[i]);
+          for (int axis = 0; axis < 3; ++axis) append_binary(out, n[axis]);
+          append_binary(out, geometry[s]->footprint_m[i]);
+        }
+        file.flush_if_full();
+      });
   file.commit();
 }
 

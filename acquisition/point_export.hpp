@@ -38,4 +38,19 @@ void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const ScanGeometry* const> geometry = {},
                std::span<const std::vector<std::uint8_t>* const> keep = {});
 
+// LAS 1.4 (revision 15), point data record format 7: X Y Z as 32-bit
+// integers at a 0.1 mm scale, offset at the points' minimum corner (so
+// georeferenced coordinates keep 0.1 mm), intensity (× 65535), return 1 of
+// 1, RGB (8-bit × 257), the scan's `source_ids` entry as point_source_id.
+// When every scan has geometry, four extra bytes fields (float NormalX,
+// NormalY, NormalZ in the world frame, and Footprint [m]) described by the
+// LASF_Spec extra bytes VLR. The legacy point counts are 0, as the
+// specification requires for formats 6–10. Throws core::InputError naming
+// `path` when the points span more than 0.1 mm × 2³¹ on an axis; All-or-
+// nothing output as write_ply.
+void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const std::uint16_t> source_ids,
+               std::span<const ScanGeometry* const> geometry = {},
+               std::span<const std::vector<std::uint8_t>* const> keep = {});
+
 }  // namespace scanbench::acquisition

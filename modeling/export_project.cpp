@@ -1,5 +1,6 @@
 #include "modeling/export_project.hpp"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,9 @@ std::vector<std::vector<std::uint8_t>> keep_masks(const Project& project,
                                                   const std::vector<std::int64_t>& ids) {
   if (!settings.merged) return {};
   const std::string file = project.path().string();
-  if (settings.format != ExportFormat::kPly && settings.format != ExportFormat::kCsv) {
-    throw core::InputError(file, {}, "--merged writes a point list: use --format ply or csv");
+  if (settings.format != ExportFormat::kPly && settings.format != ExportFormat::kCsv &&
+      settings.format != ExportFormat::kLas) {
+    throw core::InputError(file, {}, "--merged writes a point list: use --format ply, csv or las");
   }
   std::vector<std::vector<std::uint8_t>> masks;
   for (const std::int64_t id : ids) {
@@ -59,6 +61,20 @@ void write_triplet(const Project& project, const std::vector<acquisition::Scan>&
                            "directions (export it as ptx, ply or csv)");
   }
   acquisition::write_triplet(scans.front(), settings.output);
+}
+
+// The scans' ids as LAS point source ids (16 bits).
+std::vector<std::uint16_t> point_source_ids(const Project& project,
+                                            const std::vector<std::int64_t>& ids) {
+  std::vector<std::uint16_t> out;
+  for (const std::int64_t id : ids) {
+    if (id > std::numeric_limits<std::uint16_t>::max()) {
+      throw core::InputError(project.path().string(), {{}, {}, "scan " + std::to_string(id)},
+                             "a LAS point source id holds scan ids up to 65535");
+    }
+    out.push_back(static_cast<std::uint16_t>(id));
+  }
+  return out;
 }
 
 std::size_t count_points(const std::vector<acquisition::Scan>& scans,
@@ -127,6 +143,10 @@ ExportResult export_project(const Project& project, const ExportSettings& settin
       break;
     case ExportFormat::kTriplet:
       write_triplet(project, scans, settings);
+      break;
+    case ExportFormat::kLas:
+      acquisition::write_las(settings.output, scans, point_source_ids(project, ids), geometry_of,
+                             keep_of);
       break;
   }
   return {scans.size(), count_points(scans, keep)};

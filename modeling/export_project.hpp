@@ -17,12 +17,13 @@ enum class ExportFormat {
   kPly,      // binary PLY, world coordinates, with normals and footprints after geometry
   kCsv,      // text, world coordinates
   kTriplet,  // range/colour/intensity images and a JSON sidecar; one spherical scan
+  kLas,      // LAS 1.4, point format 7, world coordinates at 0.1 mm; scan id as point source
 };
 
 struct ExportSettings {
   ExportFormat format = ExportFormat::kPly;
   std::optional<std::int64_t> scan_id;  // only this scan; all scans when empty
-  // Only the points of the merged model (`scanbench merge`); PLY and CSV only.
+  // Only the points of the merged model (`scanbench merge`); PLY, CSV and LAS only.
   bool merged = false;
   std::filesystem::path output;  // the file (triplet: the .json sidecar)
 };
@@ -39,7 +40,8 @@ struct ExportResult {
 // the point formats leave its mixed pixels out and PLY carries its normals
 // and footprints. Throws core::InputError (naming the project and, where it
 // applies, the scan) for: no such scan, `merged` with a scan-grid format or
-// before a merge, a triplet of several scans or of a per-pixel scan. Output
+// before a merge, a triplet of several scans or of a per-pixel scan, LAS of
+// a scan whose id does not fit a point source id (above 65535). Output
 // is all-or-nothing (acquisition/output_file.hpp); write failures throw
 // std::runtime_error naming the file.
 ExportResult export_project(const Project& project, const ExportSettings& settings);

@@ -4,7 +4,7 @@
 # and UndefinedBehaviorSanitizer at -O1, without the benches and the tests
 # labelled release_only (the simulator's own tests, the bench smoke runs),
 # then every fuzz target for a short while (scripts/fuzz.sh; FUZZ_SECONDS,
-# default 15, per target). `--fast` runs the Release pass only.
+# default 10, per target). `--fast` runs the Release pass only.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 fast=0
@@ -30,6 +30,6 @@ if [ $fast -eq 0 ]; then
     -DSCANBENCH_SANITIZE=ON -DSCANBENCH_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1"
   echo "== fuzz =="
   start=$SECONDS
-  "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-15}"
+  "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-10}"
   echo "== fuzz: built and run in $((SECONDS - start)) s =="
 fi

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -541,6 +542,18 @@ TEST(Cli, UndoRedoAndHistoryWorkAcrossProcesses) {
   EXPECT_NE(registered, imported);  // the poses moved
   ok({"merge", project});
   ok({"export", project, "--format", "ply", "--merged", "-o", (dir / "before.ply").string()});
+  // The merged model as LAS: as many points as the PLY, point format 7.
+  const std::string ply = test::read_file_bytes(dir / "before.ply");
+  const std::size_t vertex = ply.find("element vertex ") + 15;
+  const std::uint64_t ply_points = std::stoull(ply.substr(vertex, ply.find('\n', vertex) - vertex));
+  ok({"export", project, "--format", "las", "--merged", "-o", (dir / "merged.las").string()});
+  const std::string las = test::read_file_bytes(dir / "merged.las");
+  ASSERT_GE(las.size(), 375u);
+  EXPECT_EQ(las.substr(0, 4), "LASF");
+  EXPECT_EQ(las[104], 7);
+  std::uint64_t las_points = 0;
+  std::memcpy(&las_points, las.data() + 247, sizeof las_points);
+  EXPECT_EQ(las_points, ply_points);
 
   const nlohmann::json history = nlohmann::json::parse(ok({"history", project, "--json"}).out);
   ASSERT_EQ(history["commands"].size(), 4u);

@@ -48,14 +48,14 @@ json read_json(const std::filesystem::path& file) {
   return json::parse(in);
 }
 
-// The campus's first scan at half resolution (0.2° steps) with its
-// geometry: Keller Hall's west wall faces the scanner at column 1309, row
-// 232, its south wall at column 1235, row 165.
+// The campus's first scan at a quarter of the resolution (0.4° steps) with
+// its geometry: Keller Hall's west wall faces the scanner at column 654, row
+// 116, its south wall at column 617, row 82.
 std::filesystem::path campus_project(const ScratchDir& dir) {
   const std::filesystem::path project = dir / "campus.sbproj";
   const std::vector<std::vector<std::string>> steps = {
-      {"simulate", "--site", "campus", "--scans", "1", "--columns", "1800", "--rows", "450",
-       "--out", (dir / "sim").string()},
+      {"simulate", "--site", "campus", "--scans", "1", "--columns", "900", "--rows", "225", "--out",
+       (dir / "sim").string()},
       {"import", project.string(), (dir / "sim" / "campus_scan_01.json").string()},
       {"geometry", project.string()}};
   for (const std::vector<std::string>& step : steps) {
@@ -119,16 +119,16 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
 
   // Opening the project: the panels and views laid out.
   const Layout start = run("open", json::array());
-  EXPECT_EQ(start.data["panorama"]["columns"], 1800);
+  EXPECT_EQ(start.data["panorama"]["columns"], 900);
 
   // Two walls: a seed click each, named in the name field, Enter commits.
-  const Layout segmented = run("segment", {{{"click", start.pixel(1309, 232)}},
+  const Layout segmented = run("segment", {{{"click", start.pixel(654, 116)}},
                                            {{"wait", 2}},
                                            {{"click", start.widget("name")}},
                                            {{"key", "A"}, {"mods", {"ctrl"}}},
                                            {{"text", "wall west"}},
                                            {{"key", "Enter"}},
-                                           {{"click", start.pixel(1235, 165)}},
+                                           {{"click", start.pixel(617, 82)}},
                                            {{"wait", 2}},
                                            {{"click", start.widget("name")}},
                                            {{"text", "wall south"}},
@@ -137,8 +137,8 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   ASSERT_EQ(tree.size(), 2u);
   EXPECT_EQ(tree[0]["name"], "wall west");
   EXPECT_EQ(tree[1]["name"], "wall south");
-  EXPECT_GT(tree[0]["points"].get<int>(), 5000);
-  EXPECT_GT(tree[1]["points"].get<int>(), 5000);
+  EXPECT_GT(tree[0]["points"].get<int>(), 1500);
+  EXPECT_GT(tree[1]["points"].get<int>(), 1500);
 
   // Grouped: click one wall, Ctrl+click the other, name the group, Group.
   const Layout grouped =
@@ -196,8 +196,8 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
       run("reparent_out", {{{"drag", {grouped.widget("node wall south"), empty}}}, {{"wait", 2}}});
   tree = nodes(dir, project);
   EXPECT_TRUE(tree[1]["parent"].is_null());
-  run("reparent_in", {{{"drag", {out.widget("node wall south"), out.widget("node keller hall")}}},
-                      {{"wait", 2}}});
+  run("reparent_in",
+      {{{"drag", {out.widget("node wall south"), out.widget("node keller hall")}}}, {{"wait", 2}}});
   tree = nodes(dir, project);
   EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
 }
