@@ -75,14 +75,20 @@ Eigen::Vector3d lab_to_linear_rgb(const Eigen::Vector3d& lab) {
   return xyz_to_rgb() * xyz.cwiseProduct(white());
 }
 
+Eigen::Vector3d srgb_to_linear_rgb(const std::array<std::uint8_t, 3>& rgb) {
+  return {srgb_to_linear(rgb[0]), srgb_to_linear(rgb[1]), srgb_to_linear(rgb[2])};
+}
+
+std::array<std::uint8_t, 3> linear_rgb_to_srgb(const Eigen::Vector3d& rgb) {
+  return {linear_to_srgb(rgb.x()), linear_to_srgb(rgb.y()), linear_to_srgb(rgb.z())};
+}
+
 Eigen::Vector3d srgb_to_lab(const std::array<std::uint8_t, 3>& rgb) {
-  return linear_rgb_to_lab(
-      {srgb_to_linear(rgb[0]), srgb_to_linear(rgb[1]), srgb_to_linear(rgb[2])});
+  return linear_rgb_to_lab(srgb_to_linear_rgb(rgb));
 }
 
 std::array<std::uint8_t, 3> lab_to_srgb(const Eigen::Vector3d& lab) {
-  const Eigen::Vector3d rgb = lab_to_linear_rgb(lab);
-  return {linear_to_srgb(rgb.x()), linear_to_srgb(rgb.y()), linear_to_srgb(rgb.z())};
+  return linear_rgb_to_srgb(lab_to_linear_rgb(lab));
 }
 
 }  // namespace scanbench::acquisition

@@ -20,6 +20,10 @@ std::uint8_t linear_to_srgb(double linear);
 Eigen::Vector3d linear_rgb_to_lab(const Eigen::Vector3d& rgb);
 Eigen::Vector3d lab_to_linear_rgb(const Eigen::Vector3d& lab);
 
+// 8-bit sRGB → linear RGB, and linear RGB → 8-bit sRGB (clamped, rounded).
+Eigen::Vector3d srgb_to_linear_rgb(const std::array<std::uint8_t, 3>& rgb);
+std::array<std::uint8_t, 3> linear_rgb_to_srgb(const Eigen::Vector3d& rgb);
+
 // 8-bit sRGB → L*a*b*.
 Eigen::Vector3d srgb_to_lab(const std::array<std::uint8_t, 3>& rgb);
 // L*a*b* → 8-bit sRGB, out-of-gamut channels clamped.

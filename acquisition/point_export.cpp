@@ -68,6 +68,15 @@ void append_binary(std::string& out, T value) {
   out.append(bytes, sizeof(T));
 }
 
+// A point's normal (world frame) and footprint as four floats: what PLY and
+// LAS both carry after the geometry stage.
+void append_geometry(std::string& out, const Scan& scan, const ScanGeometry& geometry,
+                     std::size_t i) {
+  const Eigen::Vector3f n = scan.T_world_scan.linear().cast<float>() * geometry.normal[i];
+  for (int axis = 0; axis < 3; ++axis) append_binary(out, n[axis]);
+  append_binary(out, geometry.footprint_m[i]);
+}
+
 std::string ply_header(std::size_t vertices, Channels channels) {
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by scanbench\n";
   header += "element vertex " + std::to_string(vertices) + "\n";
@@ -186,12 +195,7 @@ void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
                    if (channels.intensity) append_binary(out, scan.intensity[i]);
                    if (channels.color)
                      out.append(reinterpret_cast<const char*>(&scan.rgb[3 * i]), 3);
-                   if (channels.geometry) {
-                     const Eigen::Vector3f n =
-                         (scan.T_world_scan.linear().cast<float>() * geometry[s]->normal[i]);
-                     for (int axis = 0; axis < 3; ++axis) append_binary(out, n[axis]);
-                     append_binary(out, geometry[s]->footprint_m[i]);
-                   }
+                   if (channels.geometry) append_geometry(out, scan, *geometry[s], i);
                    file.flush_if_full();
                  });
   file.commit();
@@ -277,12 +281,7 @@ void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
               channels.color ? static_cast<std::uint16_t>(scan.rgb[3 * i + c] * 257) : 0;
           append_binary(out, v);
         }
-        if (channels.geometry) {
-          const Eigen::Vector3f n =
-              (scan.T_world_scan.linear().cast<float>() * geometry[s]->normal[i]);
-          for (int axis = 0; axis < 3; ++axis) append_binary(out, n[axis]);
-          append_binary(out, geometry[s]->footprint_m[i]);
-        }
+        if (channels.geometry) append_geometry(out, scan, *geometry[s], i);
         file.flush_if_full();
       });
   file.commit();

@@ -49,14 +49,6 @@ Campaign scan_campaign(const sim::ScannerModel& scanner, int scan_count, SiteLig
   return c;
 }
 
-std::vector<modeling::ScanColorCorrection> as_scan_corrections(
-    const registration::HarmonizeResult& solved) {
-  std::vector<modeling::ScanColorCorrection> out;
-  for (const registration::ColorCorrection& c : solved.corrections)
-    out.push_back({c.matrix, c.offset});
-  return out;
-}
-
 // Mean ΔE of both points of every pair from their truth colours.
 double delta_e_to_truth(std::span<const registration::ColorPair> pairs,
                         std::span<const modeling::ScanColorCorrection> corrections,
@@ -64,8 +56,7 @@ double delta_e_to_truth(std::span<const registration::ColorPair> pairs,
   if (pairs.empty()) return 0.0;
   const auto one = [&](std::uint32_t scan, std::int64_t pixel, const Eigen::Vector3f& rgb) {
     Eigen::Vector3d linear = rgb.cast<double>();
-    if (!corrections.empty())
-      linear = (corrections[scan].matrix * linear + corrections[scan].offset).cwiseMax(0.0);
+    if (!corrections.empty()) linear = corrections[scan].apply(linear).cwiseMax(0.0);
     const auto i = static_cast<std::size_t>(pixel);
     const std::vector<std::uint8_t>& t = truth_rgb[scan];
     return acquisition::delta_e(acquisition::linear_rgb_to_lab(linear),
@@ -112,7 +103,7 @@ nlohmann::json solve_and_measure(const Campaign& c, registration::ColorModel mod
       registration::harmonize_colors(c.fit, c.site.scans.size(), settings);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::vector<modeling::ScanColorCorrection> corrections = as_scan_corrections(solved);
+  const std::vector<modeling::ScanColorCorrection>& corrections = solved.corrections;
   const double before = modeling::mean_pair_delta_e(c.held_out, {});
   const double after = modeling::mean_pair_delta_e(c.held_out, corrections);
   nlohmann::json out = {

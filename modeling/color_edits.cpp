@@ -180,10 +180,9 @@ ColorPipeline::ColorPipeline(std::map<std::int64_t, ScanColorCorrection> correct
 
 Eigen::Vector3d ColorPipeline::corrected_lab(std::int64_t scan_id,
                                              const std::array<std::uint8_t, 3>& rgb) const {
-  Eigen::Vector3d linear(acquisition::srgb_to_linear(rgb[0]), acquisition::srgb_to_linear(rgb[1]),
-                         acquisition::srgb_to_linear(rgb[2]));
+  Eigen::Vector3d linear = acquisition::srgb_to_linear_rgb(rgb);
   if (const auto found = corrections_.find(scan_id); found != corrections_.end())
-    linear = (found->second.matrix * linear + found->second.offset).cwiseMax(0.0);
+    linear = found->second.apply(linear).cwiseMax(0.0);
   return acquisition::linear_rgb_to_lab(linear);
 }
 
@@ -192,15 +191,9 @@ std::array<std::uint8_t, 3> ColorPipeline::shown(std::int64_t scan_id, std::int6
   const auto correction = corrections_.find(scan_id);
   const auto edit = node == 0 ? edits_.end() : edits_.find(node);
   if (correction == corrections_.end() && edit == edits_.end()) return rgb;
-  if (edit == edits_.end()) {
-    const Eigen::Vector3d linear =
-        correction->second.matrix * Eigen::Vector3d(acquisition::srgb_to_linear(rgb[0]),
-                                                    acquisition::srgb_to_linear(rgb[1]),
-                                                    acquisition::srgb_to_linear(rgb[2])) +
-        correction->second.offset;
-    return {acquisition::linear_to_srgb(linear.x()), acquisition::linear_to_srgb(linear.y()),
-            acquisition::linear_to_srgb(linear.z())};
-  }
+  if (edit == edits_.end())
+    return acquisition::linear_rgb_to_srgb(
+        correction->second.apply(acquisition::srgb_to_linear_rgb(rgb)));
   return acquisition::lab_to_srgb(apply(edit->second, corrected_lab(scan_id, rgb)));
 }
 

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "registration/color_correction.hpp"
+
 namespace scanbench::modeling {
 
 struct ObjectNode;
@@ -64,15 +66,9 @@ std::map<std::int64_t, ResolvedColorEdit> resolve_color_edits(const std::vector<
 // The edit applied to a colour in L*a*b*.
 Eigen::Vector3d apply(const ResolvedColorEdit& edit, const Eigen::Vector3d& lab);
 
-// A scan's correction in linear RGB: rgb' = matrix · rgb + offset.
-struct ScanColorCorrection {
-  Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  bool identity() const {
-    return matrix == Eigen::Matrix3d::Identity() && offset == Eigen::Vector3d::Zero();
-  }
-  bool operator==(const ScanColorCorrection&) const = default;
-};
+// A scan's correction in linear RGB: rgb' = matrix · rgb + offset; the type
+// the harmonisation solves.
+using ScanColorCorrection = registration::ColorCorrection;
 
 // JSON of an edit (only the parameters it sets; "" for none) and of a
 // correction, as the project stores them. The readers throw

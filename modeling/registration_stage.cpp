@@ -244,8 +244,7 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
   const auto lab = [&](std::uint32_t scan, const Eigen::Vector3f& rgb) {
     Eigen::Vector3d linear = rgb.cast<double>();
     if (!corrections.empty()) {
-      const ScanColorCorrection& c = corrections[scan];
-      linear = (c.matrix * linear + c.offset).cwiseMax(0.0);
+      linear = corrections[scan].apply(linear).cwiseMax(0.0);
     }
     return acquisition::linear_rgb_to_lab(linear);
   };
@@ -275,7 +274,7 @@ HarmonizeStageResult harmonize_outcome(const LoadedScans& loaded,
     scan.name = loaded.scans[k].name;
     if (solved.reference[k] >= 0) {
       scan.reference = loaded.ids[static_cast<std::size_t>(solved.reference[k])];
-      scan.correction = {solved.corrections[k].matrix, solved.corrections[k].offset};
+      scan.correction = solved.corrections[k];
     } else if (const auto kept = stored.find(scan.id); kept != stored.end()) {
       scan.correction = kept->second;
     }

@@ -18,6 +18,7 @@
 #include <string_view>
 #include <vector>
 
+#include "registration/color_correction.hpp"
 #include "registration/prepared_scan.hpp"
 
 namespace scanbench::registration {
@@ -69,12 +70,6 @@ struct ColorPair {
 std::vector<ColorPair> find_color_pairs(std::span<const PreparedScan> scans,
                                         std::span<const Eigen::Isometry3d> T_world_scan,
                                         const ColorPairSettings& settings);
-
-struct ColorCorrection {
-  Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  Eigen::Vector3d apply(const Eigen::Vector3d& rgb) const { return matrix * rgb + offset; }
-};
 
 struct HarmonizeSettings {
   ColorModel model = ColorModel::kGainOffset;

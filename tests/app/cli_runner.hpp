@@ -25,8 +25,12 @@ inline std::string shell_quote(const std::string& arg) {
   return quoted + "'";
 }
 
-inline CliResult run_cli(const ScratchDir& dir, const std::vector<std::string>& args) {
-  std::string command = shell_quote(SCANBENCH_BINARY);
+// `prefix`, when given, runs the executable under another command (a
+// virtual display: "xvfb-run -a …"); it is passed to the shell as it is.
+inline CliResult run_cli(const ScratchDir& dir, const std::vector<std::string>& args,
+                         const std::string& prefix = "") {
+  std::string command = prefix.empty() ? std::string() : prefix + " ";
+  command += shell_quote(SCANBENCH_BINARY);
   for (const std::string& arg : args) {
     command += ' ';  // appended apart: GCC 12 warns falsely on " " + std::string&& at -O3
     command += shell_quote(arg);

@@ -27,20 +27,7 @@ using ::testing::HasSubstr;
 CliResult run_on_display(const ScratchDir& dir, const std::vector<std::string>& args) {
   std::vector<std::string> all = {"workbench"};
   all.insert(all.end(), args.begin(), args.end());
-  std::string command = "xvfb-run -a -s '-screen 0 1280x800x24' ";
-  command += shell_quote(SCANBENCH_BINARY);
-  for (const std::string& arg : all) {
-    command += ' ';
-    command += shell_quote(arg);
-  }
-  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  command += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
-  const int status = std::system(command.c_str());
-  CliResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.out = read_file_bytes(out);
-  result.err = read_file_bytes(err);
-  return result;
+  return run_cli(dir, all, "xvfb-run -a -s '-screen 0 1280x800x24'");
 }
 
 json read_json(const std::filesystem::path& file) {
