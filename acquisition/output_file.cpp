@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cassert>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -94,6 +95,19 @@ OutputFile::~OutputFile() {
 void OutputFile::write(std::string_view bytes) {
   buffer_.append(bytes);
   flush_if_full();
+}
+
+void OutputFile::rewrite(std::uint64_t offset, std::string_view bytes) {
+  assert(file_ != nullptr && "rewrite after close");
+  flush();
+  [[maybe_unused]] const long end = std::ftell(file_);
+  assert(end >= 0 && offset + bytes.size() <= static_cast<std::uint64_t>(end) &&
+         "rewrite past what was written");
+  if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0 ||
+      std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size() ||
+      std::fseek(file_, 0, SEEK_END) != 0) {
+    fail("cannot write");
+  }
 }
 
 void OutputFile::flush_if_full() {

@@ -3,6 +3,7 @@
 // interrupted export therefore never leaves a half-written file behind.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -37,6 +38,11 @@ class OutputFile {
   // close() when still open, then renames onto the target; throws
   // core::RuntimeFailure when the rename fails.
   void commit();
+
+  // Overwrites bytes already written, at `offset` from the file's start
+  // (a header whose fields are known only at the end); later writes append
+  // again. Asserts the range lies within what was written; throws as write().
+  void rewrite(std::uint64_t offset, std::string_view bytes);
 
   // Appends to an internal buffer that is flushed in large blocks: the text
   // exporters format numbers straight into it.

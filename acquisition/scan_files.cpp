@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "acquisition/e57_reader.hpp"
 #include "acquisition/pcd_reader.hpp"
 #include "acquisition/triplet_reader.hpp"
 #include "core/errors.hpp"
@@ -16,22 +17,40 @@ ScanFileFormat scan_file_format(const std::filesystem::path& path) {
   if (extension == ".ptx") return ScanFileFormat::kPtx;
   if (extension == ".json") return ScanFileFormat::kTriplet;
   if (extension == ".pcd") return ScanFileFormat::kOrganizedPcd;
+  if (extension == ".e57") return ScanFileFormat::kE57;
   throw core::InputError(path.string(), {},
                          "unknown scan file type \"" + extension +
-                             "\" (expected .ptx, .pcd, or the .json sidecar of an image triplet)");
+                             "\" (expected .ptx, .pcd, .e57, or the .json sidecar of an image triplet)");
 }
 
+namespace {
+
+// A scan of a format that holds nothing beside the grid.
+ImportedScan plain(Scan&& scan, const char* format) {
+  ImportedScan out;
+  out.source.format = format;
+  out.source.points_in_file = count_valid(scan);
+  out.scan = std::move(scan);
+  return out;
+}
+
+}  // namespace
+
 void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& settings,
-                    const std::function<void(Scan&&)>& on_scan) {
+                    const std::function<void(ImportedScan&&)>& on_scan,
+                    const std::function<void(ScanImage&&)>& on_loose_image) {
   switch (scan_file_format(path)) {
     case ScanFileFormat::kPtx:
-      read_ptx(path, settings.ptx, on_scan);
+      read_ptx(path, settings.ptx, [&on_scan](Scan&& scan) { on_scan(plain(std::move(scan), "ptx")); });
       return;
     case ScanFileFormat::kTriplet:
-      on_scan(read_triplet(path));
+      on_scan(plain(read_triplet(path), "triplet"));
       return;
     case ScanFileFormat::kOrganizedPcd:
-      on_scan(read_organized_pcd(path));
+      on_scan(plain(read_organized_pcd(path), "pcd"));
+      return;
+    case ScanFileFormat::kE57:
+      read_e57(path, on_scan, on_loose_image);
       return;
   }
 }

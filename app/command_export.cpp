@@ -1,4 +1,4 @@
-// scanbench export PROJECT --format ptx|ply|csv|las|triplet [--scan ID] [--merged] -o OUT
+// scanbench export PROJECT --format ptx|ply|csv|las|e57|triplet [--scan ID] [--merged] -o OUT
 #include <fmt/core.h>
 
 #include <map>
@@ -36,8 +36,9 @@ void add_export_command(CLI::App& app) {
       "Export scans: PTX (scan frame + pose, lossless), binary PLY or CSV (valid points in world "
       "coordinates, double precision; after `scanbench geometry`, without mixed pixels and, in "
       "PLY, with normals and footprints), LAS 1.4 (point format 7, world coordinates at 0.1 mm, "
-      "the scan id as point source id; normals and footprints as extra bytes), or an image "
-      "triplet (one scan).");
+      "the scan id as point source id; normals and footprints as extra bytes), ASTM E57 "
+      "(structured scans in spherical coordinates at 0.1 mm with their poses and images), or an "
+      "image triplet (one scan).");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -46,13 +47,15 @@ void add_export_command(CLI::App& app) {
       {"ply", modeling::ExportFormat::kPly},
       {"csv", modeling::ExportFormat::kCsv},
       {"triplet", modeling::ExportFormat::kTriplet},
-      {"las", modeling::ExportFormat::kLas}};
-  command->add_option("--format", options->settings.format, "ptx, ply, csv, las or triplet")
+      {"las", modeling::ExportFormat::kLas},
+      {"e57", modeling::ExportFormat::kE57}};
+  command->add_option("--format", options->settings.format, "ptx, ply, csv, las, e57 or triplet")
       ->required()
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   command->add_option("--scan", options->scan_id, "Export only the scan with this id");
   command->add_flag("--merged", options->settings.merged,
-                    "PLY, CSV or LAS of the merged model only: the points `scanbench merge` kept");
+                    "The merged model only: the points `scanbench merge` kept (PLY, CSV, LAS; in "
+                    "E57 the other pixels are marked invalid)");
   command->add_option("-o,--output", options->output, "Output file (triplet: the .json sidecar)")
       ->required();
   command->callback([options] { run_export(*options); });

@@ -27,6 +27,13 @@ void run_import(const ImportOptions& options) {
   fmt::print("{} {} scan(s) from {} file(s) into {} in {:.2f} s\n",
              result.created_project ? "created project; imported" : "imported",
              result.scan_ids.size(), files.size(), options.project, result.seconds);
+  if (result.images > 0) fmt::print("  {} image(s) stored with the scans\n", result.images);
+  if (result.unplaced_points > 0) {
+    fmt::print(
+        "  {} point(s) not placed in the scan grids: they fell on a pixel a nearer point of an "
+        "unstructured scan holds, or were later returns (see `scanbench info PROJECT`)\n",
+        result.unplaced_points);
+  }
 }
 
 }  // namespace
@@ -35,7 +42,8 @@ void add_import_command(CLI::App& app) {
   auto options = std::make_shared<ImportOptions>();
   CLI::App* command = app.add_subcommand(
       "import",
-      "Import raw scans (Leica .ptx, image-triplet .json sidecars, organized .pcd) into a "
+      "Import raw scans (Leica .ptx, ASTM E57 .e57, image-triplet .json sidecars, organized "
+      ".pcd) into a "
       "project, creating it when missing. All files of one call go in one transaction: "
       "on any error the project is left unchanged.");
   command->add_option("project", options->project, "Project file (.sbproj)")->required();

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -26,24 +28,67 @@ struct InfoOptions {
 struct Entry {
   std::int64_t id;
   acquisition::ScanSummary summary;
+  std::optional<acquisition::ScanSource> source;  // none for scans imported before schema 7
 };
 
-std::vector<Entry> project_entries(const std::filesystem::path& path) {
-  std::vector<Entry> entries;
-  for (auto& stored : modeling::Project::open_for_reading(path).scans()) {
-    entries.push_back({stored.id, std::move(stored.summary)});
+// An image of the project or file, and the id of its scan.
+struct ImageEntry {
+  std::int64_t id;
+  std::optional<std::int64_t> scan_id;
+  acquisition::ScanImage image;  // without data
+};
+
+struct Contents {
+  std::vector<Entry> scans;
+  std::vector<ImageEntry> images;
+};
+
+Contents project_entries(const std::filesystem::path& path) {
+  Contents contents;
+  const modeling::Project project = modeling::Project::open_for_reading(path);
+  const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
+  for (auto& stored : project.scans()) {
+    const auto source = sources.find(stored.id);
+    contents.scans.push_back({stored.id, std::move(stored.summary),
+                              source == sources.end() ? std::nullopt
+                                                      : std::optional(source->second)});
   }
-  return entries;
+  for (modeling::StoredImage& stored : project.images(false)) {
+    contents.images.push_back({stored.id, stored.scan_id, std::move(stored.image)});
+  }
+  return contents;
 }
 
 // A raw scan file: ids are 1-based positions in the file.
-std::vector<Entry> file_entries(const std::filesystem::path& path) {
-  std::vector<Entry> entries;
-  acquisition::read_scan_file(path, {}, [&entries](acquisition::Scan&& scan) {
-    entries.push_back(
-        {static_cast<std::int64_t>(entries.size() + 1), acquisition::summarize(scan)});
-  });
-  return entries;
+Contents file_entries(const std::filesystem::path& path) {
+  Contents contents;
+  const auto add_image = [&contents](acquisition::ScanImage&& image,
+                                     std::optional<std::int64_t> scan_id) {
+    image.data.clear();
+    contents.images.push_back(
+        {static_cast<std::int64_t>(contents.images.size() + 1), scan_id, std::move(image)});
+  };
+  acquisition::read_scan_file(
+      path, {},
+      [&](acquisition::ImportedScan&& imported) {
+        const auto id = static_cast<std::int64_t>(contents.scans.size() + 1);
+        contents.scans.push_back({id, acquisition::summarize(imported.scan), imported.source});
+        for (acquisition::ScanImage& image : imported.images) add_image(std::move(image), id);
+      },
+      [&](acquisition::ScanImage&& image) { add_image(std::move(image), std::nullopt); });
+  return contents;
+}
+
+nlohmann::json to_json(const ImageEntry& entry) {
+  const acquisition::ScanImage& image = entry.image;
+  return {{"id", entry.id},
+          {"scan", entry.scan_id ? nlohmann::json(*entry.scan_id) : nlohmann::json(nullptr)},
+          {"name", image.name},
+          {"guid", image.guid},
+          {"projection", acquisition::projection_name(image.projection)},
+          {"format", image.format},
+          {"width", image.width},
+          {"height", image.height}};
 }
 
 nlohmann::json to_json(const Entry& entry) {
@@ -64,20 +109,39 @@ nlohmann::json to_json(const Entry& entry) {
           {"T_world_scan", acquisition::row_major(s.T_world_scan)},
           {"bbox_world", bbox},
           {"scanner", s.scanner.name},
-          {"source_file", s.scanner.source_file}};
+          {"source_file", s.scanner.source_file},
+          {"source", entry.source ? nlohmann::json{{"format", entry.source->format},
+                                                   {"guid", entry.source->guid},
+                                                   {"points_in_file", entry.source->points_in_file},
+                                                   {"unplaced_points",
+                                                    entry.source->unplaced_points}}
+                                  : nlohmann::json(nullptr)}};
 }
 
-void print_table(const std::string& path, const std::vector<Entry>& entries) {
-  fmt::print("{}: {} scan(s)\n", path, entries.size());
+void print_table(const std::string& path, const Contents& contents) {
+  fmt::print("{}: {} scan(s)\n", path, contents.scans.size());
   fmt::print("{:>4}  {:<24} {:>13} {:>10}  {:<5} {:<9} {:<9} {}\n", "id", "name", "rows x cols",
              "valid", "color", "intensity", "angles", "position [m]");
-  for (const Entry& e : entries) {
+  for (const Entry& e : contents.scans) {
     const acquisition::ScanSummary& s = e.summary;
     const Eigen::Vector3d t = s.T_world_scan.translation();
     fmt::print("{:>4}  {:<24} {:>13} {:>10}  {:<5} {:<9} {:<9} {:.3f} {:.3f} {:.3f}\n", e.id,
                s.name, fmt::format("{} x {}", s.rows, s.columns), s.valid_points,
                s.has_color ? "yes" : "no", s.has_intensity ? "yes" : "no",
                acquisition::angle_model_name(s.spherical), t.x(), t.y(), t.z());
+    if (e.source && e.source->unplaced_points > 0) {
+      fmt::print("      {} of the file's {} records not placed in the grid (collisions of an "
+                 "unstructured scan, or later returns)\n",
+                 e.source->unplaced_points, e.source->points_in_file);
+    }
+  }
+  if (contents.images.empty()) return;
+  fmt::print("{} image(s)\n", contents.images.size());
+  for (const ImageEntry& i : contents.images) {
+    fmt::print("{:>4}  {:<24} {:>13} {:<5} {:<11} scan {}\n", i.id, i.image.name,
+               fmt::format("{} x {}", i.image.width, i.image.height), i.image.format,
+               acquisition::projection_name(i.image.projection),
+               i.scan_id ? std::to_string(*i.scan_id) : std::string("none"));
   }
 }
 
@@ -91,14 +155,16 @@ bool starts_like_sqlite(const std::filesystem::path& path) {
 void run_info(const InfoOptions& options) {
   const std::filesystem::path path = options.path;
   const bool project = path.extension() == ".sbproj" || starts_like_sqlite(path);
-  const std::vector<Entry> entries = project ? project_entries(path) : file_entries(path);
+  const Contents contents = project ? project_entries(path) : file_entries(path);
   if (!options.json) {
-    print_table(options.path, entries);
+    print_table(options.path, contents);
     return;
   }
   nlohmann::json scans = nlohmann::json::array();
-  for (const Entry& e : entries) scans.push_back(to_json(e));
-  fmt::print("{}\n", nlohmann::json{{"scans", scans}}.dump(
+  for (const Entry& e : contents.scans) scans.push_back(to_json(e));
+  nlohmann::json images = nlohmann::json::array();
+  for (const ImageEntry& i : contents.images) images.push_back(to_json(i));
+  fmt::print("{}\n", nlohmann::json{{"scans", scans}, {"images", images}}.dump(
                          2, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
@@ -107,7 +173,9 @@ void run_info(const InfoOptions& options) {
 void add_info_command(CLI::App& app) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* command = app.add_subcommand(
-      "info", "Describe the scans of a project or of a raw scan file (.ptx, .json, .pcd).");
+      "info",
+      "Describe the scans and images of a project or of a raw scan file (.ptx, .e57, .json, "
+      ".pcd).");
   command->add_option("path", options->path, "Project (.sbproj) or scan file")
       ->required()
       ->check(CLI::ExistingPath);

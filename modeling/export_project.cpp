@@ -1,9 +1,11 @@
 #include "modeling/export_project.hpp"
 
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "acquisition/e57_writer.hpp"
 #include "acquisition/point_export.hpp"
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/triplet_writer.hpp"
@@ -32,9 +34,10 @@ std::vector<std::vector<std::uint8_t>> keep_masks(const Project& project,
                                                   const std::vector<std::int64_t>& ids) {
   if (!settings.merged) return {};
   const std::string file = project.path().string();
-  if (settings.format != ExportFormat::kPly && settings.format != ExportFormat::kCsv &&
-      settings.format != ExportFormat::kLas) {
-    throw core::InputError(file, {}, "--merged writes a point list: use --format ply, csv or las");
+  if (settings.format == ExportFormat::kPtx || settings.format == ExportFormat::kTriplet) {
+    throw core::InputError(file, {},
+                           "--merged writes the merged model's points: use --format ply, csv, las "
+                           "or e57");
   }
   std::vector<std::vector<std::uint8_t>> masks;
   for (const std::int64_t id : ids) {
@@ -61,6 +64,35 @@ void write_triplet(const Project& project, const std::vector<acquisition::Scan>&
                            "directions (export it as ptx, ply or csv)");
   }
   acquisition::write_triplet(scans.front(), settings.output);
+}
+
+// The scans as E57 data3D entries with their guids (kept from an E57
+// import) and images; the images tied to no scan go with a whole-project
+// export only.
+void write_e57(const Project& project, const std::vector<std::int64_t>& ids,
+               const std::vector<acquisition::Scan>& scans,
+               const std::vector<const std::vector<std::uint8_t>*>& keep,
+               const ExportSettings& settings) {
+  const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
+  std::vector<StoredImage> images = project.images(true);
+  std::vector<acquisition::E57ScanOutput> outputs(scans.size());
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    outputs[s].scan = &scans[s];
+    if (const auto source = sources.find(ids[s]); source != sources.end()) {
+      outputs[s].guid = source->second.guid;
+    }
+    if (!keep.empty()) outputs[s].keep = keep[s];
+    for (StoredImage& stored : images) {
+      if (stored.scan_id == ids[s]) outputs[s].images.push_back(std::move(stored.image));
+    }
+  }
+  std::vector<acquisition::ScanImage> loose;
+  if (!settings.scan_id) {
+    for (StoredImage& stored : images) {
+      if (!stored.scan_id) loose.push_back(std::move(stored.image));
+    }
+  }
+  acquisition::write_e57(settings.output, outputs, loose);
 }
 
 // The scans' ids as LAS point source ids (16 bits).
@@ -147,6 +179,9 @@ ExportResult export_project(const Project& project, const ExportSettings& settin
     case ExportFormat::kLas:
       acquisition::write_las(settings.output, scans, point_source_ids(project, ids), geometry_of,
                              keep_of);
+      break;
+    case ExportFormat::kE57:
+      write_e57(project, ids, scans, keep_of, settings);
       break;
   }
   return {scans.size(), count_points(scans, keep)};

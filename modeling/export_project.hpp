@@ -18,12 +18,14 @@ enum class ExportFormat {
   kCsv,      // text, world coordinates
   kTriplet,  // range/colour/intensity images and a JSON sidecar; one spherical scan
   kLas,      // LAS 1.4, point format 7, world coordinates at 0.1 mm; scan id as point source
+  kE57,      // ASTM E57: structured scans in spherical coordinates + pose, with their images
 };
 
 struct ExportSettings {
   ExportFormat format = ExportFormat::kPly;
   std::optional<std::int64_t> scan_id;  // only this scan; all scans when empty
-  // Only the points of the merged model (`scanbench merge`); PLY, CSV and LAS only.
+  // Only the points of the merged model (`scanbench merge`); PLY, CSV, LAS
+  // and E57 (whose grids keep every pixel, the others marked invalid).
   bool merged = false;
   std::filesystem::path output;  // the file (triplet: the .json sidecar)
 };

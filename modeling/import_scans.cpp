@@ -53,14 +53,26 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
   std::set<std::int64_t> digests;  // of the scans of this import
   for (std::size_t f = 0; f < files.size(); ++f) {
     progress.throw_if_cancelled(kStage);
-    acquisition::read_scan_file(files[f], settings.readers, [&](acquisition::Scan&& scan) {
-      const EncodedScan encoded = encode_scan(scan);
+    const auto on_scan = [&](acquisition::ImportedScan&& imported) {
+      const EncodedScan encoded = encode_scan(imported.scan);
       if (!settings.allow_duplicates) refuse_duplicate(project, encoded, files[f], digests);
       progress.throw_if_cancelled(kStage);
       Project::Edit part = command.part();
-      result.scan_ids.push_back(project.insert_scan(part, encoded));
+      const std::int64_t id = project.insert_scan(part, encoded);
+      project.put_scan_source(part, id, imported.source);
+      for (const acquisition::ScanImage& image : imported.images) project.insert_image(part, id, image);
       part.commit_part();
-    });
+      result.scan_ids.push_back(id);
+      result.unplaced_points += imported.source.unplaced_points;
+      result.images += imported.images.size();
+    };
+    const auto on_loose_image = [&](acquisition::ScanImage&& image) {
+      Project::Edit part = command.part();
+      project.insert_image(part, std::nullopt, image);
+      part.commit_part();
+      ++result.images;
+    };
+    acquisition::read_scan_file(files[f], settings.readers, on_scan, on_loose_image);
     progress.update({kStage, f + 1, files.size(), files[f].filename().string()});
   }
   progress.throw_if_cancelled(kStage);

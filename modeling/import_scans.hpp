@@ -24,6 +24,9 @@ struct ImportSettings {
 struct ImportResult {
   std::int64_t command_id = 0;         // the journal entry
   std::vector<std::int64_t> scan_ids;  // new ids, in file order
+  std::size_t images = 0;              // stored with the scans (E57 images2D)
+  // Records the grids could not place (acquisition::ScanSource), all scans.
+  std::uint64_t unplaced_points = 0;
   bool created_project = false;        // import_scan_files only
   double seconds = 0.0;
 };

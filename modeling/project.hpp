@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "acquisition/scan.hpp"
+#include "acquisition/scan_source.hpp"
 #include "acquisition/scan_summary.hpp"
 #include "core/project_file.hpp"
 #include "modeling/color_edits.hpp"
@@ -61,8 +62,8 @@ inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplication
 // open; newer ones are refused.
 // 2: scan_geometry; 3: registration_runs, merge_masks; 4: the command journal,
 // versioned poses and the per-scan layer store; 5: the object tree; 6: colour
-// edits of objects and colour corrections of scans.
-inline constexpr int kProjectSchemaVersion = 6;
+// edits of objects and colour corrections of scans; 7: scan sources and images.
+inline constexpr int kProjectSchemaVersion = 7;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
@@ -82,6 +83,13 @@ struct ObjectNode {
   std::optional<double> mean_footprint_m;         // [m]; none without points
   std::optional<Eigen::AlignedBox3d> bbox_world;  // [m]; none without points
   ColorEdit color;  // what the node itself sets (color_edits.hpp); the rest it inherits
+};
+
+// An image stored with the scans (E57 images2D).
+struct StoredImage {
+  std::int64_t id = 0;                  // stable for the project's life
+  std::optional<std::int64_t> scan_id;  // the scan it was taken with; none: no scan
+  acquisition::ScanImage image;         // data empty unless asked for
 };
 
 struct StoredScanSummary {
@@ -279,6 +287,29 @@ class Project {
   // no such scan.
   void put_scan_color_correction(Edit& edit, std::int64_t id,
                                  const ScanColorCorrection& correction);
+
+  // ---- Sources and images of scans (acquisition/scan_source.hpp) ----------
+
+  // Stores what the source file says of new scan `id` as part of the
+  // `edit` that inserted it.
+  void put_scan_source(Edit& edit, std::int64_t id, const acquisition::ScanSource& source);
+
+  // The source of every live scan that has one (scans imported before
+  // schema 7 have none), by scan id. Throws core::InputError naming the
+  // scan when its row is damaged.
+  std::map<std::int64_t, acquisition::ScanSource> scan_sources() const;
+
+  // Stores an image as part of `edit`, tied to scan `scan_id` (asserted
+  // to be a scan of the project or of this edit) or to none, and returns
+  // its id. Throws core::InputError for an image that is neither JPEG nor
+  // PNG.
+  std::int64_t insert_image(Edit& edit, std::optional<std::int64_t> scan_id,
+                            const acquisition::ScanImage& image);
+
+  // The images of the live import commands, by id; with `with_data` their
+  // encoded bytes too, checked against their CRC. Throws core::InputError
+  // naming the image when its row or data is damaged.
+  std::vector<StoredImage> images(bool with_data) const;
 
   // ---- Commands and the journal ------------------------------------------
 

@@ -7,6 +7,7 @@
 #include "modeling/blob_codec.hpp"
 #include "modeling/project.hpp"
 #include "modeling/records.hpp"
+#include "modeling/row_checksum.hpp"
 #include "modeling/sqlite_statement.hpp"
 
 namespace scanbench::modeling {
@@ -125,6 +126,42 @@ std::size_t check_scan_colors(sqlite3* db, const std::string& file,
   return checked;
 }
 
+std::size_t check_scan_sources(sqlite3* db, const std::string& file,
+                               std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  for (sqlite::Statement rows(db, "SELECT scan_id, details, checksum FROM scan_sources", file);
+       rows.step(); ++checked) {
+    const ScanSourceRecord record{rows.column_int(0), rows.column_text(1)};
+    if (checksum(record) != rows.column_int(2)) {
+      damage.push_back("source of scan " + std::to_string(record.scan_id) + " fails its checksum");
+    }
+  }
+  return checked;
+}
+
+std::size_t check_scan_images(sqlite3* db, const std::string& file,
+                              std::vector<std::string>& damage) {
+  std::size_t checked = 0;
+  for (sqlite::Statement rows(db,
+                              "SELECT id, created_by, scan_id, description, format, data_crc, "
+                              "checksum, data FROM scan_images",
+                              file);
+       rows.step(); ++checked) {
+    ImageRecord record;
+    record.created_by = rows.column_int(1);
+    if (!rows.is_null(2)) record.scan_id = rows.column_int(2);
+    record.description = rows.column_text(3);
+    record.format = rows.column_text(4);
+    record.data_crc = rows.column_int(5);
+    const std::string image = "image " + std::to_string(rows.column_int(0));
+    if (checksum(record) != rows.column_int(6)) damage.push_back(image + " fails its checksum");
+    if (static_cast<std::int64_t>(crc32_of(std::as_bytes(rows.column_blob(7)))) != record.data_crc) {
+      damage.push_back(image + ": its data fails its CRC");
+    }
+  }
+  return checked;
+}
+
 }  // namespace
 
 Project::CheckReport Project::check() const {
@@ -134,6 +171,8 @@ Project::CheckReport Project::check() const {
   report.records += check_commands(db(), file_name(), report.damage);
   report.records += check_nodes(db(), file_name(), report.damage);
   report.records += check_scan_colors(db(), file_name(), report.damage);
+  report.records += check_scan_sources(db(), file_name(), report.damage);
+  report.records += check_scan_images(db(), file_name(), report.damage);
   report.layers = check_layers(db(), file_name(), report.damage);
   return report;
 }

@@ -76,8 +76,9 @@ INSERT INTO meta (key, value) VALUES
 // Tables every version has (checked before migrating) and those of the
 // current version (checked after).
 constexpr std::array<const char*, 2> kEveryVersionTables = {"meta", "scans"};
-constexpr std::array<const char*, 7> kCurrentTables = {
-    "meta", "scans", "commands", "scan_poses", "scan_layers", "object_nodes", "scan_colors"};
+constexpr std::array<const char*, 9> kCurrentTables = {
+    "meta",         "scans",       "commands",     "scan_poses", "scan_layers",
+    "object_nodes", "scan_colors", "scan_sources", "scan_images"};
 
 [[noreturn]] void refuse(const std::string& file, const std::string& problem) {
   throw core::InputError(file, {}, problem);
@@ -352,6 +353,30 @@ CREATE TABLE scan_colors (
 CREATE INDEX scan_colors_by_command ON scan_colors (command_id);
 )sql";
 
+// Version 7: what a scan's source file says of it beside the grid (its
+// E57 guid, the records it held and those the grid could not place), and
+// the images that came with the scans (E57 images2D), each tied to its
+// scan or to none. Both are written by the import that made the scan and
+// go with it.
+constexpr const char* kMigrate6To7 = R"sql(
+CREATE TABLE scan_sources (
+  scan_id INTEGER PRIMARY KEY REFERENCES scans (id) ON DELETE CASCADE,
+  details TEXT NOT NULL,  -- JSON (acquisition::ScanSource)
+  checksum INTEGER NOT NULL
+);
+CREATE TABLE scan_images (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,
+  created_by INTEGER NOT NULL REFERENCES commands (id) ON DELETE CASCADE,
+  scan_id INTEGER REFERENCES scans (id) ON DELETE CASCADE,  -- NULL: tied to no scan
+  description TEXT NOT NULL,  -- JSON: name, guid, projection, sizes, pose
+  format TEXT NOT NULL CHECK (format IN ('jpeg', 'png')),
+  data BLOB NOT NULL,
+  data_crc INTEGER NOT NULL,  -- CRC-32 of data
+  checksum INTEGER NOT NULL   -- of every column above but the id and data
+);
+CREATE INDEX scan_images_by_command ON scan_images (created_by);
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction; `original_version` is the version the file had when opened.
 void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
@@ -371,6 +396,9 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
       return;
     case 5:
       sqlite::execute(db, kMigrate5To6, file);
+      return;
+    case 6:
+      sqlite::execute(db, kMigrate6To7, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

@@ -8,6 +8,8 @@
 //   4  commands (the journal), scan_poses, scan_layers; scan_channels,
 //      scan_geometry, merge_masks and registration_runs move into them.
 //   5  object_nodes (the object tree).
+//   6  object_nodes.color_edit, scan_colors.
+//   7  scan_sources, scan_images.
 // To change the schema: bump kProjectSchemaVersion and add a case to
 // migrate_step() in project_schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by

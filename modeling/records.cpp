@@ -54,6 +54,20 @@ std::int64_t checksum(const ScanColorRecord& r) {
   return sum.value();
 }
 
+std::int64_t checksum(const ScanSourceRecord& r) {
+  RowChecksum sum;
+  sum.add(r.scan_id).add(r.details);
+  return sum.value();
+}
+
+std::int64_t checksum(const ImageRecord& r) {
+  RowChecksum sum;
+  sum.add(r.created_by);
+  sum.add(r.scan_id ? std::optional<double>(static_cast<double>(*r.scan_id)) : std::nullopt);
+  sum.add(r.description).add(r.format).add(r.data_crc);
+  return sum.value();
+}
+
 std::int64_t content_digest(std::int64_t rows, std::int64_t columns, std::string_view angle_model,
                             std::span<const std::byte> range, std::span<const std::byte> valid) {
   RowChecksum sum;

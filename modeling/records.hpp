@@ -78,6 +78,21 @@ struct ScanColorRecord {
   std::string correction;  // JSON
 };
 
+// What a scan's source file says of it.
+struct ScanSourceRecord {
+  std::int64_t scan_id = 0;
+  std::string details;  // JSON
+};
+
+// An image's row without its data (checked by data_crc).
+struct ImageRecord {
+  std::int64_t created_by = 0;
+  std::optional<std::int64_t> scan_id;
+  std::string description;  // JSON
+  std::string format;
+  std::int64_t data_crc = 0;
+};
+
 // A layer version's row without its data (whose zstd frame checks itself).
 struct LayerFields {
   std::int64_t scan_id = 0;
@@ -96,6 +111,8 @@ std::int64_t checksum(const CommandFields& record);
 std::int64_t checksum(const LayerFields& record);
 std::int64_t checksum(const NodeRecord& record);
 std::int64_t checksum(const ScanColorRecord& record);
+std::int64_t checksum(const ScanSourceRecord& record);
+std::int64_t checksum(const ImageRecord& record);
 
 // What identifies a scan's data whatever its name or pose (the same file
 // imported twice has the same): CRC-32 of its grid size, angle model and

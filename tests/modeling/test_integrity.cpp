@@ -44,13 +44,13 @@ TEST(Integrity, ASoundProjectPassesTheCheck) {
   const Project project = Project::open(sound_project(dir));
   const Project::CheckReport report = project.check();
   EXPECT_TRUE(report.damage.empty()) << joined(report.damage);
-  EXPECT_EQ(report.records, 3u);  // the scan, its pose, the import
+  EXPECT_EQ(report.records, 4u);  // the scan, its pose, its source, the import
   EXPECT_EQ(report.layers, 4u);   // range, valid, intensity, rgb
 }
 
 TEST(Integrity, ProjectsOfEveryVersionPassTheCheck) {
   const ScratchDir dir;
-  for (int version : {1, 2, 3, 4}) {
+  for (int version : {1, 2, 3, 4, 5, 6, 7}) {
     const auto file = dir / ("v" + std::to_string(version) + ".sbproj");
     std::filesystem::copy_file(fixture("projects/version" + std::to_string(version) + ".sbproj"),
                                file);
@@ -94,6 +94,23 @@ TEST(Integrity, ChangedSettingsInTheJournalAreFound) {
   const Project project = Project::open(file);
   EXPECT_THROW(project.history(), core::InputError);
   EXPECT_THAT(joined(project.check().damage), HasSubstr("command 1 (import)"));
+}
+
+TEST(Integrity, ChangedSourcesAndImagesAreFound) {
+  const ScratchDir dir;
+  const auto file = dir / "images.sbproj";
+  std::filesystem::copy_file(fixture("projects/version7.sbproj"), file);
+  RawDatabase(file).execute(
+      "UPDATE scan_sources SET details = replace(details, 'structured', 'structures')");
+  RawDatabase(file).execute("UPDATE scan_images SET data = zeroblob(length(data)) WHERE id = 2");
+  RawDatabase(file).execute("UPDATE scan_images SET format = 'jpeg' WHERE id = 1");
+  const Project project = Project::open(file);
+  EXPECT_THROW(project.scan_sources(), core::InputError);
+  EXPECT_THROW(project.images(false), core::InputError);
+  const std::string damage = joined(project.check().damage);
+  EXPECT_THAT(damage, HasSubstr("source of scan 4 fails its checksum"));
+  EXPECT_THAT(damage, HasSubstr("image 1 fails its checksum"));
+  EXPECT_THAT(damage, HasSubstr("image 2: its data fails its CRC"));
 }
 
 TEST(Integrity, ChangedColourEditsAndCorrectionsAreFound) {

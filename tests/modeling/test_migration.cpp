@@ -36,15 +36,46 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
+// fixtures/projects/version7.sbproj: version6.sbproj (below) opened by the
+// build that introduced version 7, then
+// fixtures/good/e57/structured_spherical.e57 imported: a scan with its
+// source (one record not placed) and two images, one tied to no scan.
+TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsSourcesAndImages) {
+  static_assert(kProjectSchemaVersion == 7, "add fixtures/projects/version8.sbproj");
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 7);
+  const std::string before = test::read_file_bytes(file);
+  {
+    Project project = Project::open(file);
+    EXPECT_EQ(names(project),
+              (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color", "structured"}));
+    const auto sources = project.scan_sources();
+    ASSERT_EQ(sources.size(), 1u) << "scans imported before version 7 have none";
+    EXPECT_EQ(sources.at(4).guid, "{scan-structured}");
+    EXPECT_EQ(sources.at(4).unplaced_points, 1u);
+    const std::vector<StoredImage> images = project.images(true);
+    ASSERT_EQ(images.size(), 2u);
+    EXPECT_EQ(images[0].scan_id, 4);
+    EXPECT_EQ(images[0].image.format, "png");
+    EXPECT_FALSE(images[1].scan_id.has_value());
+    EXPECT_EQ(images[1].image.data.size(), 662u);
+    EXPECT_EQ(project.history().back().name, "import");
+  }
+  EXPECT_EQ(test::read_file_bytes(file), before);
+  Project project = Project::open(file);
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_TRUE(project.images(false).empty()) << "the images go with their import";
+  EXPECT_TRUE(project.scan_sources().empty());
+  EXPECT_TRUE(project.check().damage.empty());
+}
+
 // fixtures/projects/version6.sbproj: version5.sbproj (below) opened by the
 // build that introduced version 6 (the undone rename is discarded by the
 // next command), then "wall south" recoloured (brightness 12, saturation
 // 0.8) and a hue edit of "north hall" undone.
-TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournal) {
-  static_assert(kProjectSchemaVersion == 6, "add fixtures/projects/version7.sbproj");
+TEST(Migration, VersionSixKeepsItsColourEditsAndTakesImages) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 6);
-  const std::string before = test::read_file_bytes(file);
   {
     Project project = Project::open(file);
     EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
@@ -60,11 +91,19 @@ TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournal) {
     EXPECT_EQ(nodes[1].color.saturation, 0.8);
     EXPECT_FALSE(nodes[1].color.hue_deg.has_value());
     EXPECT_TRUE(project.scan_color_corrections().empty());
+    EXPECT_TRUE(project.scan_sources().empty());
+    EXPECT_TRUE(project.images(false).empty());
   }
-  EXPECT_EQ(test::read_file_bytes(file), before);
   Project project = Project::open(file);
   ASSERT_TRUE(project.redo().has_value());
   EXPECT_EQ(project.object_nodes()[0].color.hue_deg, 20.0);
+  acquisition::ScanImage image;
+  image.format = "png";
+  image.data = {1, 2, 3};
+  Project::Edit edit = project.begin_command("import", "{}");
+  project.insert_image(edit, 1, image);
+  edit.commit("{}");
+  EXPECT_EQ(project.images(true).at(0).image.data, image.data);
   EXPECT_TRUE(project.check().damage.empty());
 }
 
@@ -140,7 +179,7 @@ TEST_P(Migration, OpensAtTheCurrentVersionWithEveryScanLoadable) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3, 4));
+INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3, 4, 5, 6));
 
 TEST(Migration, VersionOneKeepsItsScans) {
   const ScratchDir dir;

@@ -107,8 +107,8 @@ TEST(ProjectFiles, RefusesANewerSchema) {
   const ScratchDir dir;
   const auto file = dir / "future.sbproj";
   { Project project = Project::create(file); }
-  { RawDatabase(file).execute("PRAGMA user_version = 7"); }
-  expect_refused(file, "project schema version 7 is newer than this scanbench (" +
+  { RawDatabase(file).execute("PRAGMA user_version = 99"); }
+  expect_refused(file, "project schema version 99 is newer than this scanbench (" +
                            std::to_string(kProjectSchemaVersion) + "); upgrade scanbench");
 }
 
@@ -119,13 +119,13 @@ TEST(ProjectFiles, RefusesANewerSchemaThatIsOnlyInTheLog) {
   const auto file = dir / "future.sbproj";
   { Project project = Project::create(file); }
   RawDatabase newer(file);
-  newer.execute("PRAGMA wal_autocheckpoint = 0; PRAGMA user_version = 7");
+  newer.execute("PRAGMA wal_autocheckpoint = 0; PRAGMA user_version = 99");
   const std::string before = test::read_file_bytes(file);
   try {
     Project::open(file);
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& error) {
-    EXPECT_THAT(error.what(), HasSubstr("project schema version 7 is newer"));
+    EXPECT_THAT(error.what(), HasSubstr("project schema version 99 is newer"));
   }
   EXPECT_EQ(test::read_file_bytes(file), before);
 }

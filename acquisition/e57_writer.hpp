@@ -1,0 +1,40 @@
+// Writing ASTM E2807 (E57) files: each scan as a structured scan (rowIndex,
+// columnIndex) in spherical coordinates, the range as a ScaledInteger of
+// 0.1 mm and the angles as doubles, with intensity, colour, the invalid
+// state of every pixel, the pose, index bounds, limits, GUIDs and the
+// scan's images. Every pixel of the grid is one record, so that a reader
+// gets the grid back whole.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "acquisition/scan_source.hpp"
+
+namespace scanbench::acquisition {
+
+struct E57ScanOutput {
+  const Scan* scan = nullptr;
+  std::string guid;  // the scan's data3D guid; a new one when empty
+  std::vector<ScanImage> images;  // written with associatedData3DGuid = guid
+  // When given (one byte per pixel), only these pixels are written as
+  // valid: the merged model's points.
+  const std::vector<std::uint8_t>* keep = nullptr;
+};
+
+// Writes `scans` and the images tied to none (`loose_images`) to `path`
+// through an OutputFile (a .partial file renamed when complete). A valid
+// pixel has sphericalInvalidState 0; a pixel without a return 1 when its
+// direction is known (always, for the spherical angle model), else 2.
+// Throws core::InputError for a range beyond 400 km (the ScaledInteger's
+// bound) and as OutputFile.
+void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
+               std::span<const ScanImage> loose_images);
+
+// A new random GUID in the braced form E57 files use.
+std::string new_e57_guid();
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,34 @@
+// Gives an unstructured point cloud (E57 data3D without row and column
+// indices) the panoramic grid every later stage works on: each point goes
+// to the pixel of its azimuth and elevation seen from the scan's origin, at
+// an angular step estimated from the points themselves.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace scanbench::acquisition {
+
+struct PanoramaProjection {
+  int rows = 0;
+  int columns = 0;
+  double step_rad = 0.0;  // the angular step of the grid
+  // Pixel of each point (row-major), -1 for the points that fell on a pixel
+  // a nearer point holds: they are the collisions.
+  std::vector<std::int64_t> pixel;
+  std::uint64_t collisions = 0;
+};
+
+// Projects `points` (the scan's frame [m]) around the origin, or around
+// their centroid rounded to 1 m when some lie farther than 500 m from it
+// (the local origin's rule, local_origin.hpp). The step is the one at which
+// the points would fill the pixels of the area they cover once each:
+// sqrt(covered solid angle / point count), with the covered area measured
+// on a coarse occupancy grid. Azimuths start after the widest gap with no
+// point, so that a partial panorama is not split at ±180°. The grid holds at
+// most 4 pixels per point.
+PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points);
+
+}  // namespace scanbench::acquisition

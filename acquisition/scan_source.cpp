@@ -1,0 +1,17 @@
+#include "acquisition/scan_source.hpp"
+
+namespace scanbench::acquisition {
+
+const char* projection_name(ImageProjection projection) {
+  switch (projection) {
+    case ImageProjection::kPinhole:
+      return "pinhole";
+    case ImageProjection::kSpherical:
+      return "spherical";
+    case ImageProjection::kCylindrical:
+      return "cylindrical";
+  }
+  return "pinhole";
+}
+
+}  // namespace scanbench::acquisition

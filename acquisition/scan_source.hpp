@@ -1,0 +1,62 @@
+// What a scan file holds beside the scan grid: the pictures taken with the
+// scan (E57's images2D) and the file's own description of the scan. The
+// readers deliver them with each scan; the project stores them, and the E57
+// writer writes them back.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "acquisition/scan.hpp"
+
+namespace scanbench::acquisition {
+
+// How an image maps directions onto pixels (ASTM E2807 §8.4): a pinhole
+// camera, a spherical panorama or a cylindrical one. The parameters are the
+// file's, in metres and pixels; those a projection does not use stay 0.
+enum class ImageProjection { kPinhole, kSpherical, kCylindrical };
+
+struct ScanImage {
+  std::string name;         // UTF-8; may be empty
+  std::string guid;         // the file's identifier of the image; may be empty
+  ImageProjection projection = ImageProjection::kPinhole;
+  int width = 0;            // [pixels]
+  int height = 0;           // [pixels]
+  double pixel_width = 0.0;   // [m] on the sensor (pinhole) or [rad] (spherical, cylindrical)
+  double pixel_height = 0.0;  // as pixel_width
+  double focal_length = 0.0;  // pinhole [m]
+  double principal_x = 0.0;   // pinhole [pixels]
+  double principal_y = 0.0;   // pinhole and cylindrical [pixels]
+  double radius = 0.0;        // cylindrical [m]
+  // The camera's pose in the world frame (E57 poses the image in the file's
+  // coordinates, as scans).
+  Eigen::Isometry3d T_world_image = Eigen::Isometry3d::Identity();
+  std::string format;              // "jpeg" or "png"
+  std::vector<std::uint8_t> data;  // the encoded image, as the file held it
+};
+
+// The source file's description of a scan.
+struct ScanSource {
+  std::string format;  // "e57", "ptx", "triplet", "pcd"
+  std::string guid;    // E57: the data3D guid; else empty
+  // Records the file held for the scan, and how many of them the grid could
+  // not place: an unstructured scan's points that fell on a pixel already
+  // taken, or a structured scan's later returns and repeated indices.
+  std::uint64_t points_in_file = 0;
+  std::uint64_t unplaced_points = 0;
+};
+
+// One scan as a reader delivers it.
+struct ImportedScan {
+  Scan scan;
+  ScanSource source;
+  std::vector<ScanImage> images;  // those the file ties to this scan
+};
+
+// "pinhole", "spherical" or "cylindrical".
+const char* projection_name(ImageProjection projection);
+
+}  // namespace scanbench::acquisition
