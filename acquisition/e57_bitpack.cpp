@@ -42,8 +42,8 @@ bool unpack_integers(const E57Field& field, std::span<const std::byte> stream,
     // Wrapping unsigned addition: minimum + packed lies in [minimum, maximum].
     const auto raw = static_cast<std::int64_t>(static_cast<std::uint64_t>(field.minimum) +
                                                read_bits(padded.data(), position, bits));
-    value = scaled ? static_cast<double>(raw) * field.scale + field.offset
-                   : static_cast<double>(raw);
+    value =
+        scaled ? static_cast<double>(raw) * field.scale + field.offset : static_cast<double>(raw);
     position += static_cast<std::uint64_t>(bits);
   }
   return true;
@@ -74,7 +74,8 @@ std::int64_t raw_integer(const E57Field& field, double value) {
 int E57Field::bits() const {
   if (type == E57FieldType::kFloat) return single_precision ? 32 : 64;
   assert(maximum >= minimum);
-  const std::uint64_t span = static_cast<std::uint64_t>(maximum) - static_cast<std::uint64_t>(minimum);
+  const std::uint64_t span =
+      static_cast<std::uint64_t>(maximum) - static_cast<std::uint64_t>(minimum);
   return span == 0 ? 0 : static_cast<int>(std::bit_width(span));
 }
 

@@ -41,8 +41,10 @@ struct Parser {
 
   std::int64_t integer_text(const char* text, const std::string& path) const {
     std::string_view view(text);
-    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.front()))) view.remove_prefix(1);
-    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.back()))) view.remove_suffix(1);
+    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.front())))
+      view.remove_prefix(1);
+    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.back())))
+      view.remove_suffix(1);
     if (view.empty()) return 0;
     std::int64_t value = 0;
     const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);
@@ -54,8 +56,10 @@ struct Parser {
 
   double float_text(const char* text, const std::string& path) const {
     std::string_view view(text);
-    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.front()))) view.remove_prefix(1);
-    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.back()))) view.remove_suffix(1);
+    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.front())))
+      view.remove_prefix(1);
+    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.back())))
+      view.remove_suffix(1);
     if (view.empty()) return 0.0;
     double value = 0.0;
     const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);
@@ -118,9 +122,9 @@ struct Parser {
     }
     if (const pugi::xml_node translation = child(found, where, "translation", "Structure", false)) {
       const std::string at = where + "/translation";
-      pose.translation() = Eigen::Vector3d(number(translation, at, "x", 0.0),
-                                           number(translation, at, "y", 0.0),
-                                           number(translation, at, "z", 0.0));
+      pose.translation() =
+          Eigen::Vector3d(number(translation, at, "x", 0.0), number(translation, at, "y", 0.0),
+                          number(translation, at, "z", 0.0));
     }
     return pose;
   }
@@ -185,9 +189,9 @@ struct Parser {
       const auto get = [&](const char* name) {
         return static_cast<std::int64_t>(number(bounds, at, name, 0.0));
       };
-      entry.index_bounds = E57IndexBounds{get("rowMinimum"),    get("rowMaximum"),
-                                          get("columnMinimum"), get("columnMaximum"),
-                                          get("returnMinimum"), get("returnMaximum")};
+      entry.index_bounds =
+          E57IndexBounds{get("rowMinimum"),    get("rowMaximum"),    get("columnMinimum"),
+                         get("columnMaximum"), get("returnMinimum"), get("returnMaximum")};
     }
     if (const pugi::xml_node limits = child(node, path, "intensityLimits", "Structure", false)) {
       const std::string at = path + "/intensityLimits";
@@ -208,7 +212,8 @@ struct Parser {
     }
     const pugi::xml_node points = child(node, path, "points", "CompressedVector", true);
     const std::string at = path + "/points";
-    entry.points.file_offset = static_cast<std::uint64_t>(attribute_integer(points, at, "fileOffset", -1));
+    entry.points.file_offset =
+        static_cast<std::uint64_t>(attribute_integer(points, at, "fileOffset", -1));
     const std::int64_t records = attribute_integer(points, at, "recordCount", -1);
     if (records < 0) fail(at, "lacks a valid recordCount");
     entry.points.record_count = static_cast<std::uint64_t>(records);
@@ -289,8 +294,7 @@ E57Document parse_e57_xml(std::string_view xml, const std::string& file) {
   if (!parsed) {
     core::FilePosition position;
     position.detail = "XML section, character " + std::to_string(parsed.offset);
-    throw core::InputError(file, position,
-                           std::string("malformed XML: ") + parsed.description());
+    throw core::InputError(file, position, std::string("malformed XML: ") + parsed.description());
   }
   const Parser parser{file};
   const pugi::xml_node root = tree.child("e57Root");
@@ -413,8 +417,10 @@ void write_scan(pugi::xml_node parent, const E57ScanEntry& scan) {
                                {"colorGreenMinimum", "colorGreenMaximum"},
                                {"colorBlueMinimum", "colorBlueMaximum"}};
     for (int c = 0; c < 3; ++c) {
-      Builder::integer(limits, names[c][0], static_cast<std::int64_t>((*scan.color_limits)[c].first));
-      Builder::integer(limits, names[c][1], static_cast<std::int64_t>((*scan.color_limits)[c].second));
+      Builder::integer(limits, names[c][0],
+                       static_cast<std::int64_t>((*scan.color_limits)[c].first));
+      Builder::integer(limits, names[c][1],
+                       static_cast<std::int64_t>((*scan.color_limits)[c].second));
     }
   }
   pugi::xml_node points = Builder::element(node, "points", "CompressedVector");
@@ -434,12 +440,13 @@ void write_image(pugi::xml_node parent, const E57ImageEntry& entry) {
     Builder::string(node, "associatedData3DGuid", entry.associated_scan_guid);
   }
   Builder::pose(node, image.T_world_image);
-  const char* kind = image.projection == ImageProjection::kSpherical     ? "sphericalRepresentation"
-                     : image.projection == ImageProjection::kCylindrical ? "cylindricalRepresentation"
-                                                                         : "pinholeRepresentation";
+  const char* kind = image.projection == ImageProjection::kSpherical ? "sphericalRepresentation"
+                     : image.projection == ImageProjection::kCylindrical
+                         ? "cylindricalRepresentation"
+                         : "pinholeRepresentation";
   pugi::xml_node representation = Builder::element(node, kind, "Structure");
-  pugi::xml_node blob = Builder::element(representation,
-                                         image.format == "png" ? "pngImage" : "jpegImage", "Blob");
+  pugi::xml_node blob =
+      Builder::element(representation, image.format == "png" ? "pngImage" : "jpegImage", "Blob");
   blob.append_attribute("fileOffset") = fmt::format("{}", entry.blob_offset).c_str();
   blob.append_attribute("length") = fmt::format("{}", entry.blob_length).c_str();
   Builder::integer(representation, "imageWidth", image.width);

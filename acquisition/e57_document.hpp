@@ -39,7 +39,7 @@ struct E57ScanEntry {
   std::string sensor_model;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // T_file_scan
   std::optional<E57IndexBounds> index_bounds;
-  std::optional<std::pair<double, double>> intensity_limits;  // minimum, maximum
+  std::optional<std::pair<double, double>> intensity_limits;             // minimum, maximum
   std::optional<std::array<std::pair<double, double>, 3>> color_limits;  // red, green, blue
   E57PointsEntry points;
 };
@@ -48,7 +48,7 @@ struct E57ScanEntry {
 struct E57ImageEntry {
   std::string path;  // "/images2D/0"
   std::string associated_scan_guid;
-  ScanImage image;             // data left empty by the parser
+  ScanImage image;                // data left empty by the parser
   std::uint64_t blob_offset = 0;  // physical offset of the blob section header
   std::uint64_t blob_length = 0;  // bytes of the encoded image
 };

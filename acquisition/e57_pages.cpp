@@ -75,9 +75,8 @@ void E57PageReader::load_chunk(std::uint64_t first_page, const std::string& what
       core::FilePosition position;
       position.byte_offset = page * kE57PageSize;
       position.detail = "page " + std::to_string(page);
-      throw core::InputError(name_, position,
-                             "page fails its CRC-32C checksum (the file is damaged), in the " +
-                                 what);
+      throw core::InputError(
+          name_, position, "page fails its CRC-32C checksum (the file is damaged), in the " + what);
     }
     checked_[page] = 1;
   }
@@ -101,8 +100,7 @@ void E57PageReader::read(std::uint64_t physical, std::span<std::byte> out,
         page >= chunk_first_page_ + chunk_.size() / kE57PageSize) {
       load_chunk(page, what);
     }
-    const std::size_t take =
-        std::min<std::size_t>(out.size() - done, kE57PagePayload - in_page);
+    const std::size_t take = std::min<std::size_t>(out.size() - done, kE57PagePayload - in_page);
     std::memcpy(out.data() + done,
                 chunk_.data() + (page - chunk_first_page_) * kE57PageSize + in_page, take);
     done += take;

@@ -47,7 +47,8 @@ FileHeader read_header(E57PageReader& file) {
   std::memcpy(&header.xml_offset, bytes + 24, 8);
   std::memcpy(&header.xml_length, bytes + 32, 8);
   std::memcpy(&page_size, bytes + 40, 8);
-  if (major != 1) bad_header(file, 8, "E57 major version " + std::to_string(major) + " (1 is read)");
+  if (major != 1)
+    bad_header(file, 8, "E57 major version " + std::to_string(major) + " (1 is read)");
   if (page_size != kE57PageSize) bad_header(file, 40, "page size is not 1024");
   if (header.physical_length != file.physical_length()) {
     bad_header(file, 16,
@@ -127,8 +128,8 @@ Records decode_records(E57PageReader& file, const E57ScanEntry& entry) {
     throw core::InputError(file.file_name(), position,
                            "has neither cartesianX/Y/Z nor sphericalRange/Azimuth/Elevation");
   }
-  const auto invalid = decode(points, streams, spherical ? "sphericalInvalidState"
-                                                         : "cartesianInvalidState");
+  const auto invalid =
+      decode(points, streams, spherical ? "sphericalInvalidState" : "cartesianInvalidState");
   for (std::size_t i = 0; i < n; ++i) {
     if (spherical) {
       const double ce = std::cos((*el)[i]);
@@ -184,11 +185,14 @@ Placement place_structured(const std::string& file, const E57ScanEntry& entry,
     col_max = static_cast<std::int64_t>(*std::max_element(cols.begin(), cols.end()));
   }
   Placement placement;
-  const std::uint64_t height = row_max >= row_min ? static_cast<std::uint64_t>(row_max - row_min + 1) : 0;
-  const std::uint64_t width = col_max >= col_min ? static_cast<std::uint64_t>(col_max - col_min + 1) : 0;
+  const std::uint64_t height =
+      row_max >= row_min ? static_cast<std::uint64_t>(row_max - row_min + 1) : 0;
+  const std::uint64_t width =
+      col_max >= col_min ? static_cast<std::uint64_t>(col_max - col_min + 1) : 0;
   if (height * width > kMaxPixels || height > (1u << 30) || width > (1u << 30)) {
-    bad_index(file, entry, 0, "has index bounds of " + std::to_string(height) + " × " +
-                                  std::to_string(width) + " pixels, more than scanbench holds");
+    bad_index(file, entry, 0,
+              "has index bounds of " + std::to_string(height) + " × " + std::to_string(width) +
+                  " pixels, more than scanbench holds");
   }
   placement.rows = static_cast<int>(height);
   placement.columns = static_cast<int>(width);
@@ -274,7 +278,8 @@ ImportedScan build_scan(const std::filesystem::path& path, const E57ScanEntry& e
       scan.intensity[p] = static_cast<float>(std::clamp(t, 0.0, 1.0));
     }
     if (with_color) {
-      for (int c = 0; c < 3; ++c) scan.rgb[3 * p + c] = to_byte((*records.color[c])[i], color_bounds[c]);
+      for (int c = 0; c < 3; ++c)
+        scan.rgb[3 * p + c] = to_byte((*records.color[c])[i], color_bounds[c]);
     }
   }
   set_grid_from_points(scan, points_file, std::nullopt);
@@ -296,19 +301,19 @@ ScanImage read_image(E57PageReader& file, const E57ImageEntry& entry) {
     core::FilePosition position;
     position.byte_offset = entry.blob_offset;
     position.detail = entry.path;
-    throw core::InputError(file.file_name(), position,
-                           "is not a blob section of " + std::to_string(entry.blob_length) +
-                               " bytes");
+    throw core::InputError(
+        file.file_name(), position,
+        "is not a blob section of " + std::to_string(entry.blob_length) + " bytes");
   }
   image.data.resize(entry.blob_length);
-  file.read(e57_advance(entry.blob_offset, 16), std::as_writable_bytes(std::span(image.data)), what);
+  file.read(e57_advance(entry.blob_offset, 16), std::as_writable_bytes(std::span(image.data)),
+            what);
   return image;
 }
 
 }  // namespace
 
-void read_e57(const std::filesystem::path& path,
-              const std::function<void(ImportedScan&&)>& on_scan,
+void read_e57(const std::filesystem::path& path, const std::function<void(ImportedScan&&)>& on_scan,
               const std::function<void(ScanImage&&)>& on_loose_image) {
   E57PageReader file(path);
   const FileHeader header = read_header(file);
@@ -320,8 +325,8 @@ void read_e57(const std::filesystem::path& path,
     const E57ScanEntry& entry = document.scans[k];
     const Records records = decode_records(file, entry);
     const bool structured = records.row && records.column;
-    const Placement placement =
-        structured ? place_structured(file.file_name(), entry, records) : place_unstructured(records);
+    const Placement placement = structured ? place_structured(file.file_name(), entry, records)
+                                           : place_unstructured(records);
     ImportedScan scan = build_scan(path, entry, k, records, placement);
     for (std::size_t i = 0; i < document.images.size(); ++i) {
       if (entry.guid.empty() || document.images[i].associated_scan_guid != entry.guid) continue;

@@ -26,8 +26,7 @@ namespace scanbench::acquisition {
 // and the problem for a bad signature or header, a checksum failure,
 // malformed XML, a prototype without coordinates or not matching its data,
 // indices outside the index bounds, or a truncated binary section.
-void read_e57(const std::filesystem::path& path,
-              const std::function<void(ImportedScan&&)>& on_scan,
+void read_e57(const std::filesystem::path& path, const std::function<void(ImportedScan&&)>& on_scan,
               const std::function<void(ScanImage&&)>& on_loose_image);
 
 }  // namespace scanbench::acquisition

@@ -126,7 +126,8 @@ std::uint64_t write_blob(E57PageWriter& file, const ScanImage& image) {
   return section;
 }
 
-E57ImageEntry image_entry(E57PageWriter& file, const ScanImage& image, const std::string& scan_guid) {
+E57ImageEntry image_entry(E57PageWriter& file, const ScanImage& image,
+                          const std::string& scan_guid) {
   E57ImageEntry entry;
   entry.image = image;
   entry.image.data.clear();
@@ -144,7 +145,8 @@ E57ScanEntry scan_entry(E57PageWriter& file, const E57ScanOutput& output, const 
   entry.name = scan.name;
   entry.sensor_model = scan.scanner.name;
   entry.pose = scan.T_world_scan;
-  entry.index_bounds = E57IndexBounds{0, std::max(scan.rows - 1, 0), 0, std::max(scan.columns - 1, 0), 0, 0};
+  entry.index_bounds =
+      E57IndexBounds{0, std::max(scan.rows - 1, 0), 0, std::max(scan.columns - 1, 0), 0, 0};
   if (scan.has_intensity()) entry.intensity_limits = std::pair{0.0, 1.0};
   if (scan.has_color()) entry.color_limits = {{{0.0, 255.0}, {0.0, 255.0}, {0.0, 255.0}}};
   entry.points.fields = scan_fields(scan, max_range(scan, name));
@@ -179,7 +181,8 @@ void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput>
     }
     document.scans.push_back(std::move(entry));
   }
-  for (const ScanImage& image : loose_images) document.images.push_back(image_entry(file, image, ""));
+  for (const ScanImage& image : loose_images)
+    document.images.push_back(image_entry(file, image, ""));
   file.pad_to(4);
   const std::uint64_t xml_offset = file.physical_position();
   std::string xml = write_e57_xml(document);

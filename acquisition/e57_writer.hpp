@@ -18,7 +18,7 @@ namespace scanbench::acquisition {
 
 struct E57ScanOutput {
   const Scan* scan = nullptr;
-  std::string guid;  // the scan's data3D guid; a new one when empty
+  std::string guid;               // the scan's data3D guid; a new one when empty
   std::vector<ScanImage> images;  // written with associatedData3DGuid = guid
   // When given (one byte per pixel), only these pixels are written as
   // valid: the merged model's points.

@@ -85,10 +85,12 @@ PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points) 
   // Nearest point first: it is the one a scanner would have seen.
   std::vector<std::size_t> order(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return range[a] < range[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return range[a] < range[b]; });
   std::vector<std::uint8_t> taken(static_cast<std::size_t>(out.rows) * out.columns, 0);
   for (const std::size_t i : order) {
-    const auto row = std::min<std::int64_t>(std::llround((el_max - elevation[i]) / step), out.rows - 1);
+    const auto row =
+        std::min<std::int64_t>(std::llround((el_max - elevation[i]) / step), out.rows - 1);
     const auto col = std::min<std::int64_t>(std::llround(azimuth[i] / step), out.columns - 1);
     const std::int64_t p = row * out.columns + col;
     if (taken[p]) {

@@ -18,9 +18,10 @@ ScanFileFormat scan_file_format(const std::filesystem::path& path) {
   if (extension == ".json") return ScanFileFormat::kTriplet;
   if (extension == ".pcd") return ScanFileFormat::kOrganizedPcd;
   if (extension == ".e57") return ScanFileFormat::kE57;
-  throw core::InputError(path.string(), {},
-                         "unknown scan file type \"" + extension +
-                             "\" (expected .ptx, .pcd, .e57, or the .json sidecar of an image triplet)");
+  throw core::InputError(
+      path.string(), {},
+      "unknown scan file type \"" + extension +
+          "\" (expected .ptx, .pcd, .e57, or the .json sidecar of an image triplet)");
 }
 
 namespace {
@@ -41,7 +42,8 @@ void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& s
                     const std::function<void(ScanImage&&)>& on_loose_image) {
   switch (scan_file_format(path)) {
     case ScanFileFormat::kPtx:
-      read_ptx(path, settings.ptx, [&on_scan](Scan&& scan) { on_scan(plain(std::move(scan), "ptx")); });
+      read_ptx(path, settings.ptx,
+               [&on_scan](Scan&& scan) { on_scan(plain(std::move(scan), "ptx")); });
       return;
     case ScanFileFormat::kTriplet:
       on_scan(plain(read_triplet(path), "triplet"));

@@ -20,11 +20,11 @@ namespace scanbench::acquisition {
 enum class ImageProjection { kPinhole, kSpherical, kCylindrical };
 
 struct ScanImage {
-  std::string name;         // UTF-8; may be empty
-  std::string guid;         // the file's identifier of the image; may be empty
+  std::string name;  // UTF-8; may be empty
+  std::string guid;  // the file's identifier of the image; may be empty
   ImageProjection projection = ImageProjection::kPinhole;
-  int width = 0;            // [pixels]
-  int height = 0;           // [pixels]
+  int width = 0;              // [pixels]
+  int height = 0;             // [pixels]
   double pixel_width = 0.0;   // [m] on the sensor (pinhole) or [rad] (spherical, cylindrical)
   double pixel_height = 0.0;  // as pixel_width
   double focal_length = 0.0;  // pinhole [m]

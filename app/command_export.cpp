@@ -43,12 +43,9 @@ void add_export_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   const std::map<std::string, modeling::ExportFormat> formats{
-      {"ptx", modeling::ExportFormat::kPtx},
-      {"ply", modeling::ExportFormat::kPly},
-      {"csv", modeling::ExportFormat::kCsv},
-      {"triplet", modeling::ExportFormat::kTriplet},
-      {"las", modeling::ExportFormat::kLas},
-      {"e57", modeling::ExportFormat::kE57}};
+      {"ptx", modeling::ExportFormat::kPtx}, {"ply", modeling::ExportFormat::kPly},
+      {"csv", modeling::ExportFormat::kCsv}, {"triplet", modeling::ExportFormat::kTriplet},
+      {"las", modeling::ExportFormat::kLas}, {"e57", modeling::ExportFormat::kE57}};
   command->add_option("--format", options->settings.format, "ptx, ply, csv, las, e57 or triplet")
       ->required()
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));

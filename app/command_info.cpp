@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,9 +49,9 @@ Contents project_entries(const std::filesystem::path& path) {
   const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
   for (auto& stored : project.scans()) {
     const auto source = sources.find(stored.id);
-    contents.scans.push_back({stored.id, std::move(stored.summary),
-                              source == sources.end() ? std::nullopt
-                                                      : std::optional(source->second)});
+    contents.scans.push_back(
+        {stored.id, std::move(stored.summary),
+         source == sources.end() ? std::nullopt : std::optional(source->second)});
   }
   for (modeling::StoredImage& stored : project.images(false)) {
     contents.images.push_back({stored.id, stored.scan_id, std::move(stored.image)});
@@ -98,24 +98,24 @@ nlohmann::json to_json(const Entry& entry) {
     const Eigen::Vector3d lo = s.bbox_world->min(), hi = s.bbox_world->max();
     bbox = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
   }
-  return {{"id", entry.id},
-          {"name", s.name},
-          {"rows", s.rows},
-          {"columns", s.columns},
-          {"valid_points", s.valid_points},
-          {"has_color", s.has_color},
-          {"has_intensity", s.has_intensity},
-          {"angle_model", acquisition::angle_model_name(s.spherical)},
-          {"T_world_scan", acquisition::row_major(s.T_world_scan)},
-          {"bbox_world", bbox},
-          {"scanner", s.scanner.name},
-          {"source_file", s.scanner.source_file},
-          {"source", entry.source ? nlohmann::json{{"format", entry.source->format},
-                                                   {"guid", entry.source->guid},
-                                                   {"points_in_file", entry.source->points_in_file},
-                                                   {"unplaced_points",
-                                                    entry.source->unplaced_points}}
-                                  : nlohmann::json(nullptr)}};
+  return {
+      {"id", entry.id},
+      {"name", s.name},
+      {"rows", s.rows},
+      {"columns", s.columns},
+      {"valid_points", s.valid_points},
+      {"has_color", s.has_color},
+      {"has_intensity", s.has_intensity},
+      {"angle_model", acquisition::angle_model_name(s.spherical)},
+      {"T_world_scan", acquisition::row_major(s.T_world_scan)},
+      {"bbox_world", bbox},
+      {"scanner", s.scanner.name},
+      {"source_file", s.scanner.source_file},
+      {"source", entry.source ? nlohmann::json{{"format", entry.source->format},
+                                               {"guid", entry.source->guid},
+                                               {"points_in_file", entry.source->points_in_file},
+                                               {"unplaced_points", entry.source->unplaced_points}}
+                              : nlohmann::json(nullptr)}};
 }
 
 void print_table(const std::string& path, const Contents& contents) {
@@ -130,9 +130,10 @@ void print_table(const std::string& path, const Contents& contents) {
                s.has_color ? "yes" : "no", s.has_intensity ? "yes" : "no",
                acquisition::angle_model_name(s.spherical), t.x(), t.y(), t.z());
     if (e.source && e.source->unplaced_points > 0) {
-      fmt::print("      {} of the file's {} records not placed in the grid (collisions of an "
-                 "unstructured scan, or later returns)\n",
-                 e.source->unplaced_points, e.source->points_in_file);
+      fmt::print(
+          "      {} of the file's {} records not placed in the grid (collisions of an "
+          "unstructured scan, or later returns)\n",
+          e.source->unplaced_points, e.source->points_in_file);
     }
   }
   if (contents.images.empty()) return;

@@ -60,7 +60,8 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
       Project::Edit part = command.part();
       const std::int64_t id = project.insert_scan(part, encoded);
       project.put_scan_source(part, id, imported.source);
-      for (const acquisition::ScanImage& image : imported.images) project.insert_image(part, id, image);
+      for (const acquisition::ScanImage& image : imported.images)
+        project.insert_image(part, id, image);
       part.commit_part();
       result.scan_ids.push_back(id);
       result.unplaced_points += imported.source.unplaced_points;

@@ -27,7 +27,7 @@ struct ImportResult {
   std::size_t images = 0;              // stored with the scans (E57 images2D)
   // Records the grids could not place (acquisition::ScanSource), all scans.
   std::uint64_t unplaced_points = 0;
-  bool created_project = false;        // import_scan_files only
+  bool created_project = false;  // import_scan_files only
   double seconds = 0.0;
 };
 

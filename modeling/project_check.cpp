@@ -155,7 +155,8 @@ std::size_t check_scan_images(sqlite3* db, const std::string& file,
     record.data_crc = rows.column_int(5);
     const std::string image = "image " + std::to_string(rows.column_int(0));
     if (checksum(record) != rows.column_int(6)) damage.push_back(image + " fails its checksum");
-    if (static_cast<std::int64_t>(crc32_of(std::as_bytes(rows.column_blob(7)))) != record.data_crc) {
+    if (static_cast<std::int64_t>(crc32_of(std::as_bytes(rows.column_blob(7)))) !=
+        record.data_crc) {
       damage.push_back(image + ": its data fails its CRC");
     }
   }

@@ -95,7 +95,8 @@ acquisition::ScanImage image_from_json(const std::string& text, const std::strin
   image.principal_y = json.at("principal_y").get<double>();
   image.radius = json.at("radius").get<double>();
   const auto pose = json.at("T_world_image").get<std::vector<double>>();
-  if (pose.size() != 16) throw std::invalid_argument("a pose of " + std::to_string(pose.size()) + " numbers");
+  if (pose.size() != 16)
+    throw std::invalid_argument("a pose of " + std::to_string(pose.size()) + " numbers");
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) image.T_world_image.matrix()(r, c) = pose[4 * r + c];
   }
@@ -114,8 +115,12 @@ void Project::put_scan_source(Edit& edit, std::int64_t id, const acquisition::Sc
   stored_pixel_count(id, &edit);  // throws when there is no such scan
   const ScanSourceRecord record{id, to_json(source)};
   sqlite::Statement insert(
-      db(), "INSERT INTO scan_sources (scan_id, details, checksum) VALUES (?1, ?2, ?3)", file_name());
-  insert.bind_int(1, record.scan_id).bind_text(2, record.details).bind_int(3, checksum(record)).run();
+      db(), "INSERT INTO scan_sources (scan_id, details, checksum) VALUES (?1, ?2, ?3)",
+      file_name());
+  insert.bind_int(1, record.scan_id)
+      .bind_text(2, record.details)
+      .bind_int(3, checksum(record))
+      .run();
 }
 
 std::map<std::int64_t, acquisition::ScanSource> Project::scan_sources() const {
@@ -143,7 +148,8 @@ std::int64_t Project::insert_image(Edit& edit, std::optional<std::int64_t> scan_
     throw core::InputError(file_name(), {{}, {}, "image \"" + image.name + "\""},
                            "is " + image.format + "; images are JPEG or PNG");
   }
-  ImageRecord record{edit.command_id(), scan_id, describe(image), image.format, data_crc(image.data)};
+  ImageRecord record{edit.command_id(), scan_id, describe(image), image.format,
+                     data_crc(image.data)};
   sqlite::Statement insert(db(),
                            "INSERT INTO scan_images (created_by, scan_id, description, format, "
                            "data, data_crc, checksum) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",

@@ -26,10 +26,11 @@ using test::ScratchDir;
 std::vector<ImportedScan> read_all(const std::filesystem::path& path,
                                    std::vector<ScanImage>* loose = nullptr) {
   std::vector<ImportedScan> scans;
-  read_e57(path, [&scans](ImportedScan&& scan) { scans.push_back(std::move(scan)); },
-           [loose](ScanImage&& image) {
-             if (loose != nullptr) loose->push_back(std::move(image));
-           });
+  read_e57(
+      path, [&scans](ImportedScan&& scan) { scans.push_back(std::move(scan)); },
+      [loose](ScanImage&& image) {
+        if (loose != nullptr) loose->push_back(std::move(image));
+      });
   return scans;
 }
 
@@ -78,8 +79,9 @@ TEST_P(IntegerWidth, PacksAsTheReferenceAndUnpacksToTheSameValues) {
   field.minimum = bits == 64   ? std::numeric_limits<std::int64_t>::min()
                   : bits <= 53 ? -(std::int64_t{1} << (bits - 1)) + 3
                                : -(std::int64_t{1} << (bits - 1));
-  field.maximum = bits == 64 ? std::numeric_limits<std::int64_t>::max()
-                             : field.minimum + static_cast<std::int64_t>((std::uint64_t{1} << bits) - 1);
+  field.maximum = bits == 64
+                      ? std::numeric_limits<std::int64_t>::max()
+                      : field.minimum + static_cast<std::int64_t>((std::uint64_t{1} << bits) - 1);
   ASSERT_EQ(field.bits(), bits);
   std::mt19937_64 random(static_cast<unsigned>(bits));
   // Values a double holds exactly: beyond 53 bits, multiples of 2^(bits − 53).
@@ -89,7 +91,8 @@ TEST_P(IntegerWidth, PacksAsTheReferenceAndUnpacksToTheSameValues) {
   for (std::size_t i = 0; i < raw.size(); ++i) {
     raw[i] = (bits == 64 ? random() : random() % (std::uint64_t{1} << bits)) >> drop << drop;
     if (i == 0) raw[i] = 0;
-    values[i] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(field.minimum) + raw[i]));
+    values[i] = static_cast<double>(
+        static_cast<std::int64_t>(static_cast<std::uint64_t>(field.minimum) + raw[i]));
   }
   std::vector<std::byte> packed;
   e57_pack(field, values, packed);
@@ -310,8 +313,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"e57_bad_signature.e57", "signature is not \"ASTM-E57\""},
         BadCase{"e57_bad_checksum.e57", "(byte 1024), page 1: page fails its CRC-32C checksum"},
         BadCase{"e57_malformed_xml.e57", "malformed XML"},
-        BadCase{"e57_truncated_file.e57", "the header gives a length of 9216 bytes but the file "
-                                          "has 8192"},
+        BadCase{"e57_truncated_file.e57",
+                "the header gives a length of 9216 bytes but the file "
+                "has 8192"},
         BadCase{"e57_prototype_mismatch.e57", "packet of 5 bytestreams where the prototype has 6"},
         BadCase{"e57_truncated_section.e57", "fewer bytes of field \"cartesianX\""},
         BadCase{"e57_no_coordinates.e57", "neither cartesianX/Y/Z nor sphericalRange"},

@@ -50,9 +50,9 @@ void expect_same_scans(const std::filesystem::path& first, const std::filesystem
     for (int r = 0; r < x.rows; ++r) {
       for (int c = 0; c < x.columns; ++c) {
         if (!x.valid[x.index(r, c)]) continue;
-        worst = std::max(worst, (acquisition::point_in_world(x, r, c) -
-                                 acquisition::point_in_world(y, r, c))
-                                    .norm());
+        worst = std::max(
+            worst,
+            (acquisition::point_in_world(x, r, c) - acquisition::point_in_world(y, r, c)).norm());
       }
     }
     EXPECT_LT(worst, 1e-4) << x.name << ": every point within 0.1 mm";
@@ -70,7 +70,8 @@ TEST(E57Project, RoundTripKeepsScansImagesAndGuids) {
   EXPECT_EQ(b.scan_sources().at(1).guid, "{scan-structured}");
   EXPECT_EQ(b.scan_sources().at(1).unplaced_points, 0u) << "the exported grid holds first returns";
   const std::vector<StoredImage> images = b.images(true);
-  const std::vector<StoredImage> original = Project::open_for_reading(dir / "a.sbproj").images(true);
+  const std::vector<StoredImage> original =
+      Project::open_for_reading(dir / "a.sbproj").images(true);
   ASSERT_EQ(images.size(), original.size());
   for (std::size_t i = 0; i < images.size(); ++i) {
     EXPECT_EQ(images[i].scan_id, original[i].scan_id);
@@ -88,8 +89,7 @@ TEST(E57Project, PtxThroughE57KeepsEveryGeoreferencedScan) {
   const ScratchDir dir;
   import_files(dir / "ptx.sbproj",
                {fixture("good/ptx/two_scans.ptx"), fixture("good/ptx/tiny_color.ptx"),
-                fixture("good/ptx/georef_world_1e7.ptx"),
-                fixture("good/ptx/irregular.ptx")});
+                fixture("good/ptx/georef_world_1e7.ptx"), fixture("good/ptx/irregular.ptx")});
   import_files(dir / "e57.sbproj", {export_e57(dir / "ptx.sbproj", dir / "ptx.e57")});
   expect_same_scans(dir / "ptx.sbproj", dir / "e57.sbproj");
 }
