@@ -1,6 +1,7 @@
 #include "acquisition/e57_bitpack.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
 #include <cmath>
@@ -21,11 +22,13 @@ std::uint64_t read_bits(const unsigned char* data, std::uint64_t position, int b
   return bits == 64 ? value : value & ((std::uint64_t{1} << bits) - 1);
 }
 
-bool unpack_integers(const E57Field& field, std::span<const std::byte> stream,
+bool unpack_integers(const E57Field& field, std::span<const std::byte> stream, std::uint64_t first,
                      std::span<double> out) {
   const int bits = field.bits();
-  const std::uint64_t needed = e57_stream_bytes(field, out.size());
-  if (stream.size() < needed) return false;
+  const std::uint64_t begin_bit = first * static_cast<std::uint64_t>(bits);
+  assert(bits <= 64);
+  const std::uint64_t end_byte = e57_stream_bytes(field, first + out.size());
+  if (stream.size() < end_byte) return false;
   const bool scaled = field.type == E57FieldType::kScaledInteger;
   if (bits == 0) {
     const double value = scaled ? static_cast<double>(field.minimum) * field.scale + field.offset
@@ -33,28 +36,55 @@ bool unpack_integers(const E57Field& field, std::span<const std::byte> stream,
     std::fill(out.begin(), out.end(), value);
     return true;
   }
-  // Decode from a copy padded with 16 zero bytes, so that every read of two
-  // words stays inside it.
-  std::vector<unsigned char> padded(needed + 16, 0);
-  std::memcpy(padded.data(), stream.data(), needed);
-  std::uint64_t position = 0;
-  for (double& value : out) {
+  // Records whose two-word read stays inside the stream decode in place;
+  // the last few from a copy padded with zeros.
+  const auto* data = reinterpret_cast<const unsigned char*>(stream.data());
+  const auto minimum = static_cast<std::uint64_t>(field.minimum);
+  const auto value_of = [&](std::uint64_t packed) {
     // Wrapping unsigned addition: minimum + packed lies in [minimum, maximum].
-    const auto raw = static_cast<std::int64_t>(static_cast<std::uint64_t>(field.minimum) +
-                                               read_bits(padded.data(), position, bits));
-    value =
-        scaled ? static_cast<double>(raw) * field.scale + field.offset : static_cast<double>(raw);
+    const auto raw = static_cast<std::int64_t>(minimum + packed);
+    return scaled ? static_cast<double>(raw) * field.scale + field.offset
+                  : static_cast<double>(raw);
+  };
+  std::uint64_t position = begin_bit;
+  std::size_t k = 0;
+  // The in-place records: up to the last one whose 16-byte read fits.
+  const std::uint64_t in_place_bits =
+      stream.size() >= 16 ? (stream.size() - 16) * 8 + 1 : 0;  // positions below this
+  const std::size_t in_place =
+      position >= in_place_bits
+          ? 0
+          : std::min<std::size_t>(out.size(), (in_place_bits - position + bits - 1) / bits);
+  if (bits <= 56) {
+    // One 8-byte load holds the record's bits whatever its bit offset.
+    const std::uint64_t mask = (std::uint64_t{1} << bits) - 1;
+    for (; k < in_place; ++k, position += static_cast<std::uint64_t>(bits)) {
+      std::uint64_t word;
+      std::memcpy(&word, data + position / 8, 8);
+      out[k] = value_of((word >> (position % 8)) & mask);
+    }
+  }
+  for (; k < in_place; ++k, position += static_cast<std::uint64_t>(bits)) {
+    out[k] = value_of(read_bits(data, position, bits));
+  }
+  if (k == out.size()) return true;
+  const std::uint64_t tail_byte = position / 8;
+  std::array<unsigned char, 48> tail{};  // at most 16 bytes of stream and 16 of padding
+  std::memcpy(tail.data(), data + tail_byte, end_byte - tail_byte);
+  for (position -= tail_byte * 8; k < out.size(); ++k) {
+    out[k] = value_of(read_bits(tail.data(), position, bits));
     position += static_cast<std::uint64_t>(bits);
   }
   return true;
 }
 
 template <typename Real>
-bool unpack_floats(std::span<const std::byte> stream, std::span<double> out) {
-  if (stream.size() < out.size() * sizeof(Real)) return false;
+bool unpack_floats(std::span<const std::byte> stream, std::uint64_t first, std::span<double> out) {
+  if (stream.size() < (first + out.size()) * sizeof(Real)) return false;
+  const std::byte* data = stream.data() + first * sizeof(Real);
   for (std::size_t i = 0; i < out.size(); ++i) {
     Real value;
-    std::memcpy(&value, stream.data() + i * sizeof(Real), sizeof(Real));
+    std::memcpy(&value, data + i * sizeof(Real), sizeof(Real));
     out[i] = static_cast<double>(value);
   }
   return true;
@@ -83,10 +113,11 @@ std::uint64_t e57_stream_bytes(const E57Field& field, std::uint64_t records) {
   return (records * static_cast<std::uint64_t>(field.bits()) + 7) / 8;
 }
 
-bool e57_unpack(const E57Field& field, std::span<const std::byte> stream, std::span<double> out) {
-  if (field.type != E57FieldType::kFloat) return unpack_integers(field, stream, out);
-  return field.single_precision ? unpack_floats<float>(stream, out)
-                                : unpack_floats<double>(stream, out);
+bool e57_unpack(const E57Field& field, std::span<const std::byte> stream, std::uint64_t first,
+                std::span<double> out) {
+  if (field.type != E57FieldType::kFloat) return unpack_integers(field, stream, first, out);
+  return field.single_precision ? unpack_floats<float>(stream, first, out)
+                                : unpack_floats<double>(stream, first, out);
 }
 
 void e57_pack(const E57Field& field, std::span<const double> values,

@@ -39,9 +39,11 @@ struct E57Field {
 // The bytes `records` records of `field` take (rounded up to whole bytes).
 std::uint64_t e57_stream_bytes(const E57Field& field, std::uint64_t records);
 
-// Decodes the first out.size() records of `stream` into values (scaled and
-// offset for a ScaledInteger). Returns false when the stream is too short.
-bool e57_unpack(const E57Field& field, std::span<const std::byte> stream, std::span<double> out);
+// Decodes records first … first + out.size() − 1 of `stream` into values
+// (scaled and offset for a ScaledInteger). Returns false when the stream is
+// too short.
+bool e57_unpack(const E57Field& field, std::span<const std::byte> stream, std::uint64_t first,
+                std::span<double> out);
 
 // Appends the encoding of `values` to `stream`, which must end on a whole
 // record boundary that is also a whole byte (callers write records in

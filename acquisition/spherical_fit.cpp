@@ -11,6 +11,7 @@ namespace {
 
 double wrap_angle(double a) {
   constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  if (a >= -std::numbers::pi && a <= std::numbers::pi) return a;  // most calls: nothing to do
   return a - kTwoPi * std::round(a / kTwoPi);
 }
 
@@ -21,51 +22,48 @@ double median(std::vector<double> values) {
   return *middle;
 }
 
-// Angles of the valid pixels, with their grid index.
-struct Sample {
-  int row;
-  int col;
-  double azimuth;
-  double elevation;
-};
-
 // Robust step along one grid axis: the median difference of the angle between
-// valid neighbours along that axis (azimuths wrapped).
-double median_step(const std::vector<double>& angle, std::span<const std::uint8_t> valid, int rows,
+// valid neighbours along that axis (azimuths wrapped), over at most about
+// 2^17 neighbour pairs spread evenly over the grid.
+double median_step(std::span<const double> angle, std::span<const std::uint8_t> valid, int rows,
                    int columns, bool along_columns, bool wrap) {
   std::vector<double> steps;
   const int row_stop = along_columns ? rows : rows - 1;
   const int col_stop = along_columns ? columns - 1 : columns;
-  for (int row = 0; row < row_stop; ++row) {
-    for (int col = 0; col < col_stop; ++col) {
-      const std::size_t a = static_cast<std::size_t>(row) * columns + col;
-      const std::size_t b = along_columns ? a + 1 : a + columns;
-      if (!valid[a] || !valid[b]) continue;
-      const double d = angle[b] - angle[a];
-      steps.push_back(wrap ? wrap_angle(d) : d);
-    }
+  const std::size_t pairs = static_cast<std::size_t>(std::max(row_stop, 0)) * std::max(col_stop, 0);
+  const std::size_t stride =
+      std::max<std::size_t>(1, pairs >> 17) | 1;  // odd: no aliasing with rows
+  for (std::size_t k = 0; k < pairs; k += stride) {
+    const int row = static_cast<int>(k / col_stop), col = static_cast<int>(k % col_stop);
+    const std::size_t a = static_cast<std::size_t>(row) * columns + col;
+    const std::size_t b = along_columns ? a + 1 : a + columns;
+    if (!valid[a] || !valid[b]) continue;
+    const double d = angle[b] - angle[a];
+    steps.push_back(wrap ? wrap_angle(d) : d);
   }
   return median(std::move(steps));
 }
 
-// Least-squares line value = start + index · step; keeps `step` when all
+// Least-squares line value = start + index · step over samples given twice
+// (add_mean, then add_spread), without storing them; keeps `step` when all
 // samples share one index (the slope is then unobservable).
-void fit_line(const std::vector<double>& index, const std::vector<double>& value, double& start,
-              double& step) {
-  const double n = static_cast<double>(index.size());
-  double mean_i = 0, mean_v = 0;
-  for (std::size_t k = 0; k < index.size(); ++k) {
-    mean_i += index[k] / n;
-    mean_v += value[k] / n;
+struct LineFit {
+  double n = 0, sum_i = 0, sum_v = 0, s_iv = 0, s_ii = 0;
+  void add_mean(double index, double value) {
+    n += 1;
+    sum_i += index;
+    sum_v += value;
   }
-  double s_iv = 0, s_ii = 0;
-  for (std::size_t k = 0; k < index.size(); ++k) {
-    s_iv += (index[k] - mean_i) * (value[k] - mean_v);
-    s_ii += (index[k] - mean_i) * (index[k] - mean_i);
+  void add_spread(double index, double value) {
+    const double di = index - sum_i / n;
+    s_iv += di * (value - sum_v / n);
+    s_ii += di * di;
   }
-  if (s_ii > 0) step = s_iv / s_ii;
-  start = mean_v - step * mean_i;
-}
+  void solve(double& start, double& step) const {
+    if (s_ii > 0) step = s_iv / s_ii;
+    start = sum_v / n - step * sum_i / n;
+  }
+};
 
 Eigen::Vector3d model_direction(const SphericalAngles& a, int row, int col) {
   const double az = a.azimuth_start_rad + col * a.azimuth_step_rad;
@@ -73,7 +71,85 @@ Eigen::Vector3d model_direction(const SphericalAngles& a, int row, int col) {
   return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
 }
 
+// Calls visit(row, col, i) for every valid pixel, row-major.
+template <typename Visit>
+void for_each_valid(int rows, int columns, std::span<const std::uint8_t> valid, Visit&& visit) {
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < columns; ++col) {
+      const std::size_t i = static_cast<std::size_t>(row) * columns + col;
+      if (valid[i]) visit(row, col, i);
+    }
+  }
+}
+
+// The model's start and step: robust steps first, then least-squares lines
+// through the azimuths unwrapped next to the robust prediction and through
+// the elevations. Asserts a valid pixel.
+SphericalAngles fit_lines(std::span<const double> azimuth, std::span<const double> elevation,
+                          std::span<const std::uint8_t> valid, int rows, int columns) {
+  SphericalAngles angles;
+  angles.azimuth_step_rad = median_step(azimuth, valid, rows, columns, true, true);
+  angles.elevation_step_rad = median_step(elevation, valid, rows, columns, false, false);
+  const std::size_t first = static_cast<std::size_t>(
+      std::find_if(valid.begin(), valid.end(), [](std::uint8_t v) { return v != 0; }) -
+      valid.begin());
+  assert(first < valid.size());
+  // Unwrap every azimuth next to the prediction of the robust step, then fit.
+  const double reference =
+      azimuth[first] - static_cast<double>(first % columns) * angles.azimuth_step_rad;
+  const auto unwrapped = [&](int col, std::size_t i) {
+    const double predicted = reference + col * angles.azimuth_step_rad;
+    return predicted + wrap_angle(azimuth[i] - predicted);
+  };
+  LineFit az, el;
+  for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
+    az.add_mean(col, unwrapped(col, i));
+    el.add_mean(row, elevation[i]);
+  });
+  for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
+    az.add_spread(col, unwrapped(col, i));
+    el.add_spread(row, elevation[i]);
+  });
+  az.solve(angles.azimuth_start_rad, angles.azimuth_step_rad);
+  el.solve(angles.elevation_start_rad, angles.elevation_step_rad);
+  return angles;
+}
+
 }  // namespace
+
+SphericalFitResult fit_spherical_angles_to_angles(int rows, int columns,
+                                                  std::span<const double> azimuth,
+                                                  std::span<const double> elevation,
+                                                  std::span<const float> range,
+                                                  std::span<const std::uint8_t> valid,
+                                                  const SphericalFitSettings& settings) {
+  [[maybe_unused]] const std::size_t n = static_cast<std::size_t>(rows) * columns;
+  assert(azimuth.size() == n && elevation.size() == n && range.size() == n && valid.size() == n);
+  SphericalFitResult result;
+  result.points_used = static_cast<std::size_t>(
+      std::count_if(valid.begin(), valid.end(), [](std::uint8_t v) { return v != 0; }));
+  if (result.points_used < 2) return result;
+  const SphericalAngles& angles = result.angles =
+      fit_lines(azimuth, elevation, valid, rows, columns);
+  double cos_el = 1.0, model_el = 0.0, squared = 0.0;  // the largest squared deviation
+  int cos_row = -1;
+  for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
+    if (row != cos_row) {
+      cos_row = row;
+      model_el = angles.elevation_start_rad + row * angles.elevation_step_rad;
+      cos_el = std::cos(model_el);
+    }
+    const double d_az =
+        cos_el *
+        wrap_angle(azimuth[i] - (angles.azimuth_start_rad + col * angles.azimuth_step_rad));
+    const double d_el = elevation[i] - model_el;
+    const double r = range[i];
+    squared = std::max(squared, r * r * (d_az * d_az + d_el * d_el));
+  });
+  result.max_deviation_m = std::sqrt(squared);
+  result.regular = result.max_deviation_m <= settings.max_deviation_m;
+  return result;
+}
 
 SphericalFitResult fit_spherical_angles(int rows, int columns,
                                         std::span<const Eigen::Vector3d> points_scan,
@@ -84,44 +160,20 @@ SphericalFitResult fit_spherical_angles(int rows, int columns,
   SphericalFitResult result;
 
   std::vector<double> azimuth(n, 0.0), elevation(n, 0.0);
-  std::vector<Sample> samples;
-  for (int row = 0; row < rows; ++row) {
-    for (int col = 0; col < columns; ++col) {
-      const std::size_t i = static_cast<std::size_t>(row) * columns + col;
-      if (!valid[i]) continue;
-      const Eigen::Vector3d& p = points_scan[i];
-      azimuth[i] = std::atan2(p.y(), p.x());
-      elevation[i] = std::atan2(p.z(), std::hypot(p.x(), p.y()));
-      samples.push_back({row, col, azimuth[i], elevation[i]});
-    }
-  }
-  result.points_used = samples.size();
-  if (samples.size() < 2) return result;
-
-  SphericalAngles& angles = result.angles;
-  angles.azimuth_step_rad = median_step(azimuth, valid, rows, columns, true, true);
-  angles.elevation_step_rad = median_step(elevation, valid, rows, columns, false, false);
-
-  // Unwrap every azimuth next to the prediction of the robust step, then fit.
-  const double reference = samples.front().azimuth - samples.front().col * angles.azimuth_step_rad;
-  std::vector<double> col_index, unwrapped, row_index, elevations;
-  for (const Sample& s : samples) {
-    const double predicted = reference + s.col * angles.azimuth_step_rad;
-    col_index.push_back(s.col);
-    unwrapped.push_back(predicted + wrap_angle(s.azimuth - predicted));
-    row_index.push_back(s.row);
-    elevations.push_back(s.elevation);
-  }
-  fit_line(col_index, unwrapped, angles.azimuth_start_rad, angles.azimuth_step_rad);
-  fit_line(row_index, elevations, angles.elevation_start_rad, angles.elevation_step_rad);
-
-  for (const Sample& s : samples) {
-    const std::size_t i = static_cast<std::size_t>(s.row) * columns + s.col;
+  for_each_valid(rows, columns, valid, [&](int, int, std::size_t i) {
+    const Eigen::Vector3d& p = points_scan[i];
+    azimuth[i] = std::atan2(p.y(), p.x());
+    elevation[i] = std::atan2(p.z(), std::hypot(p.x(), p.y()));
+    ++result.points_used;
+  });
+  if (result.points_used < 2) return result;
+  const SphericalAngles& angles = result.angles =
+      fit_lines(azimuth, elevation, valid, rows, columns);
+  for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
     const double range = points_scan[i].norm();
-    const double deviation =
-        (range * model_direction(angles, s.row, s.col) - points_scan[i]).norm();
+    const double deviation = (range * model_direction(angles, row, col) - points_scan[i]).norm();
     result.max_deviation_m = std::max(result.max_deviation_m, deviation);
-  }
+  });
   result.regular = result.max_deviation_m <= settings.max_deviation_m;
   return result;
 }

@@ -43,4 +43,16 @@ SphericalFitResult fit_spherical_angles(int rows, int columns,
                                         std::span<const std::uint8_t> valid,
                                         const SphericalFitSettings& settings = {});
 
+// The same fit for a grid whose directions are given as angles (E57's
+// spherical coordinates): azimuth and elevation [rad] and range [m] per pixel,
+// row-major, read where `valid`. The deviation of a point is its range times
+// the angle between its direction and the model's (to first order), so no
+// point is recomputed. Asserts the spans hold rows × columns entries.
+SphericalFitResult fit_spherical_angles_to_angles(int rows, int columns,
+                                                  std::span<const double> azimuth,
+                                                  std::span<const double> elevation,
+                                                  std::span<const float> range,
+                                                  std::span<const std::uint8_t> valid,
+                                                  const SphericalFitSettings& settings = {});
+
 }  // namespace scanbench::acquisition

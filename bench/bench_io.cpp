@@ -12,6 +12,8 @@
 #include <numbers>
 #include <vector>
 
+#include "acquisition/e57_reader.hpp"
+#include "acquisition/e57_writer.hpp"
 #include "acquisition/pcd_reader.hpp"
 #include "acquisition/ptx_reader.hpp"
 #include "acquisition/ptx_writer.hpp"
@@ -130,6 +132,17 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   const double ptx_bytes = static_cast<double>(std::filesystem::file_size(ptx));
   const double read_s = best_seconds(repeats, [&] { acquisition::read_ptx(ptx); });
   const double points = static_cast<double>(scan.pixel_count());
+  // E57 of the same scan: a structured scan with colour and intensity, read
+  // on one thread (the reader has no other).
+  const std::filesystem::path e57 = dir / "room.e57";
+  acquisition::E57ScanOutput e57_scan;
+  e57_scan.scan = &scan;
+  const double e57_write_s = best_seconds(repeats, [&] {
+    acquisition::write_e57(e57, {&e57_scan, 1}, {});
+  });
+  const double e57_read_s = best_seconds(
+      repeats, [&] { acquisition::read_e57(e57, [](acquisition::ImportedScan&&) {}, {}); });
+  const double e57_bytes = static_cast<double>(std::filesystem::file_size(e57));
   const nlohmann::json pcd_ascii = compare_pcd_readers(ascii_pcd, points, repeats);
   const nlohmann::json pcd_binary = compare_pcd_readers(binary_pcd, points, repeats);
 
@@ -156,6 +169,11 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
           {"ptx_read_mb_per_s", ptx_bytes / 1e6 / read_s},
           {"ptx_read_points_per_s", points / read_s},
           {"ptx_write_mb_per_s", ptx_bytes / 1e6 / write_s},
+          {"e57_bytes", e57_bytes},
+          {"e57_read_points_per_s", points / e57_read_s},
+          {"e57_read_mb_per_s", e57_bytes / 1e6 / e57_read_s},
+          {"e57_write_points_per_s", points / e57_write_s},
+          {"e57_read_speedup_vs_ptx", read_s / e57_read_s},
           {"pcd_ascii", pcd_ascii},
           {"pcd_binary", pcd_binary},
           {"project_store_seconds", store_s},

@@ -99,10 +99,13 @@ TEST_P(IntegerWidth, PacksAsTheReferenceAndUnpacksToTheSameValues) {
   EXPECT_EQ(packed, reference_pack(raw, bits));
   EXPECT_EQ(packed.size(), e57_stream_bytes(field, raw.size()));
   std::vector<double> unpacked(values.size());
-  ASSERT_TRUE(e57_unpack(field, packed, unpacked));
+  ASSERT_TRUE(e57_unpack(field, packed, 0, unpacked));
   EXPECT_EQ(unpacked, values);
+  std::vector<double> middle(7);
+  ASSERT_TRUE(e57_unpack(field, packed, 5, middle)) << "records 5 to 11, mid-byte";
+  EXPECT_EQ(middle, std::vector<double>(values.begin() + 5, values.begin() + 12));
   packed.pop_back();
-  EXPECT_FALSE(e57_unpack(field, packed, unpacked)) << "a short stream is refused";
+  EXPECT_FALSE(e57_unpack(field, packed, 0, unpacked)) << "a short stream is refused";
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryWidth, IntegerWidth, ::testing::Range(1, 65));
@@ -118,7 +121,7 @@ TEST(ScaledInteger, StoresRoundedRawValuesAndScalesThemBack) {
   std::vector<std::byte> packed;
   e57_pack(field, values, packed);
   std::vector<double> back(values.size());
-  ASSERT_TRUE(e57_unpack(field, packed, back));
+  ASSERT_TRUE(e57_unpack(field, packed, 0, back));
   const std::vector<double> expected = {5412000.0, 5412000.25, 5411999.995, 5412001.0, 5412001.0};
   for (std::size_t i = 0; i < values.size(); ++i) EXPECT_NEAR(back[i], expected[i], 1e-9) << i;
   EXPECT_EQ(reference_pack({5, 255, 0, 1005, 1005}, 10), packed) << "raw − minimum, clamped";
@@ -132,7 +135,7 @@ TEST(ZeroWidth, TakesNoBytesAndGivesTheMinimum) {
   e57_pack(field, std::vector<double>(100, 7.0), packed);
   EXPECT_TRUE(packed.empty());
   std::vector<double> values(100);
-  ASSERT_TRUE(e57_unpack(field, {}, values));
+  ASSERT_TRUE(e57_unpack(field, {}, 0, values));
   EXPECT_THAT(values, ::testing::Each(7.0));
 }
 
@@ -148,7 +151,7 @@ TEST(Float, StoresLittleEndianIeeeNumbersOfEitherPrecision) {
     // 1.5 is 0x3FC00000 (single) or 0x3FF8000000000000 (double): its last byte first.
     EXPECT_EQ(packed[single ? 3 : 7], std::byte{0x3F});
     std::vector<double> back(values.size());
-    ASSERT_TRUE(e57_unpack(field, packed, back));
+    ASSERT_TRUE(e57_unpack(field, packed, 0, back));
     for (std::size_t i = 0; i < values.size(); ++i) {
       EXPECT_EQ(back[i], single ? static_cast<double>(static_cast<float>(values[i])) : values[i]);
     }
