@@ -3,6 +3,8 @@
 # packages. Idempotent and non-interactive: packages already present are skipped,
 # so a second run costs a few dpkg queries and no network.
 set -euo pipefail
+# --tests: also what only the tests use (CloudCompare, a real reader of our
+# exports).
 
 packages=(
   build-essential cmake ninja-build pkg-config ccache git
@@ -12,6 +14,10 @@ packages=(
   libimgui-dev libglfw3-dev libepoxy-dev libegl-dev libegl1-mesa-dev
   libgl1-mesa-dri xvfb xauth clang libclang-rt-14-dev
 )
+
+if [ "${1:-}" = "--tests" ]; then
+  packages+=(cloudcompare)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -22,6 +22,7 @@ run_pass() {
   echo "== $name: built and tested in $((SECONDS - start)) s =="
 }
 
+"$root/scripts/install-deps.sh" --tests
 run_pass release "$root/build" "" -DSCANBENCH_SANITIZE=OFF
 if [ $fast -eq 0 ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1

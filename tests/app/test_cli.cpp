@@ -304,6 +304,56 @@ TEST(Cli, RefusedImportLeavesTheProjectUnchanged) {
   EXPECT_EQ(info_json(dir, project), before);
 }
 
+TEST(Cli, E57ImportReportsUnplacedPointsAndImagesAndExportsBack) {
+  ScratchDir dir;
+  const std::string project = (dir / "p.sbproj").string();
+  const CliResult imported =
+      run_cli(dir, {"import", project, fixture("good/e57/structured_spherical.e57").string(),
+                    fixture("good/e57/unstructured_cartesian.e57").string()});
+  ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  EXPECT_THAT(imported.out, ::testing::HasSubstr("2 image(s) stored with the scans"));
+  EXPECT_THAT(imported.out, ::testing::HasSubstr("3 point(s) not placed in the scan grids"));
+  const nlohmann::json info = info_json(dir, project);
+  ASSERT_EQ(info["scans"].size(), 2u);
+  EXPECT_EQ(info["scans"][0]["source"]["unplaced_points"], 1);
+  EXPECT_EQ(info["scans"][1]["source"]["unplaced_points"], 2);
+  EXPECT_EQ(info["scans"][1]["source"]["points_in_file"], 605);
+  EXPECT_EQ(info["scans"][0]["source"]["guid"], "{scan-structured}");
+  ASSERT_EQ(info["images"].size(), 2u);
+  EXPECT_EQ(info["images"][0]["scan"], 1);
+  EXPECT_EQ(info["images"][0]["projection"], "pinhole");
+  EXPECT_TRUE(info["images"][1]["scan"].is_null());
+  // One scan exported: its image goes with it, the loose one stays home.
+  const std::string one = (dir / "one.e57").string();
+  const CliResult exported =
+      run_cli(dir, {"export", project, "--format", "e57", "--scan", "1", "-o", one});
+  ASSERT_EQ(exported.exit_code, 0) << exported.err;
+  const nlohmann::json back = info_json(dir, one);
+  ASSERT_EQ(back["scans"].size(), 1u);
+  EXPECT_EQ(back["scans"][0]["valid_points"], info["scans"][0]["valid_points"]);
+  ASSERT_EQ(back["images"].size(), 1u);
+  EXPECT_EQ(back["images"][0]["name"], "camera 1");
+}
+
+TEST(Cli, RefusedE57ImportNamesThePageAndLeavesTheProjectUnchanged) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  const nlohmann::json before = info_json(dir, project);
+  const CliResult bad =
+      run_cli(dir, {"import", project.string(), fixture("good/e57/georeferenced.e57").string(),
+                    fixture("bad/e57_bad_checksum.e57").string()});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.err, ::testing::HasSubstr("e57_bad_checksum.e57: (byte 1024), page 1: page fails "
+                                            "its CRC-32C checksum"));
+  EXPECT_EQ(info_json(dir, project), before);
+  const CliResult info = run_cli(dir, {"info", fixture("bad/e57_malformed_xml.e57").string()});
+  EXPECT_EQ(info.exit_code, 2);
+  EXPECT_THAT(info.err, ::testing::HasSubstr("malformed XML"));
+}
+
 TEST(Cli, RefusedImportIntoANewProjectCreatesNoFile) {
   ScratchDir dir;
   const std::filesystem::path project = dir / "new.sbproj";
