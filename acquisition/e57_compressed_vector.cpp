@@ -85,9 +85,17 @@ std::vector<std::vector<std::byte>> read_e57_streams(E57PageReader& file,
     bad(file, points.file_offset, what, "is not a compressed-vector section header");
   }
   const std::uint64_t section_end = logical_of(points.file_offset) + section_bytes;
+  // Every record takes at least a bit, but for fields that never vary; a
+  // million such records at most.
+  if (points.record_count > section_bytes * 8 + (1u << 20)) {
+    bad(file, points.file_offset, what,
+        "has a recordCount of " + std::to_string(points.record_count) +
+            ", more than its section of " + std::to_string(section_bytes) + " bytes can hold");
+  }
   std::vector<std::vector<std::byte>> streams(points.fields.size());
   for (std::size_t f = 0; f < streams.size(); ++f) {
-    streams[f].reserve(e57_stream_bytes(points.fields[f], points.record_count));
+    streams[f].reserve(
+        std::min(e57_stream_bytes(points.fields[f], points.record_count), section_bytes));
   }
   if (data_offset % kE57PageSize >= kE57PagePayload || logical_of(data_offset) > section_end ||
       logical_of(data_offset) < logical_of(points.file_offset) + kSectionHeaderBytes) {

@@ -67,7 +67,8 @@ ScanImage read_image(E57PageReader& file, const E57ImageEntry& entry) {
   file.read(entry.blob_offset, header, what);
   std::uint64_t section_bytes = 0;
   std::memcpy(&section_bytes, header + 8, 8);
-  if (std::to_integer<int>(header[0]) != 0 || section_bytes < 16 + entry.blob_length) {
+  if (std::to_integer<int>(header[0]) != 0 || entry.blob_length > file.physical_length() ||
+      section_bytes < 16 + entry.blob_length) {
     core::FilePosition position;
     position.byte_offset = entry.blob_offset;
     position.detail = entry.path;

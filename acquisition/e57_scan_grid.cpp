@@ -280,10 +280,14 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
   const std::uint64_t rows = range.row_max >= range.row_min ? range.row_max - range.row_min + 1 : 0;
   const std::uint64_t columns =
       range.col_max >= range.col_min ? range.col_max - range.col_min + 1 : 0;
-  if (rows > (1u << 30) || columns > (1u << 30) || rows * columns > kMaxPixels) {
+  // A grid far larger than its records is a damaged bound, not a scan.
+  const std::uint64_t most =
+      std::min(kMaxPixels, std::max<std::uint64_t>(16 * entry.points.record_count, 1u << 24));
+  if (rows > (1u << 30) || columns > (1u << 30) || rows * columns > most) {
     refuse(path, entry.path,
            "has index bounds of " + std::to_string(rows) + " × " + std::to_string(columns) +
-               " pixels, more than scanbench holds");
+               " pixels for " + std::to_string(entry.points.record_count) +
+               " records (at most 16 pixels per record, and 2^30 in all)");
   }
   ImportedScan out;
   Scan& scan = out.scan;

@@ -13,7 +13,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(fuzz_ptx fuzz_pcd fuzz_triplet fuzz_project)
+[ ${#targets[@]} -eq 0 ] && targets=(fuzz_ptx fuzz_pcd fuzz_triplet fuzz_e57 fuzz_project)
 build=${FUZZ_BUILD_DIR:-$root/build-fuzz}
 
 "$root/scripts/install-deps.sh"
@@ -27,6 +27,7 @@ seed() {  # target -> the fixtures its corpus starts from
     fuzz_ptx) ls "$root"/fixtures/good/ptx/*.ptx "$root"/fixtures/bad/ptx_*.ptx ;;
     fuzz_pcd) ls "$root"/fixtures/good/pcd/*.pcd "$root"/fixtures/bad/pcd_*.pcd ;;
     fuzz_triplet) ls "$root"/fixtures/good/triplet/*.json "$root"/fixtures/bad/triplet_*.json ;;
+    fuzz_e57) ls "$root"/fixtures/good/e57/*.e57 "$root"/fixtures/bad/e57_*.e57 ;;
     fuzz_project) ls "$root"/fixtures/projects/*.sbproj "$root"/fixtures/bad/project_*.sbproj ;;
   esac
 }
@@ -35,7 +36,8 @@ max_len() {  # projects hold compressed layers; the text readers' inputs are sma
 }
 dictionary() {
   case $1 in
-    fuzz_ptx) echo ptx ;; fuzz_pcd) echo pcd ;; fuzz_triplet) echo triplet ;; fuzz_project) echo project ;;
+    fuzz_ptx) echo ptx ;; fuzz_pcd) echo pcd ;; fuzz_triplet) echo triplet ;; fuzz_e57) echo e57 ;;
+    fuzz_project) echo project ;;
   esac
 }
 
