@@ -4,7 +4,8 @@
 #   simulate  a 4-scan campaign of the campus site with exact ground truth,
 #             the scan files carrying pose errors of up to 3° and 0.5 m
 #   import    the simulated scans, then the bundled real-format samples
-#             (multi-scan georeferenced PTX, image triplet, organized PCD)
+#             (multi-scan georeferenced PTX, image triplet, organized PCD, E57
+#             structured with its images and unstructured)
 #   geometry  per-point footprints, normals and mixed-pixel flags
 #   register  coarse (features) + point-to-plane ICP + global refinement
 #   merge     keep masks: each surface from the scan that sampled it most finely
@@ -18,7 +19,8 @@
 #             beside the simulator's truth pictures (out/demo/render/)
 #   recolor   the trees recoloured through their group, rendered, and undone
 #   info      table and JSON
-#   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as PLY
+#   export    PTX (lossless), PLY and CSV (world coordinates), the merged model as
+#             PLY, LAS and E57, and the E57 imported again
 #   bench     raw-scan I/O throughput against PCL's reader
 # Output goes to DEMO_OUT (default: out/demo/).
 set -euo pipefail
@@ -40,7 +42,8 @@ phase "import"
 "$scanbench" import "$project" "$out"/campus/campus_scan_*.json
 samples="$out/samples.sbproj"
 "$scanbench" import "$samples" "$fixtures/ptx/two_scans.ptx" "$fixtures/ptx/tiny_color.ptx" \
-  "$fixtures/triplet/small.json" "$fixtures/pcd/organized_ascii.pcd"
+  "$fixtures/triplet/small.json" "$fixtures/pcd/organized_ascii.pcd" \
+  "$fixtures/e57/structured_spherical.e57" "$fixtures/e57/unstructured_cartesian.e57"
 
 phase "geometry"
 "$scanbench" geometry "$project"
@@ -111,6 +114,13 @@ phase "export"
 "$scanbench" export "$project" --format ply --merged -o "$out/campus_merged.ply"
 "$scanbench" export "$samples" --format ptx -o "$out/samples.ptx"
 "$scanbench" export "$samples" --format csv -o "$out/samples.csv"
+# The merged campus for survey tools (LAS) and scanner software (E57), and
+# the E57 read back into a project of its own.
+"$scanbench" export "$project" --format las --merged -o "$out/campus_merged.las"
+"$scanbench" export "$project" --format e57 --merged -o "$out/campus_merged.e57"
+"$scanbench" import "$out/reimported.sbproj" "$out/campus_merged.e57"
+"$scanbench" info "$out/reimported.sbproj"
+"$scanbench" export "$samples" --format e57 -o "$out/samples.e57"
 
 phase "bench io"
 "$scanbench" bench io
