@@ -40,6 +40,54 @@ double azimuth_start(const std::vector<double>& azimuths) {
   return -std::numbers::pi + kTwoPi * best_end / kGapBins;
 }
 
+// The median distance in the (azimuth, elevation) plane from a sample of
+// at most 2^14 points to their nearest other point: the step of a scan
+// sampled on a regular grid, and about half the mean spacing of scattered
+// points. The points are bucketed by counting sort into cells of about 16
+// points each, and each sample searches its 3 × 3 cells. 0 when no sample
+// has a neighbour there.
+double median_neighbour_spacing(const std::vector<double>& azimuth,
+                                const std::vector<double>& elevation, double el_max,
+                                double az_extent, double box) {
+  const std::size_t n = azimuth.size();
+  const double cell = std::sqrt(box * 16.0 / static_cast<double>(n));
+  const auto columns = static_cast<std::size_t>(az_extent / cell) + 1;
+  const auto rows = static_cast<std::size_t>(
+                        (el_max - *std::min_element(elevation.begin(), elevation.end())) / cell) +
+                    1;
+  const auto cell_of = [&](std::size_t i, std::size_t& row, std::size_t& col) {
+    row = std::min(rows - 1, static_cast<std::size_t>((el_max - elevation[i]) / cell));
+    col = std::min(columns - 1, static_cast<std::size_t>(azimuth[i] / cell));
+  };
+  std::vector<std::size_t> first(rows * columns + 1, 0), members(n);
+  for (std::size_t i = 0, r, c; i < n; ++i) cell_of(i, r, c), ++first[r * columns + c + 1];
+  for (std::size_t k = 1; k < first.size(); ++k) first[k] += first[k - 1];
+  std::vector<std::size_t> fill(first.begin(), first.end() - 1);
+  for (std::size_t i = 0, r, c; i < n; ++i) cell_of(i, r, c), members[fill[r * columns + c]++] = i;
+  std::vector<double> spacing;
+  const std::size_t stride = std::max<std::size_t>(1, n >> 14);
+  for (std::size_t i = 0; i < n; i += stride) {
+    std::size_t row, col;
+    cell_of(i, row, col);
+    double best = HUGE_VAL;
+    for (std::size_t r = row > 0 ? row - 1 : 0; r <= std::min(rows - 1, row + 1); ++r) {
+      for (std::size_t c = col > 0 ? col - 1 : 0; c <= std::min(columns - 1, col + 1); ++c) {
+        for (std::size_t k = first[r * columns + c]; k < first[r * columns + c + 1]; ++k) {
+          const double da = azimuth[members[k]] - azimuth[i];
+          const double de = elevation[members[k]] - elevation[i];
+          const double d2 = da * da + de * de;
+          if (d2 > 1e-18 && d2 < best) best = d2;  // not itself, nor a point behind it
+        }
+      }
+    }
+    if (best < HUGE_VAL) spacing.push_back(std::sqrt(best));
+  }
+  if (spacing.empty()) return 0.0;
+  const auto middle = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
+  std::nth_element(spacing.begin(), middle, spacing.end());
+  return *middle;
+}
+
 }  // namespace
 
 PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points) {
@@ -62,20 +110,9 @@ PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points) 
     el_min = std::min(el_min, elevation[i]);
     el_max = std::max(el_max, elevation[i]);
   }
-  // The covered area on a coarse grid (about 16 points per cell), then the
-  // step at which the points would fill it once each.
   const auto n = static_cast<double>(points.size());
   const double box = std::max(az_extent, 1e-6) * std::max(el_max - el_min, 1e-6);
-  const double coarse = std::sqrt(box * 16.0 / n);
-  const int coarse_columns = static_cast<int>(az_extent / coarse) + 1;
-  const int coarse_rows = static_cast<int>((el_max - el_min) / coarse) + 1;
-  std::vector<std::uint8_t> occupied(static_cast<std::size_t>(coarse_columns) * coarse_rows, 0);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    occupied[static_cast<std::size_t>((el_max - elevation[i]) / coarse) * coarse_columns +
-             static_cast<std::size_t>(azimuth[i] / coarse)] = 1;
-  }
-  const auto cells = static_cast<double>(std::count(occupied.begin(), occupied.end(), 1));
-  double step = std::sqrt(cells * coarse * coarse / n);
+  double step = median_neighbour_spacing(azimuth, elevation, el_max, az_extent, box);
   // At most 4 pixels per point (and 2^30 in all).
   const double min_step = std::sqrt(box / (4.0 * n));
   step = std::max({step, min_step, 1e-7});

@@ -23,12 +23,12 @@ struct PanoramaProjection {
 
 // Projects `points` (the scan's frame [m]) around the origin, or around
 // their centroid rounded to 1 m when some lie farther than 500 m from it
-// (the local origin's rule, local_origin.hpp). The step is the one at which
-// the points would fill the pixels of the area they cover once each:
-// sqrt(covered solid angle / point count), with the covered area measured
-// on a coarse occupancy grid. Azimuths start after the widest gap with no
-// point, so that a partial panorama is not split at ±180°. The grid holds at
-// most 4 pixels per point.
+// (the local origin's rule, local_origin.hpp). The step is the median
+// distance between neighbouring points in the (azimuth, elevation) plane:
+// the step of a scan sampled on a regular grid, which then lands on the
+// grid's pixels one point each. Azimuths start after the widest gap with
+// no point, so that a partial panorama is not split at ±180°. The grid
+// holds at most 4 pixels per point.
 PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points);
 
 }  // namespace scanbench::acquisition
