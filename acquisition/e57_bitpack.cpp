@@ -41,7 +41,9 @@ bool unpack_integers(const E57Field& field, std::span<const std::byte> stream, s
   const auto* data = reinterpret_cast<const unsigned char*>(stream.data());
   const auto minimum = static_cast<std::uint64_t>(field.minimum);
   const auto value_of = [&](std::uint64_t packed) {
-    // Wrapping unsigned addition: minimum + packed lies in [minimum, maximum].
+    // Wrapping unsigned addition: minimum + packed stays within the int64
+    // range (it can exceed maximum when maximum − minimum + 1 is not a power
+    // of two; the value is taken as stored).
     const auto raw = static_cast<std::int64_t>(minimum + packed);
     return scaled ? static_cast<double>(raw) * field.scale + field.offset
                   : static_cast<double>(raw);

@@ -71,62 +71,92 @@ std::uint64_t records_per_packet(std::span<const E57Field> fields) {
   return std::max<std::uint64_t>(8, budget / bits * 8);  // bits per record = bytes per 8 records
 }
 
+// The section's extent in logical bytes and where its first packet starts,
+// checked against the file.
+struct Section {
+  std::uint64_t bytes = 0;        // sectionLogicalLength
+  std::uint64_t end = 0;          // logical offset just past the section
+  std::uint64_t data_offset = 0;  // physical offset of the first packet
+};
+
+Section read_section_header(E57PageReader& file, const E57PointsEntry& points,
+                            const std::string& what) {
+  std::byte header[kSectionHeaderBytes];
+  file.read(points.file_offset, header, what + " section header");
+  Section section;
+  section.bytes = load_u64(header + 8);
+  section.data_offset = load_u64(header + 16);
+  const std::uint64_t start = logical_of(points.file_offset);
+  const std::uint64_t file_bytes = logical_of(file.physical_length());
+  if (std::to_integer<int>(header[0]) != 1 || section.bytes < kSectionHeaderBytes ||
+      section.bytes % 4 != 0 || section.bytes > file_bytes - start) {
+    bad(file, points.file_offset, what, "is not a compressed-vector section header");
+  }
+  section.end = start + section.bytes;
+  if (section.data_offset % kE57PageSize >= kE57PagePayload ||
+      section.data_offset >= file.physical_length() ||
+      logical_of(section.data_offset) > section.end ||
+      logical_of(section.data_offset) < start + kSectionHeaderBytes) {
+    bad(file, points.file_offset, what, "has a data offset outside its section");
+  }
+  // Every record takes at least a bit, but for fields that never vary; a
+  // million such records at most.
+  if (points.record_count / 8 > section.bytes + (1u << 17)) {
+    bad(file, points.file_offset, what,
+        "has a recordCount of " + std::to_string(points.record_count) +
+            ", more than its section of " + std::to_string(section.bytes) + " bytes can hold");
+  }
+  return section;
+}
+
+// Appends the bytestream slices of the data packet `packet` (read from
+// physical offset `at`) to `streams`.
+void append_packet_streams(const E57PageReader& file, std::uint64_t at,
+                           std::span<const std::byte> packet, const std::string& what,
+                           std::vector<std::vector<std::byte>>& streams) {
+  if (packet.size() < 6) bad(file, at, what, "has a data packet too short for its header");
+  const std::uint64_t count = load_u16(packet.data() + 4);
+  if (count != streams.size()) {
+    bad(file, at, what,
+        "has a packet of " + std::to_string(count) + " bytestreams where the prototype has " +
+            std::to_string(streams.size()) + " fields");
+  }
+  std::uint64_t offset = 6 + 2 * count;
+  if (offset > packet.size()) bad(file, at, what, "has a packet too short for its stream table");
+  for (std::size_t f = 0; f < count; ++f) {
+    const std::uint64_t bytes = load_u16(packet.data() + 6 + 2 * f);
+    if (offset + bytes > packet.size())
+      bad(file, at, what, "has a packet whose streams overrun it");
+    const auto slice = packet.subspan(offset, bytes);
+    streams[f].insert(streams[f].end(), slice.begin(), slice.end());
+    offset += bytes;
+  }
+}
+
 }  // namespace
 
 std::vector<std::vector<std::byte>> read_e57_streams(E57PageReader& file,
                                                      const E57PointsEntry& points,
                                                      const std::string& what) {
-  std::byte header[kSectionHeaderBytes];
-  file.read(points.file_offset, header, what + " section header");
-  const std::uint64_t section_bytes = load_u64(header + 8);
-  const std::uint64_t data_offset = load_u64(header + 16);
-  if (std::to_integer<int>(header[0]) != 1 || section_bytes < kSectionHeaderBytes ||
-      section_bytes % 4 != 0) {
-    bad(file, points.file_offset, what, "is not a compressed-vector section header");
-  }
-  const std::uint64_t section_end = logical_of(points.file_offset) + section_bytes;
-  // Every record takes at least a bit, but for fields that never vary; a
-  // million such records at most.
-  if (points.record_count > section_bytes * 8 + (1u << 20)) {
-    bad(file, points.file_offset, what,
-        "has a recordCount of " + std::to_string(points.record_count) +
-            ", more than its section of " + std::to_string(section_bytes) + " bytes can hold");
-  }
+  const Section section = read_section_header(file, points, what);
   std::vector<std::vector<std::byte>> streams(points.fields.size());
   for (std::size_t f = 0; f < streams.size(); ++f) {
     streams[f].reserve(
-        std::min(e57_stream_bytes(points.fields[f], points.record_count), section_bytes));
-  }
-  if (data_offset % kE57PageSize >= kE57PagePayload || logical_of(data_offset) > section_end ||
-      logical_of(data_offset) < logical_of(points.file_offset) + kSectionHeaderBytes) {
-    bad(file, points.file_offset, what, "has a data offset outside its section");
+        std::min(e57_stream_bytes(points.fields[f], points.record_count), section.bytes));
   }
   std::vector<std::byte> packet;
-  for (std::uint64_t at = data_offset; logical_of(at) < section_end;) {
+  for (std::uint64_t at = section.data_offset; logical_of(at) < section.end;) {
     std::byte common[4];
     file.read(at, common, what + " packet");
     const int type = std::to_integer<int>(common[0]);
     const std::uint64_t length = std::uint64_t{load_u16(common + 2)} + 1;
-    if (type > kEmptyPacket || length % 4 != 0 || logical_of(at) + length > section_end) {
+    if (type > kEmptyPacket || length % 4 != 0 || logical_of(at) + length > section.end) {
       bad(file, at, what, "holds a packet of unknown type or impossible length");
     }
     if (type == kDataPacket) {
       packet.resize(length);
       file.read(at, packet, what + " packet");
-      const std::uint64_t count = load_u16(packet.data() + 4);
-      if (count != streams.size()) {
-        bad(file, at, what,
-            "has a packet of " + std::to_string(count) + " bytestreams where the prototype has " +
-                std::to_string(streams.size()) + " fields");
-      }
-      std::uint64_t offset = 6 + 2 * count;
-      for (std::size_t f = 0; f < count; ++f) {
-        const std::uint64_t bytes = load_u16(packet.data() + 6 + 2 * f);
-        if (offset + bytes > length) bad(file, at, what, "has a packet whose streams overrun it");
-        streams[f].insert(streams[f].end(), packet.begin() + static_cast<std::ptrdiff_t>(offset),
-                          packet.begin() + static_cast<std::ptrdiff_t>(offset + bytes));
-        offset += bytes;
-      }
+      append_packet_streams(file, at, packet, what, streams);
     }
     // Index packets (type 0) and empty packets carry no records.
     at = e57_advance(at, length);

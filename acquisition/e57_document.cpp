@@ -69,6 +69,24 @@ struct Parser {
     return value;
   }
 
+  // An element's whole text: every text and CDATA child, joined (a writer
+  // may split a string over several, as "]]>" must be).
+  static std::string text_of(pugi::xml_node node) {
+    std::string text;
+    for (pugi::xml_node part : node.children()) {
+      if (part.type() == pugi::node_pcdata || part.type() == pugi::node_cdata) text += part.value();
+    }
+    return text;
+  }
+
+  // The value of an Integer element, exactly; `fallback` when absent and
+  // not required.
+  std::int64_t integer(pugi::xml_node node, const std::string& path, const char* name,
+                       std::int64_t fallback, bool required) const {
+    const pugi::xml_node found = child(node, path, name, "Integer", required);
+    return found ? integer_text(text_of(found).c_str(), path + "/" + name) : fallback;
+  }
+
   // The value of a number element of any of the three number types.
   double number(pugi::xml_node node, const std::string& path, const char* name, double fallback,
                 bool required = false) const {
@@ -79,19 +97,20 @@ struct Parser {
       return fallback;
     }
     const std::string_view type = found.attribute("type").value();
-    if (type == "Float") return float_text(found.text().get(), where);
-    if (type == "Integer") return static_cast<double>(integer_text(found.text().get(), where));
+    const std::string text = text_of(found);
+    if (type == "Float") return float_text(text.c_str(), where);
+    if (type == "Integer") return static_cast<double>(integer_text(text.c_str(), where));
     if (type == "ScaledInteger") {
       const double scale = attribute_float(found, where, "scale", 1.0);
       const double offset = attribute_float(found, where, "offset", 0.0);
-      return static_cast<double>(integer_text(found.text().get(), where)) * scale + offset;
+      return static_cast<double>(integer_text(text.c_str(), where)) * scale + offset;
     }
     fail(where, "has type \"" + std::string(type) + "\" where E57 requires a number");
   }
 
   std::string string(pugi::xml_node node, const std::string& path, const char* name) const {
     const pugi::xml_node found = child(node, path, name, "String", false);
-    return found ? found.text().get() : "";
+    return found ? text_of(found) : "";
   }
 
   std::int64_t attribute_integer(pugi::xml_node node, const std::string& path, const char* name,
@@ -162,14 +181,17 @@ struct Parser {
     return field;
   }
 
-  // The prototype's terminal fields, depth first, in document order.
-  void prototype_fields(pugi::xml_node node, const std::string& path,
-                        std::vector<E57Field>& fields) const {
+  // The prototype's terminal fields, depth first, in document order;
+  // structures nest at most kMaxDepth deep.
+  void prototype_fields(pugi::xml_node node, const std::string& path, std::vector<E57Field>& fields,
+                        int depth = 0) const {
+    constexpr int kMaxDepth = 8;
+    if (depth > kMaxDepth) fail(path, "nests structures deeper than scanbench reads (8)");
     for (pugi::xml_node element : node.children()) {
       if (element.type() != pugi::node_element) continue;
       const std::string where = path + "/" + element.name();
       if (std::string_view(element.attribute("type").value()) == "Structure") {
-        prototype_fields(element, where, fields);
+        prototype_fields(element, where, fields, depth + 1);
       } else {
         fields.push_back(field(element, where));
       }
@@ -186,12 +208,12 @@ struct Parser {
     entry.pose = pose(node, path);
     if (const pugi::xml_node bounds = child(node, path, "indexBounds", "Structure", false)) {
       const std::string at = path + "/indexBounds";
-      const auto get = [&](const char* name) {
-        return static_cast<std::int64_t>(number(bounds, at, name, 0.0));
+      const auto get = [&](const char* name, bool required) {
+        return integer(bounds, at, name, 0, required);
       };
-      entry.index_bounds =
-          E57IndexBounds{get("rowMinimum"),    get("rowMaximum"),    get("columnMinimum"),
-                         get("columnMaximum"), get("returnMinimum"), get("returnMaximum")};
+      entry.index_bounds = E57IndexBounds{get("rowMinimum", true),     get("rowMaximum", true),
+                                          get("columnMinimum", true),  get("columnMaximum", true),
+                                          get("returnMinimum", false), get("returnMaximum", false)};
     }
     if (const pugi::xml_node limits = child(node, path, "intensityLimits", "Structure", false)) {
       const std::string at = path + "/intensityLimits";
@@ -212,10 +234,10 @@ struct Parser {
     }
     const pugi::xml_node points = child(node, path, "points", "CompressedVector", true);
     const std::string at = path + "/points";
-    entry.points.file_offset =
-        static_cast<std::uint64_t>(attribute_integer(points, at, "fileOffset", -1));
+    const std::int64_t offset = attribute_integer(points, at, "fileOffset", -1);
     const std::int64_t records = attribute_integer(points, at, "recordCount", -1);
-    if (records < 0) fail(at, "lacks a valid recordCount");
+    if (offset < 0 || records < 0) fail(at, "lacks a valid fileOffset or recordCount");
+    entry.points.file_offset = static_cast<std::uint64_t>(offset);
     entry.points.record_count = static_cast<std::uint64_t>(records);
     const pugi::xml_node prototype = child(points, at, "prototype", "Structure", true);
     prototype_fields(prototype, at + "/prototype", entry.points.fields);
@@ -240,7 +262,7 @@ struct Parser {
     const Kind kinds[] = {{"pinholeRepresentation", ImageProjection::kPinhole},
                           {"sphericalRepresentation", ImageProjection::kSpherical},
                           {"cylindricalRepresentation", ImageProjection::kCylindrical},
-                          {"visualReferenceRepresentation", ImageProjection::kPinhole}};
+                          {"visualReferenceRepresentation", ImageProjection::kVisualReference}};
     for (const Kind& kind : kinds) {
       const pugi::xml_node representation = child(node, path, kind.element, "Structure", false);
       if (!representation) continue;
@@ -267,8 +289,15 @@ struct Parser {
     if (offset < 0 || length < 0) fail(at, "lacks a valid fileOffset or length");
     entry.blob_offset = static_cast<std::uint64_t>(offset);
     entry.blob_length = static_cast<std::uint64_t>(length);
-    image.width = static_cast<int>(number(node, path, "imageWidth", 0.0, true));
-    image.height = static_cast<int>(number(node, path, "imageHeight", 0.0, true));
+    constexpr std::int64_t kMaxSide = 1 << 20;
+    const std::int64_t width = integer(node, path, "imageWidth", 0, true);
+    const std::int64_t height = integer(node, path, "imageHeight", 0, true);
+    if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) {
+      fail(path, "has an image of " + std::to_string(width) + " × " + std::to_string(height) +
+                     " pixels (1 to 2^20 a side)");
+    }
+    image.width = static_cast<int>(width);
+    image.height = static_cast<int>(height);
     image.pixel_width = number(node, path, "pixelWidth", 0.0);
     image.pixel_height = number(node, path, "pixelHeight", 0.0);
     image.focal_length = number(node, path, "focalLength", 0.0);
@@ -333,16 +362,8 @@ struct Builder {
   }
   static void string(pugi::xml_node parent, const char* name, const std::string& value) {
     pugi::xml_node node = element(parent, name, "String");
-    // "]]>" cannot sit inside one CDATA section: split it across two.
-    std::size_t start = 0;
-    for (std::size_t at = value.find("]]>"); at != std::string::npos;
-         at = value.find("]]>", start)) {
-      node.append_child(pugi::node_cdata).set_value(value.substr(start, at + 2 - start).c_str());
-      start = at + 2;
-    }
-    if (start < value.size()) {
-      node.append_child(pugi::node_cdata).set_value(value.substr(start).c_str());
-    }
+    // pugixml splits a "]]>" across two CDATA sections itself.
+    if (!value.empty()) node.append_child(pugi::node_cdata).set_value(value.c_str());
   }
   static void real(pugi::xml_node parent, const char* name, double value) {
     element(parent, name, "Float").text() = fmt::format("{}", value).c_str();
@@ -431,6 +452,20 @@ void write_scan(pugi::xml_node parent, const E57ScanEntry& scan) {
   Builder::element(points, "codecs", "Vector").append_attribute("allowHeterogeneousChildren") = "1";
 }
 
+const char* representation_name(ImageProjection projection) {
+  switch (projection) {
+    case ImageProjection::kPinhole:
+      return "pinholeRepresentation";
+    case ImageProjection::kSpherical:
+      return "sphericalRepresentation";
+    case ImageProjection::kCylindrical:
+      return "cylindricalRepresentation";
+    case ImageProjection::kVisualReference:
+      return "visualReferenceRepresentation";
+  }
+  return "visualReferenceRepresentation";
+}
+
 void write_image(pugi::xml_node parent, const E57ImageEntry& entry) {
   const ScanImage& image = entry.image;
   pugi::xml_node node = Builder::element(parent, "vectorChild", "Structure");
@@ -440,10 +475,7 @@ void write_image(pugi::xml_node parent, const E57ImageEntry& entry) {
     Builder::string(node, "associatedData3DGuid", entry.associated_scan_guid);
   }
   Builder::pose(node, image.T_world_image);
-  const char* kind = image.projection == ImageProjection::kSpherical ? "sphericalRepresentation"
-                     : image.projection == ImageProjection::kCylindrical
-                         ? "cylindricalRepresentation"
-                         : "pinholeRepresentation";
+  const char* kind = representation_name(image.projection);
   pugi::xml_node representation = Builder::element(node, kind, "Structure");
   pugi::xml_node blob =
       Builder::element(representation, image.format == "png" ? "pngImage" : "jpegImage", "Blob");
@@ -451,13 +483,16 @@ void write_image(pugi::xml_node parent, const E57ImageEntry& entry) {
   blob.append_attribute("length") = fmt::format("{}", entry.blob_length).c_str();
   Builder::integer(representation, "imageWidth", image.width);
   Builder::integer(representation, "imageHeight", image.height);
-  Builder::real(representation, "pixelWidth", image.pixel_width);
-  Builder::real(representation, "pixelHeight", image.pixel_height);
+  if (image.projection != ImageProjection::kVisualReference) {
+    Builder::real(representation, "pixelWidth", image.pixel_width);
+    Builder::real(representation, "pixelHeight", image.pixel_height);
+  }
   if (image.projection == ImageProjection::kPinhole) {
     Builder::real(representation, "focalLength", image.focal_length);
     Builder::real(representation, "principalPointX", image.principal_x);
   }
-  if (image.projection != ImageProjection::kSpherical) {
+  if (image.projection == ImageProjection::kPinhole ||
+      image.projection == ImageProjection::kCylindrical) {
     Builder::real(representation, "principalPointY", image.principal_y);
   }
   if (image.projection == ImageProjection::kCylindrical) {

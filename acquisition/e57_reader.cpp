@@ -97,7 +97,11 @@ void read_e57(const std::filesystem::path& path, const std::function<void(Import
     ImportedScan scan = scan_from_records(
         path, entry, k, read_e57_streams(file, entry.points, "points of " + entry.path));
     for (std::size_t i = 0; i < document.images.size(); ++i) {
-      if (entry.guid.empty() || document.images[i].associated_scan_guid != entry.guid) continue;
+      // An image goes with the first scan of its guid.
+      if (image_taken[i] || entry.guid.empty() ||
+          document.images[i].associated_scan_guid != entry.guid) {
+        continue;
+      }
       scan.images.push_back(read_image(file, document.images[i]));
       image_taken[i] = true;
     }

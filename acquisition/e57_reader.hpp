@@ -21,9 +21,9 @@
 namespace scanbench::acquisition {
 
 // Reads every scan of `path` and hands each to `on_scan` in file order;
-// images tied to no scan go to `on_loose_image`. Every page's checksum is
-// verified. Throws core::InputError naming the file, the page or element,
-// and the problem for a bad signature or header, a checksum failure,
+// images tied to no scan go to `on_loose_image`. The checksum of every page
+// read (the header, the XML and every section) is verified. Throws core::InputError naming the
+// file, the page or element, and the problem for a bad signature or header, a checksum failure,
 // malformed XML, a prototype without coordinates or not matching its data,
 // indices outside the index bounds, or a truncated binary section.
 void read_e57(const std::filesystem::path& path, const std::function<void(ImportedScan&&)>& on_scan,

@@ -11,12 +11,16 @@
 #include "acquisition/panorama_projection.hpp"
 #include "acquisition/spherical_fit.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
 constexpr std::uint64_t kBlockRecords = 1u << 16;
 constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 30;
+// Coordinates (and angles) beyond this are no point of a survey: the
+// record counts as no return.
+constexpr double kFarthestM = 1e9;
 
 // One field's bytestream, decoded a block of records at a time.
 struct FieldStream {
@@ -68,6 +72,12 @@ PointFields point_fields(const std::filesystem::path& path, const E57ScanEntry& 
   fields.state = find(fields.spherical ? "sphericalInvalidState" : "cartesianInvalidState");
   fields.row = find("rowIndex");
   fields.column = find("columnIndex");
+  for (const FieldStream* index : {&fields.row, &fields.column}) {
+    if (*index && index->field->type != E57FieldType::kInteger) {
+      refuse(path, "XML element " + entry.path + "/points/prototype/" + index->field->name,
+             "is not an Integer field, as E57 requires of grid indices");
+    }
+  }
   fields.returns = find("returnIndex");
   fields.intensity = find("intensity");
   fields.color = {find("colorRed"), find("colorGreen"), find("colorBlue")};
@@ -107,12 +117,15 @@ void decode_block(const PointFields& fields, std::uint64_t first, std::size_t co
   block.state.resize(count);
   const auto& [a, b, c] = block.coordinates;
   for (std::size_t i = 0; i < count; ++i) {
-    auto state = static_cast<std::uint8_t>(std::clamp(scratch[i], 0.0, 2.0));
-    // A return needs a finite point off the origin.
-    const bool finite = std::isfinite(a[i]) && std::isfinite(b[i]) && std::isfinite(c[i]);
+    // 0, 1 or 2 as the file says; anything else (NaN included) is nothing.
+    const double said = scratch[i];
+    std::uint8_t state = said == 0.0 ? 0 : said == 1.0 ? 1 : 2;
+    // A return needs a point off the origin and within 10^9 m of it.
+    const bool bounded = std::abs(a[i]) <= kFarthestM && std::abs(b[i]) <= kFarthestM &&
+                         std::abs(c[i]) <= kFarthestM;  // false for NaN
     const bool off_origin =
         fields.spherical ? a[i] > 0.0 : a[i] != 0.0 || b[i] != 0.0 || c[i] != 0.0;
-    if (state == 0 && !(finite && off_origin)) state = 2;
+    if (state == 0 && !(bounded && off_origin)) state = 2;
     block.state[i] = state;
   }
 }
@@ -138,7 +151,11 @@ Eigen::Vector3d point_of(bool spherical, double a, double b, double c) {
 // gives them, else the field's own bounds when finite, else `fallback`.
 struct UnitScale {
   UnitScale(double low_, double high_) : low(low_), inverse_span(1.0 / (high_ - low_)) {}
-  double operator()(double v) const { return std::clamp((v - low) * inverse_span, 0.0, 1.0); }
+  // In [0, 1]; 0 for NaN.
+  double operator()(double v) const {
+    const double t = (v - low) * inverse_span;
+    return t > 0.0 ? std::min(t, 1.0) : 0.0;
+  }
   double low;
   double inverse_span;
 };
@@ -209,10 +226,24 @@ struct IndexRange {
   std::int64_t row_min = 0, row_max = -1, col_min = 0, col_max = -1;
 };
 
+// An index as an integer, clamped to ±2^62 (far beyond any grid, so that
+// the bounds check refuses it, and differences cannot overflow).
+std::int64_t index_value(double v) {
+  constexpr double kLimit = 4.611686018427387904e18;  // 2^62
+  return static_cast<std::int64_t>(std::clamp(v, -kLimit, kLimit));
+}
+
+// The number of indices from lo to hi, 0 when hi < lo.
+std::uint64_t extent(std::int64_t lo, std::int64_t hi) {
+  return hi < lo ? 0 : static_cast<std::uint64_t>(hi) - static_cast<std::uint64_t>(lo) + 1;
+}
+
 IndexRange index_range(const E57ScanEntry& entry, const PointFields& fields) {
   if (entry.index_bounds) {
     const E57IndexBounds& b = *entry.index_bounds;
-    return {b.row_minimum, b.row_maximum, b.column_minimum, b.column_maximum};
+    const auto clamp = [](std::int64_t v) { return index_value(static_cast<double>(v)); };
+    return {clamp(b.row_minimum), clamp(b.row_maximum), clamp(b.column_minimum),
+            clamp(b.column_maximum)};
   }
   IndexRange range{
       std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::min(),
@@ -223,10 +254,10 @@ IndexRange index_range(const E57ScanEntry& entry, const PointFields& fields) {
     fields.row.decode(first, std::span(rows).first(count));
     fields.column.decode(first, std::span(columns).first(count));
     for (std::size_t i = 0; i < count; ++i) {
-      range.row_min = std::min(range.row_min, static_cast<std::int64_t>(rows[i]));
-      range.row_max = std::max(range.row_max, static_cast<std::int64_t>(rows[i]));
-      range.col_min = std::min(range.col_min, static_cast<std::int64_t>(columns[i]));
-      range.col_max = std::max(range.col_max, static_cast<std::int64_t>(columns[i]));
+      range.row_min = std::min(range.row_min, index_value(rows[i]));
+      range.row_max = std::max(range.row_max, index_value(rows[i]));
+      range.col_min = std::min(range.col_min, index_value(columns[i]));
+      range.col_max = std::max(range.col_max, index_value(columns[i]));
     }
   }
   return range;
@@ -277,9 +308,8 @@ void set_grid(const PixelCoordinates& pixels, Scan& scan) {
 ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEntry& entry,
                              const PointFields& fields) {
   const IndexRange range = index_range(entry, fields);
-  const std::uint64_t rows = range.row_max >= range.row_min ? range.row_max - range.row_min + 1 : 0;
-  const std::uint64_t columns =
-      range.col_max >= range.col_min ? range.col_max - range.col_min + 1 : 0;
+  const std::uint64_t rows = extent(range.row_min, range.row_max);
+  const std::uint64_t columns = extent(range.col_min, range.col_max);
   // A grid far larger than its records is a damaged bound, not a scan.
   const std::uint64_t most =
       std::min(kMaxPixels, std::max<std::uint64_t>(16 * entry.points.record_count, 1u << 24));
@@ -289,6 +319,9 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
                " pixels for " + std::to_string(entry.points.record_count) +
                " records (at most 16 pixels per record, and 2^30 in all)");
   }
+  // The scan's channels, the file's coordinates per pixel, and points
+  // where the grid is not a regular panorama: about 64 bytes per pixel.
+  core::check_memory(rows * columns * 64, path.string());
   ImportedScan out;
   Scan& scan = out.scan;
   scan = make_empty_scan(static_cast<int>(rows), static_cast<int>(columns),
@@ -300,12 +333,12 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
   for_each_block(fields, entry.points.record_count, [&](const Block& block) {
     pixel.assign(block.count, -1);
     for (std::size_t i = 0; i < block.count; ++i) {
-      const auto r = static_cast<std::int64_t>(block.row[i]) - range.row_min;
-      const auto c = static_cast<std::int64_t>(block.column[i]) - range.col_min;
+      const std::int64_t r = index_value(block.row[i]) - range.row_min;
+      const std::int64_t c = index_value(block.column[i]) - range.col_min;
       if (r < 0 || c < 0 || r >= scan.rows || c >= scan.columns) {
         refuse(path, "record " + std::to_string(block.first + i) + " of " + entry.path,
-               "has row " + std::to_string(static_cast<std::int64_t>(block.row[i])) + ", column " +
-                   std::to_string(static_cast<std::int64_t>(block.column[i])) +
+               "has row " + std::to_string(index_value(block.row[i])) + ", column " +
+                   std::to_string(index_value(block.column[i])) +
                    " outside the scan's index bounds");
       }
       const std::int64_t p = r * scan.columns + c;
@@ -324,7 +357,11 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
   return out;
 }
 
-ImportedScan unstructured_scan(const E57ScanEntry& entry, const PointFields& fields) {
+ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanEntry& entry,
+                               const PointFields& fields) {
+  // Each point with its angles and channels, and up to 4 pixels of grid
+  // for it: about 200 bytes per record.
+  core::check_memory(entry.points.record_count * 200, path.string());
   // The returns, compactly, with their channels.
   std::vector<Eigen::Vector3d> points;
   Scan channels = make_empty_scan(0, 0, static_cast<bool>(fields.intensity),
@@ -371,7 +408,7 @@ ImportedScan scan_from_records(const std::filesystem::path& path, const E57ScanE
   const PointFields fields = point_fields(path, entry, streams);
   const bool structured = fields.row && fields.column;
   ImportedScan out =
-      structured ? structured_scan(path, entry, fields) : unstructured_scan(entry, fields);
+      structured ? structured_scan(path, entry, fields) : unstructured_scan(path, entry, fields);
   Scan& scan = out.scan;
   scan.name = entry.name.empty() ? path.stem().string() + "#" + std::to_string(index) : entry.name;
   scan.scanner.name = entry.sensor_model;

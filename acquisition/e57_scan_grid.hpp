@@ -16,8 +16,10 @@ namespace scanbench::acquisition {
 // The scan of `entry`, the `index`-th of the file at `path`, from its
 // fields' bytestreams (one per prototype field, complete: read_e57_streams
 // checked their lengths). Throws core::InputError naming the file and the
-// record or element for a prototype without coordinates, indices outside
-// the index bounds, or a grid too large to hold.
+// record or element for a prototype without coordinates or with grid
+// indices that are not Integer fields, indices outside the index bounds, or
+// bounds of more than 16 pixels per record (or 2^30 pixels); throws
+// core::MemoryShortage when the grid would not fit in memory.
 ImportedScan scan_from_records(const std::filesystem::path& path, const E57ScanEntry& entry,
                                std::size_t index,
                                const std::vector<std::vector<std::byte>>& streams);

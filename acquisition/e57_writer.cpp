@@ -2,9 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <random>
+#include <set>
 
 #include "acquisition/e57_compressed_vector.hpp"
 #include "acquisition/e57_document.hpp"
@@ -64,7 +68,9 @@ std::vector<E57Field> scan_fields(const Scan& scan, double max_range_m) {
 // Azimuth and elevation of a pixel's direction; none when it is unknown.
 bool pixel_angles(const Scan& scan, int row, int col, double& azimuth, double& elevation) {
   if (const auto* angles = std::get_if<SphericalAngles>(&scan.angles)) {
-    azimuth = angles->azimuth_start_rad + col * angles->azimuth_step_rad;
+    // Within [−π, π], as the field's bounds say.
+    azimuth = std::remainder(angles->azimuth_start_rad + col * angles->azimuth_step_rad,
+                             2.0 * std::numbers::pi);
     elevation = angles->elevation_start_rad + row * angles->elevation_step_rad;
     return true;
   }
@@ -138,10 +144,11 @@ E57ImageEntry image_entry(E57PageWriter& file, const ScanImage& image,
   return entry;
 }
 
-E57ScanEntry scan_entry(E57PageWriter& file, const E57ScanOutput& output, const std::string& name) {
+E57ScanEntry scan_entry(E57PageWriter& file, const E57ScanOutput& output, const std::string& guid,
+                        const std::string& name) {
   const Scan& scan = *output.scan;
   E57ScanEntry entry;
-  entry.guid = output.guid.empty() ? new_e57_guid() : output.guid;
+  entry.guid = guid;
   entry.name = scan.name;
   entry.sensor_model = scan.scanner.name;
   entry.pose = scan.T_world_scan;
@@ -159,7 +166,13 @@ E57ScanEntry scan_entry(E57PageWriter& file, const E57ScanOutput& output, const 
 }  // namespace
 
 std::string new_e57_guid() {
-  static thread_local std::mt19937_64 generator{std::random_device{}()};
+  // Seeded with 256 bits: GUIDs of different runs must not collide.
+  static thread_local std::mt19937_64 generator = [] {
+    std::random_device device;
+    std::seed_seq seeds{device(), device(), device(), device(),
+                        device(), device(), device(), device()};
+    return std::mt19937_64(seeds);
+  }();
   const std::uint64_t a = generator();
   const std::uint64_t b = generator();
   return fmt::format("{{{:08x}-{:04x}-4{:03x}-{:04x}-{:012x}}}", a >> 32, (a >> 16) & 0xFFFF,
@@ -174,8 +187,14 @@ void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput>
   file.write(header_space);  // the header, written last
   E57Document document;
   document.guid = new_e57_guid();
+  std::set<std::string> guids;  // a guid names one scan of the file
   for (const E57ScanOutput& output : scans) {
-    E57ScanEntry entry = scan_entry(file, output, path.string());
+    std::string guid = output.guid;
+    if (guid.empty() || !guids.insert(guid).second) {
+      guid = new_e57_guid();
+      guids.insert(guid);
+    }
+    E57ScanEntry entry = scan_entry(file, output, guid, path.string());
     for (const ScanImage& image : output.images) {
       document.images.push_back(image_entry(file, image, entry.guid));
     }

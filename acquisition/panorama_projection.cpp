@@ -8,8 +8,9 @@ namespace scanbench::acquisition {
 namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kFarM = 500.0;  // local_origin.hpp's max_per_pixel_range_m
-constexpr int kGapBins = 3600;   // azimuth histogram for the widest gap
+constexpr double kFarM = 500.0;              // local_origin.hpp's max_per_pixel_range_m
+constexpr int kGapBins = 3600;               // azimuth histogram for the widest gap
+constexpr double kMaxPixels = 1073741824.0;  // 2^30
 
 Eigen::Vector3d projection_centre(std::span<const Eigen::Vector3d> points) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -114,7 +115,9 @@ PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points) 
   const double box = std::max(az_extent, 1e-6) * std::max(el_max - el_min, 1e-6);
   double step = median_neighbour_spacing(azimuth, elevation, el_max, az_extent, box);
   // At most 4 pixels per point (and 2^30 in all).
-  const double min_step = std::sqrt(box / (4.0 * n));
+  // Steps of at least 10^-7 rad whose grid is within 4 pixels per point and
+  // 2^30 pixels (each side of the box gains at most one pixel in rounding).
+  const double min_step = std::sqrt(box / std::min(4.0 * n, 0.9 * kMaxPixels));
   step = std::max({step, min_step, 1e-7});
   out.step_rad = step;
   out.columns = static_cast<int>(std::llround(az_extent / step)) + 1;
@@ -127,8 +130,8 @@ PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points) 
   std::vector<std::uint8_t> taken(static_cast<std::size_t>(out.rows) * out.columns, 0);
   for (const std::size_t i : order) {
     const auto row =
-        std::min<std::int64_t>(std::llround((el_max - elevation[i]) / step), out.rows - 1);
-    const auto col = std::min<std::int64_t>(std::llround(azimuth[i] / step), out.columns - 1);
+        std::clamp<std::int64_t>(std::llround((el_max - elevation[i]) / step), 0, out.rows - 1);
+    const auto col = std::clamp<std::int64_t>(std::llround(azimuth[i] / step), 0, out.columns - 1);
     const std::int64_t p = row * out.columns + col;
     if (taken[p]) {
       ++out.collisions;

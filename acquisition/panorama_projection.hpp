@@ -28,7 +28,8 @@ struct PanoramaProjection {
 // the step of a scan sampled on a regular grid, which then lands on the
 // grid's pixels one point each. Azimuths start after the widest gap with
 // no point, so that a partial panorama is not split at ±180°. The grid
-// holds at most 4 pixels per point.
+// holds at most about 4 pixels per point (rounding adds a pixel to each
+// side), and fewer than 2^30.
 PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points);
 
 }  // namespace scanbench::acquisition

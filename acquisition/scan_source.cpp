@@ -10,8 +10,10 @@ const char* projection_name(ImageProjection projection) {
       return "spherical";
     case ImageProjection::kCylindrical:
       return "cylindrical";
+    case ImageProjection::kVisualReference:
+      return "visual_reference";
   }
-  return "pinhole";
+  return "visual_reference";
 }
 
 }  // namespace scanbench::acquisition

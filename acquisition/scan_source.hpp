@@ -15,9 +15,10 @@
 namespace scanbench::acquisition {
 
 // How an image maps directions onto pixels (ASTM E2807 §8.4): a pinhole
-// camera, a spherical panorama or a cylindrical one. The parameters are the
-// file's, in metres and pixels; those a projection does not use stay 0.
-enum class ImageProjection { kPinhole, kSpherical, kCylindrical };
+// camera, a spherical panorama or a cylindrical one, or none (a visual
+// reference, a picture only). The parameters are the file's, in metres and
+// pixels; those a projection does not use stay 0.
+enum class ImageProjection { kPinhole, kSpherical, kCylindrical, kVisualReference };
 
 struct ScanImage {
   std::string name;  // UTF-8; may be empty
@@ -56,7 +57,7 @@ struct ImportedScan {
   std::vector<ScanImage> images;  // those the file ties to this scan
 };
 
-// "pinhole", "spherical" or "cylindrical".
+// "pinhole", "spherical", "cylindrical" or "visual_reference".
 const char* projection_name(ImageProjection projection);
 
 }  // namespace scanbench::acquisition

@@ -61,7 +61,7 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
       const std::int64_t id = project.insert_scan(part, encoded);
       project.put_scan_source(part, id, imported.source);
       for (const acquisition::ScanImage& image : imported.images)
-        project.insert_image(part, id, image);
+        project.insert_image(part, id, imported.scan.T_world_scan, image);
       part.commit_part();
       result.scan_ids.push_back(id);
       result.unplaced_points += imported.source.unplaced_points;
@@ -69,7 +69,7 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
     };
     const auto on_loose_image = [&](acquisition::ScanImage&& image) {
       Project::Edit part = command.part();
-      project.insert_image(part, std::nullopt, image);
+      project.insert_image(part, std::nullopt, Eigen::Isometry3d::Identity(), image);
       part.commit_part();
       ++result.images;
     };

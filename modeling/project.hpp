@@ -299,15 +299,19 @@ class Project {
   // scan when its row is damaged.
   std::map<std::int64_t, acquisition::ScanSource> scan_sources() const;
 
-  // Stores an image as part of `edit`, tied to scan `scan_id` (asserted
-  // to be a scan of the project or of this edit) or to none, and returns
-  // its id. Throws core::InputError for an image that is neither JPEG nor
-  // PNG.
+  // Stores an image as part of `edit`, tied to scan `scan_id` (asserted to
+  // be a scan of the project or of this edit) whose pose is `T_world_scan`,
+  // or to no scan (`scan_id` empty), and returns its id. A tied image keeps
+  // its pose relative to its scan, so it follows the scan when
+  // registration moves it. Throws core::InputError for an image that is
+  // neither JPEG nor PNG.
   std::int64_t insert_image(Edit& edit, std::optional<std::int64_t> scan_id,
+                            const Eigen::Isometry3d& T_world_scan,
                             const acquisition::ScanImage& image);
 
-  // The images of the live import commands, by id; with `with_data` their
-  // encoded bytes too, checked against their CRC. Throws core::InputError
+  // The images of the live import commands, by id, tied ones at their
+  // scan's current pose; with `with_data` their encoded bytes too, checked
+  // against their CRC. Throws core::InputError
   // naming the image when its row or data is damaged.
   std::vector<StoredImage> images(bool with_data) const;
 

@@ -38,7 +38,7 @@ std::string to_json(const acquisition::ScanSource& source) {
                         {"guid", source.guid},
                         {"points_in_file", source.points_in_file},
                         {"unplaced_points", source.unplaced_points}}
-      .dump();
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 acquisition::ScanSource source_from_json(const std::string& text) {
@@ -54,17 +54,37 @@ acquisition::ScanSource source_from_json(const std::string& text) {
 acquisition::ImageProjection projection_from_name(const std::string& name) {
   for (const auto projection :
        {acquisition::ImageProjection::kPinhole, acquisition::ImageProjection::kSpherical,
-        acquisition::ImageProjection::kCylindrical}) {
+        acquisition::ImageProjection::kCylindrical,
+        acquisition::ImageProjection::kVisualReference}) {
     if (name == acquisition::projection_name(projection)) return projection;
   }
   throw std::invalid_argument("unknown projection \"" + name + "\"");
 }
 
-std::string describe(const acquisition::ScanImage& image) {
-  std::vector<double> pose(16);
+// 16 numbers, row-major, and back.
+std::vector<double> to_numbers(const Eigen::Isometry3d& pose) {
+  std::vector<double> numbers(16);
   for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) pose[4 * r + c] = image.T_world_image.matrix()(r, c);
+    for (int c = 0; c < 4; ++c) numbers[4 * r + c] = pose.matrix()(r, c);
   }
+  return numbers;
+}
+
+Eigen::Isometry3d pose_from(const std::vector<double>& numbers) {
+  if (numbers.size() != 16) {
+    throw std::invalid_argument("a pose of " + std::to_string(numbers.size()) + " numbers");
+  }
+  Eigen::Isometry3d pose;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = numbers[4 * r + c];
+  }
+  return pose;
+}
+
+// The image's description; `pose_key` names its pose: "T_scan_image" (tied
+// to a scan) or "T_world_image".
+std::string describe(const acquisition::ScanImage& image, const char* pose_key,
+                     const Eigen::Isometry3d& pose) {
   return nlohmann::json{{"name", image.name},
                         {"guid", image.guid},
                         {"projection", acquisition::projection_name(image.projection)},
@@ -76,8 +96,8 @@ std::string describe(const acquisition::ScanImage& image) {
                         {"principal_x", image.principal_x},
                         {"principal_y", image.principal_y},
                         {"radius", image.radius},
-                        {"T_world_image", pose}}
-      .dump();
+                        {pose_key, to_numbers(pose)}}
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 acquisition::ScanImage image_from_json(const std::string& text, const std::string& format) {
@@ -94,12 +114,9 @@ acquisition::ScanImage image_from_json(const std::string& text, const std::strin
   image.principal_x = json.at("principal_x").get<double>();
   image.principal_y = json.at("principal_y").get<double>();
   image.radius = json.at("radius").get<double>();
-  const auto pose = json.at("T_world_image").get<std::vector<double>>();
-  if (pose.size() != 16)
-    throw std::invalid_argument("a pose of " + std::to_string(pose.size()) + " numbers");
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) image.T_world_image.matrix()(r, c) = pose[4 * r + c];
-  }
+  // A tied image's pose is relative to its scan; the caller composes it.
+  const char* key = json.contains("T_scan_image") ? "T_scan_image" : "T_world_image";
+  image.T_world_image = pose_from(json.at(key).get<std::vector<double>>());
   image.format = format;
   return image;
 }
@@ -141,6 +158,7 @@ std::map<std::int64_t, acquisition::ScanSource> Project::scan_sources() const {
 }
 
 std::int64_t Project::insert_image(Edit& edit, std::optional<std::int64_t> scan_id,
+                                   const Eigen::Isometry3d& T_world_scan,
                                    const acquisition::ScanImage& image) {
   check_edit(edit);
   if (scan_id) stored_pixel_count(*scan_id, &edit);  // throws when there is no such scan
@@ -148,8 +166,10 @@ std::int64_t Project::insert_image(Edit& edit, std::optional<std::int64_t> scan_
     throw core::InputError(file_name(), {{}, {}, "image \"" + image.name + "\""},
                            "is " + image.format + "; images are JPEG or PNG");
   }
-  ImageRecord record{edit.command_id(), scan_id, describe(image), image.format,
-                     data_crc(image.data)};
+  const std::string description =
+      scan_id ? describe(image, "T_scan_image", T_world_scan.inverse() * image.T_world_image)
+              : describe(image, "T_world_image", image.T_world_image);
+  ImageRecord record{edit.command_id(), scan_id, description, image.format, data_crc(image.data)};
   sqlite::Statement insert(db(),
                            "INSERT INTO scan_images (created_by, scan_id, description, format, "
                            "data, data_crc, checksum) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
@@ -166,6 +186,8 @@ std::int64_t Project::insert_image(Edit& edit, std::optional<std::int64_t> scan_
 }
 
 std::vector<StoredImage> Project::images(bool with_data) const {
+  std::map<std::int64_t, Eigen::Isometry3d> poses;  // of the live scans, now
+  for (const StoredScanSummary& stored : scans()) poses[stored.id] = stored.summary.T_world_scan;
   std::vector<StoredImage> out;
   for (sqlite::Statement select(db(), kSelectImages, file_name()); select.step();) {
     StoredImage stored;
@@ -186,6 +208,11 @@ std::vector<StoredImage> Project::images(bool with_data) const {
       damaged(file_name(), what, e.what());
     }
     stored.scan_id = record.scan_id;
+    if (stored.scan_id) {
+      const auto pose = poses.find(*stored.scan_id);
+      if (pose == poses.end()) continue;  // its scan is gone with an undone import
+      stored.image.T_world_image = pose->second * stored.image.T_world_image;
+    }
     if (with_data) {
       const std::span<const std::uint8_t> data = select.column_blob(7);
       if (data_crc(data) != record.data_crc) damaged(file_name(), what, "its data fails its CRC");

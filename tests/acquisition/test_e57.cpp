@@ -322,12 +322,24 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"e57_prototype_mismatch.e57", "packet of 5 bytestreams where the prototype has 6"},
         BadCase{"e57_truncated_section.e57", "fewer bytes of field \"cartesianX\""},
         BadCase{"e57_no_coordinates.e57", "neither cartesianX/Y/Z nor sphericalRange"},
-        BadCase{"e57_index_outside_bounds.e57", "outside the scan's index bounds"}),
+        BadCase{"e57_index_outside_bounds.e57", "outside the scan's index bounds"},
+        BadCase{"e57_float_index.e57", "rowIndex: is not an Integer field"},
+        BadCase{"e57_image_size.e57", "has an image of 0 × 3 pixels"},
+        BadCase{"e57_deep_prototype.e57", "nests structures deeper than scanbench reads"},
+        BadCase{"e57_short_packet.e57", "data packet too short for its header"},
+        BadCase{"e57_section_beyond_file.e57", "is not a compressed-vector section header"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       std::string name = info.param.file;
       name = name.substr(4, name.size() - 8);
       return name;
     });
+
+TEST(E57Fixture, AbsurdCoordinatesAndStatesAreNoReturns) {
+  const std::vector<ImportedScan> scans = read_all(test::fixture("good/e57/absurd_values.e57"));
+  ASSERT_EQ(scans.size(), 1u);
+  EXPECT_EQ(count_valid(scans[0].scan), 2u) << "10^300 m and a NaN state are no points";
+  EXPECT_EQ(scans[0].source.points_in_file, 4u);
+}
 
 TEST(BadE57, AFileOfNoWholePagesIsRefused) {
   const ScratchDir dir;
@@ -383,7 +395,8 @@ TEST(WriteE57, ScansComeBackWithGridValidityValuesPoseAndImages) {
   const Eigen::Isometry3d georeferenced =
       Eigen::Translation3d(9876543.21, 5412345.43, 312.5) *
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.1, 0.2, 1.0).normalized());
-  const Scan spherical = panorama(georeferenced);
+  Scan spherical = panorama(georeferenced);
+  spherical.name = "hall ]]> & <north> é";  // CDATA's end, markup and UTF-8
   // The same scan with an irregular direction per pixel, some unknown.
   Scan per_pixel = panorama(Eigen::Isometry3d(Eigen::Translation3d(10.0, -4.0, 1.0)));
   PerPixelDirections directions;
@@ -417,7 +430,7 @@ TEST(WriteE57, ScansComeBackWithGridValidityValuesPoseAndImages) {
   expect_same_scan(spherical, scans[0].scan);
   expect_same_scan(per_pixel, scans[1].scan);
   EXPECT_EQ(scans[0].scan.T_world_scan.translation(), georeferenced.translation());
-  EXPECT_EQ(scans[0].scan.name, "panorama");
+  EXPECT_EQ(scans[0].scan.name, "hall ]]> & <north> é");
   EXPECT_EQ(scans[0].scan.scanner.name, "virtual");
   EXPECT_EQ(scans[0].source.guid, "{kept-guid}");
   EXPECT_THAT(scans[1].source.guid, ::testing::StartsWith("{"));

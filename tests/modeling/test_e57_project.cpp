@@ -85,6 +85,28 @@ TEST(E57Project, RoundTripKeepsScansImagesAndGuids) {
   expect_same_scans(dir / "b.sbproj", dir / "c.sbproj");
 }
 
+TEST(E57Project, ImagesFollowTheirScanWhenItMoves) {
+  const ScratchDir dir;
+  import_files(dir / "p.sbproj", {fixture("good/e57/structured_spherical.e57")});
+  Project project = Project::open(dir / "p.sbproj");
+  const StoredImage before = project.images(false).at(0);
+  ASSERT_EQ(before.scan_id, 1);
+  const Eigen::Isometry3d was = project.scans().at(0).summary.T_world_scan;
+  acquisition::Scan scan = project.load_scan(1);
+  scan.T_world_scan = Eigen::Translation3d(5.0, -2.0, 0.5) *
+                      Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()) * scan.T_world_scan;
+  Project::Edit edit = project.begin_command("register", "{}");
+  project.set_pose(edit, 1, scan);
+  edit.commit("{}");
+  const StoredImage after = project.images(false).at(0);
+  const Eigen::Isometry3d expected = scan.T_world_scan * was.inverse() * before.image.T_world_image;
+  EXPECT_TRUE(after.image.T_world_image.isApprox(expected, 1e-12));
+  EXPECT_FALSE(after.image.T_world_image.isApprox(before.image.T_world_image, 1e-6));
+  // The loose image stays where it was.
+  EXPECT_TRUE(
+      project.images(false).at(1).image.T_world_image.isApprox(Eigen::Isometry3d::Identity()));
+}
+
 TEST(E57Project, PtxThroughE57KeepsEveryGeoreferencedScan) {
   const ScratchDir dir;
   import_files(dir / "ptx.sbproj",

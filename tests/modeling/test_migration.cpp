@@ -101,7 +101,7 @@ TEST(Migration, VersionSixKeepsItsColourEditsAndTakesImages) {
   image.format = "png";
   image.data = {1, 2, 3};
   Project::Edit edit = project.begin_command("import", "{}");
-  project.insert_image(edit, 1, image);
+  project.insert_image(edit, 1, project.scans().front().summary.T_world_scan, image);
   edit.commit("{}");
   EXPECT_EQ(project.images(true).at(0).image.data, image.data);
   EXPECT_TRUE(project.check().damage.empty());
