@@ -44,24 +44,29 @@ double median_step(std::span<const double> angle, std::span<const std::uint8_t> 
   return median(std::move(steps));
 }
 
-// Least-squares line value = start + index · step over samples given twice
-// (add_mean, then add_spread), without storing them; keeps `step` when all
-// samples share one index (the slope is then unobservable).
+// Least-squares line value = start + index · step over samples added one
+// by one, in one pass: sums of the samples taken relative to the first
+// (which keeps them small, so that the sums of squares lose nothing);
+// keeps `step` when all samples share one index (the slope is then
+// unobservable).
 struct LineFit {
-  double n = 0, sum_i = 0, sum_v = 0, s_iv = 0, s_ii = 0;
-  void add_mean(double index, double value) {
+  bool started = false;
+  double index0 = 0, value0 = 0;
+  double n = 0, sum_i = 0, sum_v = 0, sum_ii = 0, sum_iv = 0;
+  void add(double index, double value) {
+    if (!started) started = true, index0 = index, value0 = value;
+    const double i = index - index0, v = value - value0;
     n += 1;
-    sum_i += index;
-    sum_v += value;
-  }
-  void add_spread(double index, double value) {
-    const double di = index - sum_i / n;
-    s_iv += di * (value - sum_v / n);
-    s_ii += di * di;
+    sum_i += i;
+    sum_v += v;
+    sum_ii += i * i;
+    sum_iv += i * v;
   }
   void solve(double& start, double& step) const {
-    if (s_ii > 0) step = s_iv / s_ii;
-    start = sum_v / n - step * sum_i / n;
+    const double mean_i = sum_i / n, mean_v = sum_v / n;
+    const double s_ii = sum_ii - n * mean_i * mean_i;
+    if (s_ii > 0) step = (sum_iv - n * mean_i * mean_v) / s_ii;
+    start = value0 + mean_v - step * (index0 + mean_i);
   }
 };
 
@@ -103,12 +108,8 @@ SphericalAngles fit_lines(std::span<const double> azimuth, std::span<const doubl
   };
   LineFit az, el;
   for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
-    az.add_mean(col, unwrapped(col, i));
-    el.add_mean(row, elevation[i]);
-  });
-  for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
-    az.add_spread(col, unwrapped(col, i));
-    el.add_spread(row, elevation[i]);
+    az.add(col, unwrapped(col, i));
+    el.add(row, elevation[i]);
   });
   az.solve(angles.azimuth_start_rad, angles.azimuth_step_rad);
   el.solve(angles.elevation_start_rad, angles.elevation_step_rad);
