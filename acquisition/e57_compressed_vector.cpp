@@ -89,8 +89,13 @@ Section read_section_header(E57PageReader& file, const E57PointsEntry& points,
   const std::uint64_t start = logical_of(points.file_offset);
   const std::uint64_t file_bytes = logical_of(file.physical_length());
   if (std::to_integer<int>(header[0]) != 1 || section.bytes < kSectionHeaderBytes ||
-      section.bytes % 4 != 0 || section.bytes > file_bytes - start) {
+      section.bytes % 4 != 0) {
     bad(file, points.file_offset, what, "is not a compressed-vector section header");
+  }
+  if (section.bytes > file_bytes - start) {
+    bad(file, points.file_offset, what,
+        "has a section length of " + std::to_string(section.bytes) +
+            " bytes, beyond the end of the file (truncated?)");
   }
   section.end = start + section.bytes;
   if (section.data_offset % kE57PageSize >= kE57PagePayload ||

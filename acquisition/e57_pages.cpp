@@ -66,25 +66,25 @@ void E57PageReader::load_chunk(std::uint64_t first_page, const std::string& what
     throw core::RuntimeFailure(name_, {}, "cannot read the " + what);
   }
   chunk_first_page_ = first_page;
-  for (std::uint64_t p = 0; p < pages; ++p) {
-    const std::uint64_t page = first_page + p;
-    if (checked_[page]) continue;
-    const std::byte* bytes = chunk_.data() + p * kE57PageSize;
-    const std::uint32_t computed = crc32c({bytes, kE57PagePayload});
+}
+
+void E57PageReader::check_page(std::uint64_t page, const std::string& what) {
+  if (checked_[page]) return;
+  const std::byte* bytes = chunk_.data() + (page - chunk_first_page_) * kE57PageSize;
+  const std::uint32_t computed = crc32c({bytes, kE57PagePayload});
 #ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
-    const bool fuzzing = true;  // see CMakeLists.txt, SCANBENCH_FUZZ
+  const bool fuzzing = true;  // see CMakeLists.txt, SCANBENCH_FUZZ
 #else
-    const bool fuzzing = false;
+  const bool fuzzing = false;
 #endif
-    if (computed != stored_checksum(bytes) && !fuzzing) {
-      core::FilePosition position;
-      position.byte_offset = page * kE57PageSize;
-      position.detail = "page " + std::to_string(page);
-      throw core::InputError(
-          name_, position, "page fails its CRC-32C checksum (the file is damaged), in the " + what);
-    }
-    checked_[page] = 1;
+  if (computed != stored_checksum(bytes) && !fuzzing) {
+    core::FilePosition position;
+    position.byte_offset = page * kE57PageSize;
+    position.detail = "page " + std::to_string(page);
+    throw core::InputError(name_, position,
+                           "page fails its CRC-32C checksum (the file is damaged), in the " + what);
   }
+  checked_[page] = 1;
 }
 
 void E57PageReader::read(std::uint64_t physical, std::span<std::byte> out,
@@ -105,6 +105,7 @@ void E57PageReader::read(std::uint64_t physical, std::span<std::byte> out,
         page >= chunk_first_page_ + chunk_.size() / kE57PageSize) {
       load_chunk(page, what);
     }
+    check_page(page, what);
     const std::size_t take = std::min<std::size_t>(out.size() - done, kE57PagePayload - in_page);
     std::memcpy(out.data() + done,
                 chunk_.data() + (page - chunk_first_page_) * kE57PageSize + in_page, take);

@@ -47,6 +47,9 @@ class E57PageReader {
 
  private:
   void load_chunk(std::uint64_t first_page, const std::string& what);
+  // Verifies page `page` (in the chunk) the first time it is read; `what`
+  // names the part being read for the error.
+  void check_page(std::uint64_t page, const std::string& what);
 
   std::string name_;
   std::FILE* file_ = nullptr;

@@ -91,11 +91,23 @@ void read_e57(const std::filesystem::path& path, const std::function<void(Import
   std::string xml(header.xml_length, '\0');
   file.read(header.xml_offset, std::as_writable_bytes(std::span(xml)), "XML section");
   const E57Document document = parse_e57_xml(xml, file.file_name());
+  if (document.scans.empty()) {
+    core::FilePosition position;
+    position.detail = "XML element /data3D";
+    throw core::InputError(file.file_name(), position, "holds no scan");
+  }
+  for (const E57ScanEntry& entry : document.scans) {
+    if (entry.points.record_count > 0) continue;
+    core::FilePosition position;
+    position.detail = "XML element " + entry.path + "/points";
+    throw core::InputError(file.file_name(), position, "holds no point records");
+  }
   std::vector<bool> image_taken(document.images.size(), false);
   for (std::size_t k = 0; k < document.scans.size(); ++k) {
     const E57ScanEntry& entry = document.scans[k];
     ImportedScan scan = scan_from_records(
         path, entry, k, read_e57_streams(file, entry.points, "points of " + entry.path));
+    scan.source.coordinate_metadata = document.coordinate_metadata;
     for (std::size_t i = 0; i < document.images.size(); ++i) {
       // An image goes with the first scan of its guid.
       if (image_taken[i] || entry.guid.empty() ||

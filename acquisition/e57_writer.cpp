@@ -180,13 +180,14 @@ std::string new_e57_guid() {
 }
 
 void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
-               std::span<const ScanImage> loose_images) {
+               std::span<const ScanImage> loose_images, const std::string& coordinate_metadata) {
   OutputFile out(path);
   E57PageWriter file(out);
   const std::vector<std::byte> header_space(48, std::byte{0});
   file.write(header_space);  // the header, written last
   E57Document document;
   document.guid = new_e57_guid();
+  document.coordinate_metadata = coordinate_metadata;
   std::set<std::string> guids;  // a guid names one scan of the file
   for (const E57ScanOutput& output : scans) {
     std::string guid = output.guid;

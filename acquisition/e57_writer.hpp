@@ -25,14 +25,16 @@ struct E57ScanOutput {
   const std::vector<std::uint8_t>* keep = nullptr;
 };
 
-// Writes `scans` and the images tied to none (`loose_images`) to `path`
+// Writes `scans` and the images tied to none (`loose_images`) to `path`,
+// with `coordinate_metadata` (the coordinate reference system) in the XML,
 // through an OutputFile (a .partial file renamed when complete). A valid
 // pixel has sphericalInvalidState 0; a pixel without a return 1 when its
 // direction is known (always, for the spherical angle model), else 2.
 // Throws core::InputError for a range beyond 400 km (the ScaledInteger's
 // bound) and as OutputFile.
 void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
-               std::span<const ScanImage> loose_images);
+               std::span<const ScanImage> loose_images,
+               const std::string& coordinate_metadata = "");
 
 // A new random GUID in the braced form E57 files use.
 std::string new_e57_guid();

@@ -117,7 +117,10 @@ PanoramaProjection project_to_panorama(std::span<const Eigen::Vector3d> points) 
   // At most 4 pixels per point (and 2^30 in all).
   // Steps of at least 10^-7 rad whose grid is within 4 pixels per point and
   // 2^30 pixels (each side of the box gains at most one pixel in rounding).
-  const double min_step = std::sqrt(box / std::min(4.0 * n, 0.9 * kMaxPixels));
+  // A step of at least the longer side over 2n keeps a grid of points on a
+  // line (whose box is thin) within 2n + 1 pixels.
+  const double min_step = std::max(std::sqrt(box / std::min(4.0 * n, 0.9 * kMaxPixels)),
+                                   std::max(az_extent, el_max - el_min) / (2.0 * n));
   step = std::max({step, min_step, 1e-7});
   out.step_rad = step;
   out.columns = static_cast<int>(std::llround(az_extent / step)) + 1;

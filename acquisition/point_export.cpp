@@ -178,15 +178,21 @@ std::uint16_t to_u16(double unit) {
 
 }  // namespace
 
+std::size_t count_exported_points(std::span<const Scan> scans,
+                                  std::span<const ScanGeometry* const> geometry,
+                                  std::span<const std::vector<std::uint8_t>* const> keep) {
+  std::size_t points = 0;
+  for_each_point(scans, geometry, keep, common_channels(scans, geometry),
+                 [&](std::size_t, std::size_t, const Eigen::Vector3d&) { ++points; });
+  return points;
+}
+
 void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const ScanGeometry* const> geometry,
                std::span<const std::vector<std::uint8_t>* const> keep) {
   const Channels channels = common_channels(scans, geometry);
-  std::size_t vertices = 0;
-  for_each_point(scans, geometry, keep, channels,
-                 [&](std::size_t, std::size_t, const Eigen::Vector3d&) { ++vertices; });
   OutputFile file(path);
-  file.write(ply_header(vertices, channels));
+  file.write(ply_header(count_exported_points(scans, geometry, keep), channels));
   for_each_point(scans, geometry, keep, channels,
                  [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
                    const Scan& scan = scans[s];

@@ -30,7 +30,7 @@ namespace {
 ImportedScan plain(Scan&& scan, const char* format) {
   ImportedScan out;
   out.source.format = format;
-  out.source.points_in_file = count_valid(scan);
+  out.source.points_in_file = scan.pixel_count();  // every record, returns or not
   out.scan = std::move(scan);
   return out;
 }

@@ -43,7 +43,11 @@ struct ScanImage {
 struct ScanSource {
   std::string format;  // "e57", "ptx", "triplet", "pcd"
   std::string guid;    // E57: the data3D guid; else empty
-  // Records the file held for the scan, and how many of them the grid could
+  // E57: the file's coordinateMetadata (its coordinate reference system,
+  // as the file words it: an EPSG code, WKT, …); else empty.
+  std::string coordinate_metadata;
+  // Records the file held for the scan (returns or not; for the grid
+  // formats, rows × columns), and how many of them the grid could
   // not place: an unstructured scan's points that fell on a pixel already
   // taken, or a structured scan's later returns and repeated indices.
   std::uint64_t points_in_file = 0;

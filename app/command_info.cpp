@@ -98,24 +98,25 @@ nlohmann::json to_json(const Entry& entry) {
     const Eigen::Vector3d lo = s.bbox_world->min(), hi = s.bbox_world->max();
     bbox = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
   }
-  return {
-      {"id", entry.id},
-      {"name", s.name},
-      {"rows", s.rows},
-      {"columns", s.columns},
-      {"valid_points", s.valid_points},
-      {"has_color", s.has_color},
-      {"has_intensity", s.has_intensity},
-      {"angle_model", acquisition::angle_model_name(s.spherical)},
-      {"T_world_scan", acquisition::row_major(s.T_world_scan)},
-      {"bbox_world", bbox},
-      {"scanner", s.scanner.name},
-      {"source_file", s.scanner.source_file},
-      {"source", entry.source ? nlohmann::json{{"format", entry.source->format},
-                                               {"guid", entry.source->guid},
-                                               {"points_in_file", entry.source->points_in_file},
-                                               {"unplaced_points", entry.source->unplaced_points}}
-                              : nlohmann::json(nullptr)}};
+  return {{"id", entry.id},
+          {"name", s.name},
+          {"rows", s.rows},
+          {"columns", s.columns},
+          {"valid_points", s.valid_points},
+          {"has_color", s.has_color},
+          {"has_intensity", s.has_intensity},
+          {"angle_model", acquisition::angle_model_name(s.spherical)},
+          {"T_world_scan", acquisition::row_major(s.T_world_scan)},
+          {"bbox_world", bbox},
+          {"scanner", s.scanner.name},
+          {"source_file", s.scanner.source_file},
+          {"source",
+           entry.source ? nlohmann::json{{"format", entry.source->format},
+                                         {"guid", entry.source->guid},
+                                         {"coordinate_metadata", entry.source->coordinate_metadata},
+                                         {"points_in_file", entry.source->points_in_file},
+                                         {"unplaced_points", entry.source->unplaced_points}}
+                        : nlohmann::json(nullptr)}};
 }
 
 void print_table(const std::string& path, const Contents& contents) {

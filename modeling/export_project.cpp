@@ -61,9 +61,34 @@ void write_triplet(const Project& project, const std::vector<acquisition::Scan>&
   if (!scans.front().is_spherical()) {
     throw core::InputError(file, {{}, {}, "scan \"" + scans.front().name + "\""},
                            "a triplet needs the spherical angle model; this scan has per-pixel "
-                           "directions (export it as ptx, ply or csv)");
+                           "directions (export it as ptx, e57, ply, csv or las)");
   }
   acquisition::write_triplet(scans.front(), settings.output);
+}
+
+// The coordinate reference system the exported scans' files named: the
+// one they share (none when no file named one). Throws core::InputError
+// when two scans come from files that name different ones: one E57 file
+// holds one system.
+std::string common_coordinate_metadata(
+    const Project& project, const std::vector<std::int64_t>& ids,
+    const std::map<std::int64_t, acquisition::ScanSource>& sources) {
+  std::string common;
+  std::int64_t from = 0;
+  for (const std::int64_t id : ids) {
+    const auto source = sources.find(id);
+    if (source == sources.end() || source->second.coordinate_metadata.empty()) continue;
+    if (!common.empty() && source->second.coordinate_metadata != common) {
+      throw core::InputError(project.path().string(), {{}, {}, "scan " + std::to_string(id)},
+                             "comes from a file in another coordinate system than scan " +
+                                 std::to_string(from) + " (\"" +
+                                 source->second.coordinate_metadata + "\" and \"" + common +
+                                 "\"); export them apart with --scan");
+    }
+    common = source->second.coordinate_metadata;
+    from = id;
+  }
+  return common;
 }
 
 // The scans as E57 data3D entries with their guids (kept from an E57
@@ -92,7 +117,8 @@ void write_e57(const Project& project, const std::vector<std::int64_t>& ids,
       if (!stored.scan_id) loose.push_back(std::move(stored.image));
     }
   }
-  acquisition::write_e57(settings.output, outputs, loose);
+  acquisition::write_e57(settings.output, outputs, loose,
+                         common_coordinate_metadata(project, ids, sources));
 }
 
 // The scans' ids as LAS point source ids (16 bits).
@@ -184,7 +210,13 @@ ExportResult export_project(const Project& project, const ExportSettings& settin
       write_e57(project, ids, scans, keep_of, settings);
       break;
   }
-  return {scans.size(), count_points(scans, keep)};
+  // The point formats leave mixed pixels out; the grid formats keep every
+  // pixel, the valid ones (or with `merged` the kept ones) counted.
+  const bool point_list = settings.format == ExportFormat::kPly ||
+                          settings.format == ExportFormat::kCsv ||
+                          settings.format == ExportFormat::kLas;
+  return {scans.size(), point_list ? acquisition::count_exported_points(scans, geometry_of, keep_of)
+                                   : count_points(scans, keep)};
 }
 
 }  // namespace scanbench::modeling

@@ -32,7 +32,9 @@ struct ExportSettings {
 
 struct ExportResult {
   std::size_t scans = 0;
-  std::size_t points = 0;  // valid points, or with `merged` the merged model's
+  // The points written: valid (point formats: not mixed) or, with `merged`,
+  // kept ones.
+  std::size_t points = 0;
 };
 
 // Writes the project's scans as the settings say, all read from one state of

@@ -36,6 +36,7 @@ ORDER BY i.id)sql";
 std::string to_json(const acquisition::ScanSource& source) {
   return nlohmann::json{{"format", source.format},
                         {"guid", source.guid},
+                        {"coordinate_metadata", source.coordinate_metadata},
                         {"points_in_file", source.points_in_file},
                         {"unplaced_points", source.unplaced_points}}
       .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
@@ -46,6 +47,7 @@ acquisition::ScanSource source_from_json(const std::string& text) {
   acquisition::ScanSource source;
   source.format = json.at("format").get<std::string>();
   source.guid = json.at("guid").get<std::string>();
+  source.coordinate_metadata = json.value("coordinate_metadata", "");
   source.points_in_file = json.at("points_in_file").get<std::uint64_t>();
   source.unplaced_points = json.at("unplaced_points").get<std::uint64_t>();
   return source;

@@ -263,6 +263,7 @@ TEST(E57Fixture, UnstructuredScanIsProjectedKeepingEveryPointAndCountingCollisio
 TEST(E57Fixture, GeoreferencedCoordinatesKeepATenthOfAMillimetre) {
   const std::vector<ImportedScan> scans = read_all(test::fixture("good/e57/georeferenced.e57"));
   ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[0].source.coordinate_metadata, "EPSG:25832");
   const Eigen::Vector3d base(512345.6789, 5412345.4321, 312.25);
   const Scan& utm = scans[0].scan;
   ASSERT_EQ(utm.rows, 4);
@@ -314,7 +315,9 @@ INSTANTIATE_TEST_SUITE_P(
     EveryClass, BadE57,
     ::testing::Values(
         BadCase{"e57_bad_signature.e57", "signature is not \"ASTM-E57\""},
-        BadCase{"e57_bad_checksum.e57", "(byte 1024), page 1: page fails its CRC-32C checksum"},
+        BadCase{"e57_bad_checksum.e57",
+                "(byte 1024), page 1: page fails its CRC-32C checksum (the file is damaged), in "
+                "the points of /data3D/0"},
         BadCase{"e57_malformed_xml.e57", "malformed XML"},
         BadCase{"e57_truncated_file.e57",
                 "the header gives a length of 9216 bytes but the file "
@@ -327,7 +330,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"e57_image_size.e57", "has an image of 0 × 3 pixels"},
         BadCase{"e57_deep_prototype.e57", "nests structures deeper than scanbench reads"},
         BadCase{"e57_short_packet.e57", "data packet too short for its header"},
-        BadCase{"e57_section_beyond_file.e57", "is not a compressed-vector section header"}),
+        BadCase{"e57_section_beyond_file.e57", "beyond the end of the file"},
+        BadCase{"e57_no_scan.e57", "/data3D: holds no scan"},
+        BadCase{"e57_no_records.e57", "/data3D/0/points: holds no point records"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       std::string name = info.param.file;
       name = name.substr(4, name.size() - 8);

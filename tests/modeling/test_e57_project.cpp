@@ -116,6 +116,37 @@ TEST(E57Project, PtxThroughE57KeepsEveryGeoreferencedScan) {
   expect_same_scans(dir / "ptx.sbproj", dir / "e57.sbproj");
 }
 
+TEST(E57Project, TheCoordinateSystemGoesBackOutAndIsNeverMixed) {
+  const ScratchDir dir;
+  import_files(dir / "geo.sbproj", {fixture("good/e57/georeferenced.e57")});
+  import_files(dir / "again.sbproj", {export_e57(dir / "geo.sbproj", dir / "geo.e57")});
+  const auto sources = Project::open_for_reading(dir / "again.sbproj").scan_sources();
+  ASSERT_EQ(sources.size(), 2u);
+  EXPECT_EQ(sources.at(1).coordinate_metadata, "EPSG:25832");
+  // A scan of a file that names no system joins any; one that names another
+  // is refused.
+  import_files(dir / "geo.sbproj", {fixture("good/e57/structured_spherical.e57")});
+  EXPECT_NO_THROW(export_e57(dir / "geo.sbproj", dir / "mixed.e57"));
+  {
+    Project project = Project::open(dir / "geo.sbproj");
+    Project::Edit edit = project.begin_command("import", "{}");
+    acquisition::Scan scan = project.load_scan(1);
+    const std::int64_t id = project.insert_scan(edit, encode_scan(scan));
+    acquisition::ScanSource other;
+    other.format = "e57";
+    other.coordinate_metadata = "EPSG:4326";
+    project.put_scan_source(edit, id, other);
+    edit.commit("{}");
+  }
+  try {
+    export_e57(dir / "geo.sbproj", dir / "two_systems.e57");
+    FAIL() << "scans of two coordinate systems in one file";
+  } catch (const core::InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("another coordinate system"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "two_systems.e57"));
+}
+
 TEST(E57Project, ABadFileChangesNothing) {
   const ScratchDir dir;
   const auto project = dir / "p.sbproj";
