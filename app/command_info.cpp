@@ -36,6 +36,7 @@ struct ImageEntry {
   std::int64_t id;
   std::optional<std::int64_t> scan_id;
   acquisition::ScanImage image;  // without data
+  std::size_t bytes = 0;         // of the encoded image
 };
 
 struct Contents {
@@ -53,8 +54,10 @@ Contents project_entries(const std::filesystem::path& path) {
         {stored.id, std::move(stored.summary),
          source == sources.end() ? std::nullopt : std::optional(source->second)});
   }
-  for (modeling::StoredImage& stored : project.images(false)) {
-    contents.images.push_back({stored.id, stored.scan_id, std::move(stored.image)});
+  for (modeling::StoredImage& stored : project.images(true)) {
+    const std::size_t bytes = stored.image.data.size();
+    stored.image.data = {};
+    contents.images.push_back({stored.id, stored.scan_id, std::move(stored.image), bytes});
   }
   return contents;
 }
@@ -64,9 +67,10 @@ Contents file_entries(const std::filesystem::path& path) {
   Contents contents;
   const auto add_image = [&contents](acquisition::ScanImage&& image,
                                      std::optional<std::int64_t> scan_id) {
-    image.data.clear();
+    const std::size_t bytes = image.data.size();
+    image.data = {};
     contents.images.push_back(
-        {static_cast<std::int64_t>(contents.images.size() + 1), scan_id, std::move(image)});
+        {static_cast<std::int64_t>(contents.images.size() + 1), scan_id, std::move(image), bytes});
   };
   acquisition::read_scan_file(
       path, {},
@@ -88,7 +92,14 @@ nlohmann::json to_json(const ImageEntry& entry) {
           {"projection", acquisition::projection_name(image.projection)},
           {"format", image.format},
           {"width", image.width},
-          {"height", image.height}};
+          {"height", image.height},
+          {"pixel_width", image.pixel_width},
+          {"pixel_height", image.pixel_height},
+          {"focal_length", image.focal_length},
+          {"principal_point", {image.principal_x, image.principal_y}},
+          {"radius", image.radius},
+          {"T_world_image", acquisition::row_major(image.T_world_image)},
+          {"bytes", entry.bytes}};
 }
 
 nlohmann::json to_json(const Entry& entry) {

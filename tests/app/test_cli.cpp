@@ -322,6 +322,9 @@ TEST(Cli, E57ImportReportsUnplacedPointsAndImagesAndExportsBack) {
   ASSERT_EQ(info["images"].size(), 2u);
   EXPECT_EQ(info["images"][0]["scan"], 1);
   EXPECT_EQ(info["images"][0]["projection"], "pinhole");
+  EXPECT_EQ(info["images"][0]["focal_length"], 0.01);
+  EXPECT_EQ(info["images"][0]["T_world_image"][11], 10.5);  // its height, row-major
+  EXPECT_GT(info["images"][0]["bytes"], 8);
   EXPECT_TRUE(info["images"][1]["scan"].is_null());
   // One scan exported: its image goes with it, the loose one stays home.
   const std::string one = (dir / "one.e57").string();
