@@ -39,12 +39,18 @@ struct Parser {
     return found;
   }
 
-  std::int64_t integer_text(const char* text, const std::string& path) const {
+  // `text` without the white space around it.
+  static std::string_view trimmed(const char* text) {
     std::string_view view(text);
     while (!view.empty() && std::isspace(static_cast<unsigned char>(view.front())))
       view.remove_prefix(1);
     while (!view.empty() && std::isspace(static_cast<unsigned char>(view.back())))
       view.remove_suffix(1);
+    return view;
+  }
+
+  std::int64_t integer_text(const char* text, const std::string& path) const {
+    const std::string_view view = trimmed(text);
     if (view.empty()) return 0;
     std::int64_t value = 0;
     const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);
@@ -55,11 +61,7 @@ struct Parser {
   }
 
   double float_text(const char* text, const std::string& path) const {
-    std::string_view view(text);
-    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.front())))
-      view.remove_prefix(1);
-    while (!view.empty() && std::isspace(static_cast<unsigned char>(view.back())))
-      view.remove_suffix(1);
+    const std::string_view view = trimmed(text);
     if (view.empty()) return 0.0;
     double value = 0.0;
     const auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), value);

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "modeling/project.hpp"
 #include "modeling/records.hpp"
@@ -63,26 +64,6 @@ acquisition::ImageProjection projection_from_name(const std::string& name) {
   throw std::invalid_argument("unknown projection \"" + name + "\"");
 }
 
-// 16 numbers, row-major, and back.
-std::vector<double> to_numbers(const Eigen::Isometry3d& pose) {
-  std::vector<double> numbers(16);
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) numbers[4 * r + c] = pose.matrix()(r, c);
-  }
-  return numbers;
-}
-
-Eigen::Isometry3d pose_from(const std::vector<double>& numbers) {
-  if (numbers.size() != 16) {
-    throw std::invalid_argument("a pose of " + std::to_string(numbers.size()) + " numbers");
-  }
-  Eigen::Isometry3d pose;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = numbers[4 * r + c];
-  }
-  return pose;
-}
-
 // The image's description; `pose_key` names its pose: "T_scan_image" (tied
 // to a scan) or "T_world_image".
 std::string describe(const acquisition::ScanImage& image, const char* pose_key,
@@ -98,7 +79,7 @@ std::string describe(const acquisition::ScanImage& image, const char* pose_key,
                         {"principal_x", image.principal_x},
                         {"principal_y", image.principal_y},
                         {"radius", image.radius},
-                        {pose_key, to_numbers(pose)}}
+                        {pose_key, acquisition::row_major(pose)}}
       .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
@@ -118,7 +99,13 @@ acquisition::ScanImage image_from_json(const std::string& text, const std::strin
   image.radius = json.at("radius").get<double>();
   // A tied image's pose is relative to its scan; the caller composes it.
   const char* key = json.contains("T_scan_image") ? "T_scan_image" : "T_world_image";
-  image.T_world_image = pose_from(json.at(key).get<std::vector<double>>());
+  const auto numbers = json.at(key).get<std::vector<double>>();
+  if (numbers.size() != 16) {
+    throw std::invalid_argument("a pose of " + std::to_string(numbers.size()) + " numbers");
+  }
+  std::array<double, 16> values;
+  std::copy(numbers.begin(), numbers.end(), values.begin());
+  image.T_world_image = Eigen::Isometry3d(acquisition::matrix_from_row_major(values));
   image.format = format;
   return image;
 }
