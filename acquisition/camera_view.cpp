@@ -3,10 +3,10 @@
 #include <array>
 #include <cassert>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "acquisition/json_input.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 
@@ -17,21 +17,23 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-[[noreturn]] void fail(const fs::path& file, const std::string& key, const std::string& problem) {
-  throw core::InputError(file.string(), {std::nullopt, std::nullopt, "key \"" + key + "\""},
-                         problem);
+// A camera farther out than this is a typo, not a site [m]; as the scan
+// readers' bound on coordinates.
+constexpr double kMaxCoordinateM = 1e8;
+
+constexpr std::uintmax_t kMaxViewFileBytes = 1u << 20;
+
+JsonPlace place_of(const fs::path& file, const std::string& key) {
+  return {file.string(), "key \"" + key + "\""};
 }
 
 Eigen::Vector3d vector_at(const fs::path& file, const json& root, const std::string& key) {
-  if (!root.contains(key) || !root[key].is_array() || root[key].size() != 3) {
-    fail(file, key, "must be an array of 3 numbers");
-  }
+  const JsonPlace place = place_of(file, key);
+  if (!root.contains(key) || !root[key].is_array() || root[key].size() != 3)
+    place.refuse("must be an array of 3 numbers");
   Eigen::Vector3d v;
-  for (int k = 0; k < 3; ++k) {
-    if (!root[key][k].is_number()) fail(file, key, "must be an array of 3 numbers");
-    v[k] = root[key][k].get<double>();
-  }
-  if (!v.allFinite()) fail(file, key, "is not finite");
+  for (int k = 0; k < 3; ++k)
+    v[k] = finite_number(root[key][k], -kMaxCoordinateM, kMaxCoordinateM, place, "each coordinate");
   return v;
 }
 
@@ -41,33 +43,24 @@ Eigen::Isometry3d look_at_pose(const fs::path& file, const json& root) {
   const Eigen::Vector3d up =
       root.contains("up") ? vector_at(file, root, "up") : Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d z = target - position;
-  if (z.norm() < 1e-9) fail(file, "look_at", "equals the position");
+  if (z.norm() < 1e-9) place_of(file, "look_at").refuse("equals the position");
   if (z.cross(up).norm() < 1e-9 * z.norm()) {
-    fail(file, "up", "is parallel to the viewing direction");
+    place_of(file, "up").refuse("is parallel to the viewing direction");
   }
   return look_at(position, target, up);
 }
 
 Eigen::Isometry3d matrix_pose(const fs::path& file, const json& root) {
-  std::array<double, 16> values{};
-  try {
-    values = root.at("T_world_camera").get<std::array<double, 16>>();
-  } catch (const json::exception&) {
-    fail(file, "T_world_camera", "must be an array of 16 numbers");
-  }
-  const Eigen::Matrix4d m = matrix_from_row_major(values);
-  if (const std::string problem = rigid_transform_problem(m); !problem.empty()) {
-    fail(file, "T_world_camera", problem);
-  }
-  return to_isometry(m);
-}
-
-template <typename T>
-T number_at(const fs::path& file, const json& root, const std::string& key, T lo, T hi) {
-  if (!root.contains(key) || !root[key].is_number()) fail(file, key, "missing or not a number");
-  const T value = root[key].get<T>();
-  if (!(value >= lo && value <= hi)) fail(file, key, "is out of range");
-  return value;
+  const JsonPlace place = place_of(file, "T_world_camera");
+  const json& values = root["T_world_camera"];
+  if (!values.is_array() || values.size() != 16) place.refuse("must be an array of 16 numbers");
+  std::array<double, 16> m{};
+  for (std::size_t k = 0; k < 16; ++k)
+    m[k] = finite_number(values[k], -kMaxCoordinateM, kMaxCoordinateM, place, "each element");
+  const Eigen::Matrix4d matrix = matrix_from_row_major(m);
+  if (const std::string problem = rigid_transform_problem(matrix); !problem.empty())
+    place.refuse(problem);
+  return to_isometry(matrix);
 }
 
 }  // namespace
@@ -90,21 +83,26 @@ double CameraView::focal_px() const {
 }
 
 CameraView read_camera_view(const fs::path& view_json) {
-  std::ifstream in(view_json, std::ios::binary);
-  if (!in) throw core::InputError(view_json.string(), {}, "cannot open");
-  json root;
-  try {
-    root = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw core::InputError(view_json.string(), {std::nullopt, e.byte, {}}, "not valid JSON");
-  }
-  if (!root.is_object()) throw core::InputError(view_json.string(), {}, "must hold a JSON object");
+  const json root = read_json_file(view_json, kMaxViewFileBytes);
+  if (!root.is_object()) JsonPlace{view_json.string(), ""}.refuse("must hold a JSON object");
+  refuse_unknown_keys(
+      root, {"width", "height", "vertical_fov_deg", "T_world_camera", "position", "look_at", "up"},
+      {view_json.string(), ""});
+  const auto number = [&](const char* key) -> const json& {
+    if (!root.contains(key)) place_of(view_json, key).refuse("is missing");
+    return root[key];
+  };
   CameraView view;
-  view.width = number_at(view_json, root, "width", 1, 16384);
-  view.height = number_at(view_json, root, "height", 1, 16384);
-  view.vertical_fov_deg = number_at(view_json, root, "vertical_fov_deg", 1.0, 170.0);
+  view.width = static_cast<int>(
+      whole_number(number("width"), 1, 16384, place_of(view_json, "width"), "the width"));
+  view.height = static_cast<int>(
+      whole_number(number("height"), 1, 16384, place_of(view_json, "height"), "the height"));
+  view.vertical_fov_deg = finite_number(number("vertical_fov_deg"), 1.0, 170.0,
+                                        place_of(view_json, "vertical_fov_deg"), "the angle");
   view.T_world_camera = root.contains("T_world_camera") ? matrix_pose(view_json, root)
                                                         : look_at_pose(view_json, root);
+  if (!view.T_world_camera.matrix().allFinite())
+    JsonPlace{view_json.string(), ""}.refuse("the camera's pose is not finite");
   return view;
 }
 

@@ -82,6 +82,31 @@ ScanImage read_image(E57PageReader& file, const E57ImageEntry& entry) {
   return image;
 }
 
+// Refuses image entries whose blob sections are one and the same, or
+// overlap: each image needs bytes of its own, so the count and the memory
+// images take are bounded by the file's size, however often the XML
+// repeats an entry.
+void check_image_blobs(const E57Document& document, const E57PageReader& file) {
+  std::vector<const E57ImageEntry*> images;
+  for (const E57ImageEntry& entry : document.images) images.push_back(&entry);
+  std::sort(images.begin(), images.end(), [](const E57ImageEntry* a, const E57ImageEntry* b) {
+    return a->blob_offset < b->blob_offset;
+  });
+  for (std::size_t k = 1; k < images.size(); ++k) {
+    const E57ImageEntry& before = *images[k - 1];
+    const E57ImageEntry& entry = *images[k];
+    if (before.blob_length > file.physical_length() ||
+        entry.blob_offset < e57_advance(before.blob_offset, 16 + before.blob_length)) {
+      core::FilePosition position;
+      position.byte_offset = entry.blob_offset;
+      position.detail = "XML element " + entry.path;
+      throw core::InputError(file.file_name(), position,
+                             "its blob is, or overlaps, the blob of " + before.path +
+                                 ": each image needs a blob of its own");
+    }
+  }
+}
+
 }  // namespace
 
 void read_e57(const std::filesystem::path& path, const std::function<void(ImportedScan&&)>& on_scan,
@@ -102,6 +127,7 @@ void read_e57(const std::filesystem::path& path, const std::function<void(Import
     position.detail = "XML element " + entry.path + "/points";
     throw core::InputError(file.file_name(), position, "holds no point records");
   }
+  check_image_blobs(document, file);
   std::vector<bool> image_taken(document.images.size(), false);
   for (std::size_t k = 0; k < document.scans.size(); ++k) {
     const E57ScanEntry& entry = document.scans[k];

@@ -485,7 +485,7 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   FitInputs in(scan.pixel_count());
   // std::vector zero-fills the outputs on one thread (every pixel is then
   // written again); that runs beside the first passes, not before them.
-  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  tbb::task_arena arena = core::worker_arena(settings.threads);
   arena.execute([&] {
     tbb::parallel_invoke([&] { allocate(g, scan.pixel_count()); },
                          [&] {

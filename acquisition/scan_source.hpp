@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,22 @@ struct ScanImage {
   std::vector<std::uint8_t> data;  // the encoded image, as the file held it
 };
 
+// Where a source file was when it was imported: its absolute path and its
+// identity on that machine (device and inode; 0 where it could not be
+// told), so that no output replaces it, whatever link or rename leads there.
+struct SourceFile {
+  std::string path;  // UTF-8; empty when not recorded (imports before sources' files were)
+  std::uint64_t device = 0;
+  std::uint64_t inode = 0;
+};
+
+// The file at `path` as a SourceFile (its canonical absolute path).
+SourceFile identify_source_file(const std::filesystem::path& path);
+
+// True when `output` names `source`: the same absolute path, or an existing
+// file that is the same file (device and inode) as the source was.
+bool names_source_file(const std::filesystem::path& output, const SourceFile& source);
+
 // The source file's description of a scan.
 struct ScanSource {
   std::string format;  // "e57", "ptx", "triplet", "pcd"
@@ -52,6 +69,7 @@ struct ScanSource {
   // taken, or a structured scan's later returns and repeated indices.
   std::uint64_t points_in_file = 0;
   std::uint64_t unplaced_points = 0;
+  SourceFile file;  // set by the import, not by the readers
 };
 
 // One scan as a reader delivers it.

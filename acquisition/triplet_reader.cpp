@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "acquisition/image_decoder.hpp"
+#include "acquisition/json_input.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
@@ -92,22 +93,6 @@ struct Sidecar {
   }
 };
 
-// nlohmann refuses a literal such as 1e999 at parse time, which is the only way
-// JSON can spell a non-finite number. Its message quotes the literal, which
-// locates it in the text.
-core::InputError overflow_error(const std::string& file, const std::string& text,
-                                const json::out_of_range& e) {
-  const std::string what = e.what();
-  const std::size_t open = what.find('\'');
-  core::FilePosition position;
-  if (open != std::string::npos && what.size() > open + 2) {
-    const std::size_t at = text.find(what.substr(open + 1, what.size() - open - 2));
-    if (at != std::string::npos) position.byte_offset = at;
-  }
-  return core::InputError(file, position,
-                          "sidecar holds a number that is not finite (too large for a double)");
-}
-
 Sidecar parse_sidecar(const fs::path& path) {
   Sidecar sidecar{.path = path, .file = utf8(path), .root = {}};
   std::error_code error;
@@ -120,18 +105,7 @@ Sidecar parse_sidecar(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (text.empty()) throw core::InputError(sidecar.file, {}, "sidecar file is empty or unreadable");
-  try {
-    sidecar.root = json::parse(text);
-  } catch (const json::parse_error& e) {
-    core::FilePosition position;
-    position.byte_offset = e.byte > 0 ? e.byte - 1 : 0;  // nlohmann counts from 1
-    const std::size_t at = std::min<std::size_t>(*position.byte_offset, text.size());
-    position.line =
-        1 + static_cast<std::uint64_t>(std::count(text.begin(), text.begin() + at, '\n'));
-    throw core::InputError(sidecar.file, position, "sidecar is not valid JSON (syntax error)");
-  } catch (const json::out_of_range& e) {
-    throw overflow_error(sidecar.file, text, e);
-  }
+  sidecar.root = parse_json(text, sidecar.file);
   if (!sidecar.root.is_object())
     throw core::InputError(sidecar.file, {}, "sidecar must be a JSON object");
   return sidecar;

@@ -13,6 +13,7 @@
 
 #include "app/commands.hpp"
 #include "app/progress_bar.hpp"
+#include "core/errors.hpp"
 #include "modeling/color_commands.hpp"
 #include "modeling/registration_stage.hpp"
 
@@ -38,13 +39,13 @@ std::int64_t node_named(const modeling::Project& project, const std::string& opt
   std::int64_t id = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), id);
   if (error == std::errc() && end == text.data() + text.size()) return id;
-  std::vector<std::int64_t> found;
-  for (const modeling::ObjectNode& node : project.object_nodes())
-    if (node.name == text) found.push_back(node.id);
+  const std::vector<std::int64_t> found = project.nodes_named(text);
   if (found.size() == 1) return found.front();
-  throw CLI::ValidationError(option, found.empty()
-                                         ? "no node is named \"" + text + "\""
-                                         : "several nodes are named \"" + text + "\": give the id");
+  core::FilePosition position;
+  position.detail = option;
+  throw core::InputError(project.path().string(), position,
+                         found.empty() ? "no node is named \"" + text + "\""
+                                       : "several nodes are named \"" + text + "\": give the id");
 }
 
 // "SCAN:ROW0:COL0:ROW1:COL1".
@@ -81,7 +82,8 @@ std::array<std::uint8_t, 3> parse_color(const std::string& text) {
 
 void print_edit(const modeling::ObjectNode& node) {
   const std::string json = modeling::to_json(node.color);
-  fmt::print("node {} ({}): colour edit {}\n", node.id, node.name,
+  fmt::print("node {} ({}): colour edit {}\n", node.id,
+             core::one_line(node.name, core::kMaxMessagePart),
              json.empty() ? "none (inherits its parent's)" : json);
 }
 
@@ -104,8 +106,10 @@ void run_recolor(const RecolorOptions& options) {
       throw CLI::ValidationError("--object",
                                  "give at least one of --brightness, --contrast, "
                                  "--gamma, --hue, --saturation or --reset");
-    const modeling::NodeCommandResult out = modeling::recolor_object(
-        project, {node_named(project, "--object", options.object), options.set, options.reset});
+    const modeling::NodeCommandResult out = naming_project(project.path(), [&] {
+      return modeling::recolor_object(
+          project, {node_named(project, "--object", options.object), options.set, options.reset});
+    });
     node_id = out.node_id;
   } else {
     modeling::CloneSettings settings;
@@ -115,7 +119,8 @@ void run_recolor(const RecolorOptions& options) {
     if (!options.clone_region.empty()) settings.source_region = parse_region(options.clone_region);
     if (!options.paint_color.empty()) settings.source_color = parse_color(options.paint_color);
     settings.paint = options.paint;
-    const modeling::CloneResult out = modeling::clone_color(project, settings);
+    const modeling::CloneResult out =
+        naming_project(project.path(), [&] { return modeling::clone_color(project, settings); });
     node_id = out.node_id;
     if (!options.json) {
       fmt::print("matched {} target points to {} source points\n", out.target_points,
@@ -227,9 +232,7 @@ void add_harmonize_command(CLI::App& app) {
               {"matrix", registration::ColorModel::kMatrix}},
           CLI::ignore_case))
       ->default_str("gain-offset");
-  command
-      ->add_option("--threads", options->settings.pairs.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+  add_threads_option(command, options->settings.pairs.threads);
   command->add_flag("--json", options->json, "Print one JSON object");
   command->callback([options] {
     HarmonizeOptions run = *options;

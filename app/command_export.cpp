@@ -55,6 +55,9 @@ void add_export_command(CLI::App& app) {
                     "E57 the other pixels are marked invalid)");
   command->add_option("-o,--output", options->output, "Output file (triplet: the .json sidecar)")
       ->required();
+  command->add_flag("--force", options->settings.replace_existing,
+                    "Replace the output when it exists (never the project, nor a file its scans "
+                    "were imported from)");
   command->callback([options] { run_export(*options); });
 }
 

@@ -59,7 +59,7 @@ void add_geometry_command(CLI::App& app) {
       ->check(CLI::Range(1, acquisition::kMaxWindowRadius))
       ->capture_default_str();
   command->add_flag("--no-mixed-pixels", options->no_mixed_pixels, "Do not flag mixed pixels");
-  command->add_option("--threads", g.threads, "Worker threads (0 = all cores)");
+  add_threads_option(command, g.threads);
   command->callback([options] { run_geometry(*options); });
 }
 

@@ -25,6 +25,8 @@ const char* state_name(modeling::CommandState state) {
       return "undone";
     case modeling::CommandState::kPending:
       return "pending";
+    case modeling::CommandState::kInterrupted:
+      return "interrupted";
   }
   return "";
 }
@@ -35,6 +37,8 @@ nlohmann::json parsed(const std::string& text) {
 
 // One line on what a command did, from its result.
 std::string summary(const modeling::CommandRecord& c) {
+  if (c.state == modeling::CommandState::kInterrupted)
+    return "its process ended before it finished: nothing was stored";
   const nlohmann::json result = parsed(c.result);
   const nlohmann::json settings = parsed(c.settings);
   if (!result.is_object()) return "";
@@ -62,7 +66,8 @@ std::string summary(const modeling::CommandRecord& c) {
   }
   if (c.name == "commit" && result.contains("node")) {
     return fmt::format("object {} \"{}\", {} points", result.value("node", 0),
-                       settings.value("name", ""), result.value("points", 0));
+                       core::one_line(settings.value("name", ""), core::kMaxMessagePart),
+                       result.value("points", 0));
   }
   if ((c.name == "group" || c.name == "edit") && result.contains("node")) {
     return fmt::format("node {}", result.value("node", 0));
@@ -117,9 +122,9 @@ void run_history(const HistoryOptions& options) {
                            2, ' ', false, nlohmann::json::error_handler_t::replace));
     return;
   }
-  fmt::print("{:>4}  {:<7} {:<10} {:<24}  {}\n", "id", "state", "command", "at (UTC)", "what");
+  fmt::print("{:>4}  {:<11} {:<10} {:<24}  {}\n", "id", "state", "command", "at (UTC)", "what");
   for (const modeling::CommandRecord& c : history) {
-    fmt::print("{:>4}  {:<7} {:<10} {:<24}  {}\n", c.id, state_name(c.state), c.name, c.created_at,
+    fmt::print("{:>4}  {:<11} {:<10} {:<24}  {}\n", c.id, state_name(c.state), c.name, c.created_at,
                summary(c));
   }
 }

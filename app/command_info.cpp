@@ -15,6 +15,7 @@
 #include "acquisition/scan_files.hpp"
 #include "acquisition/scan_summary.hpp"
 #include "app/commands.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::app {
@@ -138,7 +139,8 @@ void print_table(const std::string& path, const Contents& contents) {
     const acquisition::ScanSummary& s = e.summary;
     const Eigen::Vector3d t = s.T_world_scan.translation();
     fmt::print("{:>4}  {:<24} {:>13} {:>10}  {:<5} {:<9} {:<9} {:.3f} {:.3f} {:.3f}\n", e.id,
-               s.name, fmt::format("{} x {}", s.rows, s.columns), s.valid_points,
+               core::one_line(s.name, core::kMaxMessagePart),
+               fmt::format("{} x {}", s.rows, s.columns), s.valid_points,
                s.has_color ? "yes" : "no", s.has_intensity ? "yes" : "no",
                acquisition::angle_model_name(s.spherical), t.x(), t.y(), t.z());
     if (e.source && e.source->unplaced_points > 0) {

@@ -49,7 +49,7 @@ void add_merge_command(CLI::App& app) {
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--threads", options->settings.threads, "Worker threads (0 = all cores)");
+  add_threads_option(command, options->settings.threads);
   command->add_flag("--json", options->json, "Print one JSON object");
   command->callback([options] { run_merge(*options); });
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "core/errors.hpp"
 #include "modeling/project.hpp"
 
 namespace scanbench::app {
@@ -60,8 +61,9 @@ void print_tree(const std::vector<modeling::ObjectNode>& nodes) {
                                                                           int depth) {
     fmt::print("{:>5}  {:<7} {:>10}  {}{}{}{}\n", node.id,
                node.kind == modeling::NodeKind::kGroup ? "group" : "object", node.points,
-               std::string(static_cast<std::size_t>(2 * depth), ' '), node.name,
-               node.hidden ? " (hidden)" : "", node.color.empty() ? "" : " (recoloured)");
+               std::string(static_cast<std::size_t>(2 * depth), ' '),
+               core::one_line(node.name, core::kMaxMessagePart), node.hidden ? " (hidden)" : "",
+               node.color.empty() ? "" : " (recoloured)");
     for (const modeling::ObjectNode* child : children[node.id]) print(*child, depth + 1);
   };
   for (const modeling::ObjectNode* root : roots) print(*root, 0);

@@ -99,7 +99,7 @@ void add_register_command(CLI::App& app) {
                     "The scanner was not levelled on site: feature poses from three matches each "
                     "instead of one");
   command->add_flag("--no-global", options->no_global, "Skip the global refinement");
-  command->add_option("--threads", options->threads, "Worker threads (0 = all cores)");
+  add_threads_option(command, options->threads);
   command->add_flag("--json", options->json, "Print the report as one JSON object");
   command->callback([options] { run_register(*options); });
 }

@@ -29,6 +29,7 @@ struct RenderOptions {
   bool all_points = false;
   bool culling = true;
   bool json = false;
+  bool force = false;
 };
 
 nlohmann::json plan_json(const render::FrameResult& frame, const render::FrameResult& first) {
@@ -50,7 +51,7 @@ void run_render(RenderOptions& options) {
   const acquisition::CameraView camera = acquisition::read_camera_view(options.view);
   const modeling::Project project = modeling::Project::open_for_reading(options.project);
   const std::filesystem::path outputs[] = {options.output};
-  modeling::refuse_to_replace_the_project(project, outputs);
+  modeling::refuse_to_replace_inputs(project, outputs, options.force);
   const auto start = std::chrono::steady_clock::now();
   modeling::RenderModelSettings model_settings;
   model_settings.merged_only = !options.all_points;
@@ -127,6 +128,8 @@ void add_render_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("-o,--output", options->output, "Picture (.png)")->required();
+  command->add_flag("--force", options->force,
+                    "Replace the picture when it exists (never the project or its sources)");
   command->add_option("--mode", s.mode, "points, splats or blended")
       ->transform(CLI::CheckedTransformer(names_of(&render::draw_mode_name, 3)))
       ->default_str("blended");
@@ -141,8 +144,9 @@ void add_render_command(CLI::App& app) {
   command->add_option("--splat-scale", s.splat_scale, "Splat radii × the sample's cell")
       ->check(CLI::Range(0.1, 10.0))
       ->capture_default_str();
-  command->add_option("--fill", s.fill_reach_px,
-                      "Fill holes ringed by splats within this many pixels (0: off)")
+  command
+      ->add_option("--fill", s.fill_reach_px,
+                   "Fill holes ringed by splats within this many pixels (0: off)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   command->add_flag("--lighting", s.lighting, "Shade by the normals, light at the eye");

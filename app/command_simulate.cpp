@@ -84,7 +84,7 @@ void add_simulate_command(CLI::App& app) {
       {"both", sim::CampaignFormat::kBoth}};
   command->add_option("--format", campaign.format, "ptx, triplet or both (default triplet)")
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
-  command->add_option("--threads", campaign.simulation.threads, "Worker threads (0 = all cores)");
+  add_threads_option(command, campaign.simulation.threads);
   command
       ->add_option("--pose-error-deg", campaign.pose_error_deg,
                    "Rotation error written into the files of scans 2.. (truth keeps true poses)")

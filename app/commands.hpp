@@ -4,6 +4,10 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
+
+#include "core/errors.hpp"
+#include "core/parallel.hpp"
 
 namespace scanbench::app {
 
@@ -29,5 +33,29 @@ void add_render_command(CLI::App& app);
 void add_recolor_command(CLI::App& app);
 void add_harmonize_command(CLI::App& app);
 void add_workbench_command(CLI::App& app);
+
+// The --threads option of every parallel command, validated once: 0 (all
+// cores) to core::kMaxThreads, anything else a usage error; a count above
+// the machine's cores runs as many workers as it has (core::worker_count).
+inline void add_threads_option(CLI::App* command, int& threads) {
+  command
+      ->add_option("--threads", threads,
+                   "Worker threads: 0 = all cores (the default), at most " +
+                       std::to_string(core::kMaxThreads) + "; more than the cores run as many")
+      ->check(CLI::Range(0, core::kMaxThreads));
+}
+
+// Runs `work`, a command of modeling/, and names `project` in a refusal that
+// names no file: the commands name the node or scan at fault, the CLI the
+// project it is in.
+template <typename Work>
+auto naming_project(const std::filesystem::path& project, Work&& work) {
+  try {
+    return work();
+  } catch (const core::InputError& error) {
+    if (!error.file().empty()) throw;
+    throw core::InputError(project.string(), error.position(), error.problem());
+  }
+}
 
 }  // namespace scanbench::app

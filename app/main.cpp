@@ -1,7 +1,7 @@
 // scanbench command line: one subcommand per pipeline stage
-// (simulate → import → geometry → register → merge → info → export, and
-// history / undo / redo over all of them;
-// segment and render join as their stages land).
+// (simulate → import → geometry → register → merge → harmonize → segment →
+// recolor → render → export, the workbench, and info / objects / history /
+// undo / redo / check over all of them).
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
@@ -16,9 +16,13 @@
 namespace {
 
 // Every failure is one line: whatever a library's text holds (newlines, a
-// 5,000-character path) is cut to fit.
-int report_error(const char* kind, const std::string& message, int exit_code) {
-  fmt::print(stderr, "scanbench: {}: {}\n", kind, scanbench::core::one_line(message, 1000));
+// 5,000-character path) is cut to fit. `parts` is how many parts of
+// core::kMaxMessagePart the message may hold: a FileError's three (file,
+// position, problem, each already cut), a usage error or another
+// library's text one.
+int report_error(const char* kind, const std::string& message, int exit_code, std::size_t parts) {
+  fmt::print(stderr, "scanbench: {}: {}\n", kind,
+             scanbench::core::one_line(message, parts * scanbench::core::kMaxMessagePart + 16));
   return exit_code;
 }
 
@@ -97,11 +101,16 @@ int main(int argc, char** argv) {
     const std::string unknown = unknown_word(app, argc, argv);
     std::string message = unknown.empty() ? e.what() : unknown;
     if (message.empty()) message = "bad arguments";
-    return report_error("usage", message + " (see scanbench --help)", sb::kExitBadInput);
+    return report_error("usage",
+                        scanbench::core::one_line(message, scanbench::core::kMaxMessagePart) +
+                            " (see scanbench --help)",
+                        sb::kExitBadInput, 1);
   } catch (const scanbench::core::InputError& e) {
-    return report_error("bad input", e.what(), sb::kExitBadInput);
+    return report_error("bad input", e.what(), sb::kExitBadInput, 3);
+  } catch (const scanbench::core::FileError& e) {
+    return report_error("error", e.what(), sb::kExitFailure, 3);
   } catch (const std::exception& e) {
-    return report_error("error", e.what(), sb::kExitFailure);
+    return report_error("error", e.what(), sb::kExitFailure, 1);
   }
   return sb::kExitOk;
 }

@@ -1,14 +1,16 @@
 #include "app/point_pairs_file.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "acquisition/json_input.hpp"
 #include "core/errors.hpp"
 
 namespace scanbench::app {
 namespace {
+
+constexpr std::uintmax_t kMaxPairsFileBytes = 16u << 20;
 
 using nlohmann::json;
 
@@ -65,15 +67,7 @@ modeling::ProjectPicks read_entry(const json& entry, const std::filesystem::path
 }  // namespace
 
 std::vector<modeling::ProjectPicks> read_point_pairs_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) bad(file, "", "cannot open the point pairs file");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw core::InputError(file.string(), {std::nullopt, static_cast<std::uint64_t>(e.byte), ""},
-                           "not valid JSON");
-  }
+  const json document = acquisition::read_json_file(file, kMaxPairsFileBytes);
   if (!document.is_object() || !document.contains("pairs") || !document["pairs"].is_array()) {
     bad(file, "pairs", "expected {\"pairs\": [...]}");
   }

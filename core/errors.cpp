@@ -4,14 +4,11 @@
 
 namespace scanbench::core {
 
-namespace {
-constexpr std::size_t kMaxPartChars = 240;
-}  // namespace
-
 // A 5,000-character file name or a 200 KB token must not flood the terminal.
 std::string one_line(std::string text, std::size_t limit) {
   for (char& c : text) {
-    if (static_cast<unsigned char>(c) < 0x20) c = '?';  // one line, whatever a name holds
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7F) c = '?';  // one line, whatever a name holds
   }
   if (text.size() <= limit) return text;
   const std::size_t half = limit / 2;
@@ -24,8 +21,8 @@ std::string one_line(std::string text, std::size_t limit) {
 
 std::string format_input_error(const std::string& file_name, const FilePosition& position,
                                const std::string& problem_text) {
-  const std::string file = one_line(file_name, kMaxPartChars);
-  const std::string problem = one_line(problem_text, kMaxPartChars);
+  const std::string file = one_line(file_name, kMaxMessagePart);
+  const std::string problem = one_line(problem_text, kMaxMessagePart);
   std::ostringstream out;
   out << file;
   std::string where;
@@ -36,7 +33,7 @@ std::string format_input_error(const std::string& file_name, const FilePosition&
   }
   if (!position.detail.empty()) {
     where += where.empty() ? "" : ", ";
-    where += one_line(position.detail, kMaxPartChars);
+    where += one_line(position.detail, kMaxMessagePart);
   }
   if (!where.empty()) out << (file.empty() ? "" : ": ") << where;
   out << (file.empty() && where.empty() ? "" : ": ") << problem;

@@ -74,13 +74,17 @@ class Cancelled : public std::runtime_error {
   explicit Cancelled(const std::string& stage);
 };
 
+// The longest part (file, position, problem) of a message [bytes].
+inline constexpr std::size_t kMaxMessagePart = 240;
+
 // "FILE: line 12 (byte 340): problem" — the form every message takes, on
-// one line; parts longer than 240 characters are cut in the middle.
+// one line; parts longer than kMaxMessagePart are cut in the middle.
 std::string format_input_error(const std::string& file, const FilePosition& position,
                                const std::string& problem);
 
-// `text` as one line for a message: control characters become '?', and it
-// is cut in the middle (between UTF-8 characters) to at most `limit` bytes.
+// `text` as one line for a message or a table: control characters (C0 and
+// DEL) become '?', and it is cut in the middle (between UTF-8 characters)
+// to at most `limit` bytes.
 std::string one_line(std::string text, std::size_t limit);
 
 }  // namespace scanbench::core

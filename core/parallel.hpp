@@ -8,22 +8,35 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cassert>
 #include <thread>
 
 namespace scanbench::core {
 
-// The number of workers `threads` stands for: itself when positive, else
-// every core (at least 1).
+// The largest thread count a caller may ask for (the CLI's --threads takes
+// 0 … kMaxThreads). What a machine runs is at most its cores.
+inline constexpr int kMaxThreads = 1024;
+
+// The number of workers `threads` stands for: every core when 0, else
+// `threads`, but never more than the machine's cores (more would only
+// oversubscribe them, and make TBB and Ceres warn). Results never depend on
+// it. Asserts 0 <= threads <= kMaxThreads.
 inline int worker_count(int threads) {
-  if (threads > 0) return threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  assert(threads >= 0 && threads <= kMaxThreads && "a thread count outside 0 … kMaxThreads");
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return threads > 0 ? std::min(threads, cores) : cores;
 }
 
-// Calls body(k) for k in [0, count) on `threads` workers (0 = all cores),
+// A TBB arena of worker_count(threads) workers.
+inline tbb::task_arena worker_arena(int threads) {
+  return tbb::task_arena(worker_count(threads));
+}
+
+// Calls body(k) for k in [0, count) on worker_count(threads) workers,
 // handing out `grain` consecutive indices at a time.
 template <typename Body>
 void parallel_for_index(int count, int threads, Body&& body, int grain = 1) {
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  tbb::task_arena arena = worker_arena(threads);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, count, grain),
                       [&](const tbb::blocked_range<int>& range) {

@@ -10,6 +10,7 @@
 #include "acquisition/ptx_writer.hpp"
 #include "acquisition/triplet_writer.hpp"
 #include "core/errors.hpp"
+#include "core/project_file.hpp"
 #include "modeling/scan_layers.hpp"
 
 namespace scanbench::modeling {
@@ -147,8 +148,10 @@ std::size_t count_points(const std::vector<acquisition::Scan>& scans,
 
 }  // namespace
 
-void refuse_to_replace_the_project(const Project& project,
-                                   std::span<const std::filesystem::path> outputs) {
+void refuse_to_replace_inputs(const Project& project,
+                              std::span<const std::filesystem::path> outputs,
+                              bool replace_existing) {
+  const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
   for (const std::filesystem::path& output : outputs) {
     std::error_code error;
     // SQLite's companion files hold the project's latest changes.
@@ -161,10 +164,30 @@ void refuse_to_replace_the_project(const Project& project,
                                "replaces its input");
       }
     }
-    if (!std::filesystem::exists(output, error)) continue;
+    if (!std::filesystem::exists(std::filesystem::symlink_status(output, error))) continue;
     if (std::filesystem::equivalent(output, project.path(), error)) {
       throw core::InputError(output.string(), {},
                              "is the project being exported; an export never replaces its input");
+    }
+    for (const StoredScanSummary& scan : project.scans()) {
+      const auto source = sources.find(scan.id);
+      const acquisition::SourceFile file =
+          source != sources.end() && !source->second.file.path.empty()
+              ? source->second.file
+              : acquisition::identify_source_file(scan.summary.scanner.source_file);
+      if (acquisition::names_source_file(output, file)) {
+        throw core::InputError(output.string(), {},
+                               "is the file scan " + std::to_string(scan.id) +
+                                   " was imported from (" + file.path +
+                                   "); an output never replaces an input of the project, "
+                                   "--force or not");
+      }
+    }
+    // Folders, devices and projects get the output file's own refusal.
+    const bool replaceable =
+        std::filesystem::is_regular_file(output, error) && !core::is_project_file(output);
+    if (replaceable && !replace_existing) {
+      throw core::InputError(output.string(), {}, "exists; --force replaces it");
     }
   }
 }
@@ -184,7 +207,7 @@ ExportResult export_project(const Project& project, const ExportSettings& settin
       settings.format == ExportFormat::kTriplet && scans.size() == 1
           ? acquisition::triplet_files(scans.front(), settings.output)
           : std::vector<std::filesystem::path>{settings.output};
-  refuse_to_replace_the_project(project, outputs);
+  refuse_to_replace_inputs(project, outputs, settings.replace_existing);
   std::vector<const acquisition::ScanGeometry*> geometry_of;
   for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
   std::vector<const std::vector<std::uint8_t>*> keep_of;

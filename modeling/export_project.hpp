@@ -28,6 +28,9 @@ struct ExportSettings {
   // and E57 (whose grids keep every pixel, the others marked invalid).
   bool merged = false;
   std::filesystem::path output;  // the file (triplet: the .json sidecar)
+  // Replace an existing output file (--force). A project, or a file a scan
+  // was imported from, is never replaced.
+  bool replace_existing = false;
 };
 
 struct ExportResult {
@@ -38,9 +41,8 @@ struct ExportResult {
 };
 
 // Writes the project's scans as the settings say, all read from one state of
-// the project (Project::read_snapshot). An output is never the project
-// itself (by any path: a symlink, a hard link, "./") or any other scanbench
-// project: core::InputError, nothing written. Where a scan has geometry,
+// the project (Project::read_snapshot). Outputs are checked first
+// (refuse_to_replace_inputs): core::InputError, nothing written. Where a scan has geometry,
 // the point formats leave its mixed pixels out and PLY carries its normals
 // and footprints. Throws core::InputError (naming the project and, where it
 // applies, the scan) for: no such scan, `merged` with a scan-grid format or
@@ -50,12 +52,17 @@ struct ExportResult {
 // std::runtime_error naming the file.
 ExportResult export_project(const Project& project, const ExportSettings& settings);
 
-// Refuses (core::InputError, nothing written) an output that would replace
-// the project being read or one of its files, by any path (a symlink, a
-// hard link, "./"). Any other project is refused by the output file itself
-// (acquisition/output_file.hpp). Every command that writes a file from a
-// project checks its outputs with it first.
-void refuse_to_replace_the_project(const Project& project,
-                                   std::span<const std::filesystem::path> outputs);
+// Refuses (core::InputError naming the output, nothing written) an output
+// that would replace an input of the project: the project itself or one of
+// its files, by any path (a symlink, a hard link, "./"), or a file one of
+// its scans was imported from (by path, or renamed or linked, by identity:
+// acquisition::names_source_file), whatever `replace_existing` says; and,
+// unless `replace_existing`, any file that exists. Any other project is
+// refused by the output file itself (acquisition/output_file.hpp). Every
+// command that writes a file from a project checks its outputs with it
+// first.
+void refuse_to_replace_inputs(const Project& project,
+                              std::span<const std::filesystem::path> outputs,
+                              bool replace_existing);
 
 }  // namespace scanbench::modeling

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 #include "core/timing.hpp"
 #include "modeling/settings_json.hpp"
 
@@ -24,14 +25,11 @@ std::string settings_json(std::span<const std::filesystem::path> files,
   return document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-// Refuses a scan whose data the project, or this import, already holds.
-void refuse_duplicate(const Project& project, const EncodedScan& scan,
-                      const std::filesystem::path& file, std::set<std::int64_t>& digests) {
-  const auto twin = project.scan_with_content(scan.content_digest);
-  const bool repeated = !digests.insert(scan.content_digest).second;
-  if (!twin && !repeated) return;
+// A scan that is already in the project, or earlier in this import.
+[[noreturn]] void refuse_duplicate(const std::filesystem::path& file, const std::string& scan,
+                                   std::optional<std::int64_t> twin) {
   core::FilePosition position;
-  position.detail = "scan \"" + scan.metadata.name + "\"";
+  position.detail = "scan \"" + scan + "\"";
   throw core::InputError(
       file.string(), position,
       (twin ? "is already in the project as scan " + std::to_string(*twin)
@@ -39,42 +37,165 @@ void refuse_duplicate(const Project& project, const EncodedScan& scan,
           "; importing it again would add a twin (--allow-duplicate imports it anyway)");
 }
 
+// Encoded scans the check may keep in memory [bytes]: a quarter of what is
+// available, 1 GiB where that cannot be told.
+std::uint64_t keep_budget_bytes() {
+  return core::available_memory_bytes().value_or(std::uint64_t{4} << 30) / 4;
+}
+
+std::uint64_t encoded_bytes(const EncodedScan& scan) {
+  std::uint64_t bytes = 0;
+  for (const EncodedLayer& layer : scan.layers) bytes += layer.blob.size();
+  return bytes;
+}
+
+std::uint64_t image_bytes(const std::vector<acquisition::ScanImage>& images) {
+  std::uint64_t bytes = 0;
+  for (const acquisition::ScanImage& image : images) bytes += image.data.size();
+  return bytes;
+}
+
+// Drops what a file's check kept: it is read again when stored.
+void release(CheckedImport::File& file) {
+  file.kept = false;
+  for (CheckedImport::Scan& scan : file.scans) {
+    scan.encoded.reset();
+    scan.images.clear();
+  }
+  file.loose_images.clear();
+}
+
+// Writes one scan, with its source and images, as a part of `command`.
+std::int64_t store_scan(Project& project, Project::LongCommand& command, const EncodedScan& scan,
+                        const acquisition::ScanSource& source,
+                        const std::vector<acquisition::ScanImage>& images) {
+  Project::Edit part = command.part();
+  const std::int64_t id = project.insert_scan(part, scan);
+  project.put_scan_source(part, id, source);
+  for (const acquisition::ScanImage& image : images)
+    project.insert_image(part, id, scan.metadata.T_world_scan, image);
+  part.commit_part();
+  return id;
+}
+
+void store_loose_image(Project& project, Project::LongCommand& command,
+                       const acquisition::ScanImage& image) {
+  Project::Edit part = command.part();
+  project.insert_image(part, std::nullopt, Eigen::Isometry3d::Identity(), image);
+  part.commit_part();
+}
+
+// Stores a file the check did not keep: read again, each scan matched to
+// what the check found.
+void store_read_again(Project& project, Project::LongCommand& command,
+                      const CheckedImport::File& file, const ImportSettings& settings,
+                      ImportResult& result) {
+  std::size_t next = 0;
+  const auto on_scan = [&](acquisition::ImportedScan&& imported) {
+    const EncodedScan encoded = encode_scan(imported.scan);
+    if (next >= file.scans.size() || file.scans[next].digest != encoded.content_digest) {
+      throw core::InputError(file.path.string(), {},
+                             "the file changed while it was imported; nothing was stored");
+    }
+    imported.source.file = file.scans[next].source.file;
+    ++next;
+    result.scan_ids.push_back(
+        store_scan(project, command, encoded, imported.source, imported.images));
+    result.images += imported.images.size();
+  };
+  const auto on_loose_image = [&](acquisition::ScanImage&& image) {
+    store_loose_image(project, command, image);
+    ++result.images;
+  };
+  acquisition::read_scan_file(file.path, settings.readers, on_scan, on_loose_image);
+  if (next != file.scans.size()) {
+    throw core::InputError(file.path.string(), {},
+                           "the file changed while it was imported; nothing was stored");
+  }
+}
+
 }  // namespace
 
-ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
-                          const ImportSettings& settings, core::Progress& progress) {
+CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
+                               const ImportSettings& settings, core::Progress& progress) {
+  CheckedImport checked;
+  std::uint64_t budget = keep_budget_bytes();
+  std::set<std::int64_t> digests;  // of the scans of this import
+  for (std::size_t f = 0; f < files.size(); ++f) {
+    progress.throw_if_cancelled(kStage);
+    CheckedImport::File& file = checked.files.emplace_back();
+    file.path = files[f];
+    file.kept = true;
+    const acquisition::SourceFile identity = acquisition::identify_source_file(file.path);
+    const auto on_scan = [&](acquisition::ImportedScan&& imported) {
+      CheckedImport::Scan& scan = file.scans.emplace_back();
+      scan.name = imported.scan.name;
+      scan.digest = scan_content_digest(imported.scan);
+      if (!settings.allow_duplicates && !digests.insert(scan.digest).second)
+        refuse_duplicate(file.path, imported.scan.name, std::nullopt);
+      scan.source = std::move(imported.source);
+      scan.source.file = identity;
+      if (!file.kept) return;
+      scan.encoded = encode_scan(imported.scan);
+      scan.images = std::move(imported.images);
+      const std::uint64_t bytes = encoded_bytes(*scan.encoded) + image_bytes(scan.images);
+      if (bytes > budget) {
+        release(file);
+        return;
+      }
+      budget -= bytes;
+    };
+    const auto on_loose_image = [&](acquisition::ScanImage&& image) {
+      if (!file.kept || image.data.size() > budget) {
+        release(file);
+        return;
+      }
+      budget -= image.data.size();
+      file.loose_images.push_back(std::move(image));
+    };
+    acquisition::read_scan_file(file.path, settings.readers, on_scan, on_loose_image);
+    progress.update({kStage, f + 1, 2 * files.size(), file.path.filename().string()});
+  }
+  return checked;
+}
+
+ImportResult store_checked_scans(Project& project, const CheckedImport& checked,
+                                 const ImportSettings& settings, core::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
+  std::vector<std::filesystem::path> paths;
+  for (const CheckedImport::File& file : checked.files) {
+    paths.push_back(file.path);
+    for (const CheckedImport::Scan& scan : file.scans) {
+      const auto twin = project.scan_with_content(scan.digest);
+      if (twin && !settings.allow_duplicates) refuse_duplicate(file.path, scan.name, twin);
+    }
+  }
+  progress.throw_if_cancelled(kStage);
   ImportResult result;
   // One part per scan: a file of many large scans never sits in memory
   // whole, and the write lock is held only while a scan's rows are written
   // (compression, most of the work, happens before).
-  Project::LongCommand command = project.begin_long_command(kStage, settings_json(files, settings));
+  Project::LongCommand command = project.begin_long_command(kStage, settings_json(paths, settings));
   result.command_id = command.command_id();
-  std::set<std::int64_t> digests;  // of the scans of this import
-  for (std::size_t f = 0; f < files.size(); ++f) {
+  for (std::size_t f = 0; f < checked.files.size(); ++f) {
     progress.throw_if_cancelled(kStage);
-    const auto on_scan = [&](acquisition::ImportedScan&& imported) {
-      const EncodedScan encoded = encode_scan(imported.scan);
-      if (!settings.allow_duplicates) refuse_duplicate(project, encoded, files[f], digests);
-      progress.throw_if_cancelled(kStage);
-      Project::Edit part = command.part();
-      const std::int64_t id = project.insert_scan(part, encoded);
-      project.put_scan_source(part, id, imported.source);
-      for (const acquisition::ScanImage& image : imported.images)
-        project.insert_image(part, id, imported.scan.T_world_scan, image);
-      part.commit_part();
-      result.scan_ids.push_back(id);
-      result.unplaced_points += imported.source.unplaced_points;
-      result.images += imported.images.size();
-    };
-    const auto on_loose_image = [&](acquisition::ScanImage&& image) {
-      Project::Edit part = command.part();
-      project.insert_image(part, std::nullopt, Eigen::Isometry3d::Identity(), image);
-      part.commit_part();
-      ++result.images;
-    };
-    acquisition::read_scan_file(files[f], settings.readers, on_scan, on_loose_image);
-    progress.update({kStage, f + 1, files.size(), files[f].filename().string()});
+    const CheckedImport::File& file = checked.files[f];
+    if (file.kept) {
+      for (const CheckedImport::Scan& scan : file.scans) {
+        result.scan_ids.push_back(
+            store_scan(project, command, *scan.encoded, scan.source, scan.images));
+        result.images += scan.images.size();
+      }
+      for (const acquisition::ScanImage& image : file.loose_images)
+        store_loose_image(project, command, image);
+      result.images += file.loose_images.size();
+    } else {
+      store_read_again(project, command, file, settings, result);
+    }
+    for (const CheckedImport::Scan& scan : file.scans)
+      result.unplaced_points += scan.source.unplaced_points;
+    progress.update({kStage, checked.files.size() + f + 1, 2 * checked.files.size(),
+                     file.path.filename().string()});
   }
   progress.throw_if_cancelled(kStage);
   // New scans can sample the merged surfaces more finely: the earlier
@@ -88,16 +209,33 @@ ImportResult import_scans(Project& project, std::span<const std::filesystem::pat
   return result;
 }
 
+ImportResult import_scans(Project& project, std::span<const std::filesystem::path> files,
+                          const ImportSettings& settings, core::Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const CheckedImport checked = check_scan_files(files, settings, progress);
+  ImportResult result = store_checked_scans(project, checked, settings, progress);
+  result.seconds = core::seconds_since(start);
+  return result;
+}
+
 ImportResult import_scan_files(const std::filesystem::path& project_path,
                                std::span<const std::filesystem::path> files,
                                const ImportSettings& settings, core::Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  // Bad input is bad input whatever the project: checked before it is opened.
+  const CheckedImport checked = check_scan_files(files, settings, progress);
+  const auto store = [&](Project& project) {
+    ImportResult result = store_checked_scans(project, checked, settings, progress);
+    result.seconds = core::seconds_since(start);
+    return result;
+  };
   std::error_code error;
   if (!std::filesystem::exists(std::filesystem::symlink_status(project_path, error))) {
     // A new project is filled as a draft and appears only once the import is
     // done: a refused import leaves nothing, and no other process ever sees
     // it half made.
     Project::Draft draft = Project::create_draft(project_path);
-    ImportResult result = import_scans(draft.project(), files, settings, progress);
+    ImportResult result = store(draft.project());
     if (draft.publish()) {
       result.created_project = true;
       return result;
@@ -105,7 +243,7 @@ ImportResult import_scan_files(const std::filesystem::path& project_path,
     // Another process created the project meanwhile: import into that one.
   }
   Project project = Project::open(project_path);
-  return import_scans(project, files, settings, progress);
+  return store(project);
 }
 
 }  // namespace scanbench::modeling

@@ -4,6 +4,7 @@
 #include <sqlite3.h>
 
 #include <cassert>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -83,20 +84,26 @@ void check_revision(sqlite3* db, const std::string& file, std::string_view name,
   }
 }
 
+// True when pending command `id` was begun by a process of this machine
+// that is gone. Only processes of this machine (host, boot, pid namespace)
+// can be judged; other machines' commands are never taken for gone.
+bool writer_is_gone(sqlite3* db, const std::string& file, std::int64_t id) {
+  sqlite::Statement select(
+      db, "SELECT owner_machine, owner_pid, owner_start FROM commands WHERE id = ?1", file);
+  select.bind_int(1, id);
+  if (!select.step() || select.is_null(0)) return false;
+  const std::string machine = select.column_text(0);
+  return machine == core::this_process().machine &&
+         !core::is_running({machine, select.column_int(1), select.column_int(2)});
+}
+
 // Removes pending commands (with their rows) whose process is gone: what a
-// killed long command left. Only processes of this machine (host, boot,
-// pid namespace) can be judged; other machines' commands are left alone.
+// killed long command left.
 void remove_abandoned(sqlite3* db, const std::string& file) {
-  sqlite::Statement select(db,
-                           "SELECT id, owner_pid, owner_start FROM commands "
-                           "WHERE state = 'pending' AND owner_machine = ?1",
-                           file);
-  const std::string machine = core::this_process().machine;
-  select.bind_text(1, machine);
   std::vector<std::int64_t> abandoned;
-  while (select.step()) {
-    if (!core::is_running({machine, select.column_int(1), select.column_int(2)}))
-      abandoned.push_back(select.column_int(0));
+  for (sqlite::Statement select(db, "SELECT id FROM commands WHERE state = 'pending'", file);
+       select.step();) {
+    if (writer_is_gone(db, file, select.column_int(0))) abandoned.push_back(select.column_int(0));
   }
   for (const std::int64_t id : abandoned) {
     sqlite::Statement remove(db, "DELETE FROM commands WHERE id = ?1", file);
@@ -124,9 +131,7 @@ std::int64_t Project::revision() const {
 
 Project::Edit Project::begin_command(std::string_view name, const std::string& settings_json,
                                      std::optional<std::int64_t> based_on_revision) {
-  assert(sqlite3_get_autocommit(db()) != 0 && "an Edit is already open on this project");
-  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
-  Edit edit(db(), file_name(), 0, Edit::Kind::kCommand);
+  Edit edit(db(), file_name(), 0, Edit::Kind::kCommand, open_.get());
   check_revision(db(), file_name(), name, based_on_revision);
   remove_abandoned(db(), file_name());
   end_redo_branch(db(), file_name());
@@ -144,9 +149,8 @@ Project::Edit Project::begin_command(std::string_view name, const std::string& s
 Project::LongCommand Project::begin_long_command(std::string_view name,
                                                  const std::string& settings_json,
                                                  std::optional<std::int64_t> based_on_revision) {
-  assert(sqlite3_get_autocommit(db()) != 0 && "an Edit is already open on this project");
-  Edit edit(db(), file_name(), 0, Edit::Kind::kPart);
-  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
+  assert(!open_->batch && "a long command inside a Batch");
+  Edit edit(db(), file_name(), 0, Edit::Kind::kPart, open_.get());
   check_revision(db(), file_name(), name, based_on_revision);
   remove_abandoned(db(), file_name());
   sqlite::Statement insert(db(),
@@ -159,12 +163,13 @@ Project::LongCommand Project::begin_long_command(std::string_view name,
   const std::int64_t id = sqlite3_last_insert_rowid(db());
   update_checksum(db(), file_name(), id);
   edit.commit_part();
-  return LongCommand(db(), file_name(), id, std::string(name), based_on_revision);
+  return LongCommand(*this, id, std::string(name), based_on_revision);
 }
 
 Project::LongCommand::LongCommand(LongCommand&& other) noexcept
     : db_(std::exchange(other.db_, nullptr)),
       file_(std::move(other.file_)),
+      open_(other.open_),
       command_id_(other.command_id_),
       name_(std::move(other.name_)),
       revision_(other.revision_) {}
@@ -181,9 +186,8 @@ Project::LongCommand::~LongCommand() {
 }
 
 Project::Edit Project::LongCommand::part() {
-  assert(db_ != nullptr && sqlite3_get_autocommit(db_) != 0 && "an Edit is already open");
-  sqlite::execute(db_, "BEGIN IMMEDIATE", file_);
-  Edit edit(db_, file_, command_id_, Edit::Kind::kPart);
+  assert(db_ != nullptr && "part of a moved-from LongCommand");
+  Edit edit(db_, file_, command_id_, Edit::Kind::kPart, open_);
   if (!select_one(db_, file_,
                   ("WHERE state = 'pending' AND id = " + std::to_string(command_id_)).c_str())) {
     throw core::RuntimeFailure(file_, {},
@@ -223,9 +227,36 @@ void Project::Edit::commit_part() {
 }
 
 void Project::Edit::finish_transaction() {
-  if (kind_ != Kind::kPart) sqlite::execute(db_, kBumpRevision, file_);
-  sqlite::execute(db_, "COMMIT", file_);
+  std::optional<std::int64_t> before;
+  if (kind_ != Kind::kPart) {
+    before = read_revision(db_, file_);
+    sqlite::execute(db_, kBumpRevision, file_);
+  }
+  sqlite::execute(db_, nested_ ? "RELEASE edit" : "COMMIT", file_);
   db_ = nullptr;
+  open_->edit = false;
+  if (before) {
+    open_->tree_committed(*before, kind_ == Kind::kJournal);
+  } else if (!open_->tree_writes.empty()) {
+    open_->tree_committed(-1, true);  // a part's nodes stay unseen until it finishes: forget
+  }
+}
+
+void Project::ConnectionState::tree_committed(std::int64_t revision, bool journal) {
+  if (journal || tree_revision != revision) {
+    tree_revision.reset();
+    tree.clear();
+  } else {
+    for (auto& [id, node] : tree_writes) {
+      if (node) {
+        tree.insert_or_assign(id, std::move(*node));
+      } else {
+        tree.erase(id);
+      }
+    }
+    tree_revision = revision + 1;
+  }
+  tree_writes.clear();
 }
 
 std::vector<CommandRecord> Project::history() const {
@@ -233,33 +264,51 @@ std::vector<CommandRecord> Project::history() const {
   sqlite::Statement select(db(), sql.c_str(), file_name());
   std::vector<CommandRecord> records;
   while (select.step()) records.push_back(read_command(select, file_name()));
+  for (CommandRecord& record : records) {
+    if (record.state == CommandState::kPending && writer_is_gone(db(), file_name(), record.id))
+      record.state = CommandState::kInterrupted;
+  }
   return records;
 }
 
 std::optional<CommandRecord> Project::undo(std::optional<std::int64_t> only) {
-  assert(sqlite3_get_autocommit(db()) != 0 && "undo while an Edit is open");
-  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
-  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal);
+  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal, open_.get());
   std::optional<CommandRecord> last =
       select_one(db(), file_name(), "WHERE state = 'done' ORDER BY seq DESC LIMIT 1");
   if (!last || !last->undoable || (only && last->id != *only)) return std::nullopt;
   set_state(db(), file_name(), last->id, "undone");
+  verify_current_rows(last->id);
   journal.finish_transaction();
   last->state = CommandState::kUndone;
   return last;
 }
 
 std::optional<CommandRecord> Project::redo(std::optional<std::int64_t> only) {
-  assert(sqlite3_get_autocommit(db()) != 0 && "redo while an Edit is open");
-  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
-  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal);
+  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal, open_.get());
   std::optional<CommandRecord> next =
       select_one(db(), file_name(), "WHERE state = 'undone' ORDER BY seq LIMIT 1");
   if (!next || (only && next->id != *only)) return std::nullopt;
   set_state(db(), file_name(), next->id, "done");
+  verify_current_rows(next->id);
   journal.finish_transaction();
   next->state = CommandState::kDone;
   return next;
+}
+
+void Project::verify_current_rows(std::int64_t command_id) const {
+  std::set<std::int64_t> live;
+  for (const StoredScanSummary& scan : scans()) live.insert(scan.id);  // records and poses
+  static_cast<void>(object_nodes());
+  static_cast<void>(scan_color_corrections());
+  static_cast<void>(scan_sources());
+  static_cast<void>(images(false));
+  sqlite::Statement layers(
+      db(), "SELECT DISTINCT scan_id, name FROM scan_layers WHERE command_id = ?1", file_name());
+  layers.bind_int(1, command_id);
+  while (layers.step()) {
+    if (live.count(layers.column_int(0)) != 0)
+      verify_current_layer(layers.column_int(0), layers.column_text(1));
+  }
 }
 
 std::optional<std::string> Project::latest_result(std::string_view name) const {
@@ -272,12 +321,48 @@ std::optional<std::string> Project::latest_result(std::string_view name) const {
 }
 
 Project::ReadSnapshot Project::read_snapshot() const {
-  assert(sqlite3_get_autocommit(db()) != 0 && "a snapshot inside an Edit");
+  assert(!open_->edit && "a snapshot inside an Edit");
+  if (open_->batch) return ReadSnapshot(nullptr);  // the batch sees one state already
   sqlite::execute(db(), "BEGIN DEFERRED", file_name());
   ReadSnapshot snapshot(db());
   // Under write-ahead logging the snapshot is taken at the first read.
   static_cast<void>(read_revision(db(), file_name()));
   return snapshot;
+}
+
+Project::Batch Project::begin_batch() {
+  assert(!open_->batch && !open_->edit && "a Batch inside an Edit or a Batch");
+  sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
+  open_->batch = true;
+  return Batch(db(), file_name(), open_.get());
+}
+
+void Project::Batch::commit() {
+  assert(db_ != nullptr && !open_->edit && "commit of a finished Batch, or with an Edit open");
+  if (sqlite3_get_autocommit(db_) != 0) {
+    roll_back();
+    throw core::RuntimeFailure(file_, {},
+                               "a write failed earlier and SQLite rolled the whole batch back; "
+                               "nothing was stored");
+  }
+  sqlite::execute(db_, "COMMIT", file_);
+  db_ = nullptr;
+  open_->batch = false;
+}
+
+Project::Batch::~Batch() {
+  roll_back();
+}
+
+void Project::Batch::roll_back() noexcept {
+  if (db_ == nullptr) return;
+  if (sqlite3_get_autocommit(db_) == 0) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  db_ = nullptr;
+  open_->batch = false;
+  // The revision goes back, and another process may reach the same number
+  // with another tree: what the batch's commands cached is forgotten.
+  open_->tree_revision.reset();
+  open_->tree.clear();
 }
 
 Project::ReadSnapshot::~ReadSnapshot() {

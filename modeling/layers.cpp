@@ -187,6 +187,24 @@ bool Project::read_layer(
   return true;
 }
 
+void Project::verify_current_layer(std::int64_t id, std::string_view name) const {
+  std::optional<ElementType> type;
+  {
+    sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
+    select.bind_int(1, id).bind_text(2, name);
+    if (!select.step()) return;
+    const LayerFields fields = verified(select, file_name());
+    if (fields.codec == "removed") return;
+    type = element_type_from_name(fields.element_type);
+    if (!type) damaged(file_name(), id, name, "unknown element type " + fields.element_type);
+  }
+  std::vector<std::byte> values;
+  read_layer(id, name, *type, [&values](std::size_t bytes) {
+    values.resize(bytes);
+    return std::span<std::byte>(values);
+  });
+}
+
 std::vector<std::string> Project::layer_names(std::int64_t id) const {
   const std::string sql = sql_of({R"sql(
 SELECT )sql",

@@ -5,6 +5,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include "core/errors.hpp"
@@ -17,12 +18,15 @@ namespace scanbench::modeling {
 namespace {
 
 // Each node's row of the newest done command that wrote it, live or not.
-const std::string kSelectCurrent = sql_of({"SELECT ", kNodeColumns, R"sql(
-FROM object_nodes n
+constexpr const char* kNewestVersion = R"sql(
 WHERE n.command_id = (SELECT q.command_id FROM object_nodes q JOIN commands c ON c.id = q.command_id
                       WHERE q.node_id = n.node_id AND c.state = 'done'
-                      ORDER BY c.seq DESC LIMIT 1)
-ORDER BY n.node_id)sql"});
+                      ORDER BY c.seq DESC LIMIT 1))sql";
+const std::string kSelectCurrent = sql_of(
+    {"SELECT ", kNodeColumns, " FROM object_nodes n", kNewestVersion, " ORDER BY n.node_id"});
+// The same, of one node (?1).
+const std::string kSelectCurrentOne = sql_of(
+    {"SELECT ", kNodeColumns, " FROM object_nodes n", kNewestVersion, " AND n.node_id = ?1"});
 
 constexpr const char* kInsert = R"sql(
 INSERT OR REPLACE INTO object_nodes (node_id, command_id, live, name, kind, parent, hidden, points,
@@ -86,6 +90,17 @@ ObjectNode node_of(const NodeRecord& r, const std::string& file) {
   return node;
 }
 
+// Reads the node of `row` (a statement selecting kNodeColumns) into
+// `node`, refused when it fails its checksum; false for a deleted one.
+bool verified_node(const sqlite::Statement& row, const std::string& file, ObjectNode& node) {
+  const auto [record, stored] = read_node_record(row);
+  if (checksum(record) != stored)
+    damaged(file, record.node_id, "the node's row fails its checksum (changed outside scanbench?)");
+  if (!record.live) return false;
+  node = node_of(record, file);
+  return true;
+}
+
 void write(sqlite3* db, const std::string& file, const NodeRecord& r) {
   sqlite::Statement insert(db, kInsert, file);
   insert.bind_int(1, r.node_id).bind_int(2, r.command_id).bind_int(3, r.live);
@@ -103,16 +118,48 @@ void write(sqlite3* db, const std::string& file, const NodeRecord& r) {
 
 }  // namespace
 
+std::map<std::int64_t, ObjectNode> Project::read_tree() const {
+  std::map<std::int64_t, ObjectNode> tree;
+  for (sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name()); select.step();) {
+    ObjectNode node;
+    if (verified_node(select, file_name(), node)) tree.emplace(node.id, std::move(node));
+  }
+  return tree;
+}
+
+const std::map<std::int64_t, ObjectNode>* Project::current_tree() const {
+  ConnectionState& state = *open_;
+  if (state.edit) return nullptr;
+  const std::int64_t now = revision();
+  if (state.tree_revision != now) {
+    state.tree = read_tree();
+    state.tree_revision = now;
+  }
+  return &state.tree;
+}
+
+std::map<std::int64_t, ObjectNode> Project::object_tree() const {
+  const std::map<std::int64_t, ObjectNode>* tree = current_tree();
+  return tree != nullptr ? *tree : read_tree();
+}
+
+std::vector<std::int64_t> Project::nodes_named(std::string_view name) const {
+  std::vector<std::int64_t> ids;
+  const auto collect = [&](const std::map<std::int64_t, ObjectNode>& tree) {
+    for (const auto& [id, node] : tree)
+      if (node.name == name) ids.push_back(id);
+  };
+  if (const std::map<std::int64_t, ObjectNode>* tree = current_tree()) {
+    collect(*tree);
+  } else {
+    collect(read_tree());
+  }
+  return ids;
+}
+
 std::vector<ObjectNode> Project::object_nodes() const {
   std::vector<ObjectNode> nodes;
-  for (sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name()); select.step();) {
-    const auto [record, stored] = read_node_record(select);
-    if (checksum(record) != stored) {
-      damaged(file_name(), record.node_id,
-              "the node's row fails its checksum (changed outside scanbench?)");
-    }
-    if (record.live) nodes.push_back(node_of(record, file_name()));
-  }
+  for (auto& [id, node] : object_tree()) nodes.push_back(std::move(node));
   return nodes;
 }
 
@@ -134,16 +181,17 @@ void Project::put_node(Edit& edit, const ObjectNode& node) {
           (node.bbox_world->min().allFinite() && node.bbox_world->max().allFinite())) &&
          "finite bounding box");
   write(db(), file_name(), record_of(node, edit.command_id(), true));
+  open_->tree_writes.emplace_back(node.id, node);
 }
 
 void Project::remove_node(Edit& edit, std::int64_t id) {
   check_edit(edit);
-  for (const ObjectNode& node : object_nodes()) {
-    if (node.id == id) {
-      write(db(), file_name(), record_of(node, edit.command_id(), false));
-      return;
-    }
-  }
+  sqlite::Statement select(db(), kSelectCurrentOne.c_str(), file_name());
+  select.bind_int(1, id);
+  ObjectNode node;
+  if (!select.step() || !verified_node(select, file_name(), node)) return;
+  write(db(), file_name(), record_of(node, edit.command_id(), false));
+  open_->tree_writes.emplace_back(id, std::nullopt);
 }
 
 }  // namespace scanbench::modeling

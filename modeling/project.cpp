@@ -259,11 +259,34 @@ void Project::check_edit([[maybe_unused]] const Edit& edit) const {
   assert(edit.active() && edit.db_ == db() && "writes need an open Edit of this project");
 }
 
+Project::Edit::Edit(sqlite3* db, std::string file, std::int64_t command_id, Kind kind,
+                    ConnectionState* open)
+    : file_(std::move(file)),
+      command_id_(command_id),
+      kind_(kind),
+      nested_(open->batch),
+      open_(open) {
+  assert(!open->edit && "an Edit is already open on this project");
+  // Outside a transaction a savepoint would begin one of its own, which
+  // its release would commit: a batch that SQLite rolled back after a write
+  // error must stop here.
+  if (nested_ && sqlite3_get_autocommit(db) != 0) {
+    throw core::RuntimeFailure(file_, {},
+                               "a write failed earlier and SQLite rolled the whole batch back; "
+                               "nothing was stored");
+  }
+  sqlite::execute(db, nested_ ? "SAVEPOINT edit" : "BEGIN IMMEDIATE", file_);
+  db_ = db;
+  open->edit = true;
+}
+
 Project::Edit::Edit(Edit&& other) noexcept
     : db_(std::exchange(other.db_, nullptr)),
       file_(std::move(other.file_)),
       command_id_(other.command_id_),
-      kind_(other.kind_) {}
+      kind_(other.kind_),
+      nested_(other.nested_),
+      open_(other.open_) {}
 
 Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
   if (this != &other) {
@@ -272,6 +295,8 @@ Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
     file_ = std::move(other.file_);
     command_id_ = other.command_id_;
     kind_ = other.kind_;
+    nested_ = other.nested_;
+    open_ = other.open_;
   }
   return *this;
 }
@@ -281,12 +306,16 @@ Project::Edit::~Edit() {
 }
 
 void Project::Edit::roll_back() noexcept {
+  if (db_ == nullptr) return;
   // SQLite may already have rolled back by itself after an I/O error or a
   // full disk; ROLLBACK would then fail, so only issue it when still open.
-  if (db_ != nullptr && sqlite3_get_autocommit(db_) == 0) {
-    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  if (sqlite3_get_autocommit(db_) == 0) {
+    sqlite3_exec(db_, nested_ ? "ROLLBACK TO edit; RELEASE edit" : "ROLLBACK", nullptr, nullptr,
+                 nullptr);
   }
   db_ = nullptr;
+  open_->edit = false;
+  open_->tree_writes.clear();
 }
 
 }  // namespace scanbench::modeling

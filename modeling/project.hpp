@@ -70,6 +70,10 @@ inline constexpr int kBusyTimeoutMs = 5000;
 
 enum class NodeKind { kGroup, kObject };
 
+// The longest name a user may give a node [bytes of UTF-8]. Names hold no
+// control characters (modeling/segment_commands.hpp refuses them).
+inline constexpr std::size_t kMaxNodeNameBytes = 256;
+
 // A node of the object tree (site → building → wall …). Objects own pixels
 // of scans (their "membership" layers); groups hold other nodes. The cached
 // figures describe the points the node owns, its descendants' included.
@@ -97,7 +101,10 @@ struct StoredScanSummary {
   acquisition::ScanSummary summary;
 };
 
-enum class CommandState { kPending, kDone, kUndone };
+// kPending: a long command still being written by a running process;
+// kInterrupted: one whose process (on this machine) is gone, so nothing of
+// it was stored and the next writer removes it.
+enum class CommandState { kPending, kDone, kUndone, kInterrupted };
 
 // One journal entry.
 struct CommandRecord {
@@ -126,6 +133,9 @@ struct EncodedScan {
 // (acquisition::check_consistency).
 EncodedScan encode_scan(const acquisition::Scan& scan);
 
+// EncodedScan::content_digest of `scan`, without encoding it.
+std::int64_t scan_content_digest(const acquisition::Scan& scan);
+
 // Deletes a project file with its SQLite side files (-journal, -wal, -shm).
 // For a project the caller itself created and must not leave behind; errors
 // are ignored (the files may not exist).
@@ -136,6 +146,7 @@ class Project {
   class Edit;
   class LongCommand;
   class ReadSnapshot;
+  class Batch;
   class Draft;
 
   // Opens an existing project for reading and writing. Never creates or
@@ -261,6 +272,14 @@ class Project {
   // damaged.
   std::vector<ObjectNode> object_nodes() const;
 
+  // The same nodes by id. Both come from a copy of the tree the project
+  // keeps between commands of this connection, so a script of many tree
+  // commands reads and verifies the nodes' rows only once.
+  std::map<std::int64_t, ObjectNode> object_tree() const;
+
+  // The ids of the live nodes called `name`, in id order.
+  std::vector<std::int64_t> nodes_named(std::string_view name) const;
+
   // An id no node of the file has (one above the largest ever stored that
   // is still in the journal: the ids of discarded commands' nodes may come
   // back).
@@ -335,10 +354,22 @@ class Project {
 
   // Reads that must agree with each other (an export of masks, poses and
   // channels) see one state of the project while the returned snapshot
-  // lives, whatever other processes commit meanwhile. Asserts no Edit is open.
+  // lives, whatever other processes commit meanwhile. Asserts no Edit is
+  // open. Inside a Batch, which already sees one state, it does nothing.
   ReadSnapshot read_snapshot() const;
 
-  // The journal in journal order (done, then undone; pending commands last).
+  // Makes the commands, undos and redos that follow one unit (a segment
+  // script): what they write lands in the file when the batch commits, or
+  // not at all, the journal's redo chain included. Takes the write lock at
+  // once and holds it until the batch ends, so no other process writes in
+  // between. Each Edit inside is a savepoint: a refused command rolls back
+  // only itself. Throws core::RuntimeFailure when another writer keeps the
+  // lock for longer than kBusyTimeoutMs. Asserts no Edit or Batch is open;
+  // long commands cannot run inside one.
+  Batch begin_batch();
+
+  // The journal in journal order (done, then undone; pending and
+  // interrupted commands last).
   std::vector<CommandRecord> history() const;
 
   // Marks the newest done command undone, in one transaction, and returns
@@ -376,8 +407,35 @@ class Project {
   };
   using Connection = std::unique_ptr<sqlite3, CloseConnection>;
 
+  // What is open on the connection (at most one Batch and, inside it or
+  // alone, at most one Edit), and the object tree as of a revision, so that
+  // a script of many tree commands does not read and verify every node's
+  // row again for each. Heap-held so that Edits keep a stable pointer when
+  // the Project moves.
+  struct ConnectionState {
+    bool batch = false;
+    bool edit = false;
+    // The live nodes at `tree_revision`, when known.
+    std::optional<std::int64_t> tree_revision;
+    std::map<std::int64_t, ObjectNode> tree;
+    // The open Edit's node writes, in order (none: removed), applied to
+    // `tree` once it commits.
+    std::vector<std::pair<std::int64_t, std::optional<ObjectNode>>> tree_writes;
+
+    // After an Edit that began at `revision` committed as revision + 1:
+    // the tree follows its writes (or is forgotten when it was not known at
+    // `revision`, or when the Edit was an undo or redo, which writes none).
+    void tree_committed(std::int64_t revision, bool journal);
+  };
+
   Project(std::filesystem::path file, Connection db);
   sqlite3* db() const;
+  // The tree the connection keeps, brought up to the current revision;
+  // none inside an Edit, whose writes it does not hold yet. Valid until the
+  // next write.
+  const std::map<std::int64_t, ObjectNode>* current_tree() const;
+  // The live nodes as their rows say, each verified.
+  std::map<std::int64_t, ObjectNode> read_tree() const;
   std::string file_name() const { return file_.string(); }
   // rows × columns of live scan `id` (or one `edit` is creating); throws
   // core::InputError when there is none.
@@ -387,6 +445,15 @@ class Project {
   // The summary of live scan `id` at its current pose; throws
   // core::InputError when there is none.
   StoredScanSummary current_summary(std::int64_t id) const;
+  // Reads, checksums verified, what the project now holds of everything
+  // command `command_id` wrote a version of (after an undo the versions
+  // before it, after a redo its own): scans and poses, nodes, colour
+  // corrections, sources and images, and each of its layers' current
+  // version decoded in full. Throws core::InputError naming the damage.
+  void verify_current_rows(std::int64_t command_id) const;
+  // Reads the current version of layer `name` of live scan `id`, its row
+  // verified and its data decoded; nothing when there is none.
+  void verify_current_layer(std::int64_t id, std::string_view name) const;
   // Decodes the current version of a layer into the buffer `allocate`
   // returns for its size in bytes; false when there is none.
   bool read_layer(std::int64_t id, std::string_view name, ElementType type,
@@ -394,6 +461,7 @@ class Project {
 
   std::filesystem::path file_;
   Connection db_;
+  std::unique_ptr<ConnectionState> open_ = std::make_unique<ConnectionState>();
 };
 
 // One write transaction of a command: everything written through the
@@ -427,9 +495,12 @@ class Project::Edit {
  private:
   friend class Project;
   enum class Kind { kCommand, kPart, kFinal, kJournal };
-  Edit(sqlite3* db, std::string file, std::int64_t command_id, Kind kind)
-      : db_(db), file_(std::move(file)), command_id_(command_id), kind_(kind) {}
-  // Advances the revision (all but parts) and commits.
+  // Opens the write transaction: BEGIN IMMEDIATE, or a savepoint inside a
+  // Batch. Asserts no other Edit is open; throws core::RuntimeFailure when
+  // the lock is held too long.
+  Edit(sqlite3* db, std::string file, std::int64_t command_id, Kind kind, ConnectionState* open);
+  // Advances the revision (all but parts) and commits, or releases the
+  // savepoint inside a Batch.
   void finish_transaction();
   void roll_back() noexcept;
 
@@ -437,6 +508,8 @@ class Project::Edit {
   std::string file_;
   std::int64_t command_id_ = 0;
   Kind kind_ = Kind::kCommand;
+  bool nested_ = false;  // a savepoint of a Batch
+  ConnectionState* open_ = nullptr;
 };
 
 // A pending command written in parts. Abandoned (removed with its rows) on
@@ -464,16 +537,18 @@ class Project::LongCommand {
 
  private:
   friend class Project;
-  LongCommand(sqlite3* db, std::string file, std::int64_t command_id, std::string name,
+  LongCommand(const Project& project, std::int64_t command_id, std::string name,
               std::optional<std::int64_t> revision)
-      : db_(db),
-        file_(std::move(file)),
+      : db_(project.db()),
+        file_(project.file_name()),
+        open_(project.open_.get()),
         command_id_(command_id),
         name_(std::move(name)),
         revision_(revision) {}
 
   sqlite3* db_ = nullptr;
   std::string file_;
+  ConnectionState* open_ = nullptr;
   std::int64_t command_id_ = 0;
   std::string name_;
   std::optional<std::int64_t> revision_;
@@ -490,6 +565,33 @@ class Project::ReadSnapshot {
   friend class Project;
   explicit ReadSnapshot(sqlite3* db) : db_(db) {}
   sqlite3* db_ = nullptr;
+};
+
+// Several commands as one transaction (see Project::begin_batch). Rolled
+// back on destruction unless committed. Must not outlive its Project, and
+// the Project must not move while it is open.
+class Project::Batch {
+ public:
+  Batch(Batch&& other) noexcept
+      : db_(std::exchange(other.db_, nullptr)), file_(std::move(other.file_)), open_(other.open_) {}
+  Batch& operator=(Batch&&) = delete;
+  ~Batch();
+
+  // Makes everything written inside durable at once. Asserts no Edit is
+  // open. Throws core::RuntimeFailure when SQLite cannot commit (I/O error,
+  // disk full) or already rolled the batch back after such an error;
+  // nothing is then stored.
+  void commit();
+
+ private:
+  friend class Project;
+  Batch(sqlite3* db, std::string file, ConnectionState* open)
+      : db_(db), file_(std::move(file)), open_(open) {}
+  void roll_back() noexcept;
+
+  sqlite3* db_ = nullptr;
+  std::string file_;
+  ConnectionState* open_ = nullptr;
 };
 
 // A project being built under a temporary name (Project::create_draft).

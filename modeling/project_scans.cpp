@@ -28,8 +28,8 @@ constexpr int kFirstPoseColumn = kFirstScanColumn + kScanRecordColumnCount;
 
 // Every live scan (its import done) with its current pose: the pose row of
 // the newest done command, in journal order.
-const std::string kSelectScans = sql_of({"SELECT s.id, ", kScanRecordColumns, ", ",
-                                         kPoseRecordColumns, R"sql(
+const std::string kSelectScans =
+    sql_of({"SELECT s.id, ", kScanRecordColumns, ", ", kPoseRecordColumns, R"sql(
 FROM scans s JOIN scan_poses p ON p.scan_id = s.id
 WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
   AND p.command_id = (SELECT q.command_id FROM scan_poses q JOIN commands c ON c.id = q.command_id
@@ -190,6 +190,12 @@ std::vector<T> required_layer(const Project& project, std::int64_t id, const cha
 
 }  // namespace
 
+std::int64_t scan_content_digest(const acquisition::Scan& scan) {
+  return content_digest(scan.rows, scan.columns, acquisition::angle_model_name(scan.is_spherical()),
+                        std::as_bytes(std::span(scan.range_m)),
+                        std::as_bytes(std::span(scan.valid)));
+}
+
 EncodedScan encode_scan(const acquisition::Scan& scan) {
   assert(acquisition::check_consistency(scan).empty() &&
          "only a consistent scan is stored (see acquisition::check_consistency)");
@@ -203,9 +209,7 @@ EncodedScan encode_scan(const acquisition::Scan& scan) {
   auto& layers = encoded.layers;
   layers.push_back(encode_layer<float>(layer::kRange, ElementType::kF32, scan.range_m));
   layers.push_back(encode_layer<std::uint8_t>(layer::kValid, ElementType::kU8, scan.valid));
-  encoded.content_digest = content_digest(
-      scan.rows, scan.columns, acquisition::angle_model_name(scan.is_spherical()),
-      std::as_bytes(std::span(scan.range_m)), std::as_bytes(std::span(scan.valid)));
+  encoded.content_digest = scan_content_digest(scan);
   if (scan.has_intensity()) {
     layers.push_back(encode_layer<float>(layer::kIntensity, ElementType::kF32, scan.intensity));
   }

@@ -35,12 +35,16 @@ ORDER BY i.id)sql";
 }
 
 std::string to_json(const acquisition::ScanSource& source) {
-  return nlohmann::json{{"format", source.format},
-                        {"guid", source.guid},
-                        {"coordinate_metadata", source.coordinate_metadata},
-                        {"points_in_file", source.points_in_file},
-                        {"unplaced_points", source.unplaced_points}}
-      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  nlohmann::json json = {{"format", source.format},
+                         {"guid", source.guid},
+                         {"coordinate_metadata", source.coordinate_metadata},
+                         {"points_in_file", source.points_in_file},
+                         {"unplaced_points", source.unplaced_points}};
+  if (!source.file.path.empty()) {
+    json["file"] = {
+        {"path", source.file.path}, {"device", source.file.device}, {"inode", source.file.inode}};
+  }
+  return json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 acquisition::ScanSource source_from_json(const std::string& text) {
@@ -51,6 +55,11 @@ acquisition::ScanSource source_from_json(const std::string& text) {
   source.coordinate_metadata = json.value("coordinate_metadata", "");
   source.points_in_file = json.at("points_in_file").get<std::uint64_t>();
   source.unplaced_points = json.at("unplaced_points").get<std::uint64_t>();
+  if (json.contains("file")) {  // imports since the source files were recorded
+    const nlohmann::json& file = json["file"];
+    source.file = {file.at("path").get<std::string>(), file.at("device").get<std::uint64_t>(),
+                   file.at("inode").get<std::uint64_t>()};
+  }
   return source;
 }
 

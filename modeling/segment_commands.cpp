@@ -6,6 +6,7 @@
 #include <unordered_set>
 
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "modeling/scan_layers.hpp"
 #include "segmentation/pixel_set.hpp"
 
@@ -26,9 +27,7 @@ std::string dump(const nlohmann::json& json) {
 }
 
 Tree load_tree(const Project& project) {
-  Tree tree;
-  for (ObjectNode& node : project.object_nodes()) tree.emplace(node.id, std::move(node));
-  return tree;
+  return project.object_tree();
 }
 
 const ObjectNode& require_node(const Tree& tree, std::int64_t id) {
@@ -46,6 +45,14 @@ void require_group(const Tree& tree, std::optional<std::int64_t> parent) {
 void require_name(const std::string& name) {
   if (name.find_first_not_of(" \t\r\n") == std::string::npos)
     refuse("name", "a node needs a name (not only spaces)");
+  if (name.size() > kMaxNodeNameBytes) {
+    refuse("name", "is " + std::to_string(name.size()) +
+                       " bytes long; a node's name holds at most " +
+                       std::to_string(kMaxNodeNameBytes));
+  }
+  if (!core::is_valid_utf8(name)) refuse("name", "is not valid UTF-8");
+  if (core::has_control_characters(name))
+    refuse("name", "holds a control character (a newline, a tab, ESC, NUL …)");
 }
 
 // True when `ancestor` is `node` or above it.
@@ -151,21 +158,23 @@ std::vector<ObjectNode> with_new_figures(const Tree& tree,
                                          const std::map<std::int64_t, Figures>& figures) {
   std::vector<ObjectNode> changed;
   for (const auto& [id, node] : tree) {
-    ObjectNode updated = node;
     const auto found = figures.find(id);
     const Figures f = found == figures.end() ? Figures{} : found->second;
-    updated.points = f.points;
-    updated.mean_footprint_m =
+    const std::optional<double> mean_footprint_m =
         f.with_footprint > 0
             ? std::optional<double>(f.footprint_sum / static_cast<double>(f.with_footprint))
             : std::nullopt;
-    updated.bbox_world = f.box.isEmpty() ? std::nullopt : std::optional<Eigen::AlignedBox3d>(f.box);
-    const bool same =
-        updated.points == node.points && updated.mean_footprint_m == node.mean_footprint_m &&
-        updated.bbox_world.has_value() == node.bbox_world.has_value() &&
-        (!updated.bbox_world || (updated.bbox_world->min() == node.bbox_world->min() &&
-                                 updated.bbox_world->max() == node.bbox_world->max()));
-    if (!same) changed.push_back(std::move(updated));
+    const std::optional<Eigen::AlignedBox3d> bbox_world =
+        f.box.isEmpty() ? std::nullopt : std::optional<Eigen::AlignedBox3d>(f.box);
+    const bool same = f.points == node.points && mean_footprint_m == node.mean_footprint_m &&
+                      bbox_world.has_value() == node.bbox_world.has_value() &&
+                      (!bbox_world || (bbox_world->min() == node.bbox_world->min() &&
+                                       bbox_world->max() == node.bbox_world->max()));
+    if (same) continue;
+    ObjectNode& updated = changed.emplace_back(node);
+    updated.points = f.points;
+    updated.mean_footprint_m = mean_footprint_m;
+    updated.bbox_world = bbox_world;
   }
   return changed;
 }

@@ -10,8 +10,10 @@
 // still to be segmented.
 //
 // Errors: a scan or node that does not exist, a seed outside the grid, a
-// scan without geometry, an empty name or selection, a node made its own
-// ancestor: core::InputError naming it, and nothing written.
+// scan without geometry, an empty selection, a node made its own ancestor,
+// a name that is only spaces, longer than kMaxNodeNameBytes, not UTF-8 or
+// holding a control character: core::InputError naming it, and nothing
+// written.
 #pragma once
 
 #include <cstdint>

@@ -1,8 +1,8 @@
 // Loading a campaign's truth back (campaign.hpp): for tests and benchmarks
 // that measure the pipeline against it.
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "acquisition/json_input.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/simulation/campaign.hpp"
 #include "acquisition/simulation/truth_images.hpp"
@@ -14,18 +14,13 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+constexpr std::uintmax_t kMaxTruthBytes = 64u << 20;
+
 // Every lookup names the file and the key when it fails.
 class TruthJson {
  public:
-  explicit TruthJson(fs::path path) : path_(std::move(path)) {
-    std::ifstream in(path_, std::ios::binary);
-    if (!in) throw core::InputError(path_.string(), {}, "cannot open");
-    try {
-      root_ = json::parse(in);
-    } catch (const json::parse_error& e) {
-      throw core::InputError(path_.string(), {std::nullopt, e.byte, {}}, "not valid JSON");
-    }
-  }
+  explicit TruthJson(fs::path path)
+      : path_(std::move(path)), root_(acquisition::read_json_file(path_, kMaxTruthBytes)) {}
 
   const json& root() const { return root_; }
 

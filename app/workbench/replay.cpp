@@ -1,9 +1,11 @@
 #include "app/workbench/replay.hpp"
 
-#include <fstream>
+#include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <string_view>
 
+#include "acquisition/json_input.hpp"
 #include "core/errors.hpp"
 #include "render/window/window_device.hpp"
 
@@ -14,20 +16,27 @@ namespace {
 using Kind = ReplayEvent::Kind;
 using nlohmann::json;
 
+constexpr std::uintmax_t kMaxReplayBytes = 16u << 20;
+
+// Events a replay may expand to (waits, drags and texts are many): about
+// nine hours at 30 frames a second.
+constexpr std::size_t kMaxEvents = 1000000;
+
+// Window coordinates beyond this are not on any screen [pixels].
+constexpr double kMaxCoordinatePx = 1e6;
+
 struct Reader {
   std::filesystem::path file;
   std::string where;
 
-  [[noreturn]] void refuse(const std::string& problem) const {
-    core::FilePosition position;
-    position.detail = where;
-    throw core::InputError(file.string(), position, problem);
-  }
+  acquisition::JsonPlace place() const { return {file.string(), where}; }
+
+  [[noreturn]] void refuse(const std::string& problem) const { place().refuse(problem); }
 
   std::array<double, 2> point(const json& j) const {
-    if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
-      refuse("expected a point [x, y] in window pixels");
-    return {j[0].get<double>(), j[1].get<double>()};
+    if (!j.is_array() || j.size() != 2) refuse("expected a point [x, y] in window pixels");
+    return {acquisition::finite_number(j[0], -kMaxCoordinatePx, kMaxCoordinatePx, place(), "x"),
+            acquisition::finite_number(j[1], -kMaxCoordinatePx, kMaxCoordinatePx, place(), "y")};
   }
 
   int button(const json& j) const {
@@ -73,9 +82,32 @@ struct Reader {
   }
 
   int count(const json& j, const char* what) const {
-    if (!j.is_number_integer() || j.get<int>() < 0 || j.get<int>() > 100000)
-      refuse(std::string(what) + " must be a whole number from 0 to 100000");
-    return j.get<int>();
+    return static_cast<int>(acquisition::whole_number(j, 0, 100000, place(), what));
+  }
+
+  // Refuses keys the event's kind does not take ("mods" goes with any).
+  void check_keys(const json& event) const {
+    static const std::map<std::string, std::vector<std::string_view>> kinds = {
+        {"move", {"move", "mods"}},
+        {"press", {"press", "mods"}},
+        {"release", {"release", "mods"}},
+        {"click", {"click", "button", "mods"}},
+        {"drag", {"drag", "button", "steps", "mods"}},
+        {"scroll", {"scroll", "at", "mods"}},
+        {"key", {"key", "mods"}},
+        {"hold", {"hold", "frames", "mods"}},
+        {"text", {"text", "mods"}},
+        {"wait", {"wait", "mods"}},
+        {"screenshot", {"screenshot", "mods"}}};
+    for (const auto& [kind, keys] : kinds) {
+      if (!event.contains(kind)) continue;
+      for (const auto& [key, value] : event.items()) {
+        if (std::find(keys.begin(), keys.end(), key) == keys.end())
+          refuse("unknown key \"" + key + "\" in a " + kind + " event");
+      }
+      return;
+    }
+    refuse("unknown event: " + event.begin().key());
   }
 };
 
@@ -161,14 +193,15 @@ bool add_pointer_event(const json& e, const Reader& reader, int mods,
     }
     add_button(out, button, false, mods);
   } else if (e.contains("scroll")) {
-    if (!e["scroll"].is_number()) reader.refuse("scroll is a number of wheel steps");
+    const double steps =
+        acquisition::finite_number(e["scroll"], -1000.0, 1000.0, reader.place(), "scroll");
     if (e.contains("at")) {
       const auto [x, y] = reader.point(e["at"]);
       add_move(out, x, y);
     }
     ReplayEvent s;
     s.kind = Kind::kScroll;
-    s.scroll = e["scroll"].get<double>();
+    s.scroll = steps;
     out.push_back(s);
   } else {
     return false;
@@ -178,6 +211,7 @@ bool add_pointer_event(const json& e, const Reader& reader, int mods,
 
 // The events one entry of the file stands for, appended to `out`.
 void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& out) {
+  reader.check_keys(e);
   const int mods = reader.mods(e);
   if (add_pointer_event(e, reader, mods, out)) return;
   if (e.contains("key")) {
@@ -212,21 +246,17 @@ void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& ou
     if (!std::filesystem::is_directory(folder))
       reader.refuse("the screenshot's folder " + folder.string() + " does not exist");
     out.push_back(s);
-  } else {
-    reader.refuse("unknown event: " + e.begin().key());
   }
 }
 
 }  // namespace
 
 std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
   Reader reader{file, ""};
-  if (!in) reader.refuse("cannot read the file");
-  const json root = json::parse(in, nullptr, false);
-  if (root.is_discarded()) reader.refuse("not valid JSON");
+  const json root = acquisition::read_json_file(file, kMaxReplayBytes);
   if (!root.is_object() || !root.contains("events") || !root["events"].is_array())
     reader.refuse("expected {\"events\": [...]}");
+  acquisition::refuse_unknown_keys(root, {"events"}, reader.place());
   std::vector<ReplayEvent> out;
   const json& events = root["events"];
   for (std::size_t k = 0; k < events.size(); ++k) {
@@ -235,6 +265,10 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
     if (!e.is_object() || e.empty())
       reader.refuse("an event is an object such as {\"key\": \"Z\"}");
     add_event(e, reader, out);
+    if (out.size() > kMaxEvents) {
+      reader.refuse("the replay expands to more than " + std::to_string(kMaxEvents) +
+                    " events (frames): split it");
+    }
   }
   return out;
 }

@@ -2,8 +2,10 @@
 // shell-quoted, stdout and stderr captured through files in a scratch folder.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -43,6 +45,33 @@ inline CliResult run_cli(const ScratchDir& dir, const std::vector<std::string>& 
   result.out = read_file_bytes(out);
   result.err = read_file_bytes(err);
   return result;
+}
+
+// Runs `shell` (with $SCANBENCH set to the executable) under /bin/sh.
+inline CliResult run_shell(const ScratchDir& dir, const std::string& shell) {
+  const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string command = "SCANBENCH=" + shell_quote(SCANBENCH_BINARY) + " /bin/sh -c " +
+                              shell_quote(shell) + " >" + shell_quote(out.string()) + " 2>" +
+                              shell_quote(err.string());
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file_bytes(out), read_file_bytes(err)};
+}
+
+// A project holding the tiny colour scan, and what `info --json` says of it.
+inline std::string make_project(const ScratchDir& dir, const std::filesystem::path& project) {
+  EXPECT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  return run_cli(dir, {"info", project.string(), "--json"}).out;
+}
+
+// One line on stderr, "scanbench: …", holding `words`, and `exit_code`.
+inline void expect_one_line_error(const CliResult& result, int exit_code,
+                                  const std::string& words) {
+  EXPECT_EQ(result.exit_code, exit_code) << result.err;
+  EXPECT_EQ(result.err.rfind("scanbench: ", 0), 0u) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_NE(result.err.find(words), std::string::npos) << result.err;
 }
 
 }  // namespace scanbench::test

@@ -54,13 +54,15 @@ TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
 }
 
-// Blocks the import after its first file, whose two scans are then written
-// (committed parts of a pending command): a kill there must leave the
-// project as it was, and the next writer must clear what the dead import left.
+// Blocks the import once its first file is stored (after every file was
+// checked), its two scans written as committed parts of a pending command:
+// a kill there must leave the project as it was, and the next writer must
+// clear what the dead import left.
 class PauseAfterFirstFile : public core::Progress {
  public:
   explicit PauseAfterFirstFile(int report_fd) : report_fd_(report_fd) {}
-  void update(const core::ProgressStep&) override {
+  void update(const core::ProgressStep& step) override {
+    if (step.done <= step.total / 2) return;  // still checking
     const char read = 'r';
     if (::write(report_fd_, &read, 1) != 1) ::_exit(3);
     ::pause();  // wait here for the kill
@@ -83,7 +85,7 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
     PauseAfterFirstFile pause(pipe_fds[1]);
     import_scan_files(project,
                       std::vector<std::filesystem::path>{fixture("good/ptx/two_scans.ptx"),
-                                                         fixture("good/ptx/tiny_color.ptx")},
+                                                         fixture("good/ptx/georef_world_1e5.ptx")},
                       {}, pause);
     ::_exit(4);  // never reached: the parent kills us first
   }
@@ -104,7 +106,8 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
     return test::RawDatabase(project).text("SELECT count(*) FROM scans");
   };
   EXPECT_EQ(raw_count(), "3");
-  EXPECT_EQ(Project::open(project).history().back().state, CommandState::kPending);
+  // History shows the dead writer's command as interrupted, not pending.
+  EXPECT_EQ(Project::open(project).history().back().state, CommandState::kInterrupted);
   // ... until the next writer removes them.
   import_files(project, {fixture("good/ptx/irregular.ptx")});
   EXPECT_EQ(raw_count(), "2");

@@ -175,6 +175,73 @@ TEST(Integrity, AChangedLayerRowIsFoundOnReadingAndByTheCheck) {
   EXPECT_THAT(report.damage[0], HasSubstr("layer intensitx of command 1: its row"));
 }
 
+// Two versions of one node and of one layer: command 2 writes the first,
+// command 3 the second. Returns the project's file.
+std::filesystem::path two_versions(const ScratchDir& dir) {
+  const auto file = sound_project(dir);
+  Project project = Project::open(file);
+  const std::int64_t scan = project.scans().front().id;
+  const std::size_t pixels = project.load_scan(scan).pixel_count();
+  for (const char* name : {"wall", "north wall"}) {
+    ObjectNode node;
+    node.id = 1;
+    node.name = name;
+    Project::Edit edit = project.begin_command("edit", "{}");
+    project.put_node(edit, node);
+    project.put_layer(edit, scan,
+                      encode_layer<std::uint8_t>("selection", ElementType::kU8,
+                                                 std::vector<std::uint8_t>(pixels, name[0])));
+    edit.commit("{}");
+  }
+  return file;
+}
+
+std::string journal_of(const Project& project) {
+  std::string out;
+  for (const CommandRecord& c : project.history())
+    out += std::to_string(c.id) + ":" + std::to_string(static_cast<int>(c.state)) + " ";
+  return out;
+}
+
+TEST(Integrity, UndoAndRedoRefuseToMakeADamagedVersionCurrent) {
+  const ScratchDir dir;
+  const auto file = two_versions(dir);
+  // The older node version is damaged: undoing command 3 would make it current.
+  RawDatabase(file).execute("UPDATE object_nodes SET name = 'wal' WHERE command_id = 2");
+  {
+    Project project = Project::open(file);
+    const std::string journal = journal_of(project);
+    try {
+      project.undo();
+      ADD_FAILURE() << "undo made a damaged node current";
+    } catch (const core::InputError& error) {
+      EXPECT_THAT(error.problem(), HasSubstr("checksum"));
+      EXPECT_THAT(error.position().detail, HasSubstr("object node 1"));
+    }
+    EXPECT_EQ(journal_of(project), journal);
+    EXPECT_EQ(project.object_nodes().front().name, "north wall");
+  }
+  RawDatabase(file).execute("UPDATE object_nodes SET name = 'wall' WHERE command_id = 2");
+  // The newer version is undone, then its layer's data damaged: redo would
+  // make it current.
+  {
+    Project project = Project::open(file);
+    ASSERT_TRUE(project.undo());
+  }
+  RawDatabase(file).execute(
+      "UPDATE scan_layers SET data = substr(data, 1, 12) || x'ff' || substr(data, 14) "
+      "WHERE command_id = 3");
+  Project project = Project::open(file);
+  const std::string journal = journal_of(project);
+  try {
+    project.redo();
+    ADD_FAILURE() << "redo made a damaged layer current";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.position().detail, HasSubstr("layer selection"));
+  }
+  EXPECT_EQ(journal_of(project), journal);
+}
+
 TEST(Integrity, TheCheckNeverChangesTheFileItChecks) {
   const ScratchDir dir;
   const auto old = dir / "v2.sbproj";

@@ -1,0 +1,18 @@
+// Text from outside the program (names typed by users, read from files):
+// what it must be before it is stored.
+#pragma once
+
+#include <string_view>
+
+namespace scanbench::core {
+
+// True when `text` is well-formed UTF-8: no stray continuation bytes, no
+// truncated or overlong sequences, no surrogates, nothing above U+10FFFF.
+bool is_valid_utf8(std::string_view text);
+
+// True when `text` holds a C0 control character (U+0000–U+001F: NUL,
+// newline, ESC …) or DEL (U+007F): bytes that would move the cursor or end
+// a line when printed.
+bool has_control_characters(std::string_view text);
+
+}  // namespace scanbench::core

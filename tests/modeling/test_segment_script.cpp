@@ -1,0 +1,126 @@
+// Segment scripts as one unit: a refused script leaves the journal, its
+// redo chain included, exactly as it was, whatever refused it, and no other
+// process's write lands in the middle of one.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "core/errors.hpp"
+#include "modeling/segment_script.hpp"
+#include "room_project.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::ScratchDir;
+using ::testing::HasSubstr;
+
+std::filesystem::path write_script(const ScratchDir& dir, const std::string& text) {
+  const std::filesystem::path file = dir / "ops.json";
+  std::ofstream(file) << text;
+  return file;
+}
+
+// The journal as a reader sees it: each command's id, name and state.
+std::string journal_of(const Project& project) {
+  std::string out;
+  for (const CommandRecord& c : project.history())
+    out += std::to_string(c.id) + ' ' + c.name + ' ' + std::to_string(static_cast<int>(c.state)) +
+           '\n';
+  return out;
+}
+
+TEST(SegmentScript, ARefusedScriptThatBeganWithUndoKeepsTheUndoneCommandRedoable) {
+  const ScratchDir dir;
+  const std::filesystem::path file = dir / "p.sbproj";
+  Project project = Project::create(file);
+  store_room(project);
+  run_segment_script(project, write_script(dir, R"({"ops": [{"op": "group", "name": "trees"}]})"));
+  const std::string journal = journal_of(project);
+  const std::string bytes = test::read_file_bytes(file);
+  // Undoes the group, grows and commits (which would end the redo chain),
+  // then is refused.
+  const std::filesystem::path script = write_script(dir, R"({"ops": [
+      {"op": "undo"},
+      {"op": "grow", "seed": [600, 100]},
+      {"op": "commit", "name": "x"},
+      {"op": "hide", "node": "no such node"}]})");
+  try {
+    run_segment_script(project, script);
+    FAIL() << "a script hiding a node that is not there ran";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("op 4 (hide)"));
+    EXPECT_THAT(error.what(), HasSubstr("the script stored nothing"));
+  }
+  EXPECT_EQ(journal_of(project), journal);
+  EXPECT_EQ(test::read_file_bytes(file), bytes);
+  ASSERT_EQ(project.object_nodes().size(), 1u);
+  // The group is still the newest command: undo takes it, redo brings it back.
+  const std::optional<CommandRecord> undone = project.undo();
+  ASSERT_TRUE(undone);
+  EXPECT_EQ(undone->name, "group");
+  const std::optional<CommandRecord> redone = project.redo();
+  ASSERT_TRUE(redone);
+  EXPECT_EQ(redone->id, undone->id);
+  EXPECT_EQ(project.object_nodes().size(), 1u);
+}
+
+TEST(SegmentScript, AScriptIsWholeWhileAnotherProcessWrites) {
+  const ScratchDir dir;
+  const std::filesystem::path file = dir / "p.sbproj";
+  Project project = Project::create(file);
+  store_room(project);
+  run_segment_script(project, write_script(dir, R"({"ops": [{"op": "group", "name": "other"}]})"));
+  std::string ops = R"({"op": "grow", "seed": [600, 100]}, {"op": "commit", "name": "floor"},)";
+  for (int k = 0; k < 22; ++k) ops += R"({"op": "group", "name": "g)" + std::to_string(k) + "\"},";
+  const std::filesystem::path script =
+      write_script(dir, R"({"ops": [)" + ops + R"({"op": "hide", "node": "other"}]})");
+  // Another connection renames the group over and over while the script
+  // runs: its writes wait for the script (or are refused, when the script
+  // committed while they computed), and none lands inside it.
+  std::atomic<bool> done = false;
+  int renames = 0;
+  std::thread other([&] {
+    Project writer = Project::open(file);
+    while (!done) {
+      NodeEdit edit;
+      edit.node = writer.object_nodes().front().id;
+      edit.name = "other";
+      try {
+        edit_node(writer, edit);
+        ++renames;
+      } catch (const core::RuntimeFailure&) {
+        // "the project changed while edit was computing": nothing stored
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const SegmentScriptResult result = run_segment_script(project, script);
+  done = true;
+  other.join();
+  EXPECT_GT(renames, 0);
+  ASSERT_EQ(result.ops.size(), 25u);
+  // The script's commands follow each other in the journal, with no other
+  // command between them.
+  std::vector<std::int64_t> script_commands;
+  for (const nlohmann::json& op : result.ops) script_commands.push_back(op["command"]);
+  const std::vector<CommandRecord> history = project.history();
+  const auto first = std::find_if(history.begin(), history.end(), [&](const CommandRecord& c) {
+    return c.id == script_commands.front();
+  });
+  ASSERT_NE(first, history.end());
+  for (std::size_t k = 0; k < script_commands.size(); ++k) {
+    ASSERT_LT(first + static_cast<std::ptrdiff_t>(k), history.end());
+    EXPECT_EQ((first + static_cast<std::ptrdiff_t>(k))->id, script_commands[k]) << k;
+  }
+  EXPECT_EQ(project.object_nodes().size(), 24u);
+}
+
+}  // namespace
+}  // namespace scanbench::modeling
