@@ -62,8 +62,9 @@ inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplication
 // open; newer ones are refused.
 // 2: scan_geometry; 3: registration_runs, merge_masks; 4: the command journal,
 // versioned poses and the per-scan layer store; 5: the object tree; 6: colour
-// edits of objects and colour corrections of scans; 7: scan sources and images.
-inline constexpr int kProjectSchemaVersion = 7;
+// edits of objects and colour corrections of scans; 7: scan sources and images;
+// 8: indexes of the journal's undone and pending commands.
+inline constexpr int kProjectSchemaVersion = 8;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;

@@ -31,7 +31,7 @@ constexpr int kFirstPoseColumn = kFirstScanColumn + kScanRecordColumnCount;
 const std::string kSelectScans =
     sql_of({"SELECT s.id, ", kScanRecordColumns, ", ", kPoseRecordColumns, R"sql(
 FROM scans s JOIN scan_poses p ON p.scan_id = s.id
-WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
+WHERE (SELECT state FROM commands WHERE id = s.created_by) = 'done'
   AND p.command_id = (SELECT q.command_id FROM scan_poses q JOIN commands c ON c.id = q.command_id
                       WHERE q.scan_id = s.id AND c.state = 'done'
                       ORDER BY c.seq DESC LIMIT 1))sql"});
@@ -229,7 +229,8 @@ EncodedScan encode_scan(const acquisition::Scan& scan) {
 std::size_t Project::stored_pixel_count(std::int64_t id, const Edit* edit) const {
   sqlite::Statement statement(db(), R"sql(
 SELECT rows * columns FROM scans
-WHERE id = ?1 AND (created_by = ?2 OR created_by IN (SELECT id FROM commands WHERE state = 'done')))sql",
+WHERE id = ?1 AND (created_by = ?2 OR
+                   (SELECT state FROM commands WHERE id = scans.created_by) = 'done'))sql",
                               file_name());
   statement.bind_int(1, id).bind_int(2, edit != nullptr ? edit->command_id() : -1);
   if (!statement.step()) {
@@ -284,7 +285,7 @@ std::vector<StoredScanSummary> Project::scans() const {
 std::optional<std::int64_t> Project::scan_with_content(std::int64_t digest) const {
   sqlite::Statement select(db(), R"sql(
 SELECT id FROM scans
-WHERE content_digest = ?1 AND created_by IN (SELECT id FROM commands WHERE state = 'done')
+WHERE content_digest = ?1 AND (SELECT state FROM commands WHERE id = scans.created_by) = 'done'
 ORDER BY id LIMIT 1)sql",
                            file_name());
   select.bind_int(1, digest);

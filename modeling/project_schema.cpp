@@ -377,6 +377,14 @@ CREATE TABLE scan_images (
 CREATE INDEX scan_images_by_command ON scan_images (created_by);
 )sql";
 
+// Version 8: the journal's commands that are not done found without
+// reading the whole journal: each new command ends the redo branch and
+// clears what killed writers left, and redo finds the oldest undone one.
+constexpr const char* kMigrate7To8 = R"sql(
+CREATE INDEX commands_undone ON commands (seq) WHERE state = 'undone';
+CREATE INDEX commands_pending ON commands (id) WHERE state = 'pending';
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction; `original_version` is the version the file had when opened.
 void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
@@ -399,6 +407,9 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
       return;
     case 6:
       sqlite::execute(db, kMigrate6To7, file);
+      return;
+    case 7:
+      sqlite::execute(db, kMigrate7To8, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

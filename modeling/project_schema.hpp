@@ -10,6 +10,7 @@
 //   5  object_nodes (the object tree).
 //   6  object_nodes.color_edit, scan_colors.
 //   7  scan_sources, scan_images.
+//   8  indexes of the commands that are undone or pending.
 // To change the schema: bump kProjectSchemaVersion and add a case to
 // migrate_step() in project_schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by

@@ -18,7 +18,7 @@ namespace {
 constexpr const char* kSelectCurrent = R"sql(
 SELECT k.scan_id, k.command_id, k.correction, k.checksum
 FROM scan_colors k JOIN scans s ON s.id = k.scan_id
-WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
+WHERE (SELECT state FROM commands WHERE id = s.created_by) = 'done'
   AND k.command_id = (SELECT q.command_id FROM scan_colors q JOIN commands c ON c.id = q.command_id
                       WHERE q.scan_id = k.scan_id AND c.state = 'done'
                       ORDER BY c.seq DESC LIMIT 1)

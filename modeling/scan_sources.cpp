@@ -18,13 +18,13 @@ namespace {
 constexpr const char* kSelectSources = R"sql(
 SELECT k.scan_id, k.details, k.checksum
 FROM scan_sources k JOIN scans s ON s.id = k.scan_id
-WHERE s.created_by IN (SELECT id FROM commands WHERE state = 'done')
+WHERE (SELECT state FROM commands WHERE id = s.created_by) = 'done'
 ORDER BY k.scan_id)sql";
 
 constexpr const char* kSelectImages = R"sql(
 SELECT i.id, i.created_by, i.scan_id, i.description, i.format, i.data_crc, i.checksum, i.data
 FROM scan_images i
-WHERE i.created_by IN (SELECT id FROM commands WHERE state = 'done')
+WHERE (SELECT state FROM commands WHERE id = i.created_by) = 'done'
 ORDER BY i.id)sql";
 
 [[noreturn]] void damaged(const std::string& file, const std::string& what,

@@ -50,7 +50,7 @@ TEST(Integrity, ASoundProjectPassesTheCheck) {
 
 TEST(Integrity, ProjectsOfEveryVersionPassTheCheck) {
   const ScratchDir dir;
-  for (int version : {1, 2, 3, 4, 5, 6, 7}) {
+  for (int version : {1, 2, 3, 4, 5, 6, 7, 8}) {
     const auto file = dir / ("v" + std::to_string(version) + ".sbproj");
     std::filesystem::copy_file(fixture("projects/version" + std::to_string(version) + ".sbproj"),
                                file);

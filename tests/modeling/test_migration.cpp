@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "modeling/project.hpp"
@@ -36,15 +37,45 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
+// fixtures/projects/version8.sbproj: version7.sbproj (below) opened by the
+// build that introduced version 8, then fixtures/good/ptx/georef_world_1e5.ptx
+// imported as station.ptx (its source file recorded), the groups "site" and
+// "annex" made by one script, and the second undone.
+TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournalIndexed) {
+  static_assert(kProjectSchemaVersion == 8, "add fixtures/projects/version9.sbproj");
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 8);
+  const std::string before = test::read_file_bytes(file);
+  {
+    const Project project = Project::open(file);
+    const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
+    ASSERT_EQ(sources.size(), 2u);
+    EXPECT_EQ(std::filesystem::path(sources.at(5).file.path).filename(), "station.ptx");
+    EXPECT_NE(sources.at(5).file.inode, 0u);
+    const std::vector<CommandRecord> history = project.history();
+    EXPECT_EQ(history.back().name, "group");
+    EXPECT_EQ(history.back().state, CommandState::kUndone);
+    ASSERT_EQ(project.object_nodes().size(), 3u);
+  }
+  EXPECT_EQ(test::read_file_bytes(file), before);
+  test::RawDatabase raw(file);
+  for (const char* index : {"commands_undone", "commands_pending"}) {
+    EXPECT_EQ(raw.text(std::string("SELECT name FROM sqlite_schema WHERE name = '") + index + "'"),
+              index);
+  }
+  Project project = Project::open(file);
+  ASSERT_TRUE(project.redo().has_value());
+  EXPECT_EQ(project.object_nodes().size(), 4u);
+  EXPECT_TRUE(project.check().damage.empty());
+}
+
 // fixtures/projects/version7.sbproj: version6.sbproj (below) opened by the
 // build that introduced version 7, then
 // fixtures/good/e57/structured_spherical.e57 imported: a scan with its
 // source (one record not placed) and two images, one tied to no scan.
-TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsSourcesAndImages) {
-  static_assert(kProjectSchemaVersion == 7, "add fixtures/projects/version8.sbproj");
+TEST(Migration, VersionSevenKeepsItsSourcesAndImages) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 7);
-  const std::string before = test::read_file_bytes(file);
   {
     Project project = Project::open(file);
     EXPECT_EQ(names(project),
@@ -61,7 +92,6 @@ TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsSourcesAndImag
     EXPECT_EQ(images[1].image.data.size(), 662u);
     EXPECT_EQ(project.history().back().name, "import");
   }
-  EXPECT_EQ(test::read_file_bytes(file), before);
   Project project = Project::open(file);
   ASSERT_TRUE(project.undo().has_value());
   EXPECT_TRUE(project.images(false).empty()) << "the images go with their import";
@@ -179,7 +209,7 @@ TEST_P(Migration, OpensAtTheCurrentVersionWithEveryScanLoadable) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3, 4, 5, 6));
+INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3, 4, 5, 6, 7));
 
 TEST(Migration, VersionOneKeepsItsScans) {
   const ScratchDir dir;
