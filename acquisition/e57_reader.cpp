@@ -87,22 +87,30 @@ ScanImage read_image(E57PageReader& file, const E57ImageEntry& entry) {
 // images take are bounded by the file's size, however often the XML
 // repeats an entry.
 void check_image_blobs(const E57Document& document, const E57PageReader& file) {
+  const auto refuse = [&file](const E57ImageEntry& entry, const std::string& problem) {
+    core::FilePosition position;
+    position.byte_offset = entry.blob_offset;
+    position.detail = "XML element " + entry.path;
+    throw core::InputError(file.file_name(), position, problem);
+  };
   std::vector<const E57ImageEntry*> images;
-  for (const E57ImageEntry& entry : document.images) images.push_back(&entry);
+  for (const E57ImageEntry& entry : document.images) {
+    if (entry.blob_offset >= file.physical_length() ||
+        entry.blob_offset % kE57PageSize >= kE57PagePayload)
+      refuse(entry, "its blob starts beyond the end of the file or inside a page checksum");
+    if (entry.blob_length > file.physical_length())
+      refuse(entry,
+             "its blob of " + std::to_string(entry.blob_length) + " bytes is longer than the file");
+    images.push_back(&entry);
+  }
   std::sort(images.begin(), images.end(), [](const E57ImageEntry* a, const E57ImageEntry* b) {
     return a->blob_offset < b->blob_offset;
   });
   for (std::size_t k = 1; k < images.size(); ++k) {
     const E57ImageEntry& before = *images[k - 1];
-    const E57ImageEntry& entry = *images[k];
-    if (before.blob_length > file.physical_length() ||
-        entry.blob_offset < e57_advance(before.blob_offset, 16 + before.blob_length)) {
-      core::FilePosition position;
-      position.byte_offset = entry.blob_offset;
-      position.detail = "XML element " + entry.path;
-      throw core::InputError(file.file_name(), position,
-                             "its blob is, or overlaps, the blob of " + before.path +
-                                 ": each image needs a blob of its own");
+    if (images[k]->blob_offset < e57_advance(before.blob_offset, 16 + before.blob_length)) {
+      refuse(*images[k], "its blob is, or overlaps, the blob of " + before.path +
+                             ": each image needs a blob of its own");
     }
   }
 }

@@ -101,11 +101,11 @@ std::int64_t whole_number(const json& value, std::int64_t lo, std::int64_t hi,
   }
   if (value.is_number_float()) {
     const double x = value.get<double>();
-    // Compared as doubles: both bounds are exact within 2^53, as every
-    // bound we read is.
-    if (!(x == std::floor(x) && x >= static_cast<double>(lo) && x <= static_cast<double>(hi)))
-      place.refuse(rule);
-    return static_cast<std::int64_t>(x);
+    // Cast only what an int64 holds (-2^63 ≤ x < 2^63), then compare exactly.
+    if (!(x == std::floor(x) && x >= -0x1p63 && x < 0x1p63)) place.refuse(rule);
+    const auto n = static_cast<std::int64_t>(x);
+    if (n < lo || n > hi) place.refuse(rule);
+    return n;
   }
   place.refuse(rule);
 }

@@ -45,9 +45,13 @@ void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& s
       read_ptx(path, settings.ptx,
                [&on_scan](Scan&& scan) { on_scan(plain(std::move(scan), "ptx")); });
       return;
-    case ScanFileFormat::kTriplet:
-      on_scan(plain(read_triplet(path), "triplet"));
+    case ScanFileFormat::kTriplet: {
+      std::vector<std::filesystem::path> images;
+      ImportedScan scan = plain(read_triplet(path, &images), "triplet");
+      scan.source.companion_files = std::move(images);
+      on_scan(std::move(scan));
       return;
+    }
     case ScanFileFormat::kOrganizedPcd:
       on_scan(plain(read_organized_pcd(path), "pcd"));
       return;

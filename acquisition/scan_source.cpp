@@ -17,6 +17,12 @@ SourceFile identify_source_file(const std::filesystem::path& path) {
   return file;
 }
 
+void identify_source_files(const std::filesystem::path& path, ScanSource& source) {
+  source.files = {identify_source_file(path)};
+  for (const std::filesystem::path& companion : source.companion_files)
+    source.files.push_back(identify_source_file(companion));
+}
+
 bool names_source_file(const std::filesystem::path& output, const SourceFile& source) {
   if (source.path.empty()) return false;
   const SourceFile out = identify_source_file(output);

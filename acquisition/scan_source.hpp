@@ -69,8 +69,17 @@ struct ScanSource {
   // taken, or a structured scan's later returns and repeated indices.
   std::uint64_t points_in_file = 0;
   std::uint64_t unplaced_points = 0;
-  SourceFile file;  // set by the import, not by the readers
+  // The files the reader read besides the one it was given (a triplet's
+  // images), as it found them.
+  std::vector<std::filesystem::path> companion_files;
+  // The file and its companions where they were when imported: set by the
+  // import (identify_source_files), not by the readers.
+  std::vector<SourceFile> files;
 };
+
+// Sets source.files: `path`, the file the scan was read from, and
+// source.companion_files, identified (identify_source_file).
+void identify_source_files(const std::filesystem::path& path, ScanSource& source);
 
 // One scan as a reader delivers it.
 struct ImportedScan {

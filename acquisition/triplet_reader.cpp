@@ -223,13 +223,14 @@ std::string describe(const cv::Mat& image) {
 // Loads one image named by `key` ("range", ...) and checks its grid size; the
 // caller checks the pixel type because each channel accepts different ones.
 struct Image {
+  std::filesystem::path path;
   std::string file;  // UTF-8 path, for messages
   cv::Mat pixels;
 };
 
 Image load_image(const Sidecar& s, const std::string& name, const std::string& key, Grid grid) {
   const fs::path path = s.path.parent_path() / fs::path(std::u8string(name.begin(), name.end()));
-  Image image{.file = utf8(path), .pixels = {}};
+  Image image{.path = path, .file = utf8(path), .pixels = {}};
   const core::FilePosition where = at_detail("named by key \"" + key + ".file\" of the sidecar");
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
@@ -371,7 +372,8 @@ Channels load_channels(const Sidecar& s, Grid grid) {
 
 }  // namespace
 
-Scan read_triplet(const std::filesystem::path& sidecar_json) {
+Scan read_triplet(const std::filesystem::path& sidecar_json,
+                  std::vector<std::filesystem::path>* image_files) {
   const Sidecar s = parse_sidecar(sidecar_json);
   check_format(s);
   const Grid grid = read_grid(s);
@@ -393,6 +395,11 @@ Scan read_triplet(const std::filesystem::path& sidecar_json) {
   scan.T_world_scan = pose;
   scan.scanner =
       ScannerMetadata{.name = scanner, .source_file = s.file, .position_world = position};
+  if (image_files != nullptr) {
+    image_files->push_back(channels.range.path);
+    if (channels.intensity) image_files->push_back(channels.intensity->path);
+    if (channels.color) image_files->push_back(channels.color->path);
+  }
   return scan;
 }
 

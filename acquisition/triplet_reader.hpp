@@ -50,6 +50,7 @@
 #pragma once
 
 #include <filesystem>
+#include <vector>
 
 #include "acquisition/scan.hpp"
 
@@ -69,6 +70,9 @@ namespace scanbench::acquisition {
 // dimensions, non-finite or zero-step angles, non-rigid pose, bad range
 // scale, missing or unreadable images, images of the wrong type or size.
 // Nothing is returned partially. Paths may contain spaces and UTF-8.
-Scan read_triplet(const std::filesystem::path& sidecar_json);
+// `image_files`, when given, receives the images' paths (range, then
+// intensity and colour where the sidecar names them).
+Scan read_triplet(const std::filesystem::path& sidecar_json,
+                  std::vector<std::filesystem::path>* image_files = nullptr);
 
 }  // namespace scanbench::acquisition

@@ -17,9 +17,10 @@ struct SegmentOptions {
 };
 
 void run_segment(const SegmentOptions& options) {
+  // Bad input first: a refused file never opens (nor migrates) the project.
+  const modeling::SegmentScript script = modeling::read_segment_script(options.script);
   modeling::Project project = modeling::Project::open(options.project);
-  const modeling::SegmentScriptResult result =
-      modeling::run_segment_script(project, options.script);
+  const modeling::SegmentScriptResult result = modeling::run_segment_script(project, script);
   if (options.json) {
     fmt::print("{}\n", nlohmann::json{{"ops", result.ops}}.dump(
                            2, ' ', false, nlohmann::json::error_handler_t::replace));

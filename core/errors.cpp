@@ -2,13 +2,14 @@
 
 #include <sstream>
 
+#include "core/text.hpp"
+
 namespace scanbench::core {
 
 // A 5,000-character file name or a 200 KB token must not flood the terminal.
 std::string one_line(std::string text, std::size_t limit) {
   for (char& c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 || byte == 0x7F) c = '?';  // one line, whatever a name holds
+    if (is_control_character(c)) c = '?';  // one line, whatever a name holds
   }
   if (text.size() <= limit) return text;
   const std::size_t half = limit / 2;

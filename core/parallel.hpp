@@ -4,12 +4,12 @@
 #pragma once
 
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cassert>
-#include <thread>
 
 namespace scanbench::core {
 
@@ -18,12 +18,13 @@ namespace scanbench::core {
 inline constexpr int kMaxThreads = 1024;
 
 // The number of workers `threads` stands for: every core when 0, else
-// `threads`, but never more than the machine's cores (more would only
+// `threads`, but never more than the cores it may use (more would only
 // oversubscribe them, and make TBB and Ceres warn). Results never depend on
 // it. Asserts 0 <= threads <= kMaxThreads.
 inline int worker_count(int threads) {
   assert(threads >= 0 && threads <= kMaxThreads && "a thread count outside 0 … kMaxThreads");
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // The cores this process may run on (its affinity mask and cgroup quota).
+  const int cores = std::max(1, tbb::info::default_concurrency());
   return threads > 0 ? std::min(threads, cores) : cores;
 }
 

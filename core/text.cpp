@@ -29,10 +29,7 @@ bool is_valid_utf8(std::string_view text) {
 }
 
 bool has_control_characters(std::string_view text) {
-  return std::any_of(text.begin(), text.end(), [](char c) {
-    const auto byte = static_cast<unsigned char>(c);
-    return byte < 0x20 || byte == 0x7F;
-  });
+  return std::any_of(text.begin(), text.end(), is_control_character);
 }
 
 }  // namespace scanbench::core

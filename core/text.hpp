@@ -10,9 +10,15 @@ namespace scanbench::core {
 // truncated or overlong sequences, no surrogates, nothing above U+10FFFF.
 bool is_valid_utf8(std::string_view text);
 
-// True when `text` holds a C0 control character (U+0000–U+001F: NUL,
-// newline, ESC …) or DEL (U+007F): bytes that would move the cursor or end
-// a line when printed.
+// True for a C0 control character (U+0000–U+001F: NUL, newline, ESC …)
+// or DEL (U+007F): bytes that would move the cursor or end a line when
+// printed.
+inline bool is_control_character(char c) {
+  const auto byte = static_cast<unsigned char>(c);
+  return byte < 0x20 || byte == 0x7F;
+}
+
+// True when `text` holds a control character (is_control_character).
 bool has_control_characters(std::string_view text);
 
 }  // namespace scanbench::core

@@ -146,6 +146,40 @@ std::size_t count_points(const std::vector<acquisition::Scan>& scans,
   return points;
 }
 
+// The files a scan imported before sources were recorded names: its path as
+// typed then (perhaps relative), taken from the current folder and from the
+// project's.
+std::vector<acquisition::SourceFile> recorded_source_files(const Project& project,
+                                                           const std::string& source_file) {
+  const std::filesystem::path path(source_file);
+  if (path.empty()) return {};
+  if (path.is_absolute()) return {acquisition::identify_source_file(path)};
+  return {acquisition::identify_source_file(path),
+          acquisition::identify_source_file(project.path().parent_path() / path)};
+}
+
+// Refuses `output` when it names a file a scan of the project was imported
+// from.
+void refuse_a_source_file(const Project& project,
+                          const std::map<std::int64_t, acquisition::ScanSource>& sources,
+                          const std::filesystem::path& output) {
+  for (const StoredScanSummary& scan : project.scans()) {
+    const auto source = sources.find(scan.id);
+    const std::vector<acquisition::SourceFile> files =
+        source != sources.end() && !source->second.files.empty()
+            ? source->second.files
+            : recorded_source_files(project, scan.summary.scanner.source_file);
+    for (const acquisition::SourceFile& file : files) {
+      if (!acquisition::names_source_file(output, file)) continue;
+      throw core::InputError(output.string(), {},
+                             "is a file scan " + std::to_string(scan.id) + " was imported from (" +
+                                 file.path +
+                                 "); an output never replaces an input of the project, --force "
+                                 "or not");
+    }
+  }
+}
+
 }  // namespace
 
 void refuse_to_replace_inputs(const Project& project,
@@ -169,20 +203,7 @@ void refuse_to_replace_inputs(const Project& project,
       throw core::InputError(output.string(), {},
                              "is the project being exported; an export never replaces its input");
     }
-    for (const StoredScanSummary& scan : project.scans()) {
-      const auto source = sources.find(scan.id);
-      const acquisition::SourceFile file =
-          source != sources.end() && !source->second.file.path.empty()
-              ? source->second.file
-              : acquisition::identify_source_file(scan.summary.scanner.source_file);
-      if (acquisition::names_source_file(output, file)) {
-        throw core::InputError(output.string(), {},
-                               "is the file scan " + std::to_string(scan.id) +
-                                   " was imported from (" + file.path +
-                                   "); an output never replaces an input of the project, "
-                                   "--force or not");
-      }
-    }
+    refuse_a_source_file(project, sources, output);
     // Folders, devices and projects get the output file's own refusal.
     const bool replaceable =
         std::filesystem::is_regular_file(output, error) && !core::is_project_file(output);

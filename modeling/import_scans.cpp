@@ -55,14 +55,29 @@ std::uint64_t image_bytes(const std::vector<acquisition::ScanImage>& images) {
   return bytes;
 }
 
-// Drops what a file's check kept: it is read again when stored.
-void release(CheckedImport::File& file) {
-  file.kept = false;
+// Drops what a file's check kept (it is read again when stored) and
+// returns the bytes it held.
+std::uint64_t release(CheckedImport::File& file) {
+  std::uint64_t bytes = image_bytes(file.loose_images);
   for (CheckedImport::Scan& scan : file.scans) {
+    if (scan.encoded) bytes += encoded_bytes(*scan.encoded) + image_bytes(scan.images);
     scan.encoded.reset();
     scan.images.clear();
   }
   file.loose_images.clear();
+  file.kept = false;
+  return bytes;
+}
+
+// `file` now also keeps `bytes` more: taken from `budget`, or, when they do
+// not fit, everything the file keeps is released (and its bytes given
+// back).
+void keep_within(CheckedImport::File& file, std::uint64_t bytes, std::uint64_t& budget) {
+  if (bytes <= budget) {
+    budget -= bytes;
+  } else {
+    budget += release(file) - bytes;  // what the file held before these bytes
+  }
 }
 
 // Writes one scan, with its source and images, as a part of `command`.
@@ -97,7 +112,7 @@ void store_read_again(Project& project, Project::LongCommand& command,
       throw core::InputError(file.path.string(), {},
                              "the file changed while it was imported; nothing was stored");
     }
-    imported.source.file = file.scans[next].source.file;
+    imported.source.files = file.scans[next].source.files;
     ++next;
     result.scan_ids.push_back(
         store_scan(project, command, encoded, imported.source, imported.images));
@@ -126,7 +141,6 @@ CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
     CheckedImport::File& file = checked.files.emplace_back();
     file.path = files[f];
     file.kept = true;
-    const acquisition::SourceFile identity = acquisition::identify_source_file(file.path);
     const auto on_scan = [&](acquisition::ImportedScan&& imported) {
       CheckedImport::Scan& scan = file.scans.emplace_back();
       scan.name = imported.scan.name;
@@ -134,24 +148,17 @@ CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
       if (!settings.allow_duplicates && !digests.insert(scan.digest).second)
         refuse_duplicate(file.path, imported.scan.name, std::nullopt);
       scan.source = std::move(imported.source);
-      scan.source.file = identity;
+      acquisition::identify_source_files(file.path, scan.source);
       if (!file.kept) return;
       scan.encoded = encode_scan(imported.scan);
       scan.images = std::move(imported.images);
-      const std::uint64_t bytes = encoded_bytes(*scan.encoded) + image_bytes(scan.images);
-      if (bytes > budget) {
-        release(file);
-        return;
-      }
-      budget -= bytes;
+      keep_within(file, encoded_bytes(*scan.encoded) + image_bytes(scan.images), budget);
     };
     const auto on_loose_image = [&](acquisition::ScanImage&& image) {
-      if (!file.kept || image.data.size() > budget) {
-        release(file);
-        return;
-      }
-      budget -= image.data.size();
+      if (!file.kept) return;
+      const std::uint64_t bytes = image.data.size();
       file.loose_images.push_back(std::move(image));
+      keep_within(file, bytes, budget);
     };
     acquisition::read_scan_file(file.path, settings.readers, on_scan, on_loose_image);
     progress.update({kStage, f + 1, 2 * files.size(), file.path.filename().string()});
@@ -161,7 +168,6 @@ CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
 
 ImportResult store_checked_scans(Project& project, const CheckedImport& checked,
                                  const ImportSettings& settings, core::Progress& progress) {
-  const auto start = std::chrono::steady_clock::now();
   std::vector<std::filesystem::path> paths;
   for (const CheckedImport::File& file : checked.files) {
     paths.push_back(file.path);
@@ -205,7 +211,6 @@ ImportResult store_checked_scans(Project& project, const CheckedImport& checked,
     project.remove_layer(finish, stored.id, layer::kKeep);
   }
   finish.commit(nlohmann::json{{"scans", result.scan_ids}}.dump());
-  result.seconds = core::seconds_since(start);
   return result;
 }
 

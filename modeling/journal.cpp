@@ -1,6 +1,7 @@
 // The commands table: Project::begin_command, begin_long_command, the
-// Edit's commits, history, undo, redo and latest_result, and the revision
-// every commit advances.
+// Edit's commits, history, undo and redo (which verify what they make
+// current), latest_result, the revision every commit advances, read
+// snapshots, and batches of commands in one transaction.
 #include <sqlite3.h>
 
 #include <cassert>
@@ -10,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "core/process.hpp"
+#include "modeling/object_tree_cache.hpp"
 #include "modeling/project.hpp"
 #include "modeling/records.hpp"
 #include "modeling/sqlite_statement.hpp"
@@ -131,7 +133,7 @@ std::int64_t Project::revision() const {
 
 Project::Edit Project::begin_command(std::string_view name, const std::string& settings_json,
                                      std::optional<std::int64_t> based_on_revision) {
-  Edit edit(db(), file_name(), 0, Edit::Kind::kCommand, open_.get());
+  Edit edit(db(), file_name(), 0, Edit::Kind::kCommand, connection_.get());
   check_revision(db(), file_name(), name, based_on_revision);
   remove_abandoned(db(), file_name());
   end_redo_branch(db(), file_name());
@@ -149,8 +151,8 @@ Project::Edit Project::begin_command(std::string_view name, const std::string& s
 Project::LongCommand Project::begin_long_command(std::string_view name,
                                                  const std::string& settings_json,
                                                  std::optional<std::int64_t> based_on_revision) {
-  assert(!open_->batch && "a long command inside a Batch");
-  Edit edit(db(), file_name(), 0, Edit::Kind::kPart, open_.get());
+  assert(!connection_->batch && "a long command inside a Batch");
+  Edit edit(db(), file_name(), 0, Edit::Kind::kPart, connection_.get());
   check_revision(db(), file_name(), name, based_on_revision);
   remove_abandoned(db(), file_name());
   sqlite::Statement insert(db(),
@@ -169,7 +171,7 @@ Project::LongCommand Project::begin_long_command(std::string_view name,
 Project::LongCommand::LongCommand(LongCommand&& other) noexcept
     : db_(std::exchange(other.db_, nullptr)),
       file_(std::move(other.file_)),
-      open_(other.open_),
+      connection_(other.connection_),
       command_id_(other.command_id_),
       name_(std::move(other.name_)),
       revision_(other.revision_) {}
@@ -186,8 +188,9 @@ Project::LongCommand::~LongCommand() {
 }
 
 Project::Edit Project::LongCommand::part() {
-  assert(db_ != nullptr && "part of a moved-from LongCommand");
-  Edit edit(db_, file_, command_id_, Edit::Kind::kPart, open_);
+  assert(db_ != nullptr && !connection_->batch &&
+         "part of a moved-from LongCommand, or in a Batch");
+  Edit edit(db_, file_, command_id_, Edit::Kind::kPart, connection_);
   if (!select_one(db_, file_,
                   ("WHERE state = 'pending' AND id = " + std::to_string(command_id_)).c_str())) {
     throw core::RuntimeFailure(file_, {},
@@ -234,29 +237,23 @@ void Project::Edit::finish_transaction() {
   }
   sqlite::execute(db_, nested_ ? "RELEASE edit" : "COMMIT", file_);
   db_ = nullptr;
-  open_->edit = false;
-  if (before) {
-    open_->tree_committed(*before, kind_ == Kind::kJournal);
-  } else if (!open_->tree_writes.empty()) {
-    open_->tree_committed(-1, true);  // a part's nodes stay unseen until it finishes: forget
+  connection_->edit = false;
+  // A whole command's nodes follow into the tree; an undo or redo changes
+  // versions without writing nodes, and a long command's parts stay unseen
+  // until it finishes: then the tree is read again.
+  if (kind_ == Kind::kCommand) {
+    connection_->tree.committed(*before);
+  } else {
+    connection_->tree.forget();
   }
 }
 
-void Project::ConnectionState::tree_committed(std::int64_t revision, bool journal) {
-  if (journal || tree_revision != revision) {
-    tree_revision.reset();
-    tree.clear();
-  } else {
-    for (auto& [id, node] : tree_writes) {
-      if (node) {
-        tree.insert_or_assign(id, std::move(*node));
-      } else {
-        tree.erase(id);
-      }
-    }
-    tree_revision = revision + 1;
-  }
-  tree_writes.clear();
+void Project::require_open_batch(sqlite3* db, ConnectionState& connection,
+                                 const std::string& file) {
+  if (sqlite3_get_autocommit(db) == 0 && !connection.batch_failed) return;
+  throw core::RuntimeFailure(file, {},
+                             "a write failed earlier and SQLite rolled the whole batch back; "
+                             "nothing was stored");
 }
 
 std::vector<CommandRecord> Project::history() const {
@@ -272,7 +269,7 @@ std::vector<CommandRecord> Project::history() const {
 }
 
 std::optional<CommandRecord> Project::undo(std::optional<std::int64_t> only) {
-  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal, open_.get());
+  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal, connection_.get());
   std::optional<CommandRecord> last =
       select_one(db(), file_name(), "WHERE state = 'done' ORDER BY seq DESC LIMIT 1");
   if (!last || !last->undoable || (only && last->id != *only)) return std::nullopt;
@@ -284,7 +281,7 @@ std::optional<CommandRecord> Project::undo(std::optional<std::int64_t> only) {
 }
 
 std::optional<CommandRecord> Project::redo(std::optional<std::int64_t> only) {
-  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal, open_.get());
+  Edit journal(db(), file_name(), 0, Edit::Kind::kJournal, connection_.get());
   std::optional<CommandRecord> next =
       select_one(db(), file_name(), "WHERE state = 'undone' ORDER BY seq LIMIT 1");
   if (!next || (only && next->id != *only)) return std::nullopt;
@@ -301,7 +298,7 @@ void Project::verify_current_rows(std::int64_t command_id) const {
   static_cast<void>(object_nodes());
   static_cast<void>(scan_color_corrections());
   static_cast<void>(scan_sources());
-  static_cast<void>(images(false));
+  static_cast<void>(images(true));
   sqlite::Statement layers(
       db(), "SELECT DISTINCT scan_id, name FROM scan_layers WHERE command_id = ?1", file_name());
   layers.bind_int(1, command_id);
@@ -321,33 +318,31 @@ std::optional<std::string> Project::latest_result(std::string_view name) const {
 }
 
 Project::ReadSnapshot Project::read_snapshot() const {
-  assert(!open_->edit && "a snapshot inside an Edit");
-  if (open_->batch) return ReadSnapshot(nullptr);  // the batch sees one state already
+  assert(!connection_->edit && !connection_->snapshot && "a snapshot inside an Edit or another");
+  if (connection_->batch) return ReadSnapshot(nullptr, nullptr);  // one state already
   sqlite::execute(db(), "BEGIN DEFERRED", file_name());
-  ReadSnapshot snapshot(db());
+  ReadSnapshot snapshot(db(), connection_.get());
   // Under write-ahead logging the snapshot is taken at the first read.
   static_cast<void>(read_revision(db(), file_name()));
   return snapshot;
 }
 
 Project::Batch Project::begin_batch() {
-  assert(!open_->batch && !open_->edit && "a Batch inside an Edit or a Batch");
+  assert(!connection_->batch && !connection_->edit && !connection_->snapshot &&
+         "a Batch inside an Edit, a snapshot or a Batch");
   sqlite::execute(db(), "BEGIN IMMEDIATE", file_name());
-  open_->batch = true;
-  return Batch(db(), file_name(), open_.get());
+  connection_->batch = true;
+  connection_->batch_failed = false;
+  return Batch(db(), file_name(), connection_.get());
 }
 
 void Project::Batch::commit() {
-  assert(db_ != nullptr && !open_->edit && "commit of a finished Batch, or with an Edit open");
-  if (sqlite3_get_autocommit(db_) != 0) {
-    roll_back();
-    throw core::RuntimeFailure(file_, {},
-                               "a write failed earlier and SQLite rolled the whole batch back; "
-                               "nothing was stored");
-  }
+  assert(db_ != nullptr && !connection_->edit &&
+         "commit of a finished Batch, or with an Edit open");
+  require_open_batch(db_, *connection_, file_);
   sqlite::execute(db_, "COMMIT", file_);
   db_ = nullptr;
-  open_->batch = false;
+  connection_->batch = false;
 }
 
 Project::Batch::~Batch() {
@@ -358,14 +353,14 @@ void Project::Batch::roll_back() noexcept {
   if (db_ == nullptr) return;
   if (sqlite3_get_autocommit(db_) == 0) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
   db_ = nullptr;
-  open_->batch = false;
+  connection_->batch = false;
   // The revision goes back, and another process may reach the same number
   // with another tree: what the batch's commands cached is forgotten.
-  open_->tree_revision.reset();
-  open_->tree.clear();
+  connection_->tree.forget();
 }
 
 Project::ReadSnapshot::~ReadSnapshot() {
+  if (connection_ != nullptr) connection_->snapshot = false;
   if (db_ != nullptr && sqlite3_get_autocommit(db_) == 0) {
     sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
   }

@@ -159,7 +159,7 @@ void Project::remove_layer(Edit& edit, std::int64_t id, std::string_view name) {
 }
 
 bool Project::read_layer(
-    std::int64_t id, std::string_view name, ElementType type,
+    std::int64_t id, std::string_view name, std::optional<ElementType> expected,
     const std::function<std::span<std::byte>(std::size_t bytes)>& allocate) const {
   const std::size_t n = stored_pixel_count(id);
   sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
@@ -168,10 +168,13 @@ bool Project::read_layer(
   const LayerFields fields = verified(select, file_name());
   if (fields.codec == "removed") return false;
   if (fields.codec != "zstd") damaged(file_name(), id, name, "unknown codec");
-  if (fields.element_type != element_type_name(type)) {
+  const std::optional<ElementType> stored = element_type_from_name(fields.element_type);
+  if (!stored) damaged(file_name(), id, name, "unknown element type " + fields.element_type);
+  if (expected && *stored != *expected) {
     damaged(file_name(), id, name,
-            "holds " + fields.element_type + " elements, expected " + element_type_name(type));
+            "holds " + fields.element_type + " elements, expected " + element_type_name(*expected));
   }
+  const ElementType type = *stored;
   if (fields.element_count != static_cast<std::int64_t>(n)) {
     damaged(file_name(), id, name,
             "has " + std::to_string(fields.element_count) + " elements, expected " +
@@ -188,18 +191,8 @@ bool Project::read_layer(
 }
 
 void Project::verify_current_layer(std::int64_t id, std::string_view name) const {
-  std::optional<ElementType> type;
-  {
-    sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
-    select.bind_int(1, id).bind_text(2, name);
-    if (!select.step()) return;
-    const LayerFields fields = verified(select, file_name());
-    if (fields.codec == "removed") return;
-    type = element_type_from_name(fields.element_type);
-    if (!type) damaged(file_name(), id, name, "unknown element type " + fields.element_type);
-  }
   std::vector<std::byte> values;
-  read_layer(id, name, *type, [&values](std::size_t bytes) {
+  read_layer(id, name, std::nullopt, [&values](std::size_t bytes) {
     values.resize(bytes);
     return std::span<std::byte>(values);
   });

@@ -1,6 +1,7 @@
-// The object_nodes table: Project::object_nodes, new_node_id, put_node,
-// remove_node. Versioned like poses (project.hpp), checksummed like every
-// record (records.hpp).
+// The object_nodes table: Project::object_tree, object_nodes, nodes_named,
+// new_node_id, put_node, remove_node. Versioned like poses (project.hpp),
+// checksummed like every record (records.hpp); the connection keeps the
+// tree between commands (object_tree_cache.hpp).
 #include <sqlite3.h>
 
 #include <cassert>
@@ -9,6 +10,7 @@
 #include <stdexcept>
 
 #include "core/errors.hpp"
+#include "modeling/object_tree_cache.hpp"
 #include "modeling/project.hpp"
 #include "modeling/records.hpp"
 #include "modeling/sqlite_statement.hpp"
@@ -128,14 +130,11 @@ std::map<std::int64_t, ObjectNode> Project::read_tree() const {
 }
 
 const std::map<std::int64_t, ObjectNode>* Project::current_tree() const {
-  ConnectionState& state = *open_;
-  if (state.edit) return nullptr;
+  ObjectTreeCache& cache = connection_->tree;
+  if (connection_->edit) return nullptr;
   const std::int64_t now = revision();
-  if (state.tree_revision != now) {
-    state.tree = read_tree();
-    state.tree_revision = now;
-  }
-  return &state.tree;
+  if (cache.at(now) == nullptr) cache.remember(now, read_tree());
+  return cache.at(now);
 }
 
 std::map<std::int64_t, ObjectNode> Project::object_tree() const {
@@ -181,7 +180,7 @@ void Project::put_node(Edit& edit, const ObjectNode& node) {
           (node.bbox_world->min().allFinite() && node.bbox_world->max().allFinite())) &&
          "finite bounding box");
   write(db(), file_name(), record_of(node, edit.command_id(), true));
-  open_->tree_writes.emplace_back(node.id, node);
+  connection_->tree.note_write(node.id, node);
 }
 
 void Project::remove_node(Edit& edit, std::int64_t id) {
@@ -191,7 +190,7 @@ void Project::remove_node(Edit& edit, std::int64_t id) {
   ObjectNode node;
   if (!select.step() || !verified_node(select, file_name(), node)) return;
   write(db(), file_name(), record_of(node, edit.command_id(), false));
-  open_->tree_writes.emplace_back(id, std::nullopt);
+  connection_->tree.note_write(id, std::nullopt);
 }
 
 }  // namespace scanbench::modeling

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
+#include "modeling/object_tree_cache.hpp"
 #include "modeling/project_schema.hpp"
 #include "modeling/sqlite_statement.hpp"
 
@@ -149,8 +150,12 @@ void Project::CloseConnection::operator()(sqlite3* db) const noexcept {
 }
 
 Project::Project(std::filesystem::path file, Connection db)
-    : file_(std::move(file)), db_(std::move(db)) {}
+    : file_(std::move(file)),
+      db_(std::move(db)),
+      connection_(std::make_unique<ConnectionState>()) {}
 
+Project::Project(Project&&) noexcept = default;
+Project& Project::operator=(Project&&) noexcept = default;
 Project::~Project() = default;
 
 sqlite3* Project::db() const {
@@ -260,24 +265,21 @@ void Project::check_edit([[maybe_unused]] const Edit& edit) const {
 }
 
 Project::Edit::Edit(sqlite3* db, std::string file, std::int64_t command_id, Kind kind,
-                    ConnectionState* open)
+                    ConnectionState* connection)
     : file_(std::move(file)),
       command_id_(command_id),
       kind_(kind),
-      nested_(open->batch),
-      open_(open) {
-  assert(!open->edit && "an Edit is already open on this project");
+      nested_(connection->batch),
+      connection_(connection) {
+  assert(!connection->edit && !connection->snapshot &&
+         "an Edit inside another Edit or a ReadSnapshot");
   // Outside a transaction a savepoint would begin one of its own, which
   // its release would commit: a batch that SQLite rolled back after a write
   // error must stop here.
-  if (nested_ && sqlite3_get_autocommit(db) != 0) {
-    throw core::RuntimeFailure(file_, {},
-                               "a write failed earlier and SQLite rolled the whole batch back; "
-                               "nothing was stored");
-  }
+  if (nested_) require_open_batch(db, *connection, file_);
   sqlite::execute(db, nested_ ? "SAVEPOINT edit" : "BEGIN IMMEDIATE", file_);
   db_ = db;
-  open->edit = true;
+  connection->edit = true;
 }
 
 Project::Edit::Edit(Edit&& other) noexcept
@@ -286,7 +288,7 @@ Project::Edit::Edit(Edit&& other) noexcept
       command_id_(other.command_id_),
       kind_(other.kind_),
       nested_(other.nested_),
-      open_(other.open_) {}
+      connection_(other.connection_) {}
 
 Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
   if (this != &other) {
@@ -296,7 +298,7 @@ Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
     command_id_ = other.command_id_;
     kind_ = other.kind_;
     nested_ = other.nested_;
-    open_ = other.open_;
+    connection_ = other.connection_;
   }
   return *this;
 }
@@ -310,12 +312,19 @@ void Project::Edit::roll_back() noexcept {
   // SQLite may already have rolled back by itself after an I/O error or a
   // full disk; ROLLBACK would then fail, so only issue it when still open.
   if (sqlite3_get_autocommit(db_) == 0) {
-    sqlite3_exec(db_, nested_ ? "ROLLBACK TO edit; RELEASE edit" : "ROLLBACK", nullptr, nullptr,
-                 nullptr);
+    const int code = sqlite3_exec(db_, nested_ ? "ROLLBACK TO edit; RELEASE edit" : "ROLLBACK",
+                                  nullptr, nullptr, nullptr);
+    // What the refused command wrote may still be in the batch: it must not commit.
+    if (nested_ && code != SQLITE_OK) connection_->batch_failed = true;
   }
   db_ = nullptr;
-  open_->edit = false;
-  open_->tree_writes.clear();
+  connection_->edit = false;
+  connection_->tree.drop_writes();
+}
+
+Project::ReadSnapshot::ReadSnapshot(sqlite3* db, ConnectionState* connection)
+    : db_(db), connection_(connection) {
+  if (connection_ != nullptr) connection_->snapshot = true;
 }
 
 }  // namespace scanbench::modeling

@@ -190,8 +190,8 @@ class Project {
   // it first, opens that one. `created` (when given) tells which happened.
   static Project open_or_create(const std::filesystem::path& file, bool* created = nullptr);
 
-  Project(Project&&) noexcept = default;
-  Project& operator=(Project&&) noexcept = default;
+  Project(Project&&) noexcept;
+  Project& operator=(Project&&) noexcept;
   ~Project();  // closes the connection; an open Edit must be gone by then
 
   // The file as passed to open/create.
@@ -408,29 +408,16 @@ class Project {
   };
   using Connection = std::unique_ptr<sqlite3, CloseConnection>;
 
-  // What is open on the connection (at most one Batch and, inside it or
-  // alone, at most one Edit), and the object tree as of a revision, so that
-  // a script of many tree commands does not read and verify every node's
-  // row again for each. Heap-held so that Edits keep a stable pointer when
-  // the Project moves.
-  struct ConnectionState {
-    bool batch = false;
-    bool edit = false;
-    // The live nodes at `tree_revision`, when known.
-    std::optional<std::int64_t> tree_revision;
-    std::map<std::int64_t, ObjectNode> tree;
-    // The open Edit's node writes, in order (none: removed), applied to
-    // `tree` once it commits.
-    std::vector<std::pair<std::int64_t, std::optional<ObjectNode>>> tree_writes;
-
-    // After an Edit that began at `revision` committed as revision + 1:
-    // the tree follows its writes (or is forgotten when it was not known at
-    // `revision`, or when the Edit was an undo or redo, which writes none).
-    void tree_committed(std::int64_t revision, bool journal);
-  };
+  // What is open on the connection, and its object tree
+  // (modeling/object_tree_cache.hpp).
+  struct ConnectionState;
 
   Project(std::filesystem::path file, Connection db);
   sqlite3* db() const;
+  // Throws core::RuntimeFailure when the batch open on `db` is gone (SQLite
+  // rolled it back after a write error) or a refused Edit in it could not
+  // be rolled back: nothing more may be written, nor the batch committed.
+  static void require_open_batch(sqlite3* db, ConnectionState& connection, const std::string& file);
   // The tree the connection keeps, brought up to the current revision;
   // none inside an Edit, whose writes it does not hold yet. Valid until the
   // next write.
@@ -448,21 +435,24 @@ class Project {
   StoredScanSummary current_summary(std::int64_t id) const;
   // Reads, checksums verified, what the project now holds of everything
   // command `command_id` wrote a version of (after an undo the versions
-  // before it, after a redo its own): scans and poses, nodes, colour
-  // corrections, sources and images, and each of its layers' current
-  // version decoded in full. Throws core::InputError naming the damage.
+  // before it, after a redo its own): every live scan and pose, node,
+  // colour correction, source and image (its data checked against its
+  // CRC), and each layer the command wrote, its current version decoded in
+  // full. Throws core::InputError naming the damage.
   void verify_current_rows(std::int64_t command_id) const;
   // Reads the current version of layer `name` of live scan `id`, its row
   // verified and its data decoded; nothing when there is none.
   void verify_current_layer(std::int64_t id, std::string_view name) const;
   // Decodes the current version of a layer into the buffer `allocate`
-  // returns for its size in bytes; false when there is none.
-  bool read_layer(std::int64_t id, std::string_view name, ElementType type,
+  // returns for its size in bytes; false when there is none. Refused as
+  // damaged when its type is not `expected` (any type it may hold when
+  // none).
+  bool read_layer(std::int64_t id, std::string_view name, std::optional<ElementType> expected,
                   const std::function<std::span<std::byte>(std::size_t bytes)>& allocate) const;
 
   std::filesystem::path file_;
   Connection db_;
-  std::unique_ptr<ConnectionState> open_ = std::make_unique<ConnectionState>();
+  std::unique_ptr<ConnectionState> connection_;
 };
 
 // One write transaction of a command: everything written through the
@@ -510,7 +500,7 @@ class Project::Edit {
   std::int64_t command_id_ = 0;
   Kind kind_ = Kind::kCommand;
   bool nested_ = false;  // a savepoint of a Batch
-  ConnectionState* open_ = nullptr;
+  ConnectionState* connection_ = nullptr;
 };
 
 // A pending command written in parts. Abandoned (removed with its rows) on
@@ -542,14 +532,14 @@ class Project::LongCommand {
               std::optional<std::int64_t> revision)
       : db_(project.db()),
         file_(project.file_name()),
-        open_(project.open_.get()),
+        connection_(project.connection_.get()),
         command_id_(command_id),
         name_(std::move(name)),
         revision_(revision) {}
 
   sqlite3* db_ = nullptr;
   std::string file_;
-  ConnectionState* open_ = nullptr;
+  ConnectionState* connection_ = nullptr;
   std::int64_t command_id_ = 0;
   std::string name_;
   std::optional<std::int64_t> revision_;
@@ -558,23 +548,28 @@ class Project::LongCommand {
 // A read transaction (see Project::read_snapshot); ends on destruction.
 class Project::ReadSnapshot {
  public:
-  ReadSnapshot(ReadSnapshot&& other) noexcept : db_(std::exchange(other.db_, nullptr)) {}
+  ReadSnapshot(ReadSnapshot&& other) noexcept
+      : db_(std::exchange(other.db_, nullptr)),
+        connection_(std::exchange(other.connection_, nullptr)) {}
   ReadSnapshot& operator=(ReadSnapshot&&) = delete;
   ~ReadSnapshot();
 
  private:
   friend class Project;
-  explicit ReadSnapshot(sqlite3* db) : db_(db) {}
+  // Marks the connection as holding a snapshot (none inside a Batch).
+  ReadSnapshot(sqlite3* db, ConnectionState* connection);
   sqlite3* db_ = nullptr;
+  ConnectionState* connection_ = nullptr;
 };
 
 // Several commands as one transaction (see Project::begin_batch). Rolled
-// back on destruction unless committed. Must not outlive its Project, and
-// the Project must not move while it is open.
+// back on destruction unless committed. Must not outlive its Project.
 class Project::Batch {
  public:
   Batch(Batch&& other) noexcept
-      : db_(std::exchange(other.db_, nullptr)), file_(std::move(other.file_)), open_(other.open_) {}
+      : db_(std::exchange(other.db_, nullptr)),
+        file_(std::move(other.file_)),
+        connection_(other.connection_) {}
   Batch& operator=(Batch&&) = delete;
   ~Batch();
 
@@ -586,13 +581,13 @@ class Project::Batch {
 
  private:
   friend class Project;
-  Batch(sqlite3* db, std::string file, ConnectionState* open)
-      : db_(db), file_(std::move(file)), open_(open) {}
+  Batch(sqlite3* db, std::string file, ConnectionState* connection)
+      : db_(db), file_(std::move(file)), connection_(connection) {}
   void roll_back() noexcept;
 
   sqlite3* db_ = nullptr;
   std::string file_;
-  ConnectionState* open_ = nullptr;
+  ConnectionState* connection_ = nullptr;
 };
 
 // A project being built under a temporary name (Project::create_draft).

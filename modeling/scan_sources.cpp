@@ -40,9 +40,10 @@ std::string to_json(const acquisition::ScanSource& source) {
                          {"coordinate_metadata", source.coordinate_metadata},
                          {"points_in_file", source.points_in_file},
                          {"unplaced_points", source.unplaced_points}};
-  if (!source.file.path.empty()) {
-    json["file"] = {
-        {"path", source.file.path}, {"device", source.file.device}, {"inode", source.file.inode}};
+  if (!source.files.empty()) {
+    nlohmann::json& files = json["files"] = nlohmann::json::array();
+    for (const acquisition::SourceFile& file : source.files)
+      files.push_back({{"path", file.path}, {"device", file.device}, {"inode", file.inode}});
   }
   return json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
@@ -55,10 +56,12 @@ acquisition::ScanSource source_from_json(const std::string& text) {
   source.coordinate_metadata = json.value("coordinate_metadata", "");
   source.points_in_file = json.at("points_in_file").get<std::uint64_t>();
   source.unplaced_points = json.at("unplaced_points").get<std::uint64_t>();
-  if (json.contains("file")) {  // imports since the source files were recorded
-    const nlohmann::json& file = json["file"];
-    source.file = {file.at("path").get<std::string>(), file.at("device").get<std::uint64_t>(),
-                   file.at("inode").get<std::uint64_t>()};
+  if (json.contains("files")) {  // imports since the source files were recorded
+    for (const nlohmann::json& file : json["files"]) {
+      source.files.push_back({file.at("path").get<std::string>(),
+                              file.at("device").get<std::uint64_t>(),
+                              file.at("inode").get<std::uint64_t>()});
+    }
   }
   return source;
 }

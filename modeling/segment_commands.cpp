@@ -55,6 +55,20 @@ void require_name(const std::string& name) {
     refuse("name", "holds a control character (a newline, a tab, ESC, NUL …)");
 }
 
+// "`base` N", `base` cut (between UTF-8 characters) so that the name fits
+// kMaxNodeNameBytes.
+std::string numbered_name(const std::string& base, std::size_t number) {
+  const std::string digits = std::to_string(number);
+  std::size_t keep = std::min(base.size(), kMaxNodeNameBytes - 1 - digits.size());
+  while (keep > 0 && keep < base.size() && (static_cast<unsigned char>(base[keep]) & 0xC0) == 0x80)
+    --keep;
+  // Appended apart: GCC 12 warns falsely on chains of std::string operator+ at -O3.
+  std::string name(base, 0, keep);
+  name += ' ';
+  name += digits;
+  return name;
+}
+
 // True when `ancestor` is `node` or above it.
 bool is_at_or_above(const Tree& tree, std::int64_t ancestor, std::int64_t node) {
   for (std::optional<std::int64_t> at = node; at;) {
@@ -309,7 +323,7 @@ SeparateResult separate_object(Project& project, const SeparateSettings& setting
   for (std::size_t k = 1; k < parts.size(); ++k) {
     ObjectNode part = object;
     part.id = next++;
-    part.name = object.name + " " + std::to_string(k + 1);
+    part.name = numbered_name(object.name, k + 1);
     for (const std::uint32_t p : parts[k]) membership[p] = static_cast<std::uint32_t>(part.id);
     tree.emplace(part.id, part);
     made.push_back(part);

@@ -203,7 +203,10 @@ nlohmann::json Runner::apply(const ScriptOp& op, const std::string& at) {
 }  // namespace
 
 SegmentScriptResult run_segment_script(Project& project, const std::filesystem::path& path) {
-  const SegmentScript script = read_segment_script(path);
+  return run_segment_script(project, read_segment_script(path));
+}
+
+SegmentScriptResult run_segment_script(Project& project, const SegmentScript& script) {
   const std::string& file = script.file;
   // One unit: a refused op rolls back every op before it, undos and redos
   // included, and no other process writes in between.

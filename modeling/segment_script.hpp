@@ -23,6 +23,10 @@ struct SegmentScriptResult {
   nlohmann::json ops = nlohmann::json::array();
 };
 
+// Plays `script` (read_segment_script) on `project`.
+SegmentScriptResult run_segment_script(Project& project, const SegmentScript& script);
+
+// Reads the file at `script`, then plays it.
 SegmentScriptResult run_segment_script(Project& project, const std::filesystem::path& script);
 
 }  // namespace scanbench::modeling

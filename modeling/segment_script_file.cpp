@@ -66,10 +66,16 @@ class OpReader {
   nlohmann::json node(const char* key, bool null_allowed) const {
     if (!json_.contains(key)) bad(std::string("key \"") + key + "\" is missing");
     const nlohmann::json& value = json_[key];
-    if (value.is_number_integer() || value.is_string() || (null_allowed && value.is_null()))
-      return value;
-    bad(std::string("key \"") + key + "\" must be a node id or name" +
-        (null_allowed ? ", or null" : ""));
+    if (null_allowed && value.is_null()) return value;
+    return node_reference(value, key);
+  }
+
+  // A NODE: a node id (a whole number a membership layer can name) or a name.
+  nlohmann::json node_reference(const nlohmann::json& value, const std::string& key) const {
+    if (value.is_string()) return value;
+    if (!value.is_number()) bad("key \"" + key + "\" must hold node ids or names");
+    return acquisition::whole_number(value, 1, std::int64_t{kDeletedPoints} - 1, {file_, at_},
+                                     "a node id in key \"" + key + "\"");
   }
 
   const nlohmann::json& json() const { return json_; }
@@ -186,12 +192,8 @@ void read_tree_op(const OpReader& in, ScriptOp& op) {
     if (!in.has(key.c_str())) in.bad("key \"" + key + "\" is missing");
     const nlohmann::json& children = in.json()[key];
     if (!children.is_array()) in.bad("key \"" + key + "\" must be an array of nodes");
-    for (const nlohmann::json& child : children) {
-      if (!child.is_number_integer() && !child.is_string()) {
-        in.bad("key \"" + key + "\" must hold node ids or names");
-      }
-      op.children.push_back(child);
-    }
+    for (const nlohmann::json& child : children)
+      op.children.push_back(in.node_reference(child, key));
     if (op.name == "merge" && op.children.size() < 2) in.bad("merge needs two objects or more");
   }
   if (op.name == "delete") {

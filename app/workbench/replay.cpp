@@ -7,6 +7,7 @@
 
 #include "acquisition/json_input.hpp"
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "render/window/window_device.hpp"
 
 namespace scanbench::app::workbench {
@@ -143,6 +144,7 @@ void add_waits(std::vector<ReplayEvent>& out, int frames) {
 
 // UTF-8 to code points (ASCII and 2–4 byte sequences).
 std::vector<unsigned> codepoints(const std::string& text, const Reader& reader) {
+  if (!core::is_valid_utf8(text)) reader.refuse("text is not valid UTF-8");
   std::vector<unsigned> out;
   for (std::size_t i = 0; i < text.size();) {
     const auto c = static_cast<unsigned char>(text[i]);

@@ -331,6 +331,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"e57_deep_prototype.e57", "nests structures deeper than scanbench reads"},
         BadCase{"e57_short_packet.e57", "data packet too short for its header"},
         BadCase{"e57_repeated_images.e57", "each image needs a blob of its own"},
+        BadCase{"e57_image_offset_in_checksum.e57", "inside a page checksum"},
         BadCase{"e57_section_beyond_file.e57", "beyond the end of the file"},
         BadCase{"e57_no_scan.e57", "/data3D: holds no scan"},
         BadCase{"e57_no_records.e57", "/data3D/0/points: holds no point records"}),

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 
 #include "acquisition/camera_view.hpp"
 #include "acquisition/json_input.hpp"
@@ -50,6 +51,10 @@ TEST(JsonInput, WholeNumbersAreNeverWrappedOrTruncated) {
     EXPECT_THAT(error.what(), HasSubstr("width must be a whole number from 1 to 16384")) << bad;
     EXPECT_THAT(error.what(), HasSubstr("f.json: key \"width\"")) << bad;
   }
+  // 2^63 as a double: beyond any int64, whatever the upper bound.
+  EXPECT_THROW(whole_number(json::parse("9223372036854775807.0"), 1,
+                            std::numeric_limits<std::int64_t>::max(), place, "id"),
+               core::InputError);
   EXPECT_THROW(finite_number(json::parse("1e308"), -1e8, 1e8, place, "x"), core::InputError);
   EXPECT_THROW(refuse_unknown_keys(json::parse(R"({"widht": 3})"), {"width"}, place),
                core::InputError);

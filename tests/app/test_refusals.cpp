@@ -91,6 +91,32 @@ TEST(Refusals, AnExportNeverReplacesTheFilesTheProjectWasImportedFrom) {
   EXPECT_NE(test::read_file_bytes(notes), "keep me");
 }
 
+TEST(Refusals, ATripletsImagesAndAnOlderProjectsRelativeSourcesAreNeverReplaced) {
+  ScratchDir dir;
+  for (const char* name :
+       {"small.json", "small_range.png", "small_intensity.png", "small_color.png"})
+    std::filesystem::copy_file(fixture(std::string("good/triplet/") + name), dir / name);
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), (dir / "small.json").string()}).exit_code, 0);
+  for (const char* image : {"small_range.png", "small_intensity.png", "small_color.png"}) {
+    expect_one_line_error(run_cli(dir, {"export", project.string(), "--format", "ply", "-o",
+                                        (dir / image).string(), "--force"}),
+                          2, "imported from");
+  }
+  // A project of schema 7 recorded its E57 scan's file as typed, relative
+  // to the folder it was imported from: taken from the project's folder too.
+  const std::filesystem::path old = dir / "old" / "version7.sbproj";
+  const std::filesystem::path source = dir / "old/fixtures/good/e57/structured_spherical.e57";
+  std::filesystem::create_directories(source.parent_path());
+  std::filesystem::copy_file(fixture("projects/version7.sbproj"), old);
+  std::filesystem::copy_file(fixture("good/e57/structured_spherical.e57"), source);
+  const std::string bytes = test::read_file_bytes(source);
+  expect_one_line_error(run_cli(dir, {"export", old.string(), "--format", "e57", "--scan", "4",
+                                      "-o", source.string(), "--force"}),
+                        2, "is a file scan 4 was imported from");
+  EXPECT_EQ(test::read_file_bytes(source), bytes);
+}
+
 TEST(Refusals, NumbersTooLargeForADoubleAreBadInputNamingTheFileAndLine) {
   ScratchDir dir;
   const std::filesystem::path project = dir / "p.sbproj";
@@ -151,6 +177,26 @@ TEST(Refusals, NodeNamesHoldNoControlCharactersAndAreBounded) {
     expect_one_line_error(run, 2, "name");
   }
   EXPECT_EQ(test::read_file_bytes(project), before);
+}
+
+TEST(Refusals, AScriptThatCannotBeWrittenWholeStoresNothing) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  const std::string history = run_cli(dir, {"history", project.string(), "--json"}).out;
+  std::string ops;
+  for (int k = 0; k < 40; ++k) ops += std::string(k ? "," : "") + R"({"op": "group", "name": "g"})";
+  const std::filesystem::path script = write_text(dir, "ops.json", R"({"ops": [)" + ops + "]}");
+  // The write-ahead log may not grow past 8 KB: the batch's commit fails.
+  const CliResult full =
+      test::run_shell(dir, "trap '' XFSZ; ulimit -f 16; exec \"$SCANBENCH\" segment " +
+                               test::shell_quote(project.string()) + " --script " +
+                               test::shell_quote(script.string()));
+  expect_one_line_error(full, 1, "p.sbproj");
+  EXPECT_EQ(run_cli(dir, {"history", project.string(), "--json"}).out, history);
+  EXPECT_EQ(run_cli(dir, {"check", project.string()}).exit_code, 0);
 }
 
 TEST(Refusals, ARefusedImportLeavesTheFileByteForByteAndIsBadInputEvenReadOnly) {

@@ -175,8 +175,8 @@ TEST(Integrity, AChangedLayerRowIsFoundOnReadingAndByTheCheck) {
   EXPECT_THAT(report.damage[0], HasSubstr("layer intensitx of command 1: its row"));
 }
 
-// Two versions of one node and of one layer: command 2 writes the first,
-// command 3 the second. Returns the project's file.
+// Two versions of one node, of one layer and of a pose: command 2 writes
+// the first, command 3 the second. Returns the project's file.
 std::filesystem::path two_versions(const ScratchDir& dir) {
   const auto file = sound_project(dir);
   Project project = Project::open(file);
@@ -191,6 +191,9 @@ std::filesystem::path two_versions(const ScratchDir& dir) {
     project.put_layer(edit, scan,
                       encode_layer<std::uint8_t>("selection", ElementType::kU8,
                                                  std::vector<std::uint8_t>(pixels, name[0])));
+    acquisition::Scan moved = project.load_scan(scan);
+    moved.T_world_scan.translation().x() += 1.0;
+    project.set_pose(edit, scan, moved);
     edit.commit("{}");
   }
   return file;
@@ -222,6 +225,20 @@ TEST(Integrity, UndoAndRedoRefuseToMakeADamagedVersionCurrent) {
     EXPECT_EQ(project.object_nodes().front().name, "north wall");
   }
   RawDatabase(file).execute("UPDATE object_nodes SET name = 'wall' WHERE command_id = 2");
+  // The older pose is damaged.
+  RawDatabase(file).execute("UPDATE scan_poses SET scanner_z = scanner_z + 1 WHERE command_id = 2");
+  {
+    Project project = Project::open(file);
+    const std::string journal = journal_of(project);
+    try {
+      project.undo();
+      ADD_FAILURE() << "undo made a damaged pose current";
+    } catch (const core::InputError& error) {
+      EXPECT_THAT(error.problem(), HasSubstr("pose fails its checksum"));
+    }
+    EXPECT_EQ(journal_of(project), journal);
+  }
+  RawDatabase(file).execute("UPDATE scan_poses SET scanner_z = scanner_z - 1 WHERE command_id = 2");
   // The newer version is undone, then its layer's data damaged: redo would
   // make it current.
   {

@@ -50,8 +50,9 @@ TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournalIndexed
     const Project project = Project::open(file);
     const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
     ASSERT_EQ(sources.size(), 2u);
-    EXPECT_EQ(std::filesystem::path(sources.at(5).file.path).filename(), "station.ptx");
-    EXPECT_NE(sources.at(5).file.inode, 0u);
+    ASSERT_EQ(sources.at(5).files.size(), 1u);
+    EXPECT_EQ(std::filesystem::path(sources.at(5).files[0].path).filename(), "station.ptx");
+    EXPECT_NE(sources.at(5).files[0].inode, 0u);
     const std::vector<CommandRecord> history = project.history();
     EXPECT_EQ(history.back().name, "group");
     EXPECT_EQ(history.back().state, CommandState::kUndone);

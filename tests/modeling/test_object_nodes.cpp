@@ -145,5 +145,39 @@ TEST(ObjectNodes, ADamagedNodeRowIsFoundByCheckAndRefusedWhenRead) {
   }
 }
 
+// The tree a connection keeps between commands follows its own commits,
+// and is read again after another process's commit, an undo, a refused
+// edit and a rolled-back batch (whose revision another process may reach
+// again with another tree).
+TEST(ObjectNodes, TheTreeAConnectionKeepsIsNeverStale) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  Project mine = Project::create(file);
+  commit_nodes(mine, {group(1, "site")});
+  ASSERT_EQ(mine.nodes_named("site"), std::vector<std::int64_t>{1});
+  commit_nodes(mine, {group(1, "campus")});  // followed from the commit itself
+  EXPECT_EQ(mine.nodes_named("campus"), std::vector<std::int64_t>{1});
+  Project other = Project::open(file);
+  commit_nodes(other, {group(1, "north campus")});
+  EXPECT_EQ(mine.object_nodes().front().name, "north campus");
+  ASSERT_TRUE(mine.undo());
+  EXPECT_EQ(mine.object_nodes().front().name, "campus");
+  {
+    Project::Edit refused = mine.begin_command("objects", "{}");
+    mine.put_node(refused, group(1, "refused"));
+  }  // rolled back
+  EXPECT_EQ(mine.object_nodes().front().name, "campus");
+  const std::int64_t revision = mine.revision();
+  {
+    Project::Batch batch = mine.begin_batch();
+    commit_nodes(mine, {group(1, "in the batch")});
+    EXPECT_EQ(mine.object_nodes().front().name, "in the batch");
+  }  // rolled back: the revision goes back
+  EXPECT_EQ(mine.revision(), revision);
+  commit_nodes(other, {group(1, "the other's")});
+  EXPECT_EQ(mine.revision(), revision + 1);
+  EXPECT_EQ(mine.object_nodes().front().name, "the other's");
+}
+
 }  // namespace
 }  // namespace scanbench::modeling

@@ -42,7 +42,7 @@ TEST(SegmentScript, ARefusedScriptThatBeganWithUndoKeepsTheUndoneCommandRedoable
   store_room(project);
   run_segment_script(project, write_script(dir, R"({"ops": [{"op": "group", "name": "trees"}]})"));
   const std::string journal = journal_of(project);
-  const std::string bytes = test::read_file_bytes(file);
+  const std::int64_t revision = project.revision();
   // Undoes the group, grows and commits (which would end the redo chain),
   // then is refused.
   const std::filesystem::path script = write_script(dir, R"({"ops": [
@@ -58,7 +58,7 @@ TEST(SegmentScript, ARefusedScriptThatBeganWithUndoKeepsTheUndoneCommandRedoable
     EXPECT_THAT(error.what(), HasSubstr("the script stored nothing"));
   }
   EXPECT_EQ(journal_of(project), journal);
-  EXPECT_EQ(test::read_file_bytes(file), bytes);
+  EXPECT_EQ(project.revision(), revision);
   ASSERT_EQ(project.object_nodes().size(), 1u);
   // The group is still the newest command: undo takes it, redo brings it back.
   const std::optional<CommandRecord> undone = project.undo();
@@ -80,17 +80,17 @@ TEST(SegmentScript, AScriptIsWholeWhileAnotherProcessWrites) {
   for (int k = 0; k < 22; ++k) ops += R"({"op": "group", "name": "g)" + std::to_string(k) + "\"},";
   const std::filesystem::path script =
       write_script(dir, R"({"ops": [)" + ops + R"({"op": "hide", "node": "other"}]})");
-  // Another connection renames the group over and over while the script
-  // runs: its writes wait for the script (or are refused, when the script
-  // committed while they computed), and none lands inside it.
+  // Another connection renames the group over and over while the scripts
+  // run: its writes wait for a script (or are refused, when the script
+  // committed while they computed), and none lands inside one.
   std::atomic<bool> done = false;
-  int renames = 0;
+  std::atomic<int> renames = 0;
   std::thread other([&] {
     Project writer = Project::open(file);
-    while (!done) {
+    for (int k = 0; !done; ++k) {
       NodeEdit edit;
-      edit.node = writer.object_nodes().front().id;
-      edit.name = "other";
+      edit.node = writer.nodes_named("other").front();
+      edit.hidden = k % 2 == 0;
       try {
         edit_node(writer, edit);
         ++renames;
@@ -100,11 +100,22 @@ TEST(SegmentScript, AScriptIsWholeWhileAnotherProcessWrites) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const auto wait_for_renames = [&renames](int at_least) {
+    while (renames < at_least) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  wait_for_renames(1);
   const SegmentScriptResult result = run_segment_script(project, script);
+  // A script refused at its last op while the other writes: none of its
+  // groups stays.
+  const int before_refused = renames;
+  std::string refused = R"({"ops": [)";
+  for (int k = 0; k < 10; ++k) refused += R"({"op": "group", "name": "refused"},)";
+  refused += R"({"op": "hide", "node": "no such node"}]})";
+  EXPECT_THROW(run_segment_script(project, write_script(dir, refused)), core::InputError);
+  wait_for_renames(before_refused + 1);
   done = true;
   other.join();
-  EXPECT_GT(renames, 0);
+  EXPECT_TRUE(project.nodes_named("refused").empty());
   ASSERT_EQ(result.ops.size(), 25u);
   // The script's commands follow each other in the journal, with no other
   // command between them.
