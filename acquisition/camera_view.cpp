@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
-#include "acquisition/json_input.hpp"
+#include "acquisition/formats/json_input.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "core/errors.hpp"
 

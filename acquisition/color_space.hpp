@@ -29,6 +29,20 @@ Eigen::Vector3d srgb_to_lab(const std::array<std::uint8_t, 3>& rgb);
 // L*a*b* → 8-bit sRGB, out-of-gamut channels clamped.
 std::array<std::uint8_t, 3> lab_to_srgb(const Eigen::Vector3d& lab);
 
+// A colour correction in linear RGB, where exposure and white balance are
+// gains: rgb' = matrix · rgb + offset. registration/color_harmonization.hpp
+// solves one per scan; the project stores it, and the model shows colours
+// through it.
+struct ColorCorrection {
+  Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  Eigen::Vector3d apply(const Eigen::Vector3d& rgb) const { return matrix * rgb + offset; }
+  bool identity() const {
+    return matrix == Eigen::Matrix3d::Identity() && offset == Eigen::Vector3d::Zero();
+  }
+  bool operator==(const ColorCorrection&) const = default;
+};
+
 // CIE 1976 colour difference: the Euclidean distance in L*a*b*.
 inline double delta_e(const Eigen::Vector3d& lab_a, const Eigen::Vector3d& lab_b) {
   return (lab_a - lab_b).norm();

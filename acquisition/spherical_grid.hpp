@@ -10,7 +10,7 @@
 #include <numbers>
 #include <type_traits>
 
-#include "acquisition/fast_atan2.hpp"
+#include "acquisition/geometry/fast_atan2.hpp"
 #include "acquisition/scan.hpp"
 
 namespace scanbench::acquisition {

@@ -7,7 +7,7 @@
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -19,8 +19,8 @@ struct CheckOptions {
 
 void run_check(const CheckOptions& options) {
   // A diagnosis never changes what it diagnoses: no migration, no recovery.
-  const modeling::Project project = modeling::Project::open_read_only(options.project);
-  const modeling::Project::CheckReport report = project.check();
+  const store::Project project = store::Project::open_read_only(options.project);
+  const store::Project::CheckReport report = project.check();
   if (options.json) {
     fmt::print("{}\n", nlohmann::json{{"damage", report.damage},
                                       {"records", report.records},

@@ -15,7 +15,9 @@
 #include "app/progress_bar.hpp"
 #include "core/errors.hpp"
 #include "modeling/color_commands.hpp"
-#include "modeling/registration_stage.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -23,7 +25,7 @@ namespace {
 struct RecolorOptions {
   std::string project;
   std::string object;  // an id or a unique name
-  modeling::ColorEdit set;
+  store::ColorEdit set;
   bool reset = false;
   std::string target;
   std::string clone;
@@ -34,7 +36,7 @@ struct RecolorOptions {
 };
 
 // A node named by its id or by its name (which must be unique).
-std::int64_t node_named(const modeling::Project& project, const std::string& option,
+std::int64_t node_named(const store::Project& project, const std::string& option,
                         const std::string& text) {
   std::int64_t id = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), id);
@@ -80,8 +82,8 @@ std::array<std::uint8_t, 3> parse_color(const std::string& text) {
           static_cast<std::uint8_t>(value)};
 }
 
-void print_edit(const modeling::ObjectNode& node) {
-  const std::string json = modeling::to_json(node.color);
+void print_edit(const store::ObjectNode& node) {
+  const std::string json = store::to_json(node.color);
   fmt::print("node {} ({}): colour edit {}\n", node.id,
              core::one_line(node.name, core::kMaxMessagePart),
              json.empty() ? "none (inherits its parent's)" : json);
@@ -98,7 +100,7 @@ void run_recolor(const RecolorOptions& options) {
     throw CLI::ValidationError("--object", "edits an object; a clone names its target with --to");
   if (cloning && (!options.set.empty() || options.reset))
     throw CLI::ValidationError("--to", "clones colours; edit parameters go with --object");
-  modeling::Project project = modeling::Project::open(options.project);
+  store::Project project = store::Project::open(options.project);
   std::int64_t node_id = 0;
   std::string result;
   if (editing) {
@@ -127,10 +129,10 @@ void run_recolor(const RecolorOptions& options) {
                  out.source_points);
     }
   }
-  for (const modeling::ObjectNode& node : project.object_nodes()) {
+  for (const store::ObjectNode& node : project.object_nodes()) {
     if (node.id != node_id) continue;
     if (options.json) {
-      const std::string json = modeling::to_json(node.color);
+      const std::string json = store::to_json(node.color);
       fmt::print("{{\"node\":{},\"color\":{}}}\n", node.id, json.empty() ? "{}" : json);
     } else {
       print_edit(node);
@@ -140,14 +142,14 @@ void run_recolor(const RecolorOptions& options) {
 
 struct HarmonizeOptions {
   std::string project;
-  modeling::HarmonizeStageSettings settings;
+  modeling::HarmonizeCommandSettings settings;
   bool json = false;
 };
 
 void run_harmonize(const HarmonizeOptions& options) {
-  modeling::Project project = modeling::Project::open(options.project);
+  store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::HarmonizeStageResult out =
+  const modeling::HarmonizeCommandResult out =
       modeling::harmonize_project(project, options.settings, progress);
   if (options.json) {
     fmt::print("{}\n", modeling::harmonize_result_json(out));
@@ -155,7 +157,7 @@ void run_harmonize(const HarmonizeOptions& options) {
   }
   fmt::print("{:>4}  {:<24} {:>9} {:>10} {:>9}  {}\n", "id", "name", "pairs", "ΔE before",
              "ΔE after", "gains (R G B), offsets");
-  for (const modeling::HarmonizeStageScan& s : out.scans) {
+  for (const modeling::HarmonizeCommandScan& s : out.scans) {
     fmt::print("{:>4}  {:<24} {:>9} {:>10.2f} {:>9.2f}  ", s.id, s.name, s.pairs, s.delta_e_before,
                s.delta_e_after);
     if (!s.reference) {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "app/commands.hpp"
-#include "modeling/export_project.hpp"
+#include "modeling/export_command.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -21,7 +21,7 @@ struct ExportOptions {
 void run_export(ExportOptions& options) {
   options.settings.scan_id = options.scan_id;
   options.settings.output = options.output;
-  const modeling::Project project = modeling::Project::open_for_reading(options.project);
+  const store::Project project = store::Project::open_for_reading(options.project);
   const modeling::ExportResult result = modeling::export_project(project, options.settings);
   fmt::print("exported {} scan(s), {} {} points, to {}\n", result.scans, result.points,
              options.settings.merged ? "merged-model" : "valid", options.output);

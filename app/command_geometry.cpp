@@ -6,7 +6,7 @@
 
 #include "app/commands.hpp"
 #include "app/progress_bar.hpp"
-#include "modeling/geometry_stage.hpp"
+#include "modeling/geometry_command.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -23,13 +23,13 @@ void run_geometry(GeometryOptions& options) {
     throw CLI::ValidationError("--edge-window", "must not exceed --window");
   }
   options.geometry.flag_mixed_pixels = !options.no_mixed_pixels;
-  modeling::Project project = modeling::Project::open(options.project);
+  store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::GeometryStageResult result =
-      modeling::run_geometry_stage(project, options.geometry, progress);
+  const modeling::GeometryCommandResult result =
+      modeling::geometry_project(project, options.geometry, progress);
   fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8}\n", "id", "name", "valid", "normals",
              "mixed", "edges", "seconds");
-  for (const modeling::GeometryStageScan& s : result.scans) {
+  for (const modeling::GeometryCommandScan& s : result.scans) {
     fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8.3f}\n", s.id, s.name, s.valid_points,
                s.normals, s.mixed_pixels, s.edge_pixels, s.seconds);
   }

@@ -7,7 +7,7 @@
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -17,15 +17,15 @@ struct HistoryOptions {
   bool json = false;
 };
 
-const char* state_name(modeling::CommandState state) {
+const char* state_name(store::CommandState state) {
   switch (state) {
-    case modeling::CommandState::kDone:
+    case store::CommandState::kDone:
       return "done";
-    case modeling::CommandState::kUndone:
+    case store::CommandState::kUndone:
       return "undone";
-    case modeling::CommandState::kPending:
+    case store::CommandState::kPending:
       return "pending";
-    case modeling::CommandState::kInterrupted:
+    case store::CommandState::kInterrupted:
       return "interrupted";
   }
   return "";
@@ -35,9 +35,10 @@ nlohmann::json parsed(const std::string& text) {
   return nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
 }
 
-// One line on what a command did, from its result.
-std::string summary(const modeling::CommandRecord& c) {
-  if (c.state == modeling::CommandState::kInterrupted)
+// One line on what a command did, from its result. Longer than 60 lines,
+// but flat: one case per command name, read at a glance.
+std::string summary(const store::CommandRecord& c) {
+  if (c.state == store::CommandState::kInterrupted)
     return "its process ended before it finished: nothing was stored";
   const nlohmann::json result = parsed(c.result);
   const nlohmann::json settings = parsed(c.settings);
@@ -102,7 +103,7 @@ std::string summary(const modeling::CommandRecord& c) {
   return "";
 }
 
-nlohmann::json to_json(const modeling::CommandRecord& c) {
+nlohmann::json to_json(const store::CommandRecord& c) {
   return {{"id", c.id},
           {"name", c.name},
           {"state", state_name(c.state)},
@@ -113,31 +114,31 @@ nlohmann::json to_json(const modeling::CommandRecord& c) {
 }
 
 void run_history(const HistoryOptions& options) {
-  const modeling::Project project = modeling::Project::open_for_reading(options.project);
-  const std::vector<modeling::CommandRecord> history = project.history();
+  const store::Project project = store::Project::open_for_reading(options.project);
+  const std::vector<store::CommandRecord> history = project.history();
   if (options.json) {
     nlohmann::json commands = nlohmann::json::array();
-    for (const modeling::CommandRecord& c : history) commands.push_back(to_json(c));
+    for (const store::CommandRecord& c : history) commands.push_back(to_json(c));
     fmt::print("{}\n", nlohmann::json{{"commands", commands}}.dump(
                            2, ' ', false, nlohmann::json::error_handler_t::replace));
     return;
   }
   fmt::print("{:>4}  {:<11} {:<10} {:<24}  {}\n", "id", "state", "command", "at (UTC)", "what");
-  for (const modeling::CommandRecord& c : history) {
+  for (const store::CommandRecord& c : history) {
     fmt::print("{:>4}  {:<11} {:<10} {:<24}  {}\n", c.id, state_name(c.state), c.name, c.created_at,
                summary(c));
   }
 }
 
 void run_undo(const std::string& path) {
-  modeling::Project project = modeling::Project::open(path);
-  const std::optional<modeling::CommandRecord> undone = project.undo();
+  store::Project project = store::Project::open(path);
+  const std::optional<store::CommandRecord> undone = project.undo();
   if (!undone) {
     // undo() declines only when no command is done or the newest done one
     // is an older project's history.
     bool any_done = false;
-    for (const modeling::CommandRecord& c : project.history()) {
-      any_done = any_done || c.state == modeling::CommandState::kDone;
+    for (const store::CommandRecord& c : project.history()) {
+      any_done = any_done || c.state == store::CommandState::kDone;
     }
     throw core::InputError(path, {},
                            any_done ? "nothing to undo: what is left was stored before this "
@@ -149,8 +150,8 @@ void run_undo(const std::string& path) {
 }
 
 void run_redo(const std::string& path) {
-  modeling::Project project = modeling::Project::open(path);
-  const std::optional<modeling::CommandRecord> redone = project.redo();
+  store::Project project = store::Project::open(path);
+  const std::optional<store::CommandRecord> redone = project.redo();
   if (!redone) throw core::InputError(path, {}, "nothing to redo");
   fmt::print("redid {} {} ({})\n", redone->id, redone->name, redone->created_at);
 }

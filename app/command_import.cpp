@@ -8,7 +8,7 @@
 
 #include "app/commands.hpp"
 #include "app/progress_bar.hpp"
-#include "modeling/import_scans.hpp"
+#include "modeling/import_command.hpp"
 
 namespace scanbench::app {
 namespace {

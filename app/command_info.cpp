@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/formats/scan_files.hpp"
 #include "acquisition/rigid_transform.hpp"
-#include "acquisition/scan_files.hpp"
 #include "acquisition/scan_summary.hpp"
 #include "app/commands.hpp"
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -47,7 +47,7 @@ struct Contents {
 
 Contents project_entries(const std::filesystem::path& path) {
   Contents contents;
-  const modeling::Project project = modeling::Project::open_for_reading(path);
+  const store::Project project = store::Project::open_for_reading(path);
   const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
   for (auto& stored : project.scans()) {
     const auto source = sources.find(stored.id);
@@ -55,7 +55,7 @@ Contents project_entries(const std::filesystem::path& path) {
         {stored.id, std::move(stored.summary),
          source == sources.end() ? std::nullopt : std::optional(source->second)});
   }
-  for (modeling::StoredImage& stored : project.images(true)) {
+  for (store::StoredImage& stored : project.images(true)) {
     const std::size_t bytes = stored.image.data.size();
     stored.image.data = {};
     contents.images.push_back({stored.id, stored.scan_id, std::move(stored.image), bytes});

@@ -6,7 +6,9 @@
 
 #include "app/commands.hpp"
 #include "app/progress_bar.hpp"
-#include "modeling/registration_stage.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -18,18 +20,18 @@ struct MergeOptions {
 };
 
 void run_merge(const MergeOptions& options) {
-  modeling::Project project = modeling::Project::open(options.project);
+  store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::MergeStageResult out =
+  const modeling::MergeCommandResult out =
       modeling::merge_project(project, options.settings, progress);
   if (options.json) {
     fmt::print("{}\n", modeling::merge_result_json(out));
     return;
   }
   std::size_t kept = 0;
-  for (const modeling::MergeStageScan& s : out.scans) kept += s.counts.kept;
+  for (const modeling::MergeCommandScan& s : out.scans) kept += s.counts.kept;
   fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>10}\n", "id", "name", "in model", "kept", "redundant");
-  for (const modeling::MergeStageScan& s : out.scans) {
+  for (const modeling::MergeCommandScan& s : out.scans) {
     fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>10}\n", s.id, s.name, s.counts.in_model,
                s.counts.kept, s.counts.redundant);
   }

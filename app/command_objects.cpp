@@ -10,7 +10,7 @@
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -20,7 +20,7 @@ struct ObjectsOptions {
   bool json = false;
 };
 
-nlohmann::json to_json(const modeling::ObjectNode& node) {
+nlohmann::json to_json(const store::ObjectNode& node) {
   nlohmann::json bbox = nullptr;
   if (node.bbox_world) {
     const Eigen::Vector3d lo = node.bbox_world->min(), hi = node.bbox_world->max();
@@ -29,7 +29,7 @@ nlohmann::json to_json(const modeling::ObjectNode& node) {
   nlohmann::json out = {
       {"id", node.id},
       {"name", node.name},
-      {"kind", node.kind == modeling::NodeKind::kGroup ? "group" : "object"},
+      {"kind", node.kind == store::NodeKind::kGroup ? "group" : "object"},
       {"parent", node.parent ? nlohmann::json(*node.parent) : nlohmann::json(nullptr)},
       {"hidden", node.hidden},
       {"points", node.points},
@@ -37,19 +37,19 @@ nlohmann::json to_json(const modeling::ObjectNode& node) {
        node.mean_footprint_m ? nlohmann::json(*node.mean_footprint_m) : nlohmann::json()},
       {"bbox_world", bbox}};
   // The node's own colour edit (what it inherits is not repeated).
-  if (const std::string color = modeling::to_json(node.color); !color.empty())
+  if (const std::string color = store::to_json(node.color); !color.empty())
     out["color"] = nlohmann::json::parse(color);
   return out;
 }
 
 // The tree depth first, children by id, each level indented by two spaces.
 // A node whose parent is not in the tree is printed as a root.
-void print_tree(const std::vector<modeling::ObjectNode>& nodes) {
-  std::map<std::int64_t, const modeling::ObjectNode*> by_id;
-  for (const modeling::ObjectNode& node : nodes) by_id[node.id] = &node;
-  std::map<std::int64_t, std::vector<const modeling::ObjectNode*>> children;
-  std::vector<const modeling::ObjectNode*> roots;
-  for (const modeling::ObjectNode& node : nodes) {
+void print_tree(const std::vector<store::ObjectNode>& nodes) {
+  std::map<std::int64_t, const store::ObjectNode*> by_id;
+  for (const store::ObjectNode& node : nodes) by_id[node.id] = &node;
+  std::map<std::int64_t, std::vector<const store::ObjectNode*>> children;
+  std::vector<const store::ObjectNode*> roots;
+  for (const store::ObjectNode& node : nodes) {
     if (node.parent && by_id.count(*node.parent)) {
       children[*node.parent].push_back(&node);
     } else {
@@ -57,21 +57,21 @@ void print_tree(const std::vector<modeling::ObjectNode>& nodes) {
     }
   }
   fmt::print("{:>5}  {:<7} {:>10}  {}\n", "id", "kind", "points", "name");
-  const std::function<void(const modeling::ObjectNode&, int)> print = [&](const auto& node,
-                                                                          int depth) {
+  const std::function<void(const store::ObjectNode&, int)> print = [&](const auto& node,
+                                                                       int depth) {
     fmt::print("{:>5}  {:<7} {:>10}  {}{}{}{}\n", node.id,
-               node.kind == modeling::NodeKind::kGroup ? "group" : "object", node.points,
+               node.kind == store::NodeKind::kGroup ? "group" : "object", node.points,
                std::string(static_cast<std::size_t>(2 * depth), ' '),
                core::one_line(node.name, core::kMaxMessagePart), node.hidden ? " (hidden)" : "",
                node.color.empty() ? "" : " (recoloured)");
-    for (const modeling::ObjectNode* child : children[node.id]) print(*child, depth + 1);
+    for (const store::ObjectNode* child : children[node.id]) print(*child, depth + 1);
   };
-  for (const modeling::ObjectNode* root : roots) print(*root, 0);
+  for (const store::ObjectNode* root : roots) print(*root, 0);
 }
 
 void run_objects(const ObjectsOptions& options) {
-  const modeling::Project project = modeling::Project::open_for_reading(options.project);
-  const std::vector<modeling::ObjectNode> nodes = project.object_nodes();
+  const store::Project project = store::Project::open_for_reading(options.project);
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
   if (!options.json) {
     if (nodes.empty()) {
       fmt::print("{}: no objects yet\n", options.project);
@@ -81,7 +81,7 @@ void run_objects(const ObjectsOptions& options) {
     return;
   }
   nlohmann::json out = nlohmann::json::array();
-  for (const modeling::ObjectNode& node : nodes) out.push_back(to_json(node));
+  for (const store::ObjectNode& node : nodes) out.push_back(to_json(node));
   fmt::print("{}\n", nlohmann::json{{"nodes", out}}.dump(2, ' ', false,
                                                          nlohmann::json::error_handler_t::replace));
 }

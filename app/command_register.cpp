@@ -8,9 +8,11 @@
 #include <string>
 
 #include "app/commands.hpp"
-#include "app/point_pairs_file.hpp"
+#include "app/formats/point_pairs_file.hpp"
 #include "app/progress_bar.hpp"
-#include "modeling/registration_stage.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -25,7 +27,7 @@ struct RegisterOptions {
   bool json = false;
 };
 
-void print_table(const modeling::RegisterStageResult& out) {
+void print_table(const modeling::RegisterCommandResult& out) {
   const registration::RegistrationResult& r = out.result;
   fmt::print("{:>6} {:>6}  {:<10} {:<8} {:>9} {:>8} {:>8} {:>5}  {}\n", "source", "target",
              "coarse", "start", "rms [mm]", "overlap", "inliers", "iter", "result");
@@ -46,7 +48,7 @@ void print_table(const modeling::RegisterStageResult& out) {
 }
 
 void run_register(const RegisterOptions& options) {
-  modeling::RegisterStageSettings settings;
+  modeling::RegisterCommandSettings settings;
   registration::RegistrationSettings& s = settings.registration;
   s.coarse = options.coarse;
   if (!options.pairs_file.empty()) {
@@ -61,9 +63,10 @@ void run_register(const RegisterOptions& options) {
   s.features.levelled = !options.unlevelled;
   s.refine_globally = !options.no_global;
   s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;
-  modeling::Project project = modeling::Project::open(options.project);
+  store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::RegisterStageResult out = modeling::register_project(project, settings, progress);
+  const modeling::RegisterCommandResult out =
+      modeling::register_project(project, settings, progress);
   if (options.json) {
     fmt::print("{}\n", out.report_json);
   } else {

@@ -10,12 +10,12 @@
 #include <string>
 
 #include "acquisition/camera_view.hpp"
-#include "acquisition/picture_file.hpp"
+#include "acquisition/formats/picture_file.hpp"
 #include "app/commands.hpp"
 #include "core/timing.hpp"
-#include "modeling/export_project.hpp"
-#include "modeling/render_model.hpp"
+#include "modeling/export_command.hpp"
 #include "render/device.hpp"
+#include "render/render_model.hpp"
 #include "render/splat_renderer.hpp"
 
 namespace scanbench::app {
@@ -49,13 +49,13 @@ void run_render(RenderOptions& options) {
   if (std::filesystem::path(options.output).extension() != ".png")
     throw CLI::ValidationError("-o", "must name a .png file");
   const acquisition::CameraView camera = acquisition::read_camera_view(options.view);
-  const modeling::Project project = modeling::Project::open_for_reading(options.project);
+  const store::Project project = store::Project::open_for_reading(options.project);
   const std::filesystem::path outputs[] = {options.output};
   modeling::refuse_to_replace_inputs(project, outputs, options.force);
   const auto start = std::chrono::steady_clock::now();
-  modeling::RenderModelSettings model_settings;
+  render::RenderModelSettings model_settings;
   model_settings.merged_only = !options.all_points;
-  const modeling::RenderModel model = modeling::build_render_model(project, model_settings);
+  const render::RenderModel model = render::build_render_model(project, model_settings);
   const double build_seconds = core::seconds_since(start);
 
   if (!options.culling) {

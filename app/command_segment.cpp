@@ -5,7 +5,7 @@
 #include <string>
 
 #include "app/commands.hpp"
-#include "modeling/segment_script.hpp"
+#include "app/formats/segment_script.hpp"
 
 namespace scanbench::app {
 namespace {
@@ -18,9 +18,9 @@ struct SegmentOptions {
 
 void run_segment(const SegmentOptions& options) {
   // Bad input first: a refused file never opens (nor migrates) the project.
-  const modeling::SegmentScript script = modeling::read_segment_script(options.script);
-  modeling::Project project = modeling::Project::open(options.project);
-  const modeling::SegmentScriptResult result = modeling::run_segment_script(project, script);
+  const SegmentScript script = read_segment_script(options.script);
+  store::Project project = store::Project::open(options.project);
+  const SegmentScriptResult result = run_segment_script(project, script);
   if (options.json) {
     fmt::print("{}\n", nlohmann::json{{"ops", result.ops}}.dump(
                            2, ' ', false, nlohmann::json::error_handler_t::replace));

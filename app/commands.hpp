@@ -19,6 +19,8 @@ inline constexpr int kExitBadInput = 2;  // bad file, bad argument, usage error
 void add_import_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_export_command(CLI::App& app);
+// The bench suites' own command (bench/command_bench.cpp; builds with the
+// benches only).
 void add_bench_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_geometry_command(CLI::App& app);

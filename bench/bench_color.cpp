@@ -14,7 +14,9 @@
 #include "acquisition/color_space.hpp"
 #include "acquisition/simulation/sites.hpp"
 #include "bench/simulated_site.hpp"
-#include "modeling/registration_stage.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 #include "registration/color_harmonization.hpp"
 
 namespace scanbench::bench {
@@ -51,7 +53,7 @@ Campaign scan_campaign(const sim::ScannerModel& scanner, int scan_count, SiteLig
 
 // Mean ΔE of both points of every pair from their truth colours.
 double delta_e_to_truth(std::span<const registration::ColorPair> pairs,
-                        std::span<const modeling::ScanColorCorrection> corrections,
+                        std::span<const store::ScanColorCorrection> corrections,
                         const std::vector<std::vector<std::uint8_t>>& truth_rgb) {
   if (pairs.empty()) return 0.0;
   const auto one = [&](std::uint32_t scan, std::int64_t pixel, const Eigen::Vector3f& rgb) {
@@ -103,7 +105,7 @@ nlohmann::json solve_and_measure(const Campaign& c, registration::ColorModel mod
       registration::harmonize_colors(c.fit, c.site.scans.size(), settings);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::vector<modeling::ScanColorCorrection>& corrections = solved.corrections;
+  const std::vector<store::ScanColorCorrection>& corrections = solved.corrections;
   const double before = modeling::mean_pair_delta_e(c.held_out, {});
   const double after = modeling::mean_pair_delta_e(c.held_out, corrections);
   nlohmann::json out = {
@@ -120,7 +122,7 @@ nlohmann::json solve_and_measure(const Campaign& c, registration::ColorModel mod
     out["after_delta_e_to_albedo"] = delta_e_to_truth(c.held_out, corrections, *truth_rgb);
   }
   nlohmann::json scans = nlohmann::json::array();
-  for (const modeling::ScanColorCorrection& k : corrections) {
+  for (const store::ScanColorCorrection& k : corrections) {
     scans.push_back({{"gains", {k.matrix(0, 0), k.matrix(1, 1), k.matrix(2, 2)}},
                      {"offsets", {k.offset.x(), k.offset.y(), k.offset.z()}}});
   }
@@ -147,9 +149,9 @@ std::vector<std::vector<std::uint8_t>> truth_colors(const sim::ScannerModel& sca
 // footprints, noise, shadow edges remain).
 nlohmann::json under_true_gains(const Campaign& campaign,
                                 const std::vector<std::vector<std::uint8_t>>& truth_rgb) {
-  std::vector<modeling::ScanColorCorrection> true_gains;
+  std::vector<store::ScanColorCorrection> true_gains;
   for (std::size_t k = 0; k < campaign.site.scans.size(); ++k) {
-    modeling::ScanColorCorrection c;
+    store::ScanColorCorrection c;
     c.matrix.diagonal() = true_gain(SiteLighting::kExposureOnly, static_cast<int>(k));
     true_gains.push_back(c);
   }

@@ -12,14 +12,14 @@
 #include <numbers>
 #include <vector>
 
-#include "acquisition/e57_reader.hpp"
-#include "acquisition/e57_writer.hpp"
-#include "acquisition/pcd_reader.hpp"
-#include "acquisition/ptx_reader.hpp"
-#include "acquisition/ptx_writer.hpp"
+#include "acquisition/formats/e57/e57_reader.hpp"
+#include "acquisition/formats/e57/e57_writer.hpp"
+#include "acquisition/formats/pcd_reader.hpp"
+#include "acquisition/formats/ptx_reader.hpp"
+#include "acquisition/formats/ptx_writer.hpp"
 #include "bench/pcl_io.hpp"
 #include "bench/scratch_folder.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::bench {
 namespace {
@@ -116,6 +116,8 @@ nlohmann::json compare_pcd_readers(const std::filesystem::path& pcd, double poin
 
 }  // namespace
 
+// Longer than 60 lines, but flat: the suite's measurements in order, each a
+// few lines, sharing the scan and files the first ones make.
 nlohmann::json run_io_bench(const BenchOptions& options) {
   const int rows = options.smoke ? 90 : 900, columns = options.smoke ? 360 : 3600;
   const ScratchFolder scratch("io");
@@ -149,16 +151,16 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   const std::filesystem::path project_path = dir / "bench.sbproj";
   double store_s = 0.0;
   {
-    modeling::Project project = modeling::Project::create(project_path);
+    store::Project project = store::Project::create(project_path);
     store_s = best_seconds(1, [&] {
-      modeling::Project::Edit edit = project.begin_command("import", "{}");
-      project.insert_scan(edit, modeling::encode_scan(scan));
+      store::Project::Edit edit = project.begin_command("import", "{}");
+      project.insert_scan(edit, store::encode_scan(scan));
       edit.commit("{}");
     });
   }
-  const std::int64_t id = modeling::Project::open(project_path).scans().front().id;
+  const std::int64_t id = store::Project::open(project_path).scans().front().id;
   const double load_s =
-      best_seconds(repeats, [&] { modeling::Project::open(project_path).load_scan(id); });
+      best_seconds(repeats, [&] { store::Project::open(project_path).load_scan(id); });
   const double project_bytes = static_cast<double>(std::filesystem::file_size(project_path));
 
   return {{"suite", "io"},

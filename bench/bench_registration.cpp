@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/scan_geometry.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/simulation/pose_error.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/sites.hpp"

@@ -18,19 +18,19 @@
 #include <optional>
 
 #include "acquisition/camera_view.hpp"
-#include "acquisition/picture_file.hpp"
+#include "acquisition/formats/picture_file.hpp"
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/truth_view.hpp"
 #include "acquisition/spherical_grid.hpp"
 #include "bench/image_metrics.hpp"
 #include "bench/scratch_folder.hpp"
 #include "bench/simulated_site.hpp"
-#include "modeling/layers.hpp"
-#include "modeling/render_model.hpp"
-#include "modeling/scan_layers.hpp"
+#include "modeling/store/layer_store.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "registration/merge.hpp"
 #include "registration/prepared_scan.hpp"
 #include "render/device.hpp"
+#include "render/render_model.hpp"
 #include "render/splat_renderer.hpp"
 
 namespace scanbench::bench {
@@ -98,25 +98,24 @@ std::vector<std::uint8_t> sampled_mask(const sim::TruthImage& truth,
 
 // The campaign in a project (true poses, geometry, the merge's keep masks)
 // and its render model: the path `scanbench render` takes.
-modeling::RenderModel campus_model(const SimulatedSite& site, const ScratchFolder& scratch) {
+render::RenderModel campus_model(const SimulatedSite& site, const ScratchFolder& scratch) {
   std::vector<registration::PreparedScan> prepared;
   for (std::size_t k = 0; k < site.scans.size(); ++k)
     prepared.push_back(registration::prepare_scan(site.scans[k], site.geometry[k], 0));
   const registration::MergeResult merged =
       registration::merge_by_sampling_rate(prepared, site.true_poses, {});
-  modeling::Project project = modeling::Project::create(scratch.path() / "render.sbproj");
-  modeling::Project::Edit edit = project.begin_command("import", "{}");
+  store::Project project = store::Project::create(scratch.path() / "render.sbproj");
+  store::Project::Edit edit = project.begin_command("import", "{}");
   for (std::size_t k = 0; k < site.scans.size(); ++k) {
-    const std::int64_t id = project.insert_scan(edit, modeling::encode_scan(site.scans[k]));
-    for (const modeling::EncodedLayer& layer : modeling::encode_geometry(site.geometry[k]))
+    const std::int64_t id = project.insert_scan(edit, store::encode_scan(site.scans[k]));
+    for (const store::EncodedLayer& layer : store::encode_geometry(site.geometry[k]))
       project.put_layer(edit, id, layer);
-    project.put_layer(
-        edit, id,
-        modeling::encode_layer<std::uint8_t>(modeling::layer::kKeep, modeling::ElementType::kU8,
-                                             merged.scans[k].keep));
+    project.put_layer(edit, id,
+                      store::encode_layer<std::uint8_t>(
+                          store::layer::kKeep, store::ElementType::kU8, merged.scans[k].keep));
   }
   edit.commit("{}");
-  return modeling::build_render_model(project, {});
+  return render::build_render_model(project, {});
 }
 
 struct ViewFigures {
@@ -124,7 +123,7 @@ struct ViewFigures {
   double blended_minus_points_db = 0.0;
 };
 
-ViewFigures measure_view(render::SplatRenderer& renderer, const modeling::RenderModel& model,
+ViewFigures measure_view(render::SplatRenderer& renderer, const render::RenderModel& model,
                          const sim::Scene& scene, const NamedView& view, const SimulatedSite& site,
                          const std::filesystem::path& pictures) {
   const sim::TruthImage truth = sim::render_truth_view(scene, view.camera);
@@ -198,6 +197,8 @@ double median_frame_ms(render::SplatRenderer& renderer, const render::RenderView
 
 }  // namespace
 
+// Longer than 60 lines, but flat: the suite's cameras and measurements in
+// order, sharing the simulated site and its render model.
 nlohmann::json run_render_bench(const BenchOptions& options) {
   sim::ScannerModel scanner;
   if (options.smoke) {
@@ -212,7 +213,7 @@ nlohmann::json run_render_bench(const BenchOptions& options) {
   const sim::Site scene_site = sim::make_site("campus", kSiteSeed, scan_count);
   const ScratchFolder scratch("render");
   const auto build_start = std::chrono::steady_clock::now();
-  const modeling::RenderModel model = campus_model(site, scratch);
+  const render::RenderModel model = campus_model(site, scratch);
   const double build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 

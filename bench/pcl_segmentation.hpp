@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/scan.hpp"
-#include "acquisition/scan_geometry.hpp"
 
 namespace scanbench::bench {
 

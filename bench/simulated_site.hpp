@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/scan_geometry.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
 
 namespace scanbench::bench {

@@ -8,7 +8,7 @@ function(scanbench_target_settings target)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
     target_compile_options(${target} PRIVATE -Wno-error=restrict)
   endif()
-  # The branch-free kernels (acquisition/branch_free.hpp, mixed_pixels.cpp)
+  # The branch-free kernels (acquisition/geometry/branch_free.hpp, mixed_pixels.cpp)
   # combine booleans with & and | on purpose: no short-circuit branches.
   if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
     target_compile_options(${target} PRIVATE -Wno-bitwise-instead-of-logical)
@@ -25,7 +25,7 @@ function(scanbench_target_settings target)
     # other allocator. glibc's and ASan's malloc both align to 16 bytes, which
     # is all Eigen needs here, so keep malloc everywhere.
     target_compile_definitions(${target} PRIVATE EIGEN_MALLOC_ALREADY_ALIGNED=1)
-    # No AVX2 clones (acquisition/branch_free.hpp): their ifunc resolvers run
+    # No AVX2 clones (acquisition/geometry/branch_free.hpp): their ifunc resolvers run
     # during relocation, before the sanitizer runtime is initialised.
     target_compile_definitions(${target} PRIVATE SCANBENCH_VECTOR_CLONES=)
   endif()

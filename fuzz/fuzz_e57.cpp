@@ -1,6 +1,6 @@
 // libFuzzer target: the E57 reader (page checksums not enforced in the fuzz
 // build, so that mutations reach the XML and the compressed vectors).
-#include "acquisition/e57_reader.hpp"
+#include "acquisition/formats/e57/e57_reader.hpp"
 #include "fuzz/fuzz_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,5 +1,5 @@
 // libFuzzer target: the organized-PCD reader (ASCII, binary, compressed).
-#include "acquisition/pcd_reader.hpp"
+#include "acquisition/formats/pcd_reader.hpp"
 #include "fuzz/fuzz_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,5 +1,5 @@
 // libFuzzer target: the Leica PTX reader.
-#include "acquisition/ptx_reader.hpp"
+#include "acquisition/formats/ptx_reader.hpp"
 #include "fuzz/fuzz_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,7 +1,7 @@
 // libFuzzer target: the segment script file (`segment --script`), read and
 // checked whole as before anything of it runs.
+#include "app/formats/segment_script_file.hpp"
 #include "fuzz/fuzz_file.hpp"
-#include "modeling/segment_script_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::filesystem::path path = scanbench::fuzz::write_input(data, size, "ops.json");

@@ -4,7 +4,7 @@
 // naming them go on into image decoding.
 #include <cstring>
 
-#include "acquisition/triplet_reader.hpp"
+#include "acquisition/formats/triplet_reader.hpp"
 #include "fuzz/fuzz_file.hpp"
 
 namespace {

@@ -7,8 +7,8 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
-#include "modeling/layers.hpp"
-#include "modeling/scan_layers.hpp"
+#include "modeling/store/layer_store.hpp"
+#include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
 
@@ -24,19 +24,20 @@ std::string node_name(std::int64_t id) {
   return "node " + std::to_string(id);
 }
 
-const ObjectNode& require_node(const std::vector<ObjectNode>& nodes, std::int64_t id) {
-  for (const ObjectNode& n : nodes) {
+const store::ObjectNode& require_node(const std::vector<store::ObjectNode>& nodes,
+                                      std::int64_t id) {
+  for (const store::ObjectNode& n : nodes) {
     if (n.id == id) return n;
   }
   refuse(node_name(id), "no such node");
 }
 
 // `root` and every node below it.
-std::set<std::int64_t> subtree(const std::vector<ObjectNode>& nodes, std::int64_t root) {
+std::set<std::int64_t> subtree(const std::vector<store::ObjectNode>& nodes, std::int64_t root) {
   std::set<std::int64_t> out{root};
   for (bool grown = true; grown;) {
     grown = false;
-    for (const ObjectNode& n : nodes) {
+    for (const store::ObjectNode& n : nodes) {
       if (n.parent && out.count(*n.parent) && out.insert(n.id).second) grown = true;
     }
   }
@@ -46,12 +47,12 @@ std::set<std::int64_t> subtree(const std::vector<ObjectNode>& nodes, std::int64_
 // `target` and the nodes below it that take their transfer from it (none
 // on the way up to it sets its own): the points a transfer set on the
 // target reaches.
-std::set<std::int64_t> inheriting_transfer(const std::vector<ObjectNode>& nodes,
+std::set<std::int64_t> inheriting_transfer(const std::vector<store::ObjectNode>& nodes,
                                            std::int64_t target) {
   std::set<std::int64_t> out{target};
   for (bool grown = true; grown;) {
     grown = false;
-    for (const ObjectNode& n : nodes) {
+    for (const store::ObjectNode& n : nodes) {
       if (n.parent && out.count(*n.parent) && !n.color.transfer && out.insert(n.id).second)
         grown = true;
     }
@@ -81,12 +82,13 @@ struct ColorLayers {
   std::optional<std::vector<std::uint32_t>> membership;
 };
 
-std::optional<ColorLayers> color_layers(const Project& project, std::int64_t scan_id) {
+std::optional<ColorLayers> color_layers(const store::Project& project, std::int64_t scan_id) {
   std::optional<std::vector<std::uint8_t>> rgb =
-      project.load_layer<std::uint8_t>(scan_id, layer::kRgb, ElementType::kU8x3);
+      project.load_layer<std::uint8_t>(scan_id, store::layer::kRgb, store::ElementType::kU8x3);
   if (!rgb) return std::nullopt;
-  return ColorLayers{std::move(*rgb), project.load_layer<std::uint32_t>(scan_id, layer::kMembership,
-                                                                        ElementType::kU32)};
+  return ColorLayers{std::move(*rgb),
+                     project.load_layer<std::uint32_t>(scan_id, store::layer::kMembership,
+                                                       store::ElementType::kU32)};
 }
 
 std::array<std::uint8_t, 3> pixel_rgb(const ColorLayers& layers, std::size_t i) {
@@ -95,10 +97,10 @@ std::array<std::uint8_t, 3> pixel_rgb(const ColorLayers& layers, std::size_t i) 
 
 // The colours of the points the nodes in `owners` own, over every scan:
 // as shown (`shown`) or after the scans' corrections only.
-LabStats node_colors(const Project& project, const ColorPipeline& pipeline,
+LabStats node_colors(const store::Project& project, const ColorPipeline& pipeline,
                      const std::set<std::int64_t>& owners, bool shown) {
   LabStats stats;
-  for (const StoredScanSummary& scan : project.scans()) {
+  for (const store::StoredScanSummary& scan : project.scans()) {
     const std::optional<ColorLayers> layers = color_layers(project, scan.id);
     if (!layers || !layers->membership) continue;
     const std::vector<std::uint32_t>& owner = *layers->membership;
@@ -112,7 +114,7 @@ LabStats node_colors(const Project& project, const ColorPipeline& pipeline,
   return stats;
 }
 
-LabStats region_colors(const Project& project, const ColorPipeline& pipeline,
+LabStats region_colors(const store::Project& project, const ColorPipeline& pipeline,
                        const PixelRect& region) {
   const std::string where = "scan " + std::to_string(region.scan_id);
   const acquisition::Scan scan = project.load_scan(region.scan_id);  // throws when missing
@@ -126,9 +128,10 @@ LabStats region_colors(const Project& project, const ColorPipeline& pipeline,
                       std::to_string(scan.columns) + " grid");
   }
   if (!scan.has_color()) refuse(where, "the scan has no colour");
-  const std::optional<std::vector<std::uint32_t>> membership =
-      project.load_layer<std::uint32_t>(region.scan_id, layer::kMembership, ElementType::kU32);
-  const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, region.scan_id);
+  const std::optional<std::vector<std::uint32_t>> membership = project.load_layer<std::uint32_t>(
+      region.scan_id, store::layer::kMembership, store::ElementType::kU32);
+  const std::optional<acquisition::ScanGeometry> geometry =
+      store::load_geometry(project, region.scan_id);
   LabStats stats;
   for (int row = region.row_begin; row < region.row_end; ++row) {
     for (int col = region.col_begin; col < region.col_end; ++col) {
@@ -137,7 +140,7 @@ LabStats region_colors(const Project& project, const ColorPipeline& pipeline,
       const std::size_t i = scan.index(row, col);
       if (!scan.valid[i] || (geometry && !acquisition::in_model(scan, *geometry, i))) continue;
       const std::uint32_t owner = membership ? (*membership)[i] : 0;
-      if (owner == kDeletedPoints) continue;
+      if (owner == store::kDeletedPoints) continue;
       const std::array<std::uint8_t, 3> rgb = {scan.rgb[3 * i], scan.rgb[3 * i + 1],
                                                scan.rgb[3 * i + 2]};
       stats.add(acquisition::srgb_to_lab(pipeline.shown(region.scan_id, owner, rgb)));
@@ -146,11 +149,12 @@ LabStats region_colors(const Project& project, const ColorPipeline& pipeline,
   return stats;
 }
 
-ColorPipeline pipeline_of(const Project& project, const std::vector<ObjectNode>& nodes) {
+ColorPipeline pipeline_of(const store::Project& project,
+                          const std::vector<store::ObjectNode>& nodes) {
   return ColorPipeline(project.scan_color_corrections(), resolve_color_edits(nodes));
 }
 
-nlohmann::json edit_json(const ColorEdit& edit) {
+nlohmann::json edit_json(const store::ColorEdit& edit) {
   const std::string text = to_json(edit);
   return text.empty() ? nlohmann::json::object() : nlohmann::json::parse(text);
 }
@@ -161,14 +165,14 @@ std::string dump(const nlohmann::json& json) {
 
 }  // namespace
 
-NodeCommandResult recolor_object(Project& project, const RecolorSettings& settings) {
+NodeCommandResult recolor_object(store::Project& project, const RecolorSettings& settings) {
   const std::int64_t revision = project.revision();
-  const std::vector<ObjectNode> nodes = project.object_nodes();
-  ObjectNode node = require_node(nodes, settings.node);
-  if (const std::string problem = check_color_edit(settings.set); !problem.empty())
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
+  store::ObjectNode node = require_node(nodes, settings.node);
+  if (const std::string problem = store::check_color_edit(settings.set); !problem.empty())
     refuse(node_name(settings.node), problem);
   if (settings.reset) node.color = {};
-  const ColorEdit& set = settings.set;
+  const store::ColorEdit& set = settings.set;
   if (set.brightness) node.color.brightness = set.brightness;
   if (set.contrast) node.color.contrast = set.contrast;
   if (set.gamma) node.color.gamma = set.gamma;
@@ -177,20 +181,20 @@ NodeCommandResult recolor_object(Project& project, const RecolorSettings& settin
   if (set.transfer) node.color.transfer = set.transfer;
   nlohmann::json json = {{"node", settings.node}, {"reset", settings.reset}};
   json["set"] = edit_json(set);
-  Project::Edit edit = project.begin_command("recolor", dump(json), revision);
+  store::Project::Edit edit = project.begin_command("recolor", dump(json), revision);
   project.put_node(edit, node);
   const std::int64_t command_id = edit.command_id();
   edit.commit(dump({{"node", node.id}, {"color", edit_json(node.color)}}));
   return {command_id, node.id};
 }
 
-CloneResult clone_color(Project& project, const CloneSettings& settings) {
+CloneResult clone_color(store::Project& project, const CloneSettings& settings) {
   const int sources = (settings.source_node ? 1 : 0) + (settings.source_region ? 1 : 0) +
                       (settings.source_color ? 1 : 0);
   if (sources != 1) refuse("clone", "give exactly one source: an object, a region or a colour");
   const std::int64_t revision = project.revision();
-  const std::vector<ObjectNode> nodes = project.object_nodes();
-  ObjectNode target = require_node(nodes, settings.target);
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
+  store::ObjectNode target = require_node(nodes, settings.target);
   const ColorPipeline pipeline = pipeline_of(project, nodes);
   nlohmann::json json = {{"target", settings.target}, {"paint", settings.paint}};
 
@@ -221,7 +225,7 @@ CloneResult clone_color(Project& project, const CloneSettings& settings) {
   // Per channel: the target's mean onto the source's, its spread scaled to
   // the source's; painting keeps the lightness spread and flattens a*b*.
   const bool paint = settings.paint || settings.source_color.has_value();
-  LabTransfer transfer;
+  store::LabTransfer transfer;
   const Eigen::Vector3d target_sd = own.deviation().cwiseMax(1e-3);
   for (int c = 0; c < 3; ++c) {
     double scale = paint ? (c == 0 ? 1.0 : 0.0) : source.deviation()[c] / target_sd[c];
@@ -229,8 +233,8 @@ CloneResult clone_color(Project& project, const CloneSettings& settings) {
     transfer.scale[c] = scale;
     transfer.offset[c] = source.mean()[c] - scale * own.mean()[c];
   }
-  target.color = ColorEdit{0.0, 1.0, 1.0, 0.0, 1.0, transfer};
-  Project::Edit edit = project.begin_command("clone", dump(json), revision);
+  target.color = store::ColorEdit{0.0, 1.0, 1.0, 0.0, 1.0, transfer};
+  store::Project::Edit edit = project.begin_command("clone", dump(json), revision);
   project.put_node(edit, target);
   CloneResult out{edit.command_id(), target.id, source.count, own.count, transfer};
   edit.commit(dump({{"node", target.id},

@@ -15,19 +15,19 @@
 #include <cstdint>
 #include <optional>
 
-#include "modeling/color_edits.hpp"
-#include "modeling/project.hpp"
-#include "modeling/segment_commands.hpp"
+#include "modeling/color_pipeline.hpp"
+#include "modeling/selection_commands.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
 
 struct RecolorSettings {
   std::int64_t node = 0;
-  ColorEdit set;       // the parameters to set; the others stay as they are
-  bool reset = false;  // first drop every parameter the node sets (it inherits them again)
+  store::ColorEdit set;  // the parameters to set; the others stay as they are
+  bool reset = false;    // first drop every parameter the node sets (it inherits them again)
 };
 
-NodeCommandResult recolor_object(Project& project, const RecolorSettings& settings);
+NodeCommandResult recolor_object(store::Project& project, const RecolorSettings& settings);
 
 // A rectangle of a scan's grid: rows [row_begin, row_end), columns
 // [col_begin, col_end).
@@ -57,7 +57,7 @@ struct CloneResult {
   std::int64_t node_id = 0;
   std::size_t source_points = 0;  // 1 for a colour source
   std::size_t target_points = 0;
-  LabTransfer transfer;  // now the target's own
+  store::LabTransfer transfer;  // now the target's own
 };
 
 // Statistics transfer in L*a*b* (Reinhard et al.'s idea, in CIELAB): the
@@ -68,6 +68,6 @@ struct CloneResult {
 // out). The target gets the transfer and neutral adjustments of its own,
 // so nothing it inherits bends the match. The transfer is fixed when
 // cloned: a later harmonize changes the target's colours under it.
-CloneResult clone_color(Project& project, const CloneSettings& settings);
+CloneResult clone_color(store::Project& project, const CloneSettings& settings);
 
 }  // namespace scanbench::modeling

@@ -2,10 +2,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "acquisition/scan_files.hpp"
-#include "acquisition/scan_geometry.hpp"
+#include "acquisition/formats/scan_files.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "core/errors.hpp"
-#include "modeling/registration_stage.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 #include "registration/merge.hpp"
 #include "registration/register_scans.hpp"
 
@@ -81,7 +83,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MergeSettings, noise, range_sigm
 namespace scanbench::modeling {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProjectPicks, source_id, target_id, pairs)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegisterStageSettings, registration, picks)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegisterCommandSettings, registration, picks)
 
 template <typename Settings>
 std::string settings_to_json(const Settings& settings) {
@@ -113,7 +115,7 @@ SCANBENCH_SETTINGS_JSON(acquisition::GeometrySettings)
 SCANBENCH_SETTINGS_JSON(acquisition::ScanFileSettings)
 SCANBENCH_SETTINGS_JSON(registration::MergeSettings)
 SCANBENCH_SETTINGS_JSON(registration::RegistrationSettings)
-SCANBENCH_SETTINGS_JSON(RegisterStageSettings)
+SCANBENCH_SETTINGS_JSON(RegisterCommandSettings)
 
 #undef SCANBENCH_SETTINGS_JSON
 

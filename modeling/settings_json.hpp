@@ -11,7 +11,7 @@ namespace scanbench::modeling {
 
 // Instantiated for acquisition::GeometrySettings, acquisition::ScanFileSettings,
 // registration::MergeSettings, registration::RegistrationSettings and
-// modeling::RegisterStageSettings.
+// modeling::RegisterCommandSettings.
 template <typename Settings>
 std::string settings_to_json(const Settings& settings);
 

@@ -146,8 +146,8 @@ void bound_parameters(ceres::Problem& problem, double* p, bool matrix,
   }
 }
 
-ColorCorrection correction_of(const std::vector<double>& p, bool matrix) {
-  ColorCorrection c;
+acquisition::ColorCorrection correction_of(const std::vector<double>& p, bool matrix) {
+  acquisition::ColorCorrection c;
   for (int r = 0; r < 3; ++r) {
     const auto ur = static_cast<std::size_t>(r);
     if (matrix) {

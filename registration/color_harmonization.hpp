@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "registration/color_correction.hpp"
+#include "acquisition/color_space.hpp"
 #include "registration/prepared_scan.hpp"
 
 namespace scanbench::registration {
@@ -93,7 +93,7 @@ struct HarmonizeSettings {
 struct HarmonizeResult {
   // One per scan: the identity for each group's fixed scan and for scans in
   // no pair.
-  std::vector<ColorCorrection> corrections;
+  std::vector<acquisition::ColorCorrection> corrections;
   // Per scan, the index of the fixed scan of its group of scans linked by
   // pairs (itself for that scan); -1 for a scan in no pair.
   std::vector<std::int32_t> reference;

@@ -4,7 +4,7 @@
 #include <cassert>
 #include <cmath>
 
-#include "acquisition/sampling.hpp"
+#include "acquisition/geometry/sampling.hpp"
 #include "core/parallel.hpp"
 
 namespace scanbench::registration {

@@ -9,8 +9,8 @@
 #include <optional>
 #include <vector>
 
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/scan.hpp"
-#include "acquisition/scan_geometry.hpp"
 #include "acquisition/spherical_grid.hpp"
 #include "registration/point_index.hpp"
 

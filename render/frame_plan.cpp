@@ -13,8 +13,8 @@ float distance_to_box(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& eye
 
 // The tile's points of levels ≤ the first whose cells are at most
 // `pixels` wide on screen at `distance` (all of them when none is).
-std::uint32_t level_of_detail_count(const modeling::RenderTile& tile, float distance,
-                                    float focal_px, float pixels) {
+std::uint32_t level_of_detail_count(const RenderTile& tile, float distance, float focal_px,
+                                    float pixels) {
   if (distance <= 0.0f) return tile.count;
   for (std::size_t level = 0; level < tile.level_ends.size(); ++level) {
     const float cell = tile.lod_cube_m / static_cast<float>(1u << std::min<std::size_t>(level, 30));
@@ -25,7 +25,7 @@ std::uint32_t level_of_detail_count(const modeling::RenderTile& tile, float dist
 
 // The splat radius that keeps a prefix of `count` points closed: the cell of
 // the deepest level the prefix holds whole (0 when it holds them all).
-float min_radius_for(const modeling::RenderTile& tile, std::uint32_t count) {
+float min_radius_for(const RenderTile& tile, std::uint32_t count) {
   if (count >= tile.count) return 0.0f;
   float cell = tile.lod_cube_m;
   for (std::size_t level = 0; level < tile.level_ends.size(); ++level) {
@@ -36,7 +36,7 @@ float min_radius_for(const modeling::RenderTile& tile, std::uint32_t count) {
 }
 
 struct Walk {
-  const modeling::RenderModel& model;
+  const RenderModel& model;
   const RenderView& view;
   const CullSettings& settings;
   std::array<Eigen::Vector4f, 6> planes;
@@ -50,7 +50,7 @@ struct Walk {
   }
 
   void visit(std::size_t index) {
-    const modeling::RenderNode& node = model.nodes[index];
+    const RenderNode& node = model.nodes[index];
     if (!node.shown) {
       plan.hidden += points_below(index);
       return;
@@ -64,12 +64,12 @@ struct Walk {
   }
 
   void visit_tile(std::size_t t) {
-    const modeling::RenderTile& tile = model.tiles[t];
+    const RenderTile& tile = model.tiles[t];
     if (settings.frustum && outside_frustum(planes, tile.box)) {
       plan.culled_frustum += tile.count;
       return;
     }
-    if (settings.backface && modeling::faces_away(tile.cone, tile.box, view.eye)) {
+    if (settings.backface && faces_away(tile.cone, tile.box, view.eye)) {
       plan.culled_backface += tile.count;
       return;
     }
@@ -83,7 +83,7 @@ struct Walk {
 
 }  // namespace
 
-FramePlan plan_frame(const modeling::RenderModel& model, const RenderView& view,
+FramePlan plan_frame(const RenderModel& model, const RenderView& view,
                      const CullSettings& settings) {
   Walk walk{model, view, settings, view.frustum_planes(), {}};
   walk.plan.points = model.points.size();
@@ -97,7 +97,7 @@ FramePlan plan_frame(const modeling::RenderModel& model, const RenderView& view,
                            : 1.0;
   std::size_t visible = 0;
   for (TileDraw& draw : plan.draws) {
-    const modeling::RenderTile& tile = model.tiles[draw.tile];
+    const RenderTile& tile = model.tiles[draw.tile];
     visible += tile.count;
     draw.count = std::max<std::uint32_t>(
         1, static_cast<std::uint32_t>(std::floor(share * static_cast<double>(draw.count))));

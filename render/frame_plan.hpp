@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "modeling/render_model.hpp"
+#include "render/render_model.hpp"
 #include "render/render_view.hpp"
 
 namespace scanbench::render {
@@ -45,7 +45,7 @@ struct FramePlan {
 // tile of a shown node either drawn (a prefix of its points, never empty) or
 // counted as culled; points of hidden nodes counted as hidden. An empty
 // model gives an empty plan.
-FramePlan plan_frame(const modeling::RenderModel& model, const RenderView& view,
+FramePlan plan_frame(const RenderModel& model, const RenderView& view,
                      const CullSettings& settings);
 
 }  // namespace scanbench::render

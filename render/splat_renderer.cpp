@@ -111,7 +111,7 @@ struct SplatRenderer::Gpu {
 
   // The planned tiles into the splat target: one opaque pass, or the
   // visibility and accumulation passes of blending.
-  void draw_splats(const modeling::RenderModel& model, const FramePlan& plan, DrawMode mode) const {
+  void draw_splats(const RenderModel& model, const FramePlan& plan, DrawMode mode) const {
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glEnable(GL_DEPTH_TEST);
@@ -183,9 +183,9 @@ struct SplatRenderer::Gpu {
   }
 };
 
-SplatRenderer::SplatRenderer(const modeling::RenderModel& model)
+SplatRenderer::SplatRenderer(const RenderModel& model)
     : model_(model), gpu_(std::make_unique<Gpu>()) {
-  const modeling::RenderPoints& p = model.points;
+  const RenderPoints& p = model.points;
   gpu_->attributes = {upload(p.position),  upload(p.normal), upload(p.radii_m),   upload(p.rgba),
                       upload(p.intensity), upload(p.node),   upload(p.major_axis)};
   gpu_->points = make_vertex_array();
@@ -216,7 +216,8 @@ SplatRenderer::SplatRenderer(const modeling::RenderModel& model)
     glVertexArrayAttribBinding(vao, k, k);
     glEnableVertexArrayAttrib(vao, k);
   }
-  gpu_->splat = build_program("splat shaders", shaders::kSplatVertex, shaders::kSplatFragment);
+  gpu_->splat =
+      build_program("splat shaders", shaders::splat_vertex().c_str(), shaders::kSplatFragment);
   gpu_->resolve =
       build_program("resolve shaders", shaders::kResolveVertex, shaders::kResolveFragment);
   height_range_ = {0.0f, 1.0f};

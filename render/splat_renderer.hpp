@@ -24,8 +24,8 @@
 #include <string_view>
 #include <vector>
 
-#include "modeling/render_model.hpp"
 #include "render/frame_plan.hpp"
+#include "render/render_model.hpp"
 #include "render/render_view.hpp"
 
 namespace scanbench::render {
@@ -81,7 +81,7 @@ class SplatRenderer {
  public:
   // Uploads the model's points. The model must outlive the renderer (its
   // tiles and tree are read every frame).
-  explicit SplatRenderer(const modeling::RenderModel& model);
+  explicit SplatRenderer(const RenderModel& model);
   ~SplatRenderer();
   SplatRenderer(const SplatRenderer&) = delete;
   SplatRenderer& operator=(const SplatRenderer&) = delete;
@@ -113,7 +113,7 @@ class SplatRenderer {
   static constexpr int kGuardBandPixels = 128;
 
   struct Gpu;
-  const modeling::RenderModel& model_;
+  const RenderModel& model_;
   std::unique_ptr<Gpu> gpu_;
   int picture_width_ = 0;
   int picture_height_ = 0;

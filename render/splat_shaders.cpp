@@ -1,5 +1,7 @@
 #include "render/splat_shaders.hpp"
 
+#include "render/object_palette.hpp"
+
 namespace scanbench::render::shaders {
 
 // Per point: its centre, normal, major axis and radii in eye space for the
@@ -7,7 +9,7 @@ namespace scanbench::render::shaders {
 // for the ellipse (the screen extent of the sphere of its major radius). A
 // point whose normal faces away from the eye is moved outside the clip
 // volume (backface culling per point).
-const char* const kSplatVertex = R"glsl(#version 450 core
+const char* const kSplatVertexHead = R"glsl(#version 450 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_radii;
@@ -40,12 +42,10 @@ vec3 ramp(float t) {  // blue, cyan, green, yellow, red
                0.0, 1.0);
 }
 
-vec3 object_color(uint id) {
-  if (id == 0u) return vec3(0.55);
-  uint h = id * 2654435761u;
-  return 0.25 + 0.7 * vec3(float(h & 255u), float((h >> 8) & 255u), float((h >> 16) & 255u)) / 255.0;
-}
+)glsl";
 
+// After the palette (render/object_palette.hpp).
+const char* const kSplatVertexBody = R"glsl(
 void main() {
   bool has_normal = dot(a_normal, a_normal) > 0.25;
   if (u_backface == 1 && has_normal && dot(a_normal, u_eye - a_position) < 0.0) {
@@ -77,6 +77,10 @@ void main() {
   v_color = color;
 }
 )glsl";
+
+std::string splat_vertex() {
+  return std::string(kSplatVertexHead) + object_color_glsl() + kSplatVertexBody;
+}
 
 // The fragment's view ray meets the splat's plane (its normal, or facing the
 // eye) at q; outside the ellipse (radii along the major axis and across it;

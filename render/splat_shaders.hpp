@@ -2,9 +2,12 @@
 // and one fragment stage for every splat pass, and the resolve.
 #pragma once
 
+#include <string>
+
 namespace scanbench::render::shaders {
 
-extern const char* const kSplatVertex;
+// The splat vertex stage, with the object palette's GLSL in it.
+std::string splat_vertex();
 extern const char* const kSplatFragment;
 extern const char* const kResolveVertex;
 extern const char* const kResolveFragment;

@@ -42,6 +42,13 @@ void check_vertices(const GridShape& shape, const Polyline& line,
 
 }  // namespace
 
+GridPixel nearest_pixel(const Eigen::Vector2d& xy) {
+  const auto index = [](double v) {
+    return static_cast<int>(std::llround(std::clamp(v, -1.0, 1e9)));
+  };
+  return {index(xy.y()), index(xy.x())};
+}
+
 bool within_reach(const GridShape& shape, const Eigen::Vector2d& v) {
   return v.allFinite() && v.x() >= -shape.columns && v.x() <= 2.0 * shape.columns &&
          v.y() >= -shape.rows && v.y() <= 2.0 * shape.rows;

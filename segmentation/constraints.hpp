@@ -22,6 +22,18 @@ namespace scanbench::segmentation {
 
 using Polyline = std::vector<Eigen::Vector2d>;  // (x = column, y = row) vertices
 
+// A pixel of the grid by (row, col), as the scan's arrays index it.
+struct GridPixel {
+  int row = 0;
+  int col = 0;
+};
+
+// The pixel whose centre is nearest image point `xy` (x = column, y = row):
+// the one place image coordinates become (row, col). Coordinates are
+// clamped to [-1, 10^9] first, so that a point far off the grid stays off
+// it instead of wrapping.
+GridPixel nearest_pixel(const Eigen::Vector2d& xy);
+
 // Whether vertex `v` is finite and within one grid size of the grid (the
 // bound above): what callers check before they hand vertices over.
 bool within_reach(const GridShape& shape, const Eigen::Vector2d& v);

@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/scan.hpp"
-#include "acquisition/scan_geometry.hpp"
 
 namespace scanbench::segmentation {
 

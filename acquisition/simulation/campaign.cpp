@@ -4,13 +4,13 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "acquisition/output_file.hpp"
-#include "acquisition/ptx_writer.hpp"
+#include "acquisition/formats/output_file.hpp"
+#include "acquisition/formats/ptx_writer.hpp"
+#include "acquisition/formats/triplet_writer.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/simulation/pose_error.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/truth_images.hpp"
-#include "acquisition/triplet_writer.hpp"
 #include "core/errors.hpp"
 #include "core/timing.hpp"
 

@@ -2,7 +2,7 @@
 // that measure the pipeline against it.
 #include <nlohmann/json.hpp>
 
-#include "acquisition/json_input.hpp"
+#include "acquisition/formats/json_input.hpp"
 #include "acquisition/rigid_transform.hpp"
 #include "acquisition/simulation/campaign.hpp"
 #include "acquisition/simulation/truth_images.hpp"

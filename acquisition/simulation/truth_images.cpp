@@ -4,7 +4,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "acquisition/image_file.hpp"
+#include "acquisition/formats/image_file.hpp"
 #include "core/errors.hpp"
 
 namespace scanbench::acquisition::sim {

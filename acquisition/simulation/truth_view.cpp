@@ -5,8 +5,8 @@
 #include <numbers>
 #include <opencv2/core.hpp>
 
-#include "acquisition/image_file.hpp"
-#include "acquisition/output_file.hpp"
+#include "acquisition/formats/image_file.hpp"
+#include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 

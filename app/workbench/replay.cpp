@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string_view>
 
-#include "acquisition/json_input.hpp"
+#include "acquisition/formats/json_input.hpp"
 #include "core/errors.hpp"
 #include "core/text.hpp"
 #include "render/window/window_device.hpp"

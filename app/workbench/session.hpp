@@ -1,8 +1,9 @@
 // The workbench's state apart from its window: the open project, the scan in
 // the panoramic view with its layers, the tools (seed, lasso, barrier), and
 // the actions, each through the same commands the CLI's segment script and
-// recolor issue (modeling/segment_commands.hpp, modeling/color_commands.hpp),
-// so every action is one journal entry that Ctrl+Z takes back. No ImGui here.
+// recolor issue (modeling/selection_commands.hpp, modeling/tree_commands.hpp,
+// modeling/color_commands.hpp), so every action is one journal entry that Ctrl+Z takes back. No
+// ImGui here.
 #pragma once
 
 #include <cstdint>
@@ -13,43 +14,38 @@
 
 #include "acquisition/scan.hpp"
 #include "modeling/color_commands.hpp"
-#include "modeling/project.hpp"
-#include "modeling/render_model.hpp"
-#include "modeling/segment_commands.hpp"
+#include "modeling/selection_commands.hpp"
+#include "modeling/selection_tools.hpp"
+#include "modeling/store/project.hpp"
+#include "render/panorama_picture.hpp"
+#include "render/render_model.hpp"
 #include "segmentation/constraints.hpp"
 #include "segmentation/segmentation_grid.hpp"
 
 namespace scanbench::app::workbench {
 
 enum class Tool { kSeed, kLasso, kBarrier };
-enum class PanoramaChannel { kColor, kRange, kIntensity, kNormal };
-
-// An RGBA8 picture, top row first.
-struct Picture {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgba;
-};
 
 class Session {
  public:
   // Opens the project (Project::open: throws as it does) and its first scan.
   explicit Session(const std::filesystem::path& project);
 
-  modeling::Project& project() { return project_; }
-  const std::vector<modeling::StoredScanSummary>& scans() const { return scans_; }
+  store::Project& project() { return project_; }
+  const std::vector<store::StoredScanSummary>& scans() const { return scans_; }
   std::int64_t scan_id() const { return scan_id_; }
   const acquisition::Scan& scan() const { return scan_; }
   void open_scan(std::int64_t id);
 
-  // ---- Tools (image coordinates: x = column, y = row) -------------------
+  // ---- Tools (image coordinates: x = column, y = row, pixel centres at
+  // integers: segmentation/constraints.hpp) --------------------------------
   Tool tool = Tool::kSeed;
   segmentation::Channel channel = segmentation::Channel::kNormal;
   double tolerance = segmentation::default_grow_settings(segmentation::Channel::kNormal).tolerance;
   modeling::SelectMode mode = modeling::SelectMode::kReplace;
-  const segmentation::Polyline& lasso() const { return lasso_; }
-  bool lasso_closed() const { return lasso_closed_; }
-  const std::vector<segmentation::Polyline>& barriers() const { return barriers_; }
+  const segmentation::Polyline& lasso() const { return tools_.lasso(); }
+  bool lasso_closed() const { return tools_.lasso_closed(); }
+  const std::vector<segmentation::Polyline>& barriers() const { return tools_.barriers(); }
   // A click of the current tool at (x, y): a seed grows a region, a lasso
   // or barrier gets a vertex.
   void click(double x, double y);
@@ -67,22 +63,22 @@ class Session {
   bool remove(std::int64_t node);
   bool separate(std::int64_t node);
   bool propose();
-  bool recolor(std::int64_t node, const modeling::ColorEdit& set, bool reset);
+  bool recolor(std::int64_t node, const store::ColorEdit& set, bool reset);
   bool clone(std::int64_t source, std::int64_t target);
   bool undo();
   bool redo();
 
-  const std::vector<modeling::ObjectNode>& nodes() const { return nodes_; }
+  const std::vector<store::ObjectNode>& nodes() const { return nodes_; }
   // What the last action did or why it was refused.
   const std::string& status() const { return status_; }
   // Changes with every change of the project the views show.
   std::int64_t revision() const { return revision_; }
 
   // The scan's channel with the objects and the selection laid over it.
-  Picture panorama(PanoramaChannel channel) const;
+  render::Picture panorama(render::PanoramaChannel channel) const;
   // The model as the 3D view draws it, rebuilt after changes to it (not
   // after a selection, which it does not show).
-  const modeling::RenderModel& render_model();
+  const render::RenderModel& render_model();
   bool render_model_stale() const { return !model_ || model_revision_ != model_changes_; }
 
  private:
@@ -92,22 +88,19 @@ class Session {
   bool act(const std::string& what, Action&& action, bool changes_model = true);
   void reload();
 
-  modeling::Project project_;
-  std::vector<modeling::StoredScanSummary> scans_;
+  store::Project project_;
+  std::vector<store::StoredScanSummary> scans_;
   std::int64_t scan_id_ = 0;
   acquisition::Scan scan_;
   std::vector<Eigen::Vector3f> normal_;    // scan frame; zero where none
   std::vector<std::uint32_t> membership_;  // empty: none
   std::vector<std::uint8_t> selection_;    // empty: none
   std::size_t selected_ = 0;
-  segmentation::Polyline lasso_;
-  bool lasso_closed_ = false;
-  std::vector<segmentation::Polyline> barriers_;
-  bool drawing_barrier_ = false;
-  std::vector<modeling::ObjectNode> nodes_;
+  modeling::SelectionTools tools_;
+  std::vector<store::ObjectNode> nodes_;
   std::string status_;
   std::int64_t revision_ = 0;
-  std::optional<modeling::RenderModel> model_;
+  std::optional<render::RenderModel> model_;
   std::int64_t model_revision_ = -1;
   std::int64_t model_changes_ = 0;  // commands that changed what the 3D view shows
 };

@@ -1,4 +1,4 @@
-// The vectorizable math of acquisition/branch_free.hpp against the library
+// The vectorizable math of acquisition/geometry/branch_free.hpp against the library
 // functions in double precision, over the ranges the geometry stage uses.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <numbers>
 
-#include "acquisition/branch_free.hpp"
+#include "acquisition/geometry/branch_free.hpp"
 
 namespace scanbench::acquisition {
 namespace {

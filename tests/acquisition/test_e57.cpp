@@ -11,10 +11,10 @@
 #include <map>
 #include <random>
 
-#include "acquisition/crc32c.hpp"
-#include "acquisition/e57_bitpack.hpp"
-#include "acquisition/e57_reader.hpp"
-#include "acquisition/e57_writer.hpp"
+#include "acquisition/formats/e57/crc32c.hpp"
+#include "acquisition/formats/e57/e57_bitpack.hpp"
+#include "acquisition/formats/e57/e57_reader.hpp"
+#include "acquisition/formats/e57/e57_writer.hpp"
 #include "core/errors.hpp"
 #include "support/test_support.hpp"
 

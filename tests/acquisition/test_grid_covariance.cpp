@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "acquisition/grid_covariance.hpp"
+#include "acquisition/geometry/grid_covariance.hpp"
 
 namespace scanbench::acquisition {
 namespace {

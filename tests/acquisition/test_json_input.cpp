@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "acquisition/camera_view.hpp"
-#include "acquisition/json_input.hpp"
+#include "acquisition/formats/json_input.hpp"
 #include "core/errors.hpp"
 #include "support/test_support.hpp"
 

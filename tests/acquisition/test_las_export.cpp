@@ -8,8 +8,8 @@
 
 #include <cstring>
 
-#include "acquisition/point_export.hpp"
-#include "acquisition/scan_geometry.hpp"
+#include "acquisition/formats/point_export.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "core/errors.hpp"
 #include "support/test_support.hpp"
 
@@ -24,7 +24,8 @@ Scan wall_scan(const Eigen::Vector3d& position) {
   constexpr double kStep = 0.2 * 3.14159265358979323846 / 180.0;
   Scan scan = make_empty_scan(kRows, kColumns, true, true);
   scan.angles = SphericalAngles{0.5 * kColumns * kStep, -kStep, 0.5 * kRows * kStep, -kStep};
-  scan.T_world_scan = Eigen::Translation3d(position) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+  scan.T_world_scan =
+      Eigen::Translation3d(position) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
   for (int row = 0; row < kRows; ++row) {
     for (int col = 0; col < kColumns; ++col) {
       const std::size_t i = scan.index(row, col);
@@ -80,7 +81,8 @@ struct LasFile {
     const std::size_t p = point_offset + k * record_length;
     LasPoint out;
     for (int a = 0; a < 3; ++a)
-      out.position[a] = at<std::int32_t>(bytes, p + 4 * static_cast<std::size_t>(a)) * scale[a] + offset[a];
+      out.position[a] =
+          at<std::int32_t>(bytes, p + 4 * static_cast<std::size_t>(a)) * scale[a] + offset[a];
     out.intensity = at<std::uint16_t>(bytes, p + 12);
     out.returns = static_cast<std::uint8_t>(bytes[p + 14]);
     out.source = at<std::uint16_t>(bytes, p + 20);
@@ -113,7 +115,8 @@ TEST(LasExport, TheHeaderFollowsTheSpecification) {
   EXPECT_EQ(las.point_offset, 375u + 54u + 4u * 192u);
   for (std::size_t k = 0; k < 6; ++k) EXPECT_EQ(at<std::uint32_t>(b, 107 + 4 * k), 0u);  // legacy
   std::size_t in_model_points = 0;
-  for (std::size_t i = 0; i < scan.pixel_count(); ++i) in_model_points += in_model(scan, geometry, i);
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i)
+    in_model_points += in_model(scan, geometry, i);
   EXPECT_EQ(las.points, in_model_points);
   EXPECT_EQ(at<std::uint64_t>(b, 255), in_model_points);  // all first returns
   EXPECT_EQ(b.size(), las.point_offset + las.points * las.record_length);

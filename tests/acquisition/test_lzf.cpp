@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/lzf.hpp"
+#include "acquisition/formats/lzf.hpp"
 
 namespace scanbench::acquisition {
 namespace {

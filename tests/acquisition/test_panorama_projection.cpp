@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "acquisition/panorama_projection.hpp"
+#include "acquisition/formats/panorama_projection.hpp"
 
 namespace scanbench::acquisition {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/pcd_reader.hpp"
+#include "acquisition/formats/pcd_reader.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
 #include "support/test_support.hpp"

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "acquisition/ptx_reader.hpp"
-#include "acquisition/ptx_writer.hpp"
+#include "acquisition/formats/ptx_reader.hpp"
+#include "acquisition/formats/ptx_writer.hpp"
 #include "core/errors.hpp"
 #include "support/test_support.hpp"
 

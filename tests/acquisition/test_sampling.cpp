@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "acquisition/sampling.hpp"
+#include "acquisition/geometry/sampling.hpp"
 
 namespace scanbench::acquisition {
 namespace {

@@ -8,8 +8,8 @@
 #include <random>
 #include <utility>
 
-#include "acquisition/scan_geometry.hpp"
-#include "acquisition/window_moments.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
+#include "acquisition/geometry/window_moments.hpp"
 
 namespace scanbench::acquisition {
 namespace {

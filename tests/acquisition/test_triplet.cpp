@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "acquisition/triplet_reader.hpp"
-#include "acquisition/triplet_writer.hpp"
+#include "acquisition/formats/triplet_reader.hpp"
+#include "acquisition/formats/triplet_writer.hpp"
 #include "core/errors.hpp"
 #include "support/test_support.hpp"
 

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "app/cli_runner.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench {
@@ -193,7 +193,7 @@ TEST(Robustness, AReadOnlyProjectWhoseLogHoldsChangesIsRefusedWithTheReason) {
   const pid_t writer = ::fork();
   if (writer == 0) {
     try {
-      modeling::Project open = modeling::Project::open(project);
+      store::Project open = store::Project::open(project);
       ::_exit(open.undo() ? 0 : 1);
     } catch (...) {
       ::_exit(2);

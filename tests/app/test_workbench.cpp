@@ -189,6 +189,36 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
 }
 
+// Clicking another scan in the Scans panel opens it: the panel's list,
+// which opening a scan reloads, was walked while it was replaced
+// (std::bad_alloc or SIGSEGV, 5 times in 5).
+TEST(Workbench, ClickingAnotherScanOpensIt) {
+  const ScratchDir dir;
+  const std::filesystem::path project = dir / "two.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
+  const std::filesystem::path layout = dir / "layout.json";
+  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
+                                 events(dir, "look.json", {{{"wait", 1}}}).string(), "--layout",
+                                 layout.string()})
+                .exit_code,
+            0);
+  const json click = Layout{read_json(layout)}.widget("scan 2");
+  const CliResult run = run_on_display(dir, {project.string(), "--replay",
+                                             events(dir, "open.json",
+                                                    {{{"screenshot", "a.png"}},
+                                                     {{"click", click}},
+                                                     {{"wait", 3}},
+                                                     {{"screenshot", "b.png"}}})
+                                                 .string(),
+                                             "--layout", layout.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "b.png"));
+  EXPECT_EQ(read_json(layout)["scan"], 2);
+}
+
 TEST(Workbench, BadEventsAndProjectsAreRefusedByName) {
   const ScratchDir dir;
   const std::filesystem::path project = dir / "empty.sbproj";

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "acquisition/scan.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::test {
 
@@ -59,9 +59,9 @@ inline acquisition::Scan tiny_scan(bool spherical, bool with_intensity, bool wit
 }
 
 // Stores `scan` as a command of its own ("import") and returns its id.
-inline std::int64_t insert_committed(modeling::Project& project, const acquisition::Scan& scan) {
-  modeling::Project::Edit edit = project.begin_command("import", "{}");
-  const std::int64_t id = project.insert_scan(edit, modeling::encode_scan(scan));
+inline std::int64_t insert_committed(store::Project& project, const acquisition::Scan& scan) {
+  store::Project::Edit edit = project.begin_command("import", "{}");
+  const std::int64_t id = project.insert_scan(edit, store::encode_scan(scan));
   edit.commit("{}");
   return id;
 }

@@ -8,9 +8,9 @@
 #include <tuple>
 #include <utility>
 
-#include "modeling/project.hpp"
-#include "modeling/scan_layers.hpp"
-#include "modeling/segment_commands.hpp"
+#include "modeling/selection_commands.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"
 #include "segmentation/room_scene.hpp"
 
@@ -18,11 +18,11 @@ namespace scanbench::modeling {
 
 // A project holding the room of tests/segmentation/room_scene.hpp with its
 // geometry; returns the scan's id.
-inline std::int64_t store_room(Project& project) {
+inline std::int64_t store_room(store::Project& project) {
   const test::RoomScan& room = test::shared_room();
   const std::int64_t id = test::insert_committed(project, room.scan);
-  Project::Edit edit = project.begin_command("geometry", "{}");
-  for (const EncodedLayer& layer : encode_geometry(room.geometry))
+  store::Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const store::EncodedLayer& layer : store::encode_geometry(room.geometry))
     project.put_layer(edit, id, layer);
   edit.commit("{}");
   return id;

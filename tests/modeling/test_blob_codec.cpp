@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "core/errors.hpp"
-#include "modeling/blob_codec.hpp"
+#include "modeling/store/zstd_blob.hpp"
 
-namespace scanbench::modeling {
+namespace scanbench::store {
 namespace {
 
 using core::InputError;
@@ -128,4 +128,4 @@ TEST(BlobCodec, ImpossibleCountIsAnInputErrorNotAnAllocation) {
 }
 
 }  // namespace
-}  // namespace scanbench::modeling
+}  // namespace scanbench::store

@@ -8,8 +8,10 @@
 #include "core/errors.hpp"
 #include "core/progress.hpp"
 #include "modeling/color_commands.hpp"
-#include "modeling/registration_stage.hpp"
-#include "modeling/render_model.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
+#include "render/render_model.hpp"
 #include "room_project.hpp"
 #include "support/test_support.hpp"
 
@@ -27,7 +29,7 @@ struct RoomObjects {
   std::int64_t wall = 0;
 };
 
-RoomObjects segment_room(Project& project) {
+RoomObjects segment_room(store::Project& project) {
   RoomObjects out;
   out.scan = store_room(project);
   out.room = group_nodes(project, {"room", std::nullopt, {}}).node_id;
@@ -38,17 +40,17 @@ RoomObjects segment_room(Project& project) {
   return out;
 }
 
-RenderModel model_of(const Project& project) {
-  RenderModelSettings settings;
+render::RenderModel model_of(const store::Project& project) {
+  render::RenderModelSettings settings;
   settings.merged_only = false;
-  return build_render_model(project, settings);
+  return render::build_render_model(project, settings);
 }
 
 // The render model's colours point by point, in its order (the same
 // project state gives the same order).
 using Colours = std::vector<std::array<std::uint8_t, 4>>;
 
-Eigen::Vector3d mean_lab(const RenderModel& model, std::uint32_t node) {
+Eigen::Vector3d mean_lab(const render::RenderModel& model, std::uint32_t node) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   std::size_t n = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {
@@ -62,9 +64,9 @@ Eigen::Vector3d mean_lab(const RenderModel& model, std::uint32_t node) {
 
 TEST(Recolor, AnEditChangesOnlyItsObjectAndUndoRestoresItBitExactly) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const RoomObjects room = segment_room(project);
-  const RenderModel before = model_of(project);
+  const render::RenderModel before = model_of(project);
   const acquisition::Scan scan_before = project.load_scan(room.scan);
 
   RecolorSettings settings;
@@ -72,7 +74,7 @@ TEST(Recolor, AnEditChangesOnlyItsObjectAndUndoRestoresItBitExactly) {
   settings.set.hue_deg = 120.0;
   settings.set.brightness = -10.0;
   recolor_object(project, settings);
-  const RenderModel after = model_of(project);
+  const render::RenderModel after = model_of(project);
   ASSERT_EQ(after.points.size(), before.points.size());
   std::size_t changed = 0, wall = 0;
   for (std::size_t k = 0; k < after.points.size(); ++k) {
@@ -97,9 +99,9 @@ TEST(Recolor, AnEditChangesOnlyItsObjectAndUndoRestoresItBitExactly) {
 
 TEST(Recolor, AGroupsEditReachesChildrenThatDoNotOverrideIt) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const RoomObjects room = segment_room(project);
-  const RenderModel before = model_of(project);
+  const render::RenderModel before = model_of(project);
   RecolorSettings group;
   group.node = room.room;
   group.set.brightness = 10.0;
@@ -108,7 +110,7 @@ TEST(Recolor, AGroupsEditReachesChildrenThatDoNotOverrideIt) {
   floor.node = room.floor;
   floor.set.brightness = 0.0;  // the floor keeps its lightness
   recolor_object(project, floor);
-  const RenderModel after = model_of(project);
+  const render::RenderModel after = model_of(project);
   const auto wall = static_cast<std::uint32_t>(room.wall);
   const auto floor_id = static_cast<std::uint32_t>(room.floor);
   EXPECT_NEAR(mean_lab(after, wall).x(), mean_lab(before, wall).x() + 10.0, 0.5);
@@ -126,9 +128,9 @@ TEST(Recolor, EditsSurviveReopeningTheProject) {
   const ScratchDir dir;
   const auto file = dir / "p.sbproj";
   Colours shown;
-  ColorEdit expected;
+  store::ColorEdit expected;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     const RoomObjects room = segment_room(project);
     RecolorSettings settings;
     settings.node = room.wall;
@@ -139,7 +141,7 @@ TEST(Recolor, EditsSurviveReopeningTheProject) {
     expected.gamma = 1.4;
     shown = model_of(project).points.rgba;
   }
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   EXPECT_EQ(project.object_nodes().back().color, expected);
   EXPECT_EQ(model_of(project).points.rgba, shown);
   EXPECT_TRUE(project.check().damage.empty());
@@ -147,7 +149,7 @@ TEST(Recolor, EditsSurviveReopeningTheProject) {
 
 TEST(Recolor, BadRequestsAreRefusedAndChangeNothing) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const RoomObjects room = segment_room(project);
   const std::int64_t revision = project.revision();
   RecolorSettings missing;
@@ -176,7 +178,7 @@ TEST(Recolor, BadRequestsAreRefusedAndChangeNothing) {
 
 TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const RoomObjects room = segment_room(project);
   RecolorSettings warm;
   warm.node = room.floor;
@@ -189,7 +191,7 @@ TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
   const CloneResult out = clone_color(project, clone);
   EXPECT_GT(out.source_points, 1000u);
   EXPECT_GT(out.target_points, 1000u);
-  const RenderModel model = model_of(project);
+  const render::RenderModel model = model_of(project);
   const Eigen::Vector3d floor = mean_lab(model, static_cast<std::uint32_t>(room.floor));
   const Eigen::Vector3d wall = mean_lab(model, static_cast<std::uint32_t>(room.wall));
   EXPECT_LT(acquisition::delta_e(floor, wall), 1.0)
@@ -209,7 +211,7 @@ TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
 }
 
 // Mean and standard deviation of the shown L* of a node's points.
-std::pair<double, double> lightness(const RenderModel& model, std::uint32_t node) {
+std::pair<double, double> lightness(const render::RenderModel& model, std::uint32_t node) {
   double sum = 0.0, squares = 0.0;
   std::size_t n = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {
@@ -229,7 +231,7 @@ std::pair<double, double> lightness(const RenderModel& model, std::uint32_t node
 // onto the source's: an inverted ratio or a wrong offset shows.
 TEST(Clone, TheTargetTakesTheSourcesMeanAndSpread) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   test::RoomScan room = test::shared_room();
   for (std::size_t i = 0; i < room.scan.pixel_count(); ++i) {
     if ((i % static_cast<std::size_t>(room.scan.columns)) % 2 != 0) continue;
@@ -238,8 +240,8 @@ TEST(Clone, TheTargetTakesTheSourcesMeanAndSpread) {
           static_cast<std::uint8_t>(std::max(0, room.scan.rgb[3 * i + c] - 40));
   }
   const std::int64_t scan = test::insert_committed(project, room.scan);
-  Project::Edit edit = project.begin_command("geometry", "{}");
-  for (const EncodedLayer& layer : encode_geometry(room.geometry))
+  store::Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const store::EncodedLayer& layer : store::encode_geometry(room.geometry))
     project.put_layer(edit, scan, layer);
   edit.commit("{}");
   select_region(project, select_at(scan, 0, -45));
@@ -267,7 +269,7 @@ TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
   const Eigen::Vector3d gains(1.25, 0.9, 1.1);
   Colours first_scan;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     store_room(project);
     first_scan = model_of(project).points.rgba;
     test::RoomScan copy = test::shared_room();
@@ -278,13 +280,13 @@ TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
       }
     }
     const std::int64_t second = test::insert_committed(project, copy.scan);
-    Project::Edit edit = project.begin_command("geometry", "{}");
-    for (const EncodedLayer& layer : encode_geometry(copy.geometry))
+    store::Project::Edit edit = project.begin_command("geometry", "{}");
+    for (const store::EncodedLayer& layer : store::encode_geometry(copy.geometry))
       project.put_layer(edit, second, layer);
     edit.commit("{}");
 
     core::Progress quiet;
-    const HarmonizeStageResult out = harmonize_project(project, {}, quiet);
+    const HarmonizeCommandResult out = harmonize_project(project, {}, quiet);
     ASSERT_EQ(out.scans.size(), 2u);
     EXPECT_EQ(out.scans[1].reference, out.scans[0].id);
     EXPECT_EQ(out.scans[0].reference, out.scans[0].id);
@@ -296,12 +298,13 @@ TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
     EXPECT_GT(out.delta_e_before, 3.0);
     EXPECT_LT(out.delta_e_after, 0.5);
   }
-  Project project = Project::open(file);
-  const std::map<std::int64_t, ScanColorCorrection> stored = project.scan_color_corrections();
+  store::Project project = store::Project::open(file);
+  const std::map<std::int64_t, store::ScanColorCorrection> stored =
+      project.scan_color_corrections();
   ASSERT_EQ(stored.size(), 2u);
   EXPECT_TRUE(stored.begin()->second.identity());
   // The copy now shows the first scan's colours.
-  const RenderModel model = model_of(project);
+  const render::RenderModel model = model_of(project);
   ASSERT_EQ(model.points.size(), 2 * first_scan.size());
   std::size_t off = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {

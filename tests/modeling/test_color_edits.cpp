@@ -6,8 +6,8 @@
 #include <random>
 
 #include "acquisition/color_space.hpp"
-#include "modeling/color_edits.hpp"
-#include "modeling/project.hpp"
+#include "modeling/color_pipeline.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
 namespace {
@@ -69,9 +69,9 @@ TEST(ColorEdit, LightnessStepsApplyInTheirOrder) {
 }
 
 TEST(ColorEdit, ChildrenInheritWhatTheyDoNotSet) {
-  std::vector<ObjectNode> nodes(3);
+  std::vector<store::ObjectNode> nodes(3);
   nodes[0].id = 1;
-  nodes[0].kind = NodeKind::kGroup;
+  nodes[0].kind = store::NodeKind::kGroup;
   nodes[0].color.brightness = 10.0;
   nodes[0].color.saturation = 0.5;
   nodes[1].id = 2;
@@ -93,30 +93,31 @@ TEST(ColorEdit, ChildrenInheritWhatTheyDoNotSet) {
 }
 
 TEST(ColorEdit, EditsAndCorrectionsRoundTripThroughJson) {
-  ColorEdit edit;
+  store::ColorEdit edit;
   edit.gamma = 1.25;
   edit.hue_deg = -0.0;
-  edit.transfer = LabTransfer{{1.0, 0.0, 2.5}, {-3.0, 0.125, 7.0}};
-  EXPECT_EQ(color_edit_from_json(to_json(edit)), edit);
-  EXPECT_EQ(to_json(ColorEdit{}), "");
-  EXPECT_TRUE(color_edit_from_json("").empty());
-  ScanColorCorrection correction;
+  edit.transfer = store::LabTransfer{{1.0, 0.0, 2.5}, {-3.0, 0.125, 7.0}};
+  EXPECT_EQ(store::color_edit_from_json(to_json(edit)), edit);
+  EXPECT_EQ(to_json(store::ColorEdit{}), "");
+  EXPECT_TRUE(store::color_edit_from_json("").empty());
+  store::ScanColorCorrection correction;
   correction.matrix << 1.1, 0.01, 0.0, -0.02, 0.9, 0.0, 0.0, 0.0, 1.3;
   correction.offset = {0.001, -0.002, 0.0};
-  EXPECT_EQ(scan_color_correction_from_json(to_json(correction)), correction);
-  EXPECT_THROW(color_edit_from_json("{\"contrast\": -1}"), std::invalid_argument);
-  EXPECT_THROW(color_edit_from_json("{\"brightness\": \"a lot\"}"), std::invalid_argument);
-  EXPECT_THROW(color_edit_from_json("[1, 2]"), std::invalid_argument);
-  EXPECT_THROW(scan_color_correction_from_json("{\"matrix\": [[1, 0, 0]], \"offset\": [0, 0, 0]}"),
-               std::invalid_argument);
+  EXPECT_EQ(store::scan_color_correction_from_json(store::to_json(correction)), correction);
+  EXPECT_THROW(store::color_edit_from_json("{\"contrast\": -1}"), std::invalid_argument);
+  EXPECT_THROW(store::color_edit_from_json("{\"brightness\": \"a lot\"}"), std::invalid_argument);
+  EXPECT_THROW(store::color_edit_from_json("[1, 2]"), std::invalid_argument);
+  EXPECT_THROW(
+      store::scan_color_correction_from_json("{\"matrix\": [[1, 0, 0]], \"offset\": [0, 0, 0]}"),
+      std::invalid_argument);
 }
 
 TEST(ColorPipeline, ColoursWithoutEditsPassBitExactly) {
-  ScanColorCorrection double_red;
+  store::ScanColorCorrection double_red;
   double_red.matrix(0, 0) = 2.0;
   ResolvedColorEdit grey;
   grey.saturation = 0.0;
-  const ColorPipeline pipeline({{2, double_red}, {3, ScanColorCorrection{}}},
+  const ColorPipeline pipeline({{2, double_red}, {3, store::ScanColorCorrection{}}},
                                {{5, grey}, {6, ResolvedColorEdit{}}});
   const std::array<std::uint8_t, 3> c = {120, 80, 40};
   EXPECT_EQ(pipeline.shown(1, 0, c), c);

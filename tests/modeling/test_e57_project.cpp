@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "modeling/export_project.hpp"
-#include "modeling/import_scans.hpp"
+#include "modeling/export_command.hpp"
+#include "modeling/import_command.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -27,13 +27,13 @@ std::filesystem::path export_e57(const std::filesystem::path& project,
   ExportSettings settings;
   settings.format = ExportFormat::kE57;
   settings.output = output;
-  export_project(Project::open_for_reading(project), settings);
+  export_project(store::Project::open_for_reading(project), settings);
   return output;
 }
 
 void expect_same_scans(const std::filesystem::path& first, const std::filesystem::path& second) {
-  const Project a = Project::open_for_reading(first);
-  const Project b = Project::open_for_reading(second);
+  const store::Project a = store::Project::open_for_reading(first);
+  const store::Project b = store::Project::open_for_reading(second);
   const auto scans_a = a.scans();
   const auto scans_b = b.scans();
   ASSERT_EQ(scans_a.size(), scans_b.size());
@@ -66,12 +66,12 @@ TEST(E57Project, RoundTripKeepsScansImagesAndGuids) {
   const ImportResult again = import_files(dir / "b.sbproj", {file});
   EXPECT_EQ(again.images, 2u);
   expect_same_scans(dir / "a.sbproj", dir / "b.sbproj");
-  const Project b = Project::open_for_reading(dir / "b.sbproj");
+  const store::Project b = store::Project::open_for_reading(dir / "b.sbproj");
   EXPECT_EQ(b.scan_sources().at(1).guid, "{scan-structured}");
   EXPECT_EQ(b.scan_sources().at(1).unplaced_points, 0u) << "the exported grid holds first returns";
-  const std::vector<StoredImage> images = b.images(true);
-  const std::vector<StoredImage> original =
-      Project::open_for_reading(dir / "a.sbproj").images(true);
+  const std::vector<store::StoredImage> images = b.images(true);
+  const std::vector<store::StoredImage> original =
+      store::Project::open_for_reading(dir / "a.sbproj").images(true);
   ASSERT_EQ(images.size(), original.size());
   for (std::size_t i = 0; i < images.size(); ++i) {
     EXPECT_EQ(images[i].scan_id, original[i].scan_id);
@@ -88,17 +88,17 @@ TEST(E57Project, RoundTripKeepsScansImagesAndGuids) {
 TEST(E57Project, ImagesFollowTheirScanWhenItMoves) {
   const ScratchDir dir;
   import_files(dir / "p.sbproj", {fixture("good/e57/structured_spherical.e57")});
-  Project project = Project::open(dir / "p.sbproj");
-  const StoredImage before = project.images(false).at(0);
+  store::Project project = store::Project::open(dir / "p.sbproj");
+  const store::StoredImage before = project.images(false).at(0);
   ASSERT_EQ(before.scan_id, 1);
   const Eigen::Isometry3d was = project.scans().at(0).summary.T_world_scan;
   acquisition::Scan scan = project.load_scan(1);
   scan.T_world_scan = Eigen::Translation3d(5.0, -2.0, 0.5) *
                       Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()) * scan.T_world_scan;
-  Project::Edit edit = project.begin_command("register", "{}");
+  store::Project::Edit edit = project.begin_command("register", "{}");
   project.set_pose(edit, 1, scan);
   edit.commit("{}");
-  const StoredImage after = project.images(false).at(0);
+  const store::StoredImage after = project.images(false).at(0);
   const Eigen::Isometry3d expected = scan.T_world_scan * was.inverse() * before.image.T_world_image;
   EXPECT_TRUE(after.image.T_world_image.isApprox(expected, 1e-12));
   EXPECT_FALSE(after.image.T_world_image.isApprox(before.image.T_world_image, 1e-6));
@@ -120,7 +120,7 @@ TEST(E57Project, TheCoordinateSystemGoesBackOutAndIsNeverMixed) {
   const ScratchDir dir;
   import_files(dir / "geo.sbproj", {fixture("good/e57/georeferenced.e57")});
   import_files(dir / "again.sbproj", {export_e57(dir / "geo.sbproj", dir / "geo.e57")});
-  const auto sources = Project::open_for_reading(dir / "again.sbproj").scan_sources();
+  const auto sources = store::Project::open_for_reading(dir / "again.sbproj").scan_sources();
   ASSERT_EQ(sources.size(), 2u);
   EXPECT_EQ(sources.at(1).coordinate_metadata, "EPSG:25832");
   // A scan of a file that names no system joins any; one that names another
@@ -128,10 +128,10 @@ TEST(E57Project, TheCoordinateSystemGoesBackOutAndIsNeverMixed) {
   import_files(dir / "geo.sbproj", {fixture("good/e57/structured_spherical.e57")});
   EXPECT_NO_THROW(export_e57(dir / "geo.sbproj", dir / "mixed.e57"));
   {
-    Project project = Project::open(dir / "geo.sbproj");
-    Project::Edit edit = project.begin_command("import", "{}");
+    store::Project project = store::Project::open(dir / "geo.sbproj");
+    store::Project::Edit edit = project.begin_command("import", "{}");
     acquisition::Scan scan = project.load_scan(1);
-    const std::int64_t id = project.insert_scan(edit, encode_scan(scan));
+    const std::int64_t id = project.insert_scan(edit, store::encode_scan(scan));
     acquisition::ScanSource other;
     other.format = "e57";
     other.coordinate_metadata = "EPSG:4326";
@@ -157,7 +157,7 @@ TEST(E57Project, ABadFileChangesNothing) {
                  core::InputError)
         << bad;
   }
-  const Project opened = Project::open_for_reading(project);
+  const store::Project opened = store::Project::open_for_reading(project);
   EXPECT_EQ(opened.scans().size(), 1u);
   EXPECT_EQ(opened.history().size(), 1u) << "no trace of the refused imports";
   EXPECT_TRUE(opened.images(false).empty());

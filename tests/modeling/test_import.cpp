@@ -9,9 +9,9 @@
 
 #include "core/errors.hpp"
 #include "core/process.hpp"
-#include "modeling/import_scans.hpp"
-#include "modeling/project.hpp"
+#include "modeling/import_command.hpp"
 #include "modeling/project_test_support.hpp"
+#include "modeling/store/project.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -22,7 +22,8 @@ using test::ScratchDir;
 
 std::vector<std::string> scan_names(const std::filesystem::path& project) {
   std::vector<std::string> names;
-  for (const auto& stored : Project::open(project).scans()) names.push_back(stored.summary.name);
+  for (const auto& stored : store::Project::open(project).scans())
+    names.push_back(stored.summary.name);
   return names;
 }
 
@@ -50,7 +51,7 @@ TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
   const std::vector<std::filesystem::path> files{fixture("good/ptx/two_scans.ptx"),
                                                  fixture("bad/ptx_color_out_of_range.ptx")};
   EXPECT_THROW(import_files(project, files), core::InputError);
-  EXPECT_EQ(Project::open(project).history().size(), 1u);
+  EXPECT_EQ(store::Project::open(project).history().size(), 1u);
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
 }
 
@@ -99,7 +100,7 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
   ASSERT_TRUE(WIFSIGNALED(status));
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
   const acquisition::Scan kept =
-      Project::open(project).load_scan(Project::open(project).scans()[0].id);
+      store::Project::open(project).load_scan(store::Project::open(project).scans()[0].id);
   EXPECT_EQ(kept.rows, 2);
   // The dead import's committed parts are there but invisible ...
   const auto raw_count = [&] {
@@ -107,12 +108,13 @@ TEST(ImportScans, KillDuringImportLeavesProjectAsBefore) {
   };
   EXPECT_EQ(raw_count(), "3");
   // History shows the dead writer's command as interrupted, not pending.
-  EXPECT_EQ(Project::open(project).history().back().state, CommandState::kInterrupted);
+  EXPECT_EQ(store::Project::open(project).history().back().state,
+            store::CommandState::kInterrupted);
   // ... until the next writer removes them.
   import_files(project, {fixture("good/ptx/irregular.ptx")});
   EXPECT_EQ(raw_count(), "2");
-  for (const CommandRecord& c : Project::open(project).history()) {
-    EXPECT_EQ(c.state, CommandState::kDone) << c.id;
+  for (const store::CommandRecord& c : store::Project::open(project).history()) {
+    EXPECT_EQ(c.state, store::CommandState::kDone) << c.id;
   }
 }
 

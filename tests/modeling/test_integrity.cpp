@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "modeling/import_scans.hpp"
-#include "modeling/project.hpp"
+#include "modeling/import_command.hpp"
 #include "modeling/project_test_support.hpp"
+#include "modeling/store/project.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -26,7 +26,7 @@ using ::testing::HasSubstr;
 // A project with one imported scan, closed.
 std::filesystem::path sound_project(const ScratchDir& dir) {
   const auto file = dir / "p.sbproj";
-  Project project = Project::create(file);
+  store::Project project = store::Project::create(file);
   core::Progress quiet;
   import_scans(project, std::vector<std::filesystem::path>{fixture("good/ptx/tiny_color.ptx")}, {},
                quiet);
@@ -41,8 +41,8 @@ std::string joined(const std::vector<std::string>& lines) {
 
 TEST(Integrity, ASoundProjectPassesTheCheck) {
   const ScratchDir dir;
-  const Project project = Project::open(sound_project(dir));
-  const Project::CheckReport report = project.check();
+  const store::Project project = store::Project::open(sound_project(dir));
+  const store::Project::CheckReport report = project.check();
   EXPECT_TRUE(report.damage.empty()) << joined(report.damage);
   EXPECT_EQ(report.records, 4u);  // the scan, its pose, its source, the import
   EXPECT_EQ(report.layers, 4u);   // range, valid, intensity, rgb
@@ -54,7 +54,7 @@ TEST(Integrity, ProjectsOfEveryVersionPassTheCheck) {
     const auto file = dir / ("v" + std::to_string(version) + ".sbproj");
     std::filesystem::copy_file(fixture("projects/version" + std::to_string(version) + ".sbproj"),
                                file);
-    const Project::CheckReport report = Project::open(file).check();
+    const store::Project::CheckReport report = store::Project::open(file).check();
     EXPECT_TRUE(report.damage.empty()) << version << ":\n" << joined(report.damage);
     EXPECT_GT(report.layers, 0u);
   }
@@ -77,7 +77,7 @@ TEST(Integrity, AFlippedByteInAPoseIsFoundOnReadingAndByTheCheck) {
   ASSERT_NE(at, std::string::npos);
   bytes[at + 3 * 8 + 6] ^= 0x10;  // 0.0 becomes a tiny non-zero x
   std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   try {
     project.scans();
     FAIL() << "expected core::InputError";
@@ -91,7 +91,7 @@ TEST(Integrity, ChangedSettingsInTheJournalAreFound) {
   const ScratchDir dir;
   const auto file = sound_project(dir);
   RawDatabase(file).execute("UPDATE commands SET settings = replace(settings, 'tiny', 'tidy')");
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   EXPECT_THROW(project.history(), core::InputError);
   EXPECT_THAT(joined(project.check().damage), HasSubstr("command 1 (import)"));
 }
@@ -104,7 +104,7 @@ TEST(Integrity, ChangedSourcesAndImagesAreFound) {
       "UPDATE scan_sources SET details = replace(details, 'structured', 'structures')");
   RawDatabase(file).execute("UPDATE scan_images SET data = zeroblob(length(data)) WHERE id = 2");
   RawDatabase(file).execute("UPDATE scan_images SET format = 'jpeg' WHERE id = 1");
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   EXPECT_THROW(project.scan_sources(), core::InputError);
   EXPECT_THROW(project.images(false), core::InputError);
   const std::string damage = joined(project.check().damage);
@@ -117,14 +117,14 @@ TEST(Integrity, ChangedColourEditsAndCorrectionsAreFound) {
   const ScratchDir dir;
   const auto file = sound_project(dir);
   {
-    Project project = Project::open(file);
-    ObjectNode node;
+    store::Project project = store::Project::open(file);
+    store::ObjectNode node;
     node.id = project.new_node_id();
     node.name = "wall";
     node.color.hue_deg = 30.0;
-    Project::Edit edit = project.begin_command("recolor", "{}");
+    store::Project::Edit edit = project.begin_command("recolor", "{}");
     project.put_node(edit, node);
-    ScanColorCorrection gains;
+    store::ScanColorCorrection gains;
     gains.matrix.diagonal() << 1.1, 1.0, 0.9;
     project.put_scan_color_correction(edit, project.scans().front().id, gains);
     edit.commit("{}");
@@ -132,7 +132,7 @@ TEST(Integrity, ChangedColourEditsAndCorrectionsAreFound) {
   RawDatabase(file).execute("UPDATE object_nodes SET color_edit = '{\"hue_deg\": 90.0}'");
   RawDatabase(file).execute(
       "UPDATE scan_colors SET correction = replace(correction, '1.1', '1.2')");
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   try {
     project.object_nodes();
     ADD_FAILURE() << "a changed colour edit was read";
@@ -158,7 +158,7 @@ TEST(Integrity, ADamagedLayerIsNamedByTheCheck) {
   RawDatabase(file).execute(
       "UPDATE scan_layers SET data = substr(data, 1, 12) || x'00' || substr(data, 14) "
       "WHERE name = 'intensity'");
-  const Project::CheckReport report = Project::open(file).check();
+  const store::Project::CheckReport report = store::Project::open(file).check();
   ASSERT_EQ(report.damage.size(), 1u) << joined(report.damage);
   EXPECT_THAT(report.damage[0], HasSubstr("scan 1, layer intensity of command 1"));
 }
@@ -168,9 +168,9 @@ TEST(Integrity, AChangedLayerRowIsFoundOnReadingAndByTheCheck) {
   const auto file = sound_project(dir);
   // The data still decodes; the row now claims another layer's name.
   RawDatabase(file).execute("UPDATE scan_layers SET name = 'intensitx' WHERE name = 'intensity'");
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   EXPECT_THROW(project.load_scan(1), core::InputError);
-  const Project::CheckReport report = project.check();
+  const store::Project::CheckReport report = project.check();
   ASSERT_EQ(report.damage.size(), 1u) << joined(report.damage);
   EXPECT_THAT(report.damage[0], HasSubstr("layer intensitx of command 1: its row"));
 }
@@ -179,18 +179,19 @@ TEST(Integrity, AChangedLayerRowIsFoundOnReadingAndByTheCheck) {
 // the first, command 3 the second. Returns the project's file.
 std::filesystem::path two_versions(const ScratchDir& dir) {
   const auto file = sound_project(dir);
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   const std::int64_t scan = project.scans().front().id;
   const std::size_t pixels = project.load_scan(scan).pixel_count();
   for (const char* name : {"wall", "north wall"}) {
-    ObjectNode node;
+    store::ObjectNode node;
     node.id = 1;
     node.name = name;
-    Project::Edit edit = project.begin_command("edit", "{}");
+    store::Project::Edit edit = project.begin_command("edit", "{}");
     project.put_node(edit, node);
-    project.put_layer(edit, scan,
-                      encode_layer<std::uint8_t>("selection", ElementType::kU8,
-                                                 std::vector<std::uint8_t>(pixels, name[0])));
+    project.put_layer(
+        edit, scan,
+        store::encode_layer<std::uint8_t>("selection", store::ElementType::kU8,
+                                          std::vector<std::uint8_t>(pixels, name[0])));
     acquisition::Scan moved = project.load_scan(scan);
     moved.T_world_scan.translation().x() += 1.0;
     project.set_pose(edit, scan, moved);
@@ -199,9 +200,9 @@ std::filesystem::path two_versions(const ScratchDir& dir) {
   return file;
 }
 
-std::string journal_of(const Project& project) {
+std::string journal_of(const store::Project& project) {
   std::string out;
-  for (const CommandRecord& c : project.history())
+  for (const store::CommandRecord& c : project.history())
     out += std::to_string(c.id) + ":" + std::to_string(static_cast<int>(c.state)) + " ";
   return out;
 }
@@ -212,7 +213,7 @@ TEST(Integrity, UndoAndRedoRefuseToMakeADamagedVersionCurrent) {
   // The older node version is damaged: undoing command 3 would make it current.
   RawDatabase(file).execute("UPDATE object_nodes SET name = 'wal' WHERE command_id = 2");
   {
-    Project project = Project::open(file);
+    store::Project project = store::Project::open(file);
     const std::string journal = journal_of(project);
     try {
       project.undo();
@@ -228,7 +229,7 @@ TEST(Integrity, UndoAndRedoRefuseToMakeADamagedVersionCurrent) {
   // The older pose is damaged.
   RawDatabase(file).execute("UPDATE scan_poses SET scanner_z = scanner_z + 1 WHERE command_id = 2");
   {
-    Project project = Project::open(file);
+    store::Project project = store::Project::open(file);
     const std::string journal = journal_of(project);
     try {
       project.undo();
@@ -242,13 +243,13 @@ TEST(Integrity, UndoAndRedoRefuseToMakeADamagedVersionCurrent) {
   // The newer version is undone, then its layer's data damaged: redo would
   // make it current.
   {
-    Project project = Project::open(file);
+    store::Project project = store::Project::open(file);
     ASSERT_TRUE(project.undo());
   }
   RawDatabase(file).execute(
       "UPDATE scan_layers SET data = substr(data, 1, 12) || x'ff' || substr(data, 14) "
       "WHERE command_id = 3");
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   const std::string journal = journal_of(project);
   try {
     project.redo();
@@ -265,19 +266,19 @@ TEST(Integrity, TheCheckNeverChangesTheFileItChecks) {
   std::filesystem::copy_file(fixture("projects/version2.sbproj"), old);
   const std::string before = test::read_file_bytes(old);
   try {
-    Project::open_read_only(old);
+    store::Project::open_read_only(old);
     FAIL() << "expected core::RuntimeFailure";
   } catch (const core::RuntimeFailure& error) {
     EXPECT_THAT(error.problem(), HasSubstr("schema version 2, read here without changes"));
   }
   EXPECT_EQ(test::read_file_bytes(old), before);
-  const Project project = Project::open_read_only(sound_project(dir));
+  const store::Project project = store::Project::open_read_only(sound_project(dir));
   EXPECT_TRUE(project.check().damage.empty());
 }
 
 TEST(Integrity, TheSameScanImportedTwiceIsRefusedUnlessAllowed) {
   const ScratchDir dir;
-  Project project = Project::open(sound_project(dir));
+  store::Project project = store::Project::open(sound_project(dir));
   core::Progress quiet;
   const std::vector<std::filesystem::path> again{fixture("good/ptx/tiny_color.ptx")};
   try {

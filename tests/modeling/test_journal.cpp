@@ -9,11 +9,13 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "modeling/geometry_stage.hpp"
-#include "modeling/import_scans.hpp"
-#include "modeling/project.hpp"
-#include "modeling/registration_stage.hpp"
-#include "modeling/scan_layers.hpp"
+#include "modeling/geometry_command.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/import_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"
 #include "support/test_support.hpp"
 
@@ -34,21 +36,21 @@ acquisition::GeometrySettings small_windows() {
   return settings;
 }
 
-std::vector<std::string> names_and_states(const Project& project) {
+std::vector<std::string> names_and_states(const store::Project& project) {
   std::vector<std::string> out;
-  for (const CommandRecord& c : project.history()) {
-    out.push_back(c.name + (c.state == CommandState::kDone ? "" : " (undone)"));
+  for (const store::CommandRecord& c : project.history()) {
+    out.push_back(c.name + (c.state == store::CommandState::kDone ? "" : " (undone)"));
   }
   return out;
 }
 
 TEST(Journal, EveryStageIsOneCommandWithItsSettingsAndResult) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   core::Progress quiet;
   const ImportResult imported = import_scans(project, kTwoScans, {}, quiet);
-  const GeometryStageResult geometry = run_geometry_stage(project, small_windows(), quiet);
-  const std::vector<CommandRecord> history = project.history();
+  const GeometryCommandResult geometry = geometry_project(project, small_windows(), quiet);
+  const std::vector<store::CommandRecord> history = project.history();
   ASSERT_EQ(history.size(), 2u);
   EXPECT_EQ(history[0].id, imported.command_id);
   EXPECT_EQ(history[0].name, "import");
@@ -66,23 +68,23 @@ TEST(Journal, UndoAndRedoWorkAcrossConnectionsAndRestoreTheStateExactly) {
   const auto file = dir / "p.sbproj";
   core::Progress quiet;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     import_scans(project, kTwoScans, {}, quiet);
   }
-  const acquisition::Scan before = Project::open(file).load_scan(1);
+  const acquisition::Scan before = store::Project::open(file).load_scan(1);
   {
-    Project project = Project::open(file);
-    run_geometry_stage(project, small_windows(), quiet);
+    store::Project project = store::Project::open(file);
+    geometry_project(project, small_windows(), quiet);
   }
   {
-    Project other = Project::open(file);  // another session
-    ASSERT_TRUE(load_geometry(other, 1).has_value());
-    const std::optional<CommandRecord> undone = other.undo();
+    store::Project other = store::Project::open(file);  // another session
+    ASSERT_TRUE(store::load_geometry(other, 1).has_value());
+    const std::optional<store::CommandRecord> undone = other.undo();
     ASSERT_TRUE(undone.has_value());
     EXPECT_EQ(undone->name, "geometry");
   }
-  Project project = Project::open(file);
-  EXPECT_FALSE(load_geometry(project, 1).has_value());
+  store::Project project = store::Project::open(file);
+  EXPECT_FALSE(store::load_geometry(project, 1).has_value());
   EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "geometry (undone)"}));
   ASSERT_TRUE(project.undo().has_value());  // the import
   EXPECT_TRUE(project.scans().empty());
@@ -90,20 +92,20 @@ TEST(Journal, UndoAndRedoWorkAcrossConnectionsAndRestoreTheStateExactly) {
   ASSERT_TRUE(project.redo().has_value());
   test::expect_identical(project.load_scan(1), before);
   ASSERT_TRUE(project.redo().has_value());
-  EXPECT_TRUE(load_geometry(project, 1).has_value());
+  EXPECT_TRUE(store::load_geometry(project, 1).has_value());
   EXPECT_FALSE(project.redo().has_value());
 }
 
 TEST(Journal, ANewCommandEndsTheRedoBranch) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   core::Progress quiet;
   import_scans(project, kTwoScans, {}, quiet);
-  run_geometry_stage(project, small_windows(), quiet);
+  geometry_project(project, small_windows(), quiet);
   project.undo();
   acquisition::GeometrySettings wider = small_windows();
   wider.window_radius = 3;
-  run_geometry_stage(project, wider, quiet);
+  geometry_project(project, wider, quiet);
   EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "geometry"}));
   EXPECT_THAT(project.history().back().settings, HasSubstr("\"window_radius\":3"));
   EXPECT_FALSE(project.redo().has_value());
@@ -114,13 +116,13 @@ TEST(Journal, ANewCommandEndsTheRedoBranch) {
 TEST(Journal, ARevisionThatMovedRefusesTheWriteAndChangesNothing) {
   const ScratchDir dir;
   const auto file = dir / "p.sbproj";
-  Project project = Project::create(file);
+  store::Project project = store::Project::create(file);
   core::Progress quiet;
   import_scans(project, kTwoScans, {}, quiet);
   const std::int64_t revision = project.revision();
   {
-    Project other = Project::open(file);
-    run_geometry_stage(other, small_windows(), quiet);  // meanwhile, another writer
+    store::Project other = store::Project::open(file);
+    geometry_project(other, small_windows(), quiet);  // meanwhile, another writer
   }
   EXPECT_NE(project.revision(), revision);
   try {
@@ -146,22 +148,22 @@ class CancelAfter : public core::Progress {
 
 TEST(Journal, ACancelledStageStoresNothing) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   core::Progress quiet;
   import_scans(project, kTwoScans, {}, quiet);
   CancelAfter cancel(1);
-  EXPECT_THROW(run_geometry_stage(project, small_windows(), cancel), core::Cancelled);
+  EXPECT_THROW(geometry_project(project, small_windows(), cancel), core::Cancelled);
   EXPECT_EQ(project.history().size(), 1u);
-  EXPECT_FALSE(load_geometry(project, 1).has_value());
+  EXPECT_FALSE(store::load_geometry(project, 1).has_value());
 }
 
 TEST(Journal, ACancelledRegistrationStoresNothing) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   core::Progress quiet;
   import_scans(project, kTwoScans, {}, quiet);
-  run_geometry_stage(project, small_windows(), quiet);
-  RegisterStageSettings settings;
+  geometry_project(project, small_windows(), quiet);
+  RegisterCommandSettings settings;
   settings.registration.coarse = registration::CoarseMethod::kNone;
   CancelAfter cancel(3);  // past loading the two scans, inside the registration
   EXPECT_THROW(register_project(project, settings, cancel), core::Cancelled);
@@ -170,7 +172,7 @@ TEST(Journal, ACancelledRegistrationStoresNothing) {
 
 TEST(Journal, ScanIdsAreNeverReused) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   core::Progress quiet;
   const ImportResult first = import_scans(project, kTwoScans, {}, quiet);
   project.undo();
@@ -183,20 +185,22 @@ TEST(Journal, ScanIdsAreNeverReused) {
 
 TEST(Journal, AnImportMakesTheEarlierKeepMasksStale) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   core::Progress quiet;
   const ImportResult first = import_scans(project, kTwoScans, {}, quiet);
   const std::int64_t id = first.scan_ids.front();
   const std::vector<std::uint8_t> keep(project.load_scan(id).pixel_count(), 1);
   {
-    Project::Edit edit = project.begin_command("merge", "{}");
-    project.put_layer(edit, id, encode_layer<std::uint8_t>(layer::kKeep, ElementType::kU8, keep));
+    store::Project::Edit edit = project.begin_command("merge", "{}");
+    project.put_layer(
+        edit, id,
+        store::encode_layer<std::uint8_t>(store::layer::kKeep, store::ElementType::kU8, keep));
     edit.commit("{}");
   }
   import_scans(project, kTinyColor, {}, quiet);
-  EXPECT_FALSE(load_keep_mask(project, id).has_value());
+  EXPECT_FALSE(store::load_keep_mask(project, id).has_value());
   project.undo();
-  EXPECT_EQ(load_keep_mask(project, id), keep);
+  EXPECT_EQ(store::load_keep_mask(project, id), keep);
 }
 
 // Imports a scan through another connection when the first scan is done:
@@ -206,7 +210,7 @@ class WriteMeanwhile : public core::Progress {
   explicit WriteMeanwhile(std::filesystem::path file) : file_(std::move(file)) {}
   void update(const core::ProgressStep& step) override {
     if (step.done != 1) return;
-    Project other = Project::open(file_);
+    store::Project other = store::Project::open(file_);
     core::Progress quiet;
     import_scans(other, kTinyColor, {}, quiet);
   }
@@ -218,19 +222,19 @@ class WriteMeanwhile : public core::Progress {
 TEST(Journal, AStageWhoseProjectChangedMeanwhileStoresNothing) {
   const ScratchDir dir;
   const auto file = dir / "p.sbproj";
-  Project project = Project::create(file);
+  store::Project project = store::Project::create(file);
   core::Progress quiet;
   import_scans(project, kTwoScans, {}, quiet);
   WriteMeanwhile meanwhile(file);
   try {
-    run_geometry_stage(project, small_windows(), meanwhile);
+    geometry_project(project, small_windows(), meanwhile);
     FAIL() << "expected core::RuntimeFailure";
   } catch (const core::RuntimeFailure& error) {
     EXPECT_THAT(error.what(), HasSubstr("changed while geometry was computing"));
   }
   EXPECT_EQ(names_and_states(project), (std::vector<std::string>{"import", "import"}));
-  for (const StoredScanSummary& stored : project.scans()) {
-    EXPECT_FALSE(load_geometry(project, stored.id).has_value()) << stored.id;
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    EXPECT_FALSE(store::load_geometry(project, stored.id).has_value()) << stored.id;
   }
   // The written parts went with the refused command.
   EXPECT_EQ(test::RawDatabase(file).text("SELECT count(*) FROM scan_layers WHERE name = 'normal'"),
@@ -241,15 +245,15 @@ TEST(Journal, UndoStopsAtAnOlderProjectsHistory) {
   const ScratchDir dir;
   const auto file = dir / "old.sbproj";
   std::filesystem::copy_file(fixture("projects/version2.sbproj"), file);
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   core::Progress quiet;
-  run_geometry_stage(project, small_windows(), quiet);
-  const std::optional<CommandRecord> undone = project.undo();
+  geometry_project(project, small_windows(), quiet);
+  const std::optional<store::CommandRecord> undone = project.undo();
   ASSERT_TRUE(undone.has_value());
   EXPECT_EQ(undone->name, "geometry");
   EXPECT_TRUE(undone->undoable);
   EXPECT_FALSE(project.undo().has_value());  // the migrated geometry stays
-  EXPECT_TRUE(load_geometry(project, 1).has_value());
+  EXPECT_TRUE(store::load_geometry(project, 1).has_value());
 }
 
 TEST(Journal, TwoProcessesMigratingOneFileAtOnceBothOpenIt) {
@@ -260,20 +264,20 @@ TEST(Journal, TwoProcessesMigratingOneFileAtOnceBothOpenIt) {
   std::atomic<int> opened{0};
   for (int k = 0; k < 4; ++k) {
     openers.emplace_back([&] {
-      if (Project::open(file).schema_version() == kProjectSchemaVersion) ++opened;
+      if (store::Project::open(file).schema_version() == store::kProjectSchemaVersion) ++opened;
     });
   }
   for (std::thread& t : openers) t.join();
   EXPECT_EQ(opened.load(), 4);
-  EXPECT_EQ(Project::open(file).history().size(), 4u);  // migrated once
+  EXPECT_EQ(store::Project::open(file).history().size(), 4u);  // migrated once
 }
 
 TEST(Journal, TheMigrationOfAnOlderProjectCannotBeUndone) {
   const ScratchDir dir;
   const auto file = dir / "old.sbproj";
   std::filesystem::copy_file(fixture("projects/version1.sbproj"), file);
-  Project project = Project::open(file);
-  const std::vector<CommandRecord> history = project.history();
+  store::Project project = store::Project::open(file);
+  const std::vector<store::CommandRecord> history = project.history();
   ASSERT_EQ(history.size(), 1u);
   EXPECT_EQ(history[0].name, "migrate");
   EXPECT_FALSE(history[0].undoable);

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
-#include "modeling/scan_layers.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"
 #include "support/test_support.hpp"
 
@@ -26,22 +26,23 @@ acquisition::ScanGeometry made_up_geometry(std::size_t n) {
 }
 
 // Writes `layers` to scan `id` as one command.
-void put_committed(Project& project, std::int64_t id, const std::vector<EncodedLayer>& layers) {
-  Project::Edit edit = project.begin_command("test", "{}");
-  for (const EncodedLayer& layer : layers) project.put_layer(edit, id, layer);
+void put_committed(store::Project& project, std::int64_t id,
+                   const std::vector<store::EncodedLayer>& layers) {
+  store::Project::Edit edit = project.begin_command("test", "{}");
+  for (const store::EncodedLayer& layer : layers) project.put_layer(edit, id, layer);
   edit.commit("{}");
 }
 
 TEST(Layers, GeometryRoundTripsBitForBit) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const acquisition::Scan scan = test::tiny_scan(true, true, true, 3, 4);
   const std::int64_t id = test::insert_committed(project, scan);
-  EXPECT_FALSE(load_geometry(project, id).has_value());
+  EXPECT_FALSE(store::load_geometry(project, id).has_value());
   const acquisition::ScanGeometry geometry = made_up_geometry(scan.pixel_count());
-  put_committed(project, id, encode_geometry(geometry));
+  put_committed(project, id, store::encode_geometry(geometry));
   const std::optional<acquisition::ScanGeometry> back =
-      load_geometry(Project::open(dir / "p.sbproj"), id);
+      store::load_geometry(store::Project::open(dir / "p.sbproj"), id);
   ASSERT_TRUE(back.has_value());
   EXPECT_TRUE(test::same_bytes(back->footprint_m, geometry.footprint_m));
   EXPECT_TRUE(test::same_bytes(back->normal, geometry.normal));
@@ -51,35 +52,40 @@ TEST(Layers, GeometryRoundTripsBitForBit) {
 
 TEST(Layers, ANewLayerNeedsNoSchemaChangeAndTheNewestVersionWins) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t id = test::insert_committed(project, test::tiny_scan(true, false, false));
   const std::vector<std::uint32_t> first = {7, 0, 0, 7, 1, 2};
   const std::vector<std::uint32_t> second = {1, 1, 1, 0, 0, 0};
-  put_committed(project, id, {encode_layer<std::uint32_t>("membership", ElementType::kU32, first)});
-  put_committed(project, id,
-                {encode_layer<std::uint32_t>("membership", ElementType::kU32, second)});
-  EXPECT_EQ(project.load_layer<std::uint32_t>(id, "membership", ElementType::kU32), second);
+  put_committed(
+      project, id,
+      {store::encode_layer<std::uint32_t>("membership", store::ElementType::kU32, first)});
+  put_committed(
+      project, id,
+      {store::encode_layer<std::uint32_t>("membership", store::ElementType::kU32, second)});
+  EXPECT_EQ(project.load_layer<std::uint32_t>(id, "membership", store::ElementType::kU32), second);
   EXPECT_THAT(project.layer_names(id), ::testing::Contains("membership"));
   project.undo();
-  EXPECT_EQ(project.load_layer<std::uint32_t>(id, "membership", ElementType::kU32), first);
+  EXPECT_EQ(project.load_layer<std::uint32_t>(id, "membership", store::ElementType::kU32), first);
 }
 
 TEST(Layers, RemovingALayerHidesItUntilUndone) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t id = test::insert_committed(project, test::tiny_scan(true, false, false));
   const std::vector<std::uint8_t> keep = {1, 0, 1, 1, 0, 0};
-  put_committed(project, id, {encode_layer<std::uint8_t>(layer::kKeep, ElementType::kU8, keep)});
+  put_committed(
+      project, id,
+      {store::encode_layer<std::uint8_t>(store::layer::kKeep, store::ElementType::kU8, keep)});
   {
-    Project::Edit edit = project.begin_command("test", "{}");
-    project.remove_layer(edit, id, layer::kKeep);
+    store::Project::Edit edit = project.begin_command("test", "{}");
+    project.remove_layer(edit, id, store::layer::kKeep);
     project.remove_layer(edit, id, "never stored");  // no effect
     edit.commit("{}");
   }
-  EXPECT_FALSE(load_keep_mask(project, id).has_value());
+  EXPECT_FALSE(store::load_keep_mask(project, id).has_value());
   EXPECT_THAT(project.layer_names(id), ::testing::Not(::testing::Contains("keep")));
   project.undo();
-  EXPECT_EQ(load_keep_mask(project, id), keep);
+  EXPECT_EQ(store::load_keep_mask(project, id), keep);
 }
 
 TEST(Layers, AWrongTypeOrSizeIsReportedAsDamage) {
@@ -87,14 +93,15 @@ TEST(Layers, AWrongTypeOrSizeIsReportedAsDamage) {
   const auto file = dir / "p.sbproj";
   std::int64_t id = 0;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     id = test::insert_committed(project, test::tiny_scan(true, false, false));
     const std::vector<float> values(6, 1.0f);
-    put_committed(project, id, {encode_layer<float>("weights", ElementType::kF32, values)});
+    put_committed(project, id,
+                  {store::encode_layer<float>("weights", store::ElementType::kF32, values)});
   }
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   try {
-    project.load_layer<std::uint8_t>(id, "weights", ElementType::kU8);
+    project.load_layer<std::uint8_t>(id, "weights", store::ElementType::kU8);
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& error) {
     EXPECT_EQ(error.position().detail, "scan " + std::to_string(id) + ", layer weights");
@@ -102,33 +109,34 @@ TEST(Layers, AWrongTypeOrSizeIsReportedAsDamage) {
   }
   test::RawDatabase(file).execute(
       "UPDATE scan_layers SET element_count = 5 WHERE name = 'weights'");
-  EXPECT_THROW(Project::open(file).load_layer<float>(id, "weights", ElementType::kF32),
-               core::InputError);
+  EXPECT_THROW(
+      store::Project::open(file).load_layer<float>(id, "weights", store::ElementType::kF32),
+      core::InputError);
 }
 
 TEST(Layers, PartialGeometryIsDamage) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t id = test::insert_committed(project, test::tiny_scan(true, false, false));
-  std::vector<EncodedLayer> layers = encode_geometry(made_up_geometry(6));
+  std::vector<store::EncodedLayer> layers = store::encode_geometry(made_up_geometry(6));
   layers.pop_back();
   put_committed(project, id, layers);
-  EXPECT_THROW(load_geometry(project, id), core::InputError);
+  EXPECT_THROW(store::load_geometry(project, id), core::InputError);
 }
 
 TEST(Poses, SetPoseMovesPoseScannerAndBoundsAndKeepsTheOldPose) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   acquisition::Scan scan = test::tiny_scan(true, false, false, 3, 4);
   const Eigen::Isometry3d before = scan.T_world_scan;
   const std::int64_t id = test::insert_committed(project, scan);
   {
-    Project::Edit edit = project.begin_command("register", "{}");
+    store::Project::Edit edit = project.begin_command("register", "{}");
     scan.T_world_scan.translation() += Eigen::Vector3d(10.0, -2.0, 0.5);
     project.set_pose(edit, id, scan);
     edit.commit("{}");
   }
-  StoredScanSummary stored = Project::open(dir / "p.sbproj").scans().at(0);
+  store::StoredScanSummary stored = store::Project::open(dir / "p.sbproj").scans().at(0);
   EXPECT_TRUE(stored.summary.T_world_scan.isApprox(scan.T_world_scan));
   // The scanner moved with the scan: its place in the scan frame is the same.
   const Eigen::Vector3d scanner_scan =

@@ -9,8 +9,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "modeling/project.hpp"
-#include "modeling/scan_layers.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"
 #include "support/test_support.hpp"
 
@@ -27,9 +27,9 @@ std::filesystem::path migrated_copy(const ScratchDir& dir, int version) {
   return file;
 }
 
-std::vector<std::string> names(const Project& project) {
+std::vector<std::string> names(const store::Project& project) {
   std::vector<std::string> out;
-  for (const StoredScanSummary& s : project.scans()) out.push_back(s.summary.name);
+  for (const store::StoredScanSummary& s : project.scans()) out.push_back(s.summary.name);
   return out;
 }
 
@@ -42,20 +42,20 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
 // imported as station.ptx (its source file recorded), the groups "site" and
 // "annex" made by one script, and the second undone.
 TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournalIndexed) {
-  static_assert(kProjectSchemaVersion == 8, "add fixtures/projects/version9.sbproj");
+  static_assert(store::kProjectSchemaVersion == 8, "add fixtures/projects/version9.sbproj");
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 8);
   const std::string before = test::read_file_bytes(file);
   {
-    const Project project = Project::open(file);
+    const store::Project project = store::Project::open(file);
     const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
     ASSERT_EQ(sources.size(), 2u);
     ASSERT_EQ(sources.at(5).files.size(), 1u);
     EXPECT_EQ(std::filesystem::path(sources.at(5).files[0].path).filename(), "station.ptx");
     EXPECT_NE(sources.at(5).files[0].inode, 0u);
-    const std::vector<CommandRecord> history = project.history();
+    const std::vector<store::CommandRecord> history = project.history();
     EXPECT_EQ(history.back().name, "group");
-    EXPECT_EQ(history.back().state, CommandState::kUndone);
+    EXPECT_EQ(history.back().state, store::CommandState::kUndone);
     ASSERT_EQ(project.object_nodes().size(), 3u);
   }
   EXPECT_EQ(test::read_file_bytes(file), before);
@@ -64,7 +64,7 @@ TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournalIndexed
     EXPECT_EQ(raw.text(std::string("SELECT name FROM sqlite_schema WHERE name = '") + index + "'"),
               index);
   }
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   ASSERT_TRUE(project.redo().has_value());
   EXPECT_EQ(project.object_nodes().size(), 4u);
   EXPECT_TRUE(project.check().damage.empty());
@@ -78,14 +78,14 @@ TEST(Migration, VersionSevenKeepsItsSourcesAndImages) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 7);
   {
-    Project project = Project::open(file);
+    store::Project project = store::Project::open(file);
     EXPECT_EQ(names(project),
               (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color", "structured"}));
     const auto sources = project.scan_sources();
     ASSERT_EQ(sources.size(), 1u) << "scans imported before version 7 have none";
     EXPECT_EQ(sources.at(4).guid, "{scan-structured}");
     EXPECT_EQ(sources.at(4).unplaced_points, 1u);
-    const std::vector<StoredImage> images = project.images(true);
+    const std::vector<store::StoredImage> images = project.images(true);
     ASSERT_EQ(images.size(), 2u);
     EXPECT_EQ(images[0].scan_id, 4);
     EXPECT_EQ(images[0].image.format, "png");
@@ -93,7 +93,7 @@ TEST(Migration, VersionSevenKeepsItsSourcesAndImages) {
     EXPECT_EQ(images[1].image.data.size(), 662u);
     EXPECT_EQ(project.history().back().name, "import");
   }
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   ASSERT_TRUE(project.undo().has_value());
   EXPECT_TRUE(project.images(false).empty()) << "the images go with their import";
   EXPECT_TRUE(project.scan_sources().empty());
@@ -108,14 +108,14 @@ TEST(Migration, VersionSixKeepsItsColourEditsAndTakesImages) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 6);
   {
-    Project project = Project::open(file);
+    store::Project project = store::Project::open(file);
     EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
-    const std::vector<CommandRecord> history = project.history();
+    const std::vector<store::CommandRecord> history = project.history();
     ASSERT_EQ(history.size(), 4u);
     EXPECT_EQ(history[2].name, "recolor");
     EXPECT_EQ(history[3].name, "recolor");
-    EXPECT_EQ(history[3].state, CommandState::kUndone);
-    const std::vector<ObjectNode> nodes = project.object_nodes();
+    EXPECT_EQ(history[3].state, store::CommandState::kUndone);
+    const std::vector<store::ObjectNode> nodes = project.object_nodes();
     ASSERT_EQ(nodes.size(), 2u);
     EXPECT_TRUE(nodes[0].color.empty());
     EXPECT_EQ(nodes[1].color.brightness, 12.0);
@@ -125,13 +125,13 @@ TEST(Migration, VersionSixKeepsItsColourEditsAndTakesImages) {
     EXPECT_TRUE(project.scan_sources().empty());
     EXPECT_TRUE(project.images(false).empty());
   }
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   ASSERT_TRUE(project.redo().has_value());
   EXPECT_EQ(project.object_nodes()[0].color.hue_deg, 20.0);
   acquisition::ScanImage image;
   image.format = "png";
   image.data = {1, 2, 3};
-  Project::Edit edit = project.begin_command("import", "{}");
+  store::Project::Edit edit = project.begin_command("import", "{}");
   project.insert_image(edit, 1, project.scans().front().summary.T_world_scan, image);
   edit.commit("{}");
   EXPECT_EQ(project.images(true).at(0).image.data, image.data);
@@ -145,12 +145,12 @@ TEST(Migration, VersionSixKeepsItsColourEditsAndTakesImages) {
 TEST(Migration, VersionFiveKeepsItsTreeAndTakesColourEdits) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 5);
-  Project project = Project::open(file);
-  EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
-  const std::vector<CommandRecord> history = project.history();
+  store::Project project = store::Project::open(file);
+  EXPECT_EQ(project.schema_version(), store::kProjectSchemaVersion);
+  const std::vector<store::CommandRecord> history = project.history();
   ASSERT_EQ(history.size(), 3u);
-  EXPECT_EQ(history[2].state, CommandState::kUndone);
-  std::vector<ObjectNode> nodes = project.object_nodes();
+  EXPECT_EQ(history[2].state, store::CommandState::kUndone);
+  std::vector<store::ObjectNode> nodes = project.object_nodes();
   ASSERT_EQ(nodes.size(), 2u);
   EXPECT_EQ(nodes[1].name, "wall south");
   EXPECT_EQ(nodes[1].points, 5);
@@ -160,7 +160,7 @@ TEST(Migration, VersionFiveKeepsItsTreeAndTakesColourEdits) {
   nodes = project.object_nodes();
   EXPECT_EQ(nodes[1].name, "wall west");
   nodes[1].color.hue_deg = 45.0;
-  Project::Edit edit = project.begin_command("recolor", "{}");
+  store::Project::Edit edit = project.begin_command("recolor", "{}");
   project.put_node(edit, nodes[1]);
   edit.commit("{}");
   EXPECT_EQ(project.object_nodes()[1].color.hue_deg, 45.0);
@@ -172,16 +172,16 @@ TEST(Migration, VersionFiveKeepsItsTreeAndTakesColourEdits) {
 TEST(Migration, VersionFourKeepsItsJournalWithTheUndoneGeometry) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 4);
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color"}));
-  const std::vector<CommandRecord> history = project.history();
+  const std::vector<store::CommandRecord> history = project.history();
   ASSERT_EQ(history.size(), 2u);
   EXPECT_EQ(history[1].name, "geometry");
-  EXPECT_EQ(history[1].state, CommandState::kUndone);
+  EXPECT_EQ(history[1].state, store::CommandState::kUndone);
   EXPECT_TRUE(project.object_nodes().empty());
-  EXPECT_FALSE(load_geometry(project, 3).has_value());
+  EXPECT_FALSE(store::load_geometry(project, 3).has_value());
   ASSERT_TRUE(project.redo().has_value());
-  const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, 3);
+  const std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, 3);
   ASSERT_TRUE(geometry.has_value());
   EXPECT_EQ(geometry->footprint_m.size(), 6u);  // tiny_color is 2 × 3
 }
@@ -192,9 +192,9 @@ TEST_P(Migration, OpensAtTheCurrentVersionWithEveryScanLoadable) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, GetParam());
   {
-    const Project project = Project::open(file);
-    EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
-    for (const StoredScanSummary& stored : project.scans()) {
+    const store::Project project = store::Project::open(file);
+    EXPECT_EQ(project.schema_version(), store::kProjectSchemaVersion);
+    for (const store::StoredScanSummary& stored : project.scans()) {
       const acquisition::Scan scan = project.load_scan(stored.id);
       EXPECT_EQ(acquisition::count_valid(scan), stored.summary.valid_points) << stored.id;
     }
@@ -214,26 +214,27 @@ INSTANTIATE_TEST_SUITE_P(Versions, Migration, ::testing::Values(1, 2, 3, 4, 5, 6
 
 TEST(Migration, VersionOneKeepsItsScans) {
   const ScratchDir dir;
-  const Project project = Project::open(migrated_copy(dir, 1));
+  const store::Project project = store::Project::open(migrated_copy(dir, 1));
   EXPECT_EQ(names(project), (std::vector<std::string>{"two_scans", "two_scans-2", "tiny_color",
                                                       "lobby", "organized_ascii"}));
   const acquisition::Scan color = project.load_scan(3);
   EXPECT_TRUE(color.has_color());
-  EXPECT_FALSE(load_geometry(project, 1).has_value());
+  EXPECT_FALSE(store::load_geometry(project, 1).has_value());
   EXPECT_FALSE(project.load_scan(5).is_spherical());  // the PCD's per-pixel directions
 }
 
 TEST(Migration, VersionTwoKeepsItsGeometry) {
   const ScratchDir dir;
-  const Project project = Project::open(migrated_copy(dir, 2));
+  const store::Project project = store::Project::open(migrated_copy(dir, 2));
   ASSERT_EQ(project.scans().size(), 5u);
-  for (const StoredScanSummary& stored : project.scans()) {
-    const std::optional<acquisition::ScanGeometry> geometry = load_geometry(project, stored.id);
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    const std::optional<acquisition::ScanGeometry> geometry =
+        store::load_geometry(project, stored.id);
     ASSERT_TRUE(geometry.has_value()) << stored.id;
     EXPECT_EQ(geometry->normal.size(), project.load_scan(stored.id).pixel_count());
   }
   // two_scans had 2 normals (scanbench geometry --window 2 --edge-window 1 on v2).
-  const auto geometry = load_geometry(project, 1);
+  const auto geometry = store::load_geometry(project, 1);
   EXPECT_EQ(std::count_if(geometry->confidence.begin(), geometry->confidence.end(),
                           [](float c) { return c > 0.0f; }),
             2);
@@ -241,13 +242,13 @@ TEST(Migration, VersionTwoKeepsItsGeometry) {
 
 TEST(Migration, VersionThreeKeepsPosesKeepMasksAndTheRegistrationReport) {
   const ScratchDir dir;
-  const Project project = Project::open(migrated_copy(dir, 3));
+  const store::Project project = store::Project::open(migrated_copy(dir, 3));
   EXPECT_EQ(names(project), (std::vector<std::string>{"campus_scan_01", "campus_scan_02"}));
   // As `scanbench merge` reported when the fixture was made.
-  EXPECT_EQ(count_ones(*load_keep_mask(project, 1)), 6803u);
-  EXPECT_EQ(count_ones(*load_keep_mask(project, 2)), 6415u);
+  EXPECT_EQ(count_ones(*store::load_keep_mask(project, 1)), 6803u);
+  EXPECT_EQ(count_ones(*store::load_keep_mask(project, 2)), 6415u);
   // What the project held, as the journal entries that made it, in order.
-  const std::vector<CommandRecord> history = project.history();
+  const std::vector<store::CommandRecord> history = project.history();
   ASSERT_EQ(history.size(), 4u);
   EXPECT_EQ(history[0].name, "migrate");
   EXPECT_THAT(history[0].settings, ::testing::HasSubstr("\"from_schema_version\":3"));
@@ -258,7 +259,7 @@ TEST(Migration, VersionThreeKeepsPosesKeepMasksAndTheRegistrationReport) {
   EXPECT_THAT(history[2].result, ::testing::HasSubstr("\"converged\":true"));
   EXPECT_EQ(history[3].name, "merge");
   EXPECT_THAT(history[3].result, ::testing::HasSubstr("\"kept\":13218"));
-  for (const CommandRecord& c : history) EXPECT_FALSE(c.undoable) << c.name;
+  for (const store::CommandRecord& c : history) EXPECT_FALSE(c.undoable) << c.name;
   EXPECT_LE(history[0].created_at, history[1].created_at);
   EXPECT_EQ(project.latest_result("register"), history[2].result);
   // The registered pose of the second scan (as the report has it), not the

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
+#include "modeling/store/project.hpp"
 #include "project_test_support.hpp"
 #include "support/test_support.hpp"
 
@@ -17,16 +17,16 @@ namespace {
 using test::ScratchDir;
 using ::testing::HasSubstr;
 
-ObjectNode group(std::int64_t id, std::string name) {
-  ObjectNode node;
+store::ObjectNode group(std::int64_t id, std::string name) {
+  store::ObjectNode node;
   node.id = id;
   node.name = std::move(name);
-  node.kind = NodeKind::kGroup;
+  node.kind = store::NodeKind::kGroup;
   return node;
 }
 
-ObjectNode wall(std::int64_t id, std::int64_t parent) {
-  ObjectNode node;
+store::ObjectNode wall(std::int64_t id, std::int64_t parent) {
+  store::ObjectNode node;
   node.id = id;
   node.name = "wall south";
   node.parent = parent;
@@ -38,7 +38,7 @@ ObjectNode wall(std::int64_t id, std::int64_t parent) {
   return node;
 }
 
-void expect_same(const ObjectNode& a, const ObjectNode& b) {
+void expect_same(const store::ObjectNode& a, const store::ObjectNode& b) {
   EXPECT_EQ(a.id, b.id);
   EXPECT_EQ(a.name, b.name);
   EXPECT_EQ(a.kind, b.kind);
@@ -55,23 +55,23 @@ void expect_same(const ObjectNode& a, const ObjectNode& b) {
 }
 
 // Commits a command that writes `nodes`.
-void commit_nodes(Project& project, const std::vector<ObjectNode>& nodes) {
-  Project::Edit edit = project.begin_command("objects", "{}");
-  for (const ObjectNode& node : nodes) project.put_node(edit, node);
+void commit_nodes(store::Project& project, const std::vector<store::ObjectNode>& nodes) {
+  store::Project::Edit edit = project.begin_command("objects", "{}");
+  for (const store::ObjectNode& node : nodes) project.put_node(edit, node);
   edit.commit("{}");
 }
 
 TEST(ObjectNodes, NodesReadBackBitForBitAcrossReopen) {
   const ScratchDir dir;
   {
-    Project project = Project::create(dir / "p.sbproj");
+    store::Project project = store::Project::create(dir / "p.sbproj");
     EXPECT_TRUE(project.object_nodes().empty());
     EXPECT_EQ(project.new_node_id(), 1);
     commit_nodes(project, {group(1, "north hall"), wall(2, 1)});
     EXPECT_EQ(project.new_node_id(), 3);
   }
-  const Project project = Project::open(dir / "p.sbproj");
-  const std::vector<ObjectNode> nodes = project.object_nodes();
+  const store::Project project = store::Project::open(dir / "p.sbproj");
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
   ASSERT_EQ(nodes.size(), 2u);
   expect_same(nodes[0], group(1, "north hall"));
   expect_same(nodes[1], wall(2, 1));
@@ -80,13 +80,13 @@ TEST(ObjectNodes, NodesReadBackBitForBitAcrossReopen) {
 TEST(ObjectNodes, ChangesAndDeletionsAreUndoneAndRedoneAcrossProcesses) {
   const ScratchDir dir;
   {
-    Project project = Project::create(dir / "p.sbproj");
+    store::Project project = store::Project::create(dir / "p.sbproj");
     commit_nodes(project, {group(1, "north hall"), wall(2, 1)});
-    ObjectNode renamed = wall(2, 1);
+    store::ObjectNode renamed = wall(2, 1);
     renamed.name = "wall west";
     renamed.hidden = true;
     commit_nodes(project, {renamed});
-    Project::Edit edit = project.begin_command("delete", "{}");
+    store::Project::Edit edit = project.begin_command("delete", "{}");
     project.remove_node(edit, 1);
     project.remove_node(edit, 99);  // no such node: nothing happens
     edit.commit("{}");
@@ -94,13 +94,13 @@ TEST(ObjectNodes, ChangesAndDeletionsAreUndoneAndRedoneAcrossProcesses) {
     EXPECT_EQ(project.object_nodes()[0].name, "wall west");
   }
   {
-    Project project = Project::open(dir / "p.sbproj");
+    store::Project project = store::Project::open(dir / "p.sbproj");
     ASSERT_TRUE(project.undo().has_value());  // the deletion
     ASSERT_EQ(project.object_nodes().size(), 2u);
     ASSERT_TRUE(project.undo().has_value());  // the rename
     expect_same(project.object_nodes()[1], wall(2, 1));
   }
-  Project project = Project::open(dir / "p.sbproj");
+  store::Project project = store::Project::open(dir / "p.sbproj");
   ASSERT_TRUE(project.redo().has_value());
   EXPECT_EQ(project.object_nodes()[1].name, "wall west");
   EXPECT_TRUE(project.object_nodes()[1].hidden);
@@ -111,7 +111,7 @@ TEST(ObjectNodes, ChangesAndDeletionsAreUndoneAndRedoneAcrossProcesses) {
 
 TEST(ObjectNodes, ANewCommandDiscardsTheUndoneNodeVersions) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   commit_nodes(project, {group(1, "site")});
   commit_nodes(project, {group(2, "north hall")});
   ASSERT_TRUE(project.undo().has_value());
@@ -126,15 +126,15 @@ TEST(ObjectNodes, ANewCommandDiscardsTheUndoneNodeVersions) {
 TEST(ObjectNodes, ADamagedNodeRowIsFoundByCheckAndRefusedWhenRead) {
   const ScratchDir dir;
   {
-    Project project = Project::create(dir / "p.sbproj");
+    store::Project project = store::Project::create(dir / "p.sbproj");
     commit_nodes(project, {group(1, "north hall"), wall(2, 1)});
   }
   {
     test::RawDatabase raw(dir / "p.sbproj");
     raw.execute("UPDATE object_nodes SET points = 4321 WHERE node_id = 2");
   }
-  const Project project = Project::open(dir / "p.sbproj");
-  const Project::CheckReport report = project.check();
+  const store::Project project = store::Project::open(dir / "p.sbproj");
+  const store::Project::CheckReport report = project.check();
   ASSERT_EQ(report.damage.size(), 1u);
   EXPECT_THAT(report.damage[0], HasSubstr("object node 2"));
   try {
@@ -152,24 +152,24 @@ TEST(ObjectNodes, ADamagedNodeRowIsFoundByCheckAndRefusedWhenRead) {
 TEST(ObjectNodes, TheTreeAConnectionKeepsIsNeverStale) {
   const ScratchDir dir;
   const auto file = dir / "p.sbproj";
-  Project mine = Project::create(file);
+  store::Project mine = store::Project::create(file);
   commit_nodes(mine, {group(1, "site")});
   ASSERT_EQ(mine.nodes_named("site"), std::vector<std::int64_t>{1});
   commit_nodes(mine, {group(1, "campus")});  // followed from the commit itself
   EXPECT_EQ(mine.nodes_named("campus"), std::vector<std::int64_t>{1});
-  Project other = Project::open(file);
+  store::Project other = store::Project::open(file);
   commit_nodes(other, {group(1, "north campus")});
   EXPECT_EQ(mine.object_nodes().front().name, "north campus");
   ASSERT_TRUE(mine.undo());
   EXPECT_EQ(mine.object_nodes().front().name, "campus");
   {
-    Project::Edit refused = mine.begin_command("objects", "{}");
+    store::Project::Edit refused = mine.begin_command("objects", "{}");
     mine.put_node(refused, group(1, "refused"));
   }  // rolled back
   EXPECT_EQ(mine.object_nodes().front().name, "campus");
   const std::int64_t revision = mine.revision();
   {
-    Project::Batch batch = mine.begin_batch();
+    store::Project::Batch batch = mine.begin_batch();
     commit_nodes(mine, {group(1, "in the batch")});
     EXPECT_EQ(mine.object_nodes().front().name, "in the batch");
   }  // rolled back: the revision goes back

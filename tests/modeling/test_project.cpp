@@ -8,8 +8,8 @@
 
 #include "acquisition/scan_summary.hpp"
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
 #include "modeling/project_test_support.hpp"
+#include "modeling/store/project.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -28,14 +28,14 @@ TEST(Project, CreateMakesAnEmptyProjectOfTheCurrentSchema) {
   const ScratchDir dir;
   const auto file = dir / "site.sbproj";
   {
-    const Project project = Project::create(file);
+    const store::Project project = store::Project::create(file);
     EXPECT_EQ(project.path(), file);
-    EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
+    EXPECT_EQ(project.schema_version(), store::kProjectSchemaVersion);
     EXPECT_TRUE(project.scans().empty());
   }
   RawDatabase raw(file);
-  EXPECT_EQ(raw.text("PRAGMA application_id"), std::to_string(kProjectApplicationId));
-  EXPECT_EQ(raw.text("PRAGMA user_version"), std::to_string(kProjectSchemaVersion));
+  EXPECT_EQ(raw.text("PRAGMA application_id"), std::to_string(store::kProjectApplicationId));
+  EXPECT_EQ(raw.text("PRAGMA user_version"), std::to_string(store::kProjectSchemaVersion));
   EXPECT_EQ(raw.text("PRAGMA journal_mode"), "wal");
   EXPECT_EQ(raw.text("SELECT value FROM meta WHERE key = 'created_by'"), "scanbench");
   EXPECT_EQ(raw.text("PRAGMA integrity_check"), "ok");
@@ -44,10 +44,10 @@ TEST(Project, CreateMakesAnEmptyProjectOfTheCurrentSchema) {
 TEST(Project, OpenFindsWhatCreateLeft) {
   const ScratchDir dir;
   const auto file = dir / "site.sbproj";
-  { Project::create(file); }
+  { store::Project::create(file); }
   EXPECT_TRUE(test::no_side_files(file));  // the last close checkpoints the WAL away
-  const Project project = Project::open(file);
-  EXPECT_EQ(project.schema_version(), kProjectSchemaVersion);
+  const store::Project project = store::Project::open(file);
+  EXPECT_EQ(project.schema_version(), store::kProjectSchemaVersion);
   EXPECT_TRUE(project.scans().empty());
 }
 
@@ -55,34 +55,34 @@ TEST(Project, OpenOrCreateCreatesOnceThenOpens) {
   const ScratchDir dir;
   const auto file = dir / "site.sbproj";
   {
-    Project project = Project::open_or_create(file);
+    store::Project project = store::Project::open_or_create(file);
     insert_committed(project, tiny_scan(true, false, false));
   }
-  EXPECT_EQ(Project::open_or_create(file).scans().size(), 1u);
+  EXPECT_EQ(store::Project::open_or_create(file).scans().size(), 1u);
 }
 
 TEST(Project, CreateRefusesAnExistingFileAndLeavesItAlone) {
   const ScratchDir dir;
   const auto file = dir / "notes.sbproj";
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     insert_committed(project, tiny_scan(true, true, true));
   }
   const std::string before = test::read_file_bytes(file);
   try {
-    Project::create(file);
+    store::Project::create(file);
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& error) {
     EXPECT_EQ(error.file(), file.string());
     EXPECT_THAT(error.what(), HasSubstr("already exists"));
   }
   EXPECT_EQ(test::read_file_bytes(file), before);
-  EXPECT_EQ(Project::open(file).scans().size(), 1u);
+  EXPECT_EQ(store::Project::open(file).scans().size(), 1u);
 }
 
 TEST(Project, CreateInAMissingFolderIsAnInputError) {
   const ScratchDir dir;
-  EXPECT_THROW(Project::create(dir / "no such folder" / "site.sbproj"), core::InputError);
+  EXPECT_THROW(store::Project::create(dir / "no such folder" / "site.sbproj"), core::InputError);
 }
 
 // (spherical, intensity, color)
@@ -95,11 +95,11 @@ TEST_P(ProjectRoundTrip, LoadReturnsTheInsertedScanBitForBit) {
   const auto file = dir / "site.sbproj";
   std::int64_t id = 0;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     id = insert_committed(project, scan);
     expect_identical(project.load_scan(id), scan);  // same connection
   }
-  expect_identical(Project::open(file).load_scan(id), scan);  // after reopening
+  expect_identical(store::Project::open(file).load_scan(id), scan);  // after reopening
 }
 
 INSTANTIATE_TEST_SUITE_P(AngleModelsAndChannels, ProjectRoundTrip,
@@ -108,7 +108,7 @@ INSTANTIATE_TEST_SUITE_P(AngleModelsAndChannels, ProjectRoundTrip,
 
 TEST(Project, EmptyGridRoundTrips) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "site.sbproj");
+  store::Project project = store::Project::create(dir / "site.sbproj");
   for (const bool spherical : {true, false}) {
     const acquisition::Scan scan = tiny_scan(spherical, false, false, 0, 0);
     expect_identical(project.load_scan(insert_committed(project, scan)), scan);
@@ -117,7 +117,7 @@ TEST(Project, EmptyGridRoundTrips) {
 
 TEST(Project, ScansListsSummariesInIdOrder) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "site.sbproj");
+  store::Project project = store::Project::create(dir / "site.sbproj");
   acquisition::Scan first = tiny_scan(true, true, false);
   acquisition::Scan empty = tiny_scan(false, false, true);
   empty.name = "no returns";
@@ -158,7 +158,7 @@ TEST(Project, ScansListsSummariesInIdOrder) {
 TEST(Project, LoadingAMissingIdIsAnInputError) {
   const ScratchDir dir;
   const auto file = dir / "site.sbproj";
-  const Project project = Project::create(file);
+  const store::Project project = store::Project::create(file);
   try {
     project.load_scan(42);
     FAIL() << "expected core::InputError";
@@ -170,10 +170,10 @@ TEST(Project, LoadingAMissingIdIsAnInputError) {
 
 TEST(Project, AnExceptionInsideAnEditLeavesNoScanAndNoJournalEntry) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "site.sbproj");
+  store::Project project = store::Project::create(dir / "site.sbproj");
   const auto import_then_fail = [&] {
-    Project::Edit edit = project.begin_command("import", "{}");
-    project.insert_scan(edit, encode_scan(tiny_scan(true, true, true)));
+    store::Project::Edit edit = project.begin_command("import", "{}");
+    project.insert_scan(edit, store::encode_scan(tiny_scan(true, true, true)));
     throw std::runtime_error("reader failed on the second file");
   };
   EXPECT_THROW(import_then_fail(), std::runtime_error);
@@ -186,33 +186,33 @@ TEST(Project, AnExceptionInsideAnEditLeavesNoScanAndNoJournalEntry) {
 TEST(Project, TwoInsertsInOneEditAreAllOrNothing) {
   const ScratchDir dir;
   const auto file = dir / "site.sbproj";
-  Project project = Project::create(file);
+  store::Project project = store::Project::create(file);
   {
-    Project::Edit edit = project.begin_command("import", "{}");
-    project.insert_scan(edit, encode_scan(tiny_scan(true, false, false)));
-    project.insert_scan(edit, encode_scan(tiny_scan(false, true, true)));
+    store::Project::Edit edit = project.begin_command("import", "{}");
+    project.insert_scan(edit, store::encode_scan(tiny_scan(true, false, false)));
+    project.insert_scan(edit, store::encode_scan(tiny_scan(false, true, true)));
     EXPECT_EQ(project.scans().size(), 2u);  // visible inside the edit
   }                                         // not committed
   EXPECT_TRUE(project.scans().empty());
-  EXPECT_TRUE(Project::open(file).scans().empty());  // nor to another connection
+  EXPECT_TRUE(store::Project::open(file).scans().empty());  // nor to another connection
 
-  Project::Edit edit = project.begin_command("import", "{}");
-  project.insert_scan(edit, encode_scan(tiny_scan(true, false, false)));
-  project.insert_scan(edit, encode_scan(tiny_scan(false, true, true)));
+  store::Project::Edit edit = project.begin_command("import", "{}");
+  project.insert_scan(edit, store::encode_scan(tiny_scan(true, false, false)));
+  project.insert_scan(edit, store::encode_scan(tiny_scan(false, true, true)));
   edit.commit("{}");
   EXPECT_FALSE(edit.active());
-  EXPECT_EQ(Project::open(file).scans().size(), 2u);
+  EXPECT_EQ(store::Project::open(file).scans().size(), 2u);
 }
 
 TEST(Project, MovedEditAndProjectKeepWorking) {
   const ScratchDir dir;
-  Project original = Project::create(dir / "site.sbproj");
-  Project project = std::move(original);
-  Project::Edit first = project.begin_command("import", "{}");
-  Project::Edit moved = std::move(first);
+  store::Project original = store::Project::create(dir / "site.sbproj");
+  store::Project project = std::move(original);
+  store::Project::Edit first = project.begin_command("import", "{}");
+  store::Project::Edit moved = std::move(first);
   EXPECT_FALSE(first.active());
   EXPECT_TRUE(moved.active());
-  project.insert_scan(moved, encode_scan(tiny_scan(true, false, false)));
+  project.insert_scan(moved, store::encode_scan(tiny_scan(true, false, false)));
   moved.commit("{}");
   EXPECT_EQ(project.scans().size(), 1u);
 }
@@ -222,14 +222,14 @@ TEST(Project, ADamagedChannelNamesTheScanAndChannel) {
   const auto file = dir / "site.sbproj";
   std::int64_t id = 0;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     id = insert_committed(project, tiny_scan(true, true, false));
   }
   {
     RawDatabase raw(file);
     raw.execute("UPDATE scan_layers SET data = substr(data, 1, 10) WHERE name = 'intensity'");
   }
-  const Project project = Project::open(file);
+  const store::Project project = store::Project::open(file);
   EXPECT_EQ(project.scans().size(), 1u);  // summaries do not touch channel data
   try {
     project.load_scan(id);
@@ -245,11 +245,11 @@ TEST(Project, AMissingChannelIsAnInputError) {
   const auto file = dir / "site.sbproj";
   std::int64_t id = 0;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     id = insert_committed(project, tiny_scan(false, false, false));
   }
   { RawDatabase(file).execute("DELETE FROM scan_layers WHERE name = 'directions'"); }
-  EXPECT_THROW(Project::open(file).load_scan(id), core::InputError);
+  EXPECT_THROW(store::Project::open(file).load_scan(id), core::InputError);
 }
 
 TEST(ProjectDeathTest, WritingThroughAFinishedEditIsAProgrammerError) {
@@ -257,10 +257,10 @@ TEST(ProjectDeathTest, WritingThroughAFinishedEditIsAProgrammerError) {
   GTEST_SKIP() << "assertions are compiled out in this build";
 #else
   const ScratchDir dir;
-  Project project = Project::create(dir / "site.sbproj");
-  Project::Edit edit = project.begin_command("import", "{}");
+  store::Project project = store::Project::create(dir / "site.sbproj");
+  store::Project::Edit edit = project.begin_command("import", "{}");
   edit.commit("{}");
-  EXPECT_DEATH(project.insert_scan(edit, encode_scan(tiny_scan(true, false, false))),
+  EXPECT_DEATH(project.insert_scan(edit, store::encode_scan(tiny_scan(true, false, false))),
                "writes need an open Edit of this project");
 #endif
 }

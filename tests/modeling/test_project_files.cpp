@@ -10,8 +10,8 @@
 #include <random>
 
 #include "core/errors.hpp"
-#include "modeling/project.hpp"
 #include "modeling/project_test_support.hpp"
+#include "modeling/store/project.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -32,10 +32,10 @@ void write_file(const std::filesystem::path& file, const std::string& bytes) {
 // refuse it the same way rather than overwrite it.
 void expect_refused(const std::filesystem::path& file, const std::string& problem) {
   const std::string before = test::read_file_bytes(file);
-  const std::function<Project(const std::filesystem::path&)> openers[] = {
-      [](const std::filesystem::path& f) { return Project::open(f); },
-      [](const std::filesystem::path& f) { return Project::open_or_create(f); },
-      [](const std::filesystem::path& f) { return Project::open_for_reading(f); }};
+  const std::function<store::Project(const std::filesystem::path&)> openers[] = {
+      [](const std::filesystem::path& f) { return store::Project::open(f); },
+      [](const std::filesystem::path& f) { return store::Project::open_or_create(f); },
+      [](const std::filesystem::path& f) { return store::Project::open_for_reading(f); }};
   for (const auto& opener : openers) {
     try {
       opener(file);
@@ -75,15 +75,15 @@ TEST(ProjectFiles, RefusesADirectory) {
   const ScratchDir dir;
   const auto folder = dir / "folder.sbproj";
   std::filesystem::create_directory(folder);
-  EXPECT_THROW(Project::open(folder), core::InputError);
-  EXPECT_THROW(Project::open_or_create(folder), core::InputError);
+  EXPECT_THROW(store::Project::open(folder), core::InputError);
+  EXPECT_THROW(store::Project::open_or_create(folder), core::InputError);
   EXPECT_TRUE(std::filesystem::is_empty(folder));
 }
 
 TEST(ProjectFiles, RefusesAMissingFileWithoutCreatingIt) {
   const ScratchDir dir;
   const auto file = dir / "gone.sbproj";
-  EXPECT_THROW(Project::open(file), core::InputError);
+  EXPECT_THROW(store::Project::open(file), core::InputError);
   EXPECT_FALSE(std::filesystem::exists(file));
 }
 
@@ -106,10 +106,10 @@ TEST(ProjectFiles, RefusesAPlainSqliteDatabase) {
 TEST(ProjectFiles, RefusesANewerSchema) {
   const ScratchDir dir;
   const auto file = dir / "future.sbproj";
-  { Project project = Project::create(file); }
+  { store::Project project = store::Project::create(file); }
   { RawDatabase(file).execute("PRAGMA user_version = 99"); }
   expect_refused(file, "project schema version 99 is newer than this scanbench (" +
-                           std::to_string(kProjectSchemaVersion) + "); upgrade scanbench");
+                           std::to_string(store::kProjectSchemaVersion) + "); upgrade scanbench");
 }
 
 // The version bump sits only in the -wal file while another connection keeps
@@ -117,12 +117,12 @@ TEST(ProjectFiles, RefusesANewerSchema) {
 TEST(ProjectFiles, RefusesANewerSchemaThatIsOnlyInTheLog) {
   const ScratchDir dir;
   const auto file = dir / "future.sbproj";
-  { Project project = Project::create(file); }
+  { store::Project project = store::Project::create(file); }
   RawDatabase newer(file);
   newer.execute("PRAGMA wal_autocheckpoint = 0; PRAGMA user_version = 99");
   const std::string before = test::read_file_bytes(file);
   try {
-    Project::open(file);
+    store::Project::open(file);
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr("project schema version 99 is newer"));
@@ -134,7 +134,7 @@ TEST(ProjectFiles, RefusesADamagedProjectUntouched) {
   const ScratchDir dir;
   const auto file = dir / "damaged.sbproj";
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     test::insert_committed(project, tiny_scan(true, true, true));
   }
   std::string bytes = test::read_file_bytes(file);
@@ -189,9 +189,9 @@ acquisition::Scan large_scan() {
 [[noreturn]] void child_insert_and_wait(const std::filesystem::path& file, int report_fd) {
   char status = 'E';
   try {
-    Project project = Project::open(file);
-    Project::Edit edit = project.begin_command("import", "{}");
-    project.insert_scan(edit, encode_scan(large_scan()));
+    store::Project project = store::Project::open(file);
+    store::Project::Edit edit = project.begin_command("import", "{}");
+    project.insert_scan(edit, store::encode_scan(large_scan()));
     status = 'K';
     [[maybe_unused]] const auto ignored = ::write(report_fd, &status, 1);
     for (;;) ::pause();
@@ -228,7 +228,7 @@ TEST_P(ProjectKill, SigkillMidTransactionLeavesTheCommittedStateOnly) {
   const auto file = dir / "site.sbproj";
   std::vector<std::int64_t> ids_before;
   {
-    Project project = Project::create(file);
+    store::Project project = store::Project::create(file);
     for (int i = 0; i < GetParam(); ++i) {
       ids_before.push_back(test::insert_committed(project, tiny_scan(i % 2 == 0, true, true)));
     }
@@ -237,7 +237,7 @@ TEST_P(ProjectKill, SigkillMidTransactionLeavesTheCommittedStateOnly) {
   EXPECT_GT(std::filesystem::file_size(file.string() + "-wal"), 0u)
       << "the kill should leave uncommitted pages in the log";
 
-  Project project = Project::open(file);
+  store::Project project = store::Project::open(file);
   std::vector<std::int64_t> ids_after;
   for (const auto& stored : project.scans()) ids_after.push_back(stored.id);
   EXPECT_EQ(ids_after, ids_before);

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "core/errors.hpp"
-#include "modeling/scan_layers.hpp"
-#include "modeling/segment_commands.hpp"
+#include "modeling/selection_commands.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"
 #include "room_project.hpp"
 #include "support/test_support.hpp"
@@ -22,31 +22,32 @@ namespace {
 using test::ScratchDir;
 using ::testing::HasSubstr;
 
-std::size_t count_owned(const Project& project, std::int64_t scan, std::uint32_t owner) {
+std::size_t count_owned(const store::Project& project, std::int64_t scan, std::uint32_t owner) {
   const auto membership =
-      project.load_layer<std::uint32_t>(scan, layer::kMembership, ElementType::kU32);
+      project.load_layer<std::uint32_t>(scan, store::layer::kMembership, store::ElementType::kU32);
   if (!membership) return owner == 0 ? test::shared_room().scan.pixel_count() : 0;
   return static_cast<std::size_t>(std::count(membership->begin(), membership->end(), owner));
 }
 
 // Everything a segmentation session changes: the tree and each scan's
 // selection and membership, bit for bit.
-std::string state_of(const Project& project) {
+std::string state_of(const store::Project& project) {
   std::ostringstream out;
   out.precision(17);  // every bit of a coordinate
-  for (const ObjectNode& n : project.object_nodes()) {
+  for (const store::ObjectNode& n : project.object_nodes()) {
     out << n.id << '|' << n.name << '|' << static_cast<int>(n.kind) << '|' << n.parent.value_or(-1)
         << '|' << n.hidden << '|' << n.points << '|' << n.mean_footprint_m.value_or(-1.0);
     if (n.bbox_world)
       out << '|' << n.bbox_world->min().transpose() << n.bbox_world->max().transpose();
     out << '\n';
   }
-  for (const StoredScanSummary& s : project.scans()) {
-    for (const char* name : {layer::kSelection, layer::kMembership}) {
+  for (const store::StoredScanSummary& s : project.scans()) {
+    for (const char* name : {store::layer::kSelection, store::layer::kMembership}) {
       out << s.id << name;
       if (const auto u8 = project.load_layer<std::uint8_t>(
               s.id, name,
-              name == std::string(layer::kSelection) ? ElementType::kU8 : ElementType::kU32)) {
+              name == std::string(store::layer::kSelection) ? store::ElementType::kU8
+                                                            : store::ElementType::kU32)) {
         out << std::string(u8->begin(), u8->end());
       }
     }
@@ -56,14 +57,14 @@ std::string state_of(const Project& project) {
 
 TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
   const SelectResult selected = select_region(project, select_at(scan, -20, 0));
   ASSERT_TRUE(selected.seed_open);
   EXPECT_GT(selected.selected_pixels, 10000u);
   const NodeCommandResult wall = commit_selection(project, {scan, "wall +x", room.node_id});
-  const std::vector<ObjectNode> nodes = project.object_nodes();
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
   ASSERT_EQ(nodes.size(), 2u);
   EXPECT_EQ(nodes[1].id, wall.node_id);
   EXPECT_EQ(nodes[1].parent, room.node_id);
@@ -76,7 +77,8 @@ TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
   EXPECT_GT(*nodes[1].mean_footprint_m, 0.0);
   EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(wall.node_id)),
             selected.selected_pixels);
-  EXPECT_FALSE(project.load_layer<std::uint8_t>(scan, layer::kSelection, ElementType::kU8));
+  EXPECT_FALSE(
+      project.load_layer<std::uint8_t>(scan, store::layer::kSelection, store::ElementType::kU8));
   // The wall's pixels are no longer in the pool: a click on them grows nothing.
   EXPECT_FALSE(select_region(project, select_at(scan, -20, 0)).seed_open);
 }
@@ -88,7 +90,7 @@ TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
   std::size_t committed = 0;
   std::string before_commit;
   {
-    Project project = Project::create(dir / "p.sbproj");
+    store::Project project = store::Project::create(dir / "p.sbproj");
     scan = store_room(project);
     wall_only = select_region(project, select_at(scan, -20, 0)).selected_pixels;
     const SelectResult both = select_region(project, select_at(scan, 0, -45, SelectMode::kAdd));
@@ -103,11 +105,11 @@ TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
     commit_selection(project, {scan, "wall", std::nullopt});
   }
   {
-    Project project = Project::open(dir / "p.sbproj");
+    store::Project project = store::Project::open(dir / "p.sbproj");
     ASSERT_TRUE(project.undo().has_value());
     EXPECT_EQ(state_of(project), before_commit);
   }
-  Project project = Project::open(dir / "p.sbproj");
+  store::Project project = store::Project::open(dir / "p.sbproj");
   ASSERT_TRUE(project.redo().has_value());
   EXPECT_EQ(project.object_nodes().size(), 1u);
   EXPECT_EQ(project.object_nodes()[0].points, static_cast<std::int64_t>(committed));
@@ -115,14 +117,14 @@ TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
 
 TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
   const std::size_t floor = select_region(project, select_at(scan, 0, -45)).selected_pixels;
   const NodeCommandResult object = commit_selection(project, {scan, "floor", room.node_id});
   delete_node(project, {room.node_id, DeletedPoints::kDeleted});
   EXPECT_TRUE(project.object_nodes().empty());  // the group and the floor in it
-  EXPECT_EQ(count_owned(project, scan, kDeletedPoints), floor);
+  EXPECT_EQ(count_owned(project, scan, store::kDeletedPoints), floor);
   ASSERT_TRUE(project.undo().has_value());
   EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(object.node_id)), floor);
   delete_node(project, {object.node_id, DeletedPoints::kToPool});
@@ -133,7 +135,7 @@ TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
 
 TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult site = group_nodes(project, {"site", std::nullopt, {}});
   const NodeCommandResult room = group_nodes(project, {"room", site.node_id, {}});
@@ -142,7 +144,7 @@ TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
   const std::string before = state_of(project);
   const UngroupResult ungrouped = ungroup_node(project, room.node_id);
   EXPECT_EQ(ungrouped.children, std::vector<std::int64_t>{floor.node_id});
-  const std::vector<ObjectNode> nodes = project.object_nodes();
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
   ASSERT_EQ(nodes.size(), 2u);  // the site and the floor
   EXPECT_EQ(nodes[1].id, floor.node_id);
   EXPECT_EQ(nodes[1].parent, site.node_id);
@@ -159,16 +161,16 @@ TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
 
 TEST(SegmentCommands, MovingAScanMovesItsObjectsBoxes) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
   select_region(project, select_at(scan, -20, 0));
   commit_selection(project, {scan, "wall +x", room.node_id});
-  const std::vector<ObjectNode> before = project.object_nodes();
+  const std::vector<store::ObjectNode> before = project.object_nodes();
   const Eigen::Vector3d shift(10.0, -2.0, 0.5);
   const Eigen::Isometry3d moved =
       Eigen::Translation3d(shift) * project.load_scan(scan).T_world_scan;
-  const std::vector<ObjectNode> after = node_figures_after_moving(project, {{scan, moved}});
+  const std::vector<store::ObjectNode> after = node_figures_after_moving(project, {{scan, moved}});
   ASSERT_EQ(after.size(), 2u);  // the wall and its group
   for (std::size_t k = 0; k < 2; ++k) {
     EXPECT_EQ(after[k].id, before[k].id);
@@ -181,7 +183,7 @@ TEST(SegmentCommands, MovingAScanMovesItsObjectsBoxes) {
 
 TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const std::size_t pane = select_region(project, select_at(scan, 0, 8)).selected_pixels;
   const std::size_t both = select_region(project, select_at(scan, 36, 0, SelectMode::kAdd,
@@ -191,7 +193,7 @@ TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
       commit_selection(project, {scan, "pane and poster", std::nullopt});
   const SeparateResult parts = separate_object(project, {object.node_id, scan});
   ASSERT_EQ(parts.nodes.size(), 2u);
-  const std::vector<ObjectNode> nodes = project.object_nodes();
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
   ASSERT_EQ(nodes.size(), 2u);
   EXPECT_EQ(nodes[1].name, "pane and poster 2");
   EXPECT_EQ(nodes[0].points + nodes[1].points, static_cast<std::int64_t>(both));
@@ -210,7 +212,7 @@ TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
 
 TEST(SegmentCommands, ProposalsCoverThePoolInOneUndoableCommand) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   select_region(project, select_at(scan, 0, -45));
   const NodeCommandResult floor = commit_selection(project, {scan, "floor", std::nullopt});
@@ -219,9 +221,9 @@ TEST(SegmentCommands, ProposalsCoverThePoolInOneUndoableCommand) {
   settings.scan_id = scan;
   const SeparateResult proposed = propose_objects(project, settings);
   ASSERT_GE(proposed.nodes.size(), 5u);  // four walls and the pane at least
-  const std::vector<ObjectNode> nodes = project.object_nodes();
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
   EXPECT_EQ(nodes[1].name, "proposals");
-  EXPECT_EQ(nodes[1].kind, NodeKind::kGroup);
+  EXPECT_EQ(nodes[1].kind, store::NodeKind::kGroup);
   EXPECT_EQ(nodes[0].id, floor.node_id);
   EXPECT_EQ(nodes[0].points, static_cast<std::int64_t>(count_owned(
                                  project, scan, static_cast<std::uint32_t>(floor.node_id))));
@@ -231,7 +233,7 @@ TEST(SegmentCommands, ProposalsCoverThePoolInOneUndoableCommand) {
 
 TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
   const ScratchDir dir;
-  Project project = Project::create(dir / "p.sbproj");
+  store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult site = group_nodes(project, {"site", std::nullopt, {}});
   const NodeCommandResult hall = group_nodes(project, {"hall", site.node_id, {}});
@@ -264,33 +266,33 @@ TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
 // What must hold after every command: each parent is a live group, and each
 // object's point count is what the membership layer gives it (a group's, the
 // sum below it).
-void expect_consistent_tree(const Project& project, std::int64_t scan, int step) {
-  const std::vector<ObjectNode> nodes = project.object_nodes();
-  std::map<std::int64_t, const ObjectNode*> by_id;
-  for (const ObjectNode& n : nodes) by_id[n.id] = &n;
+void expect_consistent_tree(const store::Project& project, std::int64_t scan, int step) {
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
+  std::map<std::int64_t, const store::ObjectNode*> by_id;
+  for (const store::ObjectNode& n : nodes) by_id[n.id] = &n;
   std::map<std::int64_t, std::int64_t> owned;  // points below each node
   const auto membership =
-      project.load_layer<std::uint32_t>(scan, layer::kMembership, ElementType::kU32);
+      project.load_layer<std::uint32_t>(scan, store::layer::kMembership, store::ElementType::kU32);
   if (membership) {
     for (const std::uint32_t owner : *membership) {
-      if (owner == 0 || owner == kDeletedPoints) continue;
+      if (owner == 0 || owner == store::kDeletedPoints) continue;
       ASSERT_TRUE(by_id.count(owner)) << "step " << step << ": pixels of a removed node " << owner;
       for (std::optional<std::int64_t> at = owner; at; at = by_id.at(*at)->parent) ++owned[*at];
     }
   }
-  for (const ObjectNode& n : nodes) {
+  for (const store::ObjectNode& n : nodes) {
     if (n.parent) {
       ASSERT_TRUE(by_id.count(*n.parent)) << "step " << step << ": node " << n.id;
-      EXPECT_EQ(by_id.at(*n.parent)->kind, NodeKind::kGroup) << "step " << step;
+      EXPECT_EQ(by_id.at(*n.parent)->kind, store::NodeKind::kGroup) << "step " << step;
     }
     EXPECT_EQ(n.points, owned[n.id]) << "step " << step << ": node " << n.id;
   }
 }
 
-std::int64_t newest_done(const Project& project) {
+std::int64_t newest_done(const store::Project& project) {
   std::int64_t newest = 0;
-  for (const CommandRecord& c : project.history()) {
-    if (c.state == CommandState::kDone) newest = c.id;
+  for (const store::CommandRecord& c : project.history()) {
+    if (c.state == store::CommandState::kDone) newest = c.id;
   }
   return newest;
 }
@@ -305,8 +307,8 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
       std::filesystem::is_directory(shm)
           ? shm / ("scanbench-property-" + std::to_string(::getpid()) + ".sbproj")
           : scratch / "p.sbproj";
-  remove_project_files(file);
-  Project project = Project::create(file);
+  store::remove_project_files(file);
+  store::Project project = store::Project::create(file);
   const std::int64_t scan = store_room(project);
   const std::int64_t baseline = project.history().back().id;
   const std::string initial = state_of(project);
@@ -314,7 +316,7 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
   const auto pick = [&](int n) { return std::uniform_int_distribution<int>(0, n - 1)(random); };
   int applied = 0, refused = 0;
   for (int k = 0; k < 1000; ++k) {
-    const std::vector<ObjectNode> nodes = project.object_nodes();
+    const std::vector<store::ObjectNode> nodes = project.object_nodes();
     const auto some_node = [&] {
       return nodes[static_cast<std::size_t>(pick(static_cast<int>(nodes.size())))].id;
     };
@@ -386,7 +388,7 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
   EXPECT_GT(applied, 700);
   while (newest_done(project) > baseline) ASSERT_TRUE(project.undo().has_value());
   EXPECT_EQ(state_of(project), initial);
-  remove_project_files(file);
+  store::remove_project_files(file);
   RecordProperty("refused", refused);
 }
 

@@ -4,10 +4,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "acquisition/scan_files.hpp"
-#include "acquisition/scan_geometry.hpp"
+#include "acquisition/formats/scan_files.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "core/errors.hpp"
-#include "modeling/registration_stage.hpp"
+#include "modeling/harmonize_command.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 #include "modeling/settings_json.hpp"
 #include "registration/merge.hpp"
 
@@ -51,12 +53,12 @@ TEST(SettingsJson, MergeRoundTrips) {
 }
 
 TEST(SettingsJson, RegistrationWithPicksRoundTrips) {
-  RegisterStageSettings settings;
+  RegisterCommandSettings settings;
   settings.registration.coarse = registration::CoarseMethod::kPointPairs;
   settings.picks.push_back({2, 1, {{{1.0, 2.0, 3.0}, {4.0, 5.0, 6.5}}}});
   expect_every_field_round_trips(settings);
-  const RegisterStageSettings back =
-      settings_from_json<RegisterStageSettings>(settings_to_json(settings), "test");
+  const RegisterCommandSettings back =
+      settings_from_json<RegisterCommandSettings>(settings_to_json(settings), "test");
   EXPECT_EQ(back.registration.coarse, registration::CoarseMethod::kPointPairs);
   ASSERT_EQ(back.picks.size(), 1u);
   EXPECT_EQ(back.picks[0].pairs[0].target, Eigen::Vector3d(4.0, 5.0, 6.5));
@@ -102,12 +104,12 @@ TEST(SettingsJson, EveryFieldOfEveryStructIsWritten) {
                                                   "SphericalFitSettings");
   expect_whole<registration::MergeSettings>(
       nlohmann::json::parse(settings_to_json(registration::MergeSettings{})), "MergeSettings");
-  RegisterStageSettings stage;
+  RegisterCommandSettings stage;
   stage.picks.push_back({2, 1, {{}}});
   stage.registration.picks.push_back({1, 0, {{}}});
   const nlohmann::json register_ = nlohmann::json::parse(settings_to_json(stage));
   const nlohmann::json& r = register_["registration"];
-  expect_whole<RegisterStageSettings>(register_, "RegisterStageSettings");
+  expect_whole<RegisterCommandSettings>(register_, "RegisterCommandSettings");
   expect_whole<ProjectPicks>(register_["picks"][0], "ProjectPicks");
   expect_whole<registration::RegistrationSettings>(r, "RegistrationSettings");
   expect_whole<registration::PickedPairs>(r["picks"][0], "PickedPairs");

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "acquisition/scan_geometry.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"

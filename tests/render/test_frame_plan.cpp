@@ -11,7 +11,7 @@ namespace {
 const Eigen::Vector3d kOrigin(1000.0, 2000.0, 0.0);
 
 TEST(FramePlan, AWallInFullViewIsDrawnWholeNearestTileFirst) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   ASSERT_GE(model.tiles.size(), 8u);  // 4800 points in tiles of 600
   const RenderView view =
       make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 640, 480), kOrigin);
@@ -25,7 +25,7 @@ TEST(FramePlan, AWallInFullViewIsDrawnWholeNearestTileFirst) {
 }
 
 TEST(FramePlan, BehindTheCameraOrFacingAwayIsCulled) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   // Looking away from the wall: the group's box is outside, all of it culled.
   acquisition::CameraView away = test::camera_at({1000.0, 2000.0, 1.5});
   away.T_world_camera.linear() = -away.T_world_camera.linear().eval();
@@ -45,7 +45,7 @@ TEST(FramePlan, BehindTheCameraOrFacingAwayIsCulled) {
 }
 
 TEST(FramePlan, HiddenObjectsAreSkippedAndCounted) {
-  const modeling::RenderModel model = test::wall_model(true);
+  const RenderModel model = test::wall_model(true);
   const FramePlan plan =
       plan_frame(model, make_render_view(test::camera_at({1000.0, 2000.0, 1.5}), kOrigin), {});
   EXPECT_EQ(plan.hidden, 2400u);
@@ -53,7 +53,7 @@ TEST(FramePlan, HiddenObjectsAreSkippedAndCounted) {
 }
 
 TEST(FramePlan, FarAwayTilesAreThinnedAndTheBudgetHolds) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   // From 1 km, 5 cm is a twentieth of a pixel: each tile shrinks to a prefix
   // whose cells are about a pixel, and its splats grow to close it.
   const RenderView far = make_render_view(test::camera_at({0.0, 2000.0, 1.5}, 640, 480), kOrigin);

@@ -24,7 +24,7 @@ RenderDevice& device() {
 TEST(SplatRenderer, DevicesComeAndGoWhileAnotherDraws) {
   device();
   { const std::unique_ptr<RenderDevice> second = make_headless_device(); }
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   device();
   SplatRenderer renderer(model);
   renderer.draw(make_render_view(test::camera_at({1000.0, 2000.0, 1.5}), kOrigin), {});
@@ -62,7 +62,7 @@ Inside inside_the_wall(const RenderedImage& image) {
   return out;
 }
 
-RenderedImage render(const modeling::RenderModel& model, const RenderSettings& settings,
+RenderedImage render(const RenderModel& model, const RenderSettings& settings,
                      const Eigen::Vector3d& eye = {1000.0, 2000.0, 1.5}) {
   device();
   SplatRenderer renderer(model);
@@ -75,7 +75,7 @@ TEST(SplatRenderer, TheHeadlessDeviceIsOpenGl45) {
 }
 
 TEST(SplatRenderer, RawPointsLeaveHolesThatBlendedSplatsClose) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   RenderSettings points;
   points.mode = DrawMode::kPoints;
   const Inside raw = inside_the_wall(render(model, points));
@@ -93,7 +93,7 @@ TEST(SplatRenderer, RawPointsLeaveHolesThatBlendedSplatsClose) {
 }
 
 TEST(SplatRenderer, EveryKernelClosesTheWallAndTheBackgroundStaysEmpty) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   for (const Kernel kernel : {Kernel::kDisk, Kernel::kGaussian, Kernel::kCosine}) {
     RenderSettings settings;
     settings.kernel = kernel;
@@ -110,7 +110,7 @@ TEST(SplatRenderer, EveryKernelClosesTheWallAndTheBackgroundStaysEmpty) {
 // resolve fills each from the splats round it, and nothing beyond the
 // wall's edges, where background lies on one side.
 TEST(SplatRenderer, PinholesRingedBySplatsAreFilledAndTheSilhouetteStays) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   RenderSettings thin;
   thin.splat_scale = 0.8f;
   thin.fill_reach_px = 0;
@@ -141,7 +141,7 @@ TEST(SplatRenderer, HiddenObjectsAreNotDrawn) {
 }
 
 TEST(SplatRenderer, TheBackOfTheWallIsCulledUnlessAskedFor) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   const Eigen::Vector3d behind(1020.0, 2000.0, 1.5);
   std::size_t drawn = 0;
   const RenderedImage culled = render(model, {}, behind);
@@ -154,7 +154,7 @@ TEST(SplatRenderer, TheBackOfTheWallIsCulledUnlessAskedFor) {
 }
 
 TEST(SplatRenderer, ColourModesDrawWhatTheyName) {
-  const modeling::RenderModel model = test::wall_model();
+  const RenderModel model = test::wall_model();
   RenderSettings settings;
   settings.color = ColorMode::kObject;
   const RenderedImage objects = render(model, settings);

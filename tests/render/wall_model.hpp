@@ -8,12 +8,12 @@
 #include <vector>
 
 #include "acquisition/camera_view.hpp"
-#include "modeling/render_model.hpp"
+#include "render/render_model.hpp"
 
 namespace scanbench::render::test {
 
-inline modeling::RenderModel wall_model(bool hide_right = false) {
-  modeling::RenderPoints p;
+inline RenderModel wall_model(bool hide_right = false) {
+  RenderPoints p;
   for (int i = 0; i < 80; ++i) {
     for (int j = 0; j < 60; ++j) {
       const float y = -2.0f + 0.05f * static_cast<float>(i) + 0.025f;
@@ -29,16 +29,16 @@ inline modeling::RenderModel wall_model(bool hide_right = false) {
       p.node.push_back(left ? 1u : 2u);
     }
   }
-  std::vector<modeling::ObjectNode> tree(3);
+  std::vector<store::ObjectNode> tree(3);
   tree[0].id = 1;
   tree[0].parent = 3;
   tree[1].id = 2;
   tree[1].parent = 3;
   tree[1].hidden = hide_right;
   tree[2].id = 3;
-  tree[2].kind = modeling::NodeKind::kGroup;
-  return modeling::assemble_render_model(std::move(p), Eigen::Vector3d(1000.0, 2000.0, 0.0), tree,
-                                         {600, 1.0f});
+  tree[2].kind = store::NodeKind::kGroup;
+  return assemble_render_model(std::move(p), Eigen::Vector3d(1000.0, 2000.0, 0.0), tree,
+                               {600, 1.0f});
 }
 
 // A camera at `position` [world] looking at the wall's centre.

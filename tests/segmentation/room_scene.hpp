@@ -13,8 +13,8 @@
 #include <numbers>
 #include <vector>
 
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/scan.hpp"
-#include "acquisition/scan_geometry.hpp"
 
 namespace scanbench::test {
 

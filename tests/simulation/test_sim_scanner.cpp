@@ -4,11 +4,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "acquisition/formats/triplet_reader.hpp"
 #include "acquisition/simulation/campaign.hpp"
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/truth_view.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
-#include "acquisition/triplet_reader.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::acquisition::sim {

@@ -1,0 +1,27 @@
+// One E57 data3D entry's point records made into a scan grid (see
+// e57_reader.hpp for the mapping). Internal to acquisition/: e57_reader.cpp
+// reads the section, this decodes it block by block, so that no field is
+// ever held decoded whole.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <vector>
+
+#include "acquisition/formats/e57/e57_document.hpp"
+#include "acquisition/scan_source.hpp"
+
+namespace scanbench::acquisition {
+
+// The scan of `entry`, the `index`-th of the file at `path`, from its
+// fields' bytestreams (one per prototype field, complete: read_e57_streams
+// checked their lengths). Throws core::InputError naming the file and the
+// record or element for a prototype without coordinates or with grid
+// indices that are not Integer fields, indices outside the index bounds, or
+// bounds of more than 16 pixels per record (or 2^30 pixels); throws
+// core::MemoryShortage when the grid would not fit in memory.
+ImportedScan scan_from_records(const std::filesystem::path& path, const E57ScanEntry& entry,
+                               std::size_t index,
+                               const std::vector<std::vector<std::byte>>& streams);
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,63 @@
+// Point-list exports of one or more scans in world coordinates: binary PLY
+// and CSV. Only valid pixels are written. World coordinates are written in
+// double precision: georeferenced sites sit at 10^5–10^6 m.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <vector>
+
+#include "acquisition/geometry/scan_geometry.hpp"
+#include "acquisition/scan.hpp"
+
+namespace scanbench::acquisition {
+
+// `geometry`, when not empty, holds one entry per scan (nullptr where a scan
+// has none). When every scan has geometry, its mixed pixels are left out —
+// they float between surfaces and belong to no model — and the PLY gains the
+// normals and footprints.
+//
+// `keep`, when not empty, holds one entry per scan: a mask of one byte per
+// pixel (1 = write the point; the merged model of `scanbench merge`), or
+// nullptr to write every point of that scan.
+
+// The number of points write_ply, write_csv and write_las write for these
+// arguments: valid, kept, and not mixed pixels when every scan has
+// geometry.
+std::size_t count_exported_points(std::span<const Scan> scans,
+                                  std::span<const ScanGeometry* const> geometry = {},
+                                  std::span<const std::vector<std::uint8_t>* const> keep = {});
+
+// Binary little-endian PLY: double x y z, then float intensity when every scan
+// has intensity, then uchar red green blue when every scan has colour, then
+// float nx ny nz (unit, world frame; 0 0 0 where invalid) and float radius
+// (the footprint [m]) when every scan has geometry. All-or-nothing output;
+// throws std::runtime_error naming `path` on write errors.
+void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const ScanGeometry* const> geometry = {},
+               std::span<const std::vector<std::uint8_t>* const> keep = {});
+
+// CSV with a header line "x,y,z[,intensity][,r,g,b]" (channel columns as for
+// PLY), one valid point per line, shortest exact decimals. All-or-nothing
+// output; throws std::runtime_error naming `path` on write errors.
+void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const ScanGeometry* const> geometry = {},
+               std::span<const std::vector<std::uint8_t>* const> keep = {});
+
+// LAS 1.4 (revision 15), point data record format 7: X Y Z as 32-bit
+// integers at a 0.1 mm scale, offset at the points' minimum corner (so
+// georeferenced coordinates keep 0.1 mm), intensity (× 65535), return 1 of
+// 1, RGB (8-bit × 257), the scan's `source_ids` entry as point_source_id.
+// When every scan has geometry, four extra bytes fields (float NormalX,
+// NormalY, NormalZ in the world frame, and Footprint [m]) described by the
+// LASF_Spec extra bytes VLR. The legacy point counts are 0, as the
+// specification requires for formats 6–10. Throws core::InputError naming
+// `path` when the points span more than 0.1 mm × 2³¹ on an axis; All-or-
+// nothing output as write_ply.
+void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
+               std::span<const std::uint16_t> source_ids,
+               std::span<const ScanGeometry* const> geometry = {},
+               std::span<const std::vector<std::uint8_t>* const> keep = {});
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,64 @@
+#include "acquisition/formats/scan_files.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "acquisition/formats/e57/e57_reader.hpp"
+#include "acquisition/formats/pcd_reader.hpp"
+#include "acquisition/formats/triplet_reader.hpp"
+#include "core/errors.hpp"
+
+namespace scanbench::acquisition {
+
+ScanFileFormat scan_file_format(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".ptx") return ScanFileFormat::kPtx;
+  if (extension == ".json") return ScanFileFormat::kTriplet;
+  if (extension == ".pcd") return ScanFileFormat::kOrganizedPcd;
+  if (extension == ".e57") return ScanFileFormat::kE57;
+  throw core::InputError(
+      path.string(), {},
+      "unknown scan file type \"" + extension +
+          "\" (expected .ptx, .pcd, .e57, or the .json sidecar of an image triplet)");
+}
+
+namespace {
+
+// A scan of a format that holds nothing beside the grid.
+ImportedScan plain(Scan&& scan, const char* format) {
+  ImportedScan out;
+  out.source.format = format;
+  out.source.points_in_file = scan.pixel_count();  // every record, returns or not
+  out.scan = std::move(scan);
+  return out;
+}
+
+}  // namespace
+
+void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& settings,
+                    const std::function<void(ImportedScan&&)>& on_scan,
+                    const std::function<void(ScanImage&&)>& on_loose_image) {
+  switch (scan_file_format(path)) {
+    case ScanFileFormat::kPtx:
+      read_ptx(path, settings.ptx,
+               [&on_scan](Scan&& scan) { on_scan(plain(std::move(scan), "ptx")); });
+      return;
+    case ScanFileFormat::kTriplet: {
+      std::vector<std::filesystem::path> images;
+      ImportedScan scan = plain(read_triplet(path, &images), "triplet");
+      scan.source.companion_files = std::move(images);
+      on_scan(std::move(scan));
+      return;
+    }
+    case ScanFileFormat::kOrganizedPcd:
+      on_scan(plain(read_organized_pcd(path), "pcd"));
+      return;
+    case ScanFileFormat::kE57:
+      read_e57(path, on_scan, on_loose_image);
+      return;
+  }
+}
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,517 @@
+// Footprints and normals from pixel adjacency (seed 004 §4.2).
+//
+// Normals of spherical scans come from the gradient of log-range over the
+// angles. With p = r·u(θ, φ) and the orthonormal frame (u, e_θ, e_φ),
+//   ∂p/∂θ = r_θ u + r cos φ e_θ,   ∂p/∂φ = r_φ u + r e_φ,
+//   ∂p/∂θ × ∂p/∂φ ∝ u − (∂ln r/∂θ) / cos φ · e_θ − (∂ln r/∂φ) · e_φ,
+// so a normal needs only the two slopes of ln r, which a least-squares plane
+// fit of ln r over the pixel window gives from integral images of its moments
+// (window_moments.hpp): constant time per pixel for any window size. That fit
+// is exact to second order only in a full, symmetric window; windows cut by a
+// depth discontinuity, by invalid pixels or by the grid's border get a
+// covariance fit of their 3D points instead (grid_covariance.hpp), leaving
+// out the neighbours across the discontinuity. Scans with per-pixel
+// directions have no angle model and always take the covariance fit.
+//
+// The stage runs as three passes over the grid, each parallel and each
+// touching a pixel's data once: mixed pixels; mask, log-range and depth
+// jumps; then tile by tile the window slopes, normals, confidences and
+// footprints, so a tile's data is still in cache when its pixels finish.
+#include "acquisition/geometry/scan_geometry.hpp"
+
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
+#include "acquisition/geometry/branch_free.hpp"
+#include "acquisition/geometry/grid_covariance.hpp"
+#include "acquisition/geometry/mixed_pixels.hpp"
+#include "acquisition/geometry/window_moments.hpp"
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+template <typename Body>
+void parallel_rows(int rows, int threads, Body&& body) {
+  core::parallel_for_index(rows, threads, body, 8);
+}
+
+// What every fit reads per pixel. Scratch arrays are left uninitialised
+// (make_unique_for_overwrite) and first written by the parallel passes, so
+// their pages are faulted in by the threads that use them.
+struct FitInputs {
+  std::unique_ptr<std::uint8_t[]> mixed;  // 1 = mixed pixel
+  std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive finite range
+  std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
+  std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
+
+  explicit FitInputs(std::size_t n)
+      : mixed(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        mask(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        clean(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
+        log_range(std::make_unique_for_overwrite<float[]>(n)) {}
+
+  // The mixed-pixel and edge flags of pixel i (an edge: masked, not clean).
+  std::uint8_t flags(std::size_t i) const {
+    return static_cast<std::uint8_t>((mixed[i] ? kFlagMixedPixel : 0) |
+                                     (mask[i] && !clean[i] ? kFlagEdge : 0));
+  }
+};
+
+// mask and log_range of n pixels of a row. Branch-free over plain,
+// unaliased arrays, so that it vectorizes. A range that is not a positive
+// normal float (or is infinite) is no return here.
+SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict valid,
+                                      const std::uint8_t* __restrict mixed,
+                                      const float* __restrict range_m,
+                                      std::uint8_t* __restrict mask, float* __restrict log_range) {
+  constexpr std::uint32_t kNaN = 0x7fc00000u;
+  for (int i = 0; i < n; ++i) {
+    const bool masked = (valid[i] != 0) & (mixed[i] == 0) &
+                        (range_m[i] >= std::numeric_limits<float>::min()) &
+                        (range_m[i] <= std::numeric_limits<float>::max());
+    const std::uint32_t keep = all_bits(masked);
+    mask[i] = masked;
+    log_range[i] = std::bit_cast<float>(
+        (std::bit_cast<std::uint32_t>(log_positive(range_m[i])) & keep) | (kNaN & ~keep));
+  }
+}
+
+// mixed, mask and log_range of every pixel.
+void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
+  const std::span<std::uint8_t> mixed(in.mixed.get(), scan.pixel_count());
+  if (settings.flag_mixed_pixels) detect_mixed_pixels(scan, settings, mixed);
+  parallel_rows(scan.rows, settings.threads, [&](int row) {
+    const std::size_t i = scan.index(row, 0);
+    if (!settings.flag_mixed_pixels) std::fill(&mixed[i], &mixed[i] + scan.columns, 0);
+    mask_row(scan.columns, scan.valid.data() + i, &mixed[i], scan.range_m.data() + i,
+             in.mask.get() + i, in.log_range.get() + i);
+  });
+}
+
+// The depth-jump test of GeometrySettings: a second difference `d` of
+// log-range above depth_jump_relative, or above depth_jump_sigmas · √6 ·
+// σ(range) / range — compared as d · range > √6 · depth_jump_sigmas · σ,
+// without a division.
+struct JumpTest {
+  float relative;          // threshold on d (ln range: no unit)
+  float noise0_m, noise1;  // threshold · range [m] = noise0_m + noise1 · range [m]
+
+  explicit JumpTest(const GeometrySettings& s)
+      : relative(static_cast<float>(s.depth_jump_relative)),
+        noise0_m(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_m)),
+        noise1(
+            static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_per_m)) {}
+
+  bool operator()(float before, float centre, float after, float range_m) const {
+    const float d = std::abs(before - 2.0f * centre + after);
+    return (d > relative) | (d * range_m > noise0_m + noise1 * range_m);
+  }
+};
+
+// Interior pixels 1 … n − 2 of a row whose rows above and below exist;
+// branch-free over plain, unaliased arrays so that the loop vectorizes.
+SCANBENCH_VECTOR_CLONES void interior_jumps(int n, std::ptrdiff_t stride, const JumpTest& test,
+                                            const std::uint8_t* __restrict mask,
+                                            const float* __restrict v,
+                                            const float* __restrict range_m,
+                                            std::uint8_t* __restrict clean) {
+  for (int c = 1; c + 1 < n; ++c) {
+    const bool along_row =
+        (mask[c - 1] != 0) & (mask[c + 1] != 0) & test(v[c - 1], v[c], v[c + 1], range_m[c]);
+    const bool along_column = (mask[c - stride] != 0) & (mask[c + stride] != 0) &
+                              test(v[c - stride], v[c], v[c + stride], range_m[c]);
+    const bool jumps = (mask[c] != 0) & (along_row | along_column);
+    clean[c] = (mask[c] != 0) & !jumps;
+  }
+}
+
+// clean (masked and no depth jump) for every pixel.
+void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
+  const JumpTest test(settings);
+  const int rows = scan.rows, columns = scan.columns;
+  const std::uint8_t* mask = in.mask.get();
+  const float* v = in.log_range.get();
+  const auto one_pixel = [&](int r, int c) {
+    const std::size_t i = scan.index(r, c);
+    const auto jumps_between = [&](std::size_t before, std::size_t after) {
+      return mask[before] && mask[after] && test(v[before], v[i], v[after], scan.range_m[i]);
+    };
+    const bool jumps =
+        mask[i] && ((c > 0 && c + 1 < columns && jumps_between(i - 1, i + 1)) ||
+                    (r > 0 && r + 1 < rows && jumps_between(i - columns, i + columns)));
+    in.clean[i] = mask[i] && !jumps;
+  };
+  parallel_rows(rows, settings.threads, [&](int r) {
+    const std::size_t i = scan.index(r, 0);
+    if (r == 0 || r + 1 == rows || columns < 3) {
+      for (int c = 0; c < columns; ++c) one_pixel(r, c);
+      return;
+    }
+    one_pixel(r, 0);
+    interior_jumps(columns, columns, test, mask + i, v + i, scan.range_m.data() + i,
+                   in.clean.get() + i);
+    one_pixel(r, columns - 1);
+  });
+}
+
+// Per-row factors of a spherical scan, so the per-pixel work is free of
+// trigonometry and division.
+struct RowFactors {
+  std::vector<float> azimuth_gradient;  // 1 / (Δaz · cos el): d ln r / d col → ∂ ln r/∂az / cos el
+  // Half the pixel cell's diagonal [rad]: the footprint [m] per metre of range.
+  std::vector<float> half_spacing_rad;
+  float elevation_gradient = 0.0f;  // 1 / Δel
+
+  explicit RowFactors(const Scan& scan) {
+    const auto* a = std::get_if<SphericalAngles>(&scan.angles);
+    if (a == nullptr) return;
+    for (int row = 0; row < scan.rows; ++row) {
+      const double cos_el = std::cos(a->elevation_start_rad + row * a->elevation_step_rad);
+      azimuth_gradient.push_back(
+          static_cast<float>(1.0 / a->azimuth_step_rad / std::max(cos_el, 1e-3)));
+      const double az = std::abs(a->azimuth_step_rad) * cos_el, el = a->elevation_step_rad;
+      half_spacing_rad.push_back(static_cast<float>(0.5 * std::sqrt(az * az + el * el)));
+    }
+    elevation_gradient = static_cast<float>(1.0 / a->elevation_step_rad);
+  }
+};
+
+// Half the pixel cell's diagonal [rad] on a per-pixel direction grid, from
+// the angles to the next column and row.
+float per_pixel_half_spacing_rad(const Scan& scan, int row, int col) {
+  const Eigen::Vector3f d = direction(scan, row, col);
+  const int c2 = col + 1 < scan.columns ? col + 1 : col - 1,
+            r2 = row + 1 < scan.rows ? row + 1 : row - 1;
+  double az = 0, el = 0;
+  if (c2 >= 0) az = std::acos(std::clamp(d.dot(direction(scan, row, c2)), -1.0f, 1.0f));
+  if (r2 >= 0) el = std::acos(std::clamp(d.dot(direction(scan, r2, col)), -1.0f, 1.0f));
+  return static_cast<float>(0.5 * std::sqrt(az * az + el * el));
+}
+
+struct Counts {
+  std::atomic<std::size_t> valid{0}, normals{0}, mixed{0}, edges{0};
+};
+
+struct StageContext {
+  const Scan& scan;
+  const GeometrySettings& settings;
+  const FitInputs& in;
+  const GridDirections& directions;
+  const RowFactors& factors;
+  ScanGeometry& g;
+  Counts& counts;
+};
+
+// Normal, confidence, footprint and the no-normal flag of valid pixel i
+// from a covariance fit (or from none: fit.ok false).
+void store_fit(const StageContext& c, const NormalFit& fit, std::size_t i, float half_spacing_rad) {
+  const bool ok = fit.ok && fit.used >= c.settings.min_neighbours && fit.normal.allFinite();
+  float cos_incidence = 1.0f;
+  if (ok) {
+    cos_incidence = fit.cos_incidence;
+    c.g.normal[i] = fit.normal;
+    c.g.confidence[i] =
+        std::max(1e-6f, std::min(1.0f, static_cast<float>(fit.used) / fit.window) * cos_incidence);
+  } else {
+    c.g.normal[i] = Eigen::Vector3f::Zero();
+    c.g.confidence[i] = 0.0f;
+    c.g.flags[i] |= kFlagNoNormal;
+  }
+  const float stretch = static_cast<float>(1.0 / c.settings.max_footprint_stretch);
+  c.g.footprint_m[i] = c.scan.range_m[i] * half_spacing_rad / std::max(cos_incidence, stretch);
+}
+
+// Adds the counts of GeometryResult for pixels [first, first + count).
+void count_pixels(const StageContext& c, std::size_t first, int count) {
+  std::size_t valid = 0, normals = 0, mixed = 0, edges = 0;
+  for (std::size_t i = first; i < first + count; ++i) {
+    valid += c.scan.valid[i] != 0;
+    normals += c.g.confidence[i] > 0.0f;
+    mixed += (c.g.flags[i] & kFlagMixedPixel) != 0;
+    edges += (c.g.flags[i] & kFlagEdge) != 0;
+  }
+  c.counts.valid += valid, c.counts.normals += normals;
+  c.counts.mixed += mixed, c.counts.edges += edges;
+}
+
+// What the window normals of one row share.
+struct RowConstants {
+  float cos_el, sin_el;
+  float az_gradient, el_gradient;  // slope per pixel → per radian (see RowFactors)
+  float half_spacing_rad;          // see RowFactors
+  float max_stretch;
+  std::uint16_t min_used;  // pixels a window fit needs
+};
+
+// The per-pixel arrays of a row segment that window_normals reads, n entries
+// each, and those it writes. No output overlaps another array: the
+// __restrict members say so, which GCC uses for a struct passed by value.
+struct WindowNormalInputs {
+  // The window fits (WindowSlopeRow).
+  const float* __restrict per_column;
+  const float* __restrict per_row;
+  const std::uint16_t* __restrict used;
+  // The pixels' azimuths (GridDirections).
+  const float* __restrict cos_az;
+  const float* __restrict sin_az;
+  // The scan's, then FitInputs'.
+  const float* __restrict range_m;
+  const std::uint8_t* __restrict valid;
+  const std::uint8_t* __restrict mask;
+  const std::uint8_t* __restrict mixed;
+  const std::uint8_t* __restrict clean;
+};
+
+struct WindowNormalOutputs {
+  float* __restrict nx;  // the unit normal's components
+  float* __restrict ny;
+  float* __restrict nz;
+  float* __restrict confidence;
+  float* __restrict footprint_m;
+  std::uint8_t* __restrict flags;
+};
+
+// The normal towards the scanner is −u + g_az·e_az + g_el·e_el in the
+// orthonormal frame (u, e_az, e_el), with g the log-range slopes per radian
+// (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
+// of the incidence angle is one over it, so the footprint's stretch is the
+// length itself. Writes n pixels' normals (as three arrays), confidences,
+// footprints and flags. Branch-free over plain, unaliased arrays, so that
+// the loop vectorizes. Masked pixels without a clean window are left for the
+// covariance fit (no flag).
+SCANBENCH_VECTOR_CLONES void window_normals(int n, const RowConstants& constants,
+                                            WindowNormalInputs in, WindowNormalOutputs out) {
+  for (int j = 0; j < n; ++j) {
+    const float g_az = in.per_column[j] * constants.az_gradient,
+                g_el = in.per_row[j] * constants.el_gradient;
+    const float q = 1.0f + g_az * g_az + g_el * g_el;
+    const float inverse = inverse_sqrt(q), length = q * inverse;
+    const std::uint32_t ok = all_bits((in.used[j] >= constants.min_used) &
+                                      (length <= std::numeric_limits<float>::max()));
+    const std::uint32_t is_valid = all_bits(in.valid[j] != 0);
+    const std::uint32_t pending = all_bits((in.used[j] == 0) & (in.mask[j] != 0));
+    const float ca = in.cos_az[j], sa = in.sin_az[j];
+    out.nx[j] = select_bits(
+        (-constants.cos_el * ca - g_az * sa - g_el * constants.sin_el * ca) * inverse, ok);
+    out.ny[j] = select_bits(
+        (-constants.cos_el * sa + g_az * ca - g_el * constants.sin_el * sa) * inverse, ok);
+    out.nz[j] = select_bits((-constants.sin_el + g_el * constants.cos_el) * inverse, ok);
+    out.confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
+    const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
+    out.footprint_m[j] = select_bits(
+        in.range_m[j] * constants.half_spacing_rad * std::min(stretch, constants.max_stretch),
+        is_valid);
+    const std::uint32_t edge = all_bits((in.mask[j] != 0) & (in.clean[j] == 0));
+    out.flags[j] =
+        static_cast<std::uint8_t>((in.mixed[j] != 0 ? kFlagMixedPixel : 0) | (edge & kFlagEdge) |
+                                  (is_valid & ~ok & ~pending & kFlagNoNormal));
+  }
+}
+
+RowConstants row_constants(const StageContext& c, int row) {
+  return {c.directions.cos_el[row],
+          c.directions.sin_el[row],
+          c.factors.azimuth_gradient[row],
+          c.factors.elevation_gradient,
+          c.factors.half_spacing_rad[row],
+          static_cast<float>(c.settings.max_footprint_stretch),
+          static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
+}
+
+// A spherical row segment, pixels (row, begin … begin + n − 1), with its
+// window fits' pixel counts (0: no clean window).
+struct RowSegment {
+  int row, begin, n;
+  std::size_t first;  // the scan index of its first pixel
+  const std::uint16_t* used;
+  float half_spacing_rad;  // see RowFactors
+
+  // Segment pixel j is masked and has no window fit.
+  bool pending(const StageContext& c, int j) const {
+    return j < n && used[j] == 0 && c.in.mask[first + j];
+  }
+};
+
+// Stores the covariance fit of pending segment pixel j, together with those
+// of the pending pixels among the next kCovarianceLanes − 1 where their
+// windows allow it; returns how many pixels it has done.
+int store_fallback_from(const StageContext& c, const RowSegment& s, int j) {
+  const float* range_m = c.scan.range_m.data();
+  const int col = s.begin + j;
+  if (!covariance_lanes_fit(c.directions, s.row, col, c.scan.rows, c.settings)) {
+    store_fit(c,
+              covariance_fit(c.directions, range_m, c.in.mask.get(), c.in.log_range.get(), s.row,
+                             col, c.scan.rows, c.settings),
+              s.first + j, s.half_spacing_rad);
+    return 1;
+  }
+  unsigned wanted = 0;
+  for (int lane = 0; lane < kCovarianceLanes; ++lane)
+    wanted |= s.pending(c, j + lane) ? 1u << lane : 0u;
+  NormalFit fits[kCovarianceLanes];
+  covariance_fits(c.directions, range_m, c.in.log_range.get(), s.row, col, c.scan.rows, c.settings,
+                  wanted, fits);
+  for (int lane = 0; lane < kCovarianceLanes; ++lane) {
+    if (wanted & (1u << lane)) store_fit(c, fits[lane], s.first + j + lane, s.half_spacing_rad);
+  }
+  return kCovarianceLanes;
+}
+
+// The covariance fits of a spherical row segment's masked pixels without a
+// clean window (cut by a discontinuity, an invalid region or the grid's
+// border): the log-range slope of a lopsided window is biased by the
+// curvature of ln r, a 3D plane fit is not. Runs of them go in lanes.
+void store_fallback_fits(const StageContext& c, const RowSegment& s) {
+  int j = 0;
+  while (j < s.n) j += s.pending(c, j) ? store_fallback_from(c, s, j) : 1;
+}
+
+// A spherical scan's row segment: window normals in chunks (scratch arrays
+// on the stack), then the covariance fit where no clean window exists.
+void store_window_fits(const StageContext& c, int row, int begin, int end,
+                       const WindowSlopeRow& s) {
+  constexpr int kChunk = 128;
+  const RowConstants constants = row_constants(c, row);
+  const std::size_t first = c.scan.index(row, begin);
+  for (int j0 = 0; j0 < end - begin; j0 += kChunk) {
+    const int n = std::min(kChunk, end - begin - j0);
+    const std::size_t i0 = first + j0;
+    float nx[kChunk], ny[kChunk], nz[kChunk];
+    const WindowNormalInputs inputs{s.per_column + j0,
+                                    s.per_row + j0,
+                                    s.used + j0,
+                                    c.directions.cos_az.data() + begin + j0,
+                                    c.directions.sin_az.data() + begin + j0,
+                                    c.scan.range_m.data() + i0,
+                                    c.scan.valid.data() + i0,
+                                    c.in.mask.get() + i0,
+                                    c.in.mixed.get() + i0,
+                                    c.in.clean.get() + i0};
+    window_normals(n, constants, inputs,
+                   {nx, ny, nz, c.g.confidence.data() + i0, c.g.footprint_m.data() + i0,
+                    c.g.flags.data() + i0});
+    for (int j = 0; j < n; ++j) c.g.normal[i0 + j] = Eigen::Vector3f(nx[j], ny[j], nz[j]);
+  }
+  store_fallback_fits(c, {row, begin, end - begin, first, s.used, constants.half_spacing_rad});
+  count_pixels(c, first, end - begin);
+}
+
+// A row of a per-pixel direction grid: covariance fits only.
+void store_covariance_fits(const StageContext& c, int row) {
+  for (int col = 0; col < c.scan.columns; ++col) {
+    const std::size_t i = c.scan.index(row, col);
+    c.g.normal[i] = Eigen::Vector3f::Zero();
+    c.g.flags[i] = c.in.flags(i);
+    if (!c.scan.valid[i]) continue;
+    NormalFit fit;
+    if (c.in.mask[i]) {
+      fit = covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(),
+                           c.in.log_range.get(), row, col, c.scan.rows, c.settings);
+    }
+    store_fit(c, fit, i, per_pixel_half_spacing_rad(c.scan, row, col));
+  }
+  count_pixels(c, c.scan.index(row, 0), c.scan.columns);
+}
+
+// The window radii of the cascade, widest first: halving from window_radius
+// down to edge_window_radius.
+std::vector<int> cascade_radii(const GeometrySettings& settings) {
+  std::vector<int> radii;
+  for (int radius = settings.window_radius;;) {
+    radii.push_back(radius);
+    if (radius <= settings.edge_window_radius) break;
+    radius =
+        radius / 2 >= 2 * settings.edge_window_radius ? radius / 2 : settings.edge_window_radius;
+  }
+  return radii;
+}
+
+// Maps the pages of [data, data + bytes) in one system call (Linux ≥ 5.14),
+// instead of one page fault per 4 KB at the first write; it runs beside the
+// first passes (see compute_geometry). A no-op elsewhere or on failure.
+void prefault(const void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+  const auto begin = reinterpret_cast<std::uintptr_t>(data) & ~(page - 1);
+  const auto end = reinterpret_cast<std::uintptr_t>(data) + bytes;
+  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+#else
+  (void)data, (void)bytes;
+#endif
+}
+
+// Reserves, maps in bulk, then fills.
+template <typename T>
+void allocate_filled(std::vector<T>& v, std::size_t n, T value) {
+  v.reserve(n);
+  prefault(v.data(), n * sizeof(T));
+  v.assign(n, value);
+}
+
+// The outputs; every pixel is written by the passes below.
+void allocate(ScanGeometry& g, std::size_t n) {
+  allocate_filled(g.footprint_m, n, 0.0f);
+  g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
+  prefault(g.normal.data(), n * sizeof(Eigen::Vector3f));
+  allocate_filled(g.confidence, n, 0.0f);
+  allocate_filled(g.flags, n, std::uint8_t{0});
+}
+
+}  // namespace
+
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
+  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
+         settings.window_radius >= settings.edge_window_radius &&
+         settings.window_radius <= kMaxWindowRadius);
+  const auto start = std::chrono::steady_clock::now();
+  GeometryResult result;
+  ScanGeometry& g = result.geometry;
+  FitInputs in(scan.pixel_count());
+  // std::vector zero-fills the outputs on one thread (every pixel is then
+  // written again); that runs beside the first passes, not before them.
+  tbb::task_arena arena = core::worker_arena(settings.threads);
+  arena.execute([&] {
+    tbb::parallel_invoke([&] { allocate(g, scan.pixel_count()); },
+                         [&] {
+                           mark_mixed_and_mask(scan, settings, in);
+                           mark_jumps(scan, settings, in);
+                         });
+  });
+  const GridDirections directions(scan);
+  const RowFactors factors(scan);
+  Counts counts;
+  const StageContext context{scan, settings, in, directions, factors, g, counts};
+  if (scan.is_spherical()) {
+    const std::vector<int> radii = cascade_radii(settings);
+    visit_window_slopes(scan.rows, scan.columns, radii, {in.clean.get(), scan.pixel_count()},
+                        {in.log_range.get(), scan.pixel_count()}, settings.threads,
+                        [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
+                          store_window_fits(context, row, begin, end, slopes);
+                        });
+  } else {
+    parallel_rows(scan.rows, settings.threads,
+                  [&](int row) { store_covariance_fits(context, row); });
+  }
+  result.valid_points = counts.valid, result.normals = counts.normals;
+  result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;
+  result.seconds = core::seconds_since(start);
+  return result;
+}
+
+}  // namespace scanbench::acquisition

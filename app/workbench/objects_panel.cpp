@@ -1,0 +1,126 @@
+#include <cstring>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "app/workbench/panels.hpp"
+
+namespace scanbench::app::workbench {
+
+namespace {
+
+using Children = std::map<std::int64_t, std::vector<const store::ObjectNode*>>;
+
+std::string node_label(const store::ObjectNode& node) {
+  std::string label = node.name;
+  if (node.hidden) label += " (hidden)";
+  if (!node.color.empty()) label += " (recoloured)";
+  label += "##" + std::to_string(node.id);
+  return label;
+}
+
+// A node dragged onto `onto` (a group; none: the roots) moves there once
+// the tree is drawn.
+void accept_drop(WorkbenchState& s, std::optional<std::int64_t> onto) {
+  if (const ImGuiPayload* payload = ImGui::AcceptDragDropPayload("scanbench-node")) {
+    std::int64_t moved = 0;
+    std::memcpy(&moved, payload->Data, sizeof moved);
+    if (moved != onto) s.pending_reparent = {moved, onto};
+  }
+}
+
+void node_tree(WorkbenchState& s, const store::ObjectNode& n, const Children& children) {
+  ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_DefaultOpen |
+                             ImGuiTreeNodeFlags_SpanAvailWidth;
+  if (s.selected.count(n.id)) flags |= ImGuiTreeNodeFlags_Selected;
+  const auto found = children.find(n.id);
+  if (found == children.end()) flags |= ImGuiTreeNodeFlags_Leaf;
+  const bool open = ImGui::TreeNodeEx(node_label(n).c_str(), flags);
+  s.probe("node " + n.name);
+  if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) {
+    if (ImGui::GetIO().KeyCtrl) {
+      if (!s.selected.erase(n.id)) s.selected.insert(n.id);
+      s.primary_id = n.id;
+      s.load_color_editor();
+    } else {
+      s.select_only(n.id);
+    }
+  }
+  if (ImGui::BeginDragDropSource()) {
+    ImGui::SetDragDropPayload("scanbench-node", &n.id, sizeof n.id);
+    ImGui::Text("move %s", n.name.c_str());
+    ImGui::EndDragDropSource();
+  }
+  if (n.kind == store::NodeKind::kGroup && ImGui::BeginDragDropTarget()) {
+    accept_drop(s, n.id);
+    ImGui::EndDragDropTarget();
+  }
+  if (!open) return;
+  if (found != children.end()) {
+    for (const store::ObjectNode* child : found->second) node_tree(s, *child, children);
+  }
+  ImGui::TreePop();
+}
+
+// The tree of nodes, roots first; a drop outside every group moves the
+// node to the roots.
+void tree(WorkbenchState& s) {
+  Children children;
+  std::vector<const store::ObjectNode*> roots;
+  std::set<std::int64_t> ids;
+  for (const store::ObjectNode& n : s.session.nodes()) ids.insert(n.id);
+  for (const store::ObjectNode& n : s.session.nodes()) {
+    if (n.parent && ids.count(*n.parent)) {
+      children[*n.parent].push_back(&n);
+    } else {
+      roots.push_back(&n);
+    }
+  }
+  ImGui::BeginChild("tree", ImVec2(0, 190), true);
+  if (roots.empty()) ImGui::TextDisabled("no objects yet: click a seed, then Commit");
+  for (const store::ObjectNode* root : roots) node_tree(s, *root, children);
+  ImGui::EndChild();
+  if (ImGui::BeginDragDropTarget()) {
+    accept_drop(s, std::nullopt);
+    ImGui::EndDragDropTarget();
+  }
+  if (s.pending_reparent) {
+    s.session.reparent(s.pending_reparent->first, s.pending_reparent->second);
+    s.pending_reparent.reset();
+  }
+}
+
+}  // namespace
+
+void objects_panel(WorkbenchState& s) {
+  if (!ImGui::CollapsingHeader("Objects", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  tree(s);
+  const auto p = s.primary();
+  ImGui::BeginDisabled(s.selected.empty());
+  if (ImGui::Button("Group")) s.group();
+  s.probe("group");
+  ImGui::SameLine();
+  if (ImGui::Button("Rename") && p) s.session.rename(*p, s.name_text());
+  s.probe("rename");
+  ImGui::SameLine();
+  const std::optional<store::ObjectNode> n = p ? s.node(*p) : std::nullopt;
+  if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n) s.session.set_hidden(n->id, !n->hidden);
+  s.probe("hide");
+  ImGui::SameLine();
+  if (ImGui::Button("Delete") && p) {
+    s.session.remove(*p);
+    s.selected.clear();
+  }
+  s.probe("delete");
+  ImGui::SameLine();
+  if (ImGui::Button("Separate") && p) s.session.separate(*p);
+  s.probe("separate");
+  ImGui::SameLine();
+  if (ImGui::Button("Frame")) s.frame_selection();
+  s.probe("frame");
+  ImGui::EndDisabled();
+}
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,37 @@
+// The workbench's panels and views, one file each: what they show comes
+// from the shared state, what they do goes through it (the session's
+// commands, the camera). The frame loop (workbench.cpp) draws them in
+// order, each frame.
+#pragma once
+
+#include <imgui.h>
+
+#include "app/workbench/workbench_state.hpp"
+
+namespace scanbench::app::workbench {
+
+// The project panel's sections, inside its window (workbench.cpp):
+void scans_panel(WorkbenchState& s);          // the scans; the shown one's pose
+void objects_panel(WorkbenchState& s);        // the object tree and its commands
+void color_panel(WorkbenchState& s);          // the selected object's colour edit
+void view_settings_panel(WorkbenchState& s);  // how the 3D view draws
+
+// Windows of their own:
+void toolbar_panel(WorkbenchState& s);  // tools, channel, tolerance, name, commit, undo
+void status_panel(WorkbenchState& s);   // what the last action did, the 3D frame's figures
+
+// Views, drawn behind the panels; input reaches them when ImGui does not
+// want it (input.hpp).
+void panorama_view(WorkbenchState& s);
+void view_3d(WorkbenchState& s);
+
+// A fixed window at (x, y) of w × h pixels.
+inline void place_window(float x, float y, float w, float h) {
+  ImGui::SetNextWindowPos(ImVec2(x, y));
+  ImGui::SetNextWindowSize(ImVec2(w, h));
+}
+
+inline constexpr ImGuiWindowFlags kFixedWindow =
+    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
+
+}  // namespace scanbench::app::workbench

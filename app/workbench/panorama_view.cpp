@@ -1,0 +1,58 @@
+#include <epoxy/gl.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "app/workbench/panels.hpp"
+
+namespace scanbench::app::workbench {
+
+namespace {
+
+// Uploads the panorama when the project, the channel or the scan changed.
+void refresh_texture(WorkbenchState& s) {
+  const std::array<std::int64_t, 3> key = {s.session.revision(), s.panorama_channel,
+                                           s.session.scan_id()};
+  if (key == s.panorama_key) return;
+  const render::Picture picture =
+      s.session.panorama(static_cast<render::PanoramaChannel>(s.panorama_channel));
+  glBindTexture(GL_TEXTURE_2D, s.panorama_texture);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, picture.width, picture.height, 0, GL_RGBA,
+               GL_UNSIGNED_BYTE, picture.rgba.data());
+  s.panorama_key = key;
+}
+
+// A lasso or barrier drawn over the panorama, its vertices marked.
+void polyline(const WorkbenchState& s, ImDrawList* draw, const segmentation::Polyline& line,
+              ImU32 colour, bool closed) {
+  std::vector<ImVec2> points;
+  for (const Eigen::Vector2d& v : line) points.push_back(s.panorama_screen(v));
+  if (points.empty()) return;
+  draw->AddPolyline(points.data(), static_cast<int>(points.size()), colour,
+                    closed ? ImDrawFlags_Closed : 0, 2.0f);
+  for (const ImVec2& p : points) draw->AddCircleFilled(p, 3.0f, colour);
+}
+
+}  // namespace
+
+void panorama_view(WorkbenchState& s) {
+  refresh_texture(s);
+  ImDrawList* draw = ImGui::GetBackgroundDrawList();
+  const ImVec2 low(s.panorama.x, s.panorama.y),
+      high(s.panorama.x + s.panorama.w, s.panorama.y + s.panorama.h);
+  draw->PushClipRect(low, high, true);
+  draw->AddRectFilled(low, high, IM_COL32(20, 20, 24, 255));
+  const acquisition::Scan& scan = s.session.scan();
+  draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(s.panorama_texture)),
+                 s.panorama_screen({-0.5, -0.5}),
+                 s.panorama_screen({scan.columns - 0.5, scan.rows - 0.5}));
+  polyline(s, draw, s.session.lasso(), IM_COL32(80, 220, 255, 255), s.session.lasso_closed());
+  for (const segmentation::Polyline& b : s.session.barriers())
+    polyline(s, draw, b, IM_COL32(255, 70, 70, 255), false);
+  draw->PopClipRect();
+}
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,97 @@
+#include <algorithm>
+
+#include "app/workbench/panels.hpp"
+
+namespace scanbench::app::workbench {
+
+namespace {
+
+// The first row: the tool, the channel a seed grows on and its tolerance,
+// and how a region joins the selection.
+void tools_row(WorkbenchState& s) {
+  Session& session = s.session;
+  int tool = static_cast<int>(session.tool);
+  ImGui::RadioButton("seed (S)", &tool, 0);
+  s.probe("tool seed");
+  ImGui::SameLine();
+  ImGui::RadioButton("lasso (L)", &tool, 1);
+  s.probe("tool lasso");
+  ImGui::SameLine();
+  ImGui::RadioButton("barrier (B)", &tool, 2);
+  s.probe("tool barrier");
+  session.tool = static_cast<Tool>(tool);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(100);
+  int channel = static_cast<int>(session.channel);
+  if (ImGui::Combo("##channel", &channel, "range\0colour\0intensity\0normal\0")) {
+    session.channel = static_cast<segmentation::Channel>(channel);
+    session.tolerance = segmentation::default_grow_settings(session.channel).tolerance;
+  }
+  s.probe("channel");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  float tolerance = static_cast<float>(session.tolerance);
+  // Units by channel (region_grow.hpp): range in footprints, colour in
+  // ΔE, intensity in shares of the scan's spread, normal in degrees.
+  if (ImGui::DragFloat("tolerance", &tolerance, 0.01f * std::max(tolerance, 0.01f), 0.001f, 100.0f,
+                       "%.3g"))
+    session.tolerance = tolerance;
+  ImGui::SameLine();
+  int mode = static_cast<int>(session.mode);
+  ImGui::RadioButton("new", &mode, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("add", &mode, 1);
+  s.probe("mode add");
+  ImGui::SameLine();
+  ImGui::RadioButton("subtract", &mode, 2);
+  session.mode = static_cast<modeling::SelectMode>(mode);
+  ImGui::SameLine();
+  if (ImGui::Button("Clear lasso")) session.clear_constraints();
+}
+
+// The second row: the name for commits, groups and renames, commit,
+// proposals, the panoramic view's channel, undo and redo.
+void commands_row(WorkbenchState& s) {
+  ImGui::SetNextItemWidth(220);
+  if (ImGui::InputText("name", s.name.data(), s.name.size(),
+                       ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll))
+    s.commit();
+  s.probe("name");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(s.session.selected_pixels() == 0);
+  if (ImGui::Button("Commit (C)")) s.commit();
+  s.probe("commit");
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (ImGui::Button("Automatic proposals")) s.session.propose();
+  s.probe("propose");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(110);
+  ImGui::Combo("view", &s.panorama_channel, "colour\0range\0intensity\0normals\0");
+  s.probe("panorama channel");
+  ImGui::SameLine();
+  if (ImGui::Button("Undo")) {
+    s.session.undo();
+    s.after_command();
+  }
+  s.probe("undo");
+  ImGui::SameLine();
+  if (ImGui::Button("Redo")) {
+    s.session.redo();
+    s.after_command();
+  }
+  s.probe("redo");
+}
+
+}  // namespace
+
+void toolbar_panel(WorkbenchState& s) {
+  const float w = ImGui::GetIO().DisplaySize.x - kPanelWidth;
+  place_window(kPanelWidth, 0, w, kToolbarHeight);
+  ImGui::Begin("Tools", nullptr, kFixedWindow | ImGuiWindowFlags_NoTitleBar);
+  tools_row(s);
+  commands_row(s);
+  ImGui::End();
+}
+
+}  // namespace scanbench::app::workbench

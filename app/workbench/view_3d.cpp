@@ -1,0 +1,53 @@
+#include <epoxy/gl.h>
+
+#include <cstdint>
+#include <memory>
+
+#include "app/workbench/panels.hpp"
+#include "render/render_view.hpp"
+
+namespace scanbench::app::workbench {
+
+namespace {
+
+// Draws the model into the renderer's picture when the view or the model
+// changed.
+void redraw(WorkbenchState& s, int width, int height) {
+  if (s.session.render_model_stale() || !s.renderer) {
+    s.renderer.reset();
+    s.renderer = std::make_unique<render::SplatRenderer>(s.session.render_model());
+    s.view_dirty = true;
+  }
+  if (!s.view_dirty) return;
+  const render::RenderView view =
+      render::make_render_view(s.navigation.camera(width, height), s.session.render_model().origin);
+  const render::FrameResult frame = s.renderer->draw(view, s.settings);
+  s.last_plan = frame.plan;
+  s.last_draw_ms = frame.frame_ms;
+  // Back to the state ImGui's renderer expects.
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  glDisable(GL_PROGRAM_POINT_SIZE);
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  s.view_dirty = false;
+}
+
+}  // namespace
+
+void view_3d(WorkbenchState& s) {
+  const int w = static_cast<int>(s.view3d.w), h = static_cast<int>(s.view3d.h);
+  if (w <= 0 || h <= 0) return;
+  redraw(s, w, h);
+  const render::SplatRenderer::PictureTexture picture = s.renderer->picture_texture();
+  ImDrawList* draw = ImGui::GetBackgroundDrawList();
+  const Rect& r = s.view3d;
+  // The texture's bottom row first: flipped.
+  draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(picture.texture)),
+                 ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h),
+                 ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
+  draw->AddText(ImVec2(r.x + 8, r.y + 6), IM_COL32(255, 255, 255, 200),
+                s.fly ? "walk/fly: W A S D Q E, drag to look"
+                      : "orbit: drag to turn, right-drag to pan, wheel to zoom");
+}
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,33 @@
+#include "app/workbench/panels.hpp"
+
+namespace scanbench::app::workbench {
+
+void view_settings_panel(WorkbenchState& s) {
+  if (!ImGui::CollapsingHeader("3D view", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  render::RenderSettings& settings = s.settings;
+  bool changed = false;
+  int kernel = static_cast<int>(settings.kernel);
+  changed |= ImGui::Combo("kernel", &kernel, "disk\0gaussian\0cosine\0");
+  settings.kernel = static_cast<render::Kernel>(kernel);
+  changed |= ImGui::SliderFloat("splat scale", &settings.splat_scale, 0.5f, 4.0f, "%.2f");
+  bool blended = settings.mode == render::DrawMode::kBlended;
+  changed |= ImGui::Checkbox("two-pass blending", &blended);
+  settings.mode = blended ? render::DrawMode::kBlended : render::DrawMode::kSplats;
+  int budget = static_cast<int>(settings.culling.budget / 1000);
+  changed |= ImGui::SliderInt("budget (k)", &budget, 50, 8000);
+  settings.culling.budget = static_cast<std::size_t>(budget) * 1000;
+  int color = static_cast<int>(settings.color);
+  changed |= ImGui::Combo("colour", &color, "colour\0intensity\0height\0normal\0object\0");
+  settings.color = static_cast<render::ColorMode>(color);
+  int navigation = s.fly ? 1 : 0;
+  ImGui::RadioButton("orbit", &navigation, 0);
+  s.probe("orbit");
+  ImGui::SameLine();
+  ImGui::RadioButton("walk/fly (W A S D Q E)", &navigation, 1);
+  s.probe("fly");
+  s.fly = navigation == 1;
+  ImGui::Text("speed %.1f m/s", s.navigation.speed_m_per_s());
+  if (changed) s.view_dirty = true;
+}
+
+}  // namespace scanbench::app::workbench

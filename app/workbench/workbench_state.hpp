@@ -1,0 +1,135 @@
+// What the workbench's input layer, panels and views share: the session
+// (the project and the tools, session.hpp), the 3D camera and renderer,
+// the window's layout, the selection in the object tree, the colour
+// editor's sliders, and the widgets' places for replays. The panels
+// (panels.hpp) draw from it and act through it; the input layer
+// (input.hpp) feeds it events.
+#pragma once
+
+#include <imgui.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "app/workbench/navigation.hpp"
+#include "app/workbench/session.hpp"
+#include "app/workbench/workbench.hpp"
+#include "render/splat_renderer.hpp"
+#include "render/window/window_device.hpp"
+
+namespace scanbench::app::workbench {
+
+// The window's fixed layout [pixels]: the project panel on the left, the
+// tools across the top, the panoramic view above the 3D view, the status
+// bar at the bottom.
+inline constexpr float kPanelWidth = 340.0f;
+inline constexpr float kToolbarHeight = 64.0f;
+inline constexpr float kStatusHeight = 26.0f;
+
+struct Rect {
+  float x = 0, y = 0, w = 0, h = 0;
+  bool contains(double px, double py) const {
+    return px >= x && py >= y && px < x + w && py < y + h;
+  }
+};
+
+// What a mouse drag moves.
+enum class Drag { kNone, kOrbit, kPan3d, kPanPanorama };
+
+// The colour editor's sliders.
+struct ColorSliders {
+  float brightness = 0.0f, contrast = 1.0f, gamma = 1.0f, hue = 0.0f, saturation = 1.0f;
+};
+
+struct WorkbenchState {
+  WorkbenchState(const WorkbenchOptions& options, render::WindowDevice& window);
+
+  const WorkbenchOptions& options;
+  render::WindowDevice& window;
+  Session session;
+
+  // ---- The 3D view --------------------------------------------------------
+  Navigation navigation;
+  render::RenderSettings settings;
+  std::unique_ptr<render::SplatRenderer> renderer;
+  render::FramePlan last_plan;
+  double last_draw_ms = 0.0;
+  bool view_dirty = true;
+  bool fly = false;
+
+  // ---- Layout and the panoramic view ------------------------------------
+  Rect panorama;
+  Rect view3d;
+  float zoom = 1.0f;
+  std::array<float, 2> pan = {0.0f, 0.0f};
+  int panorama_channel = 0;  // PanoramaChannel
+  unsigned panorama_texture = 0;
+  std::array<std::int64_t, 3> panorama_key = {-1, -1, -1};  // what the texture shows
+
+  // ---- Input --------------------------------------------------------------
+  std::set<int> held;  // keys down
+  std::array<double, 2> cursor = {0.0, 0.0};
+  Drag drag = Drag::kNone;
+
+  // ---- The object tree and the colour editor ----------------------------
+  std::array<char, 128> name = {'o', 'b', 'j', 'e', 'c', 't'};  // for commits, groups, renames
+  std::set<std::int64_t> selected;
+  std::int64_t primary_id = 0;
+  ColorSliders color;
+  std::array<bool, 5> touched{};  // the colour sliders moved since the node was selected
+  // A drop in the object tree, made after the tree is drawn (the move
+  // reloads the nodes the tree is walking): the node and its new parent.
+  std::optional<std::pair<std::int64_t, std::optional<std::int64_t>>> pending_reparent;
+
+  // ---- Replays and the status bar ----------------------------------------
+  std::map<std::string, std::array<float, 2>> probes;  // widgets' centres by name
+  double frame_seconds = 0.0;
+  std::int64_t frames = 0;
+
+  std::string name_text() const { return std::string(name.data()); }
+
+  // Places the views for a window of `width` × `height` pixels.
+  void layout(int width, int height);
+
+  // The panoramic view's scale [window pixels per scan pixel], the image
+  // point (x = column, y = row, pixel centres at integers) under window
+  // point (x, y), and the window point of an image point.
+  float panorama_scale() const;
+  std::array<double, 2> panorama_pixel(double x, double y) const;
+  ImVec2 panorama_screen(const Eigen::Vector2d& pixel) const;
+
+  // Records the last widget's centre under `name` (a slider's: its frame's).
+  void probe(const std::string& widget);
+  void probe_slider(const std::string& widget);
+
+  // The selected node the colour editor and Frame act on, if any.
+  std::optional<std::int64_t> primary() const;
+  // A copy of node `id`: a command reloads the tree, so pointers into it do
+  // not outlive one.
+  std::optional<store::ObjectNode> node(std::int64_t id) const;
+  void select_only(std::int64_t id);
+  void load_color_editor();
+  // After undo or redo: a selection that is gone is dropped.
+  void after_command();
+
+  // A new object from the selection, in the selected group if one is; a
+  // group of the selected nodes.
+  void commit();
+  void group();
+
+  // Frames the bulk of the model: per axis the 2nd to 98th percentile of a
+  // sample of its points, so that far stray returns and the long splats of
+  // distant ground do not shrink the site to a speck.
+  void frame_whole_model();
+  // Frames the selected node, or the whole model.
+  void frame_selection();
+};
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,267 @@
+#include "modeling/export_command.hpp"
+
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "acquisition/formats/e57/e57_writer.hpp"
+#include "acquisition/formats/point_export.hpp"
+#include "acquisition/formats/ptx_writer.hpp"
+#include "acquisition/formats/triplet_writer.hpp"
+#include "core/errors.hpp"
+#include "core/project_file.hpp"
+#include "modeling/store/typed_layers.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+// The exported scans' ids, in id order.
+std::vector<std::int64_t> exported_ids(const store::Project& project,
+                                       const ExportSettings& settings) {
+  std::vector<std::int64_t> ids;
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    if (!settings.scan_id || stored.id == *settings.scan_id) ids.push_back(stored.id);
+  }
+  if (settings.scan_id && ids.empty()) {
+    throw core::InputError(project.path().string(), {},
+                           "no scan with id " + std::to_string(*settings.scan_id));
+  }
+  return ids;
+}
+
+// With `merged`, the keep mask of every exported scan; none otherwise.
+std::vector<std::vector<std::uint8_t>> keep_masks(const store::Project& project,
+                                                  const ExportSettings& settings,
+                                                  const std::vector<std::int64_t>& ids) {
+  if (!settings.merged) return {};
+  const std::string file = project.path().string();
+  if (settings.format == ExportFormat::kPtx || settings.format == ExportFormat::kTriplet) {
+    throw core::InputError(file, {},
+                           "--merged writes the merged model's points: use --format ply, csv, las "
+                           "or e57");
+  }
+  std::vector<std::vector<std::uint8_t>> masks;
+  for (const std::int64_t id : ids) {
+    std::optional<std::vector<std::uint8_t>> mask = store::load_keep_mask(project, id);
+    if (!mask) {
+      throw core::InputError(
+          file, {{}, {}, "scan " + std::to_string(id)},
+          "no merged model for this scan: run `scanbench merge` after the last registration");
+    }
+    masks.push_back(std::move(*mask));
+  }
+  return masks;
+}
+
+void write_triplet(const store::Project& project, const std::vector<acquisition::Scan>& scans,
+                   const ExportSettings& settings) {
+  const std::string file = project.path().string();
+  if (scans.size() != 1) {
+    throw core::InputError(file, {}, "a triplet holds one scan: choose it with --scan ID");
+  }
+  if (!scans.front().is_spherical()) {
+    throw core::InputError(file, {{}, {}, "scan \"" + scans.front().name + "\""},
+                           "a triplet needs the spherical angle model; this scan has per-pixel "
+                           "directions (export it as ptx, e57, ply, csv or las)");
+  }
+  acquisition::write_triplet(scans.front(), settings.output);
+}
+
+// The coordinate reference system the exported scans' files named: the
+// one they share (none when no file named one). Throws core::InputError
+// when two scans come from files that name different ones: one E57 file
+// holds one system.
+std::string common_coordinate_metadata(
+    const store::Project& project, const std::vector<std::int64_t>& ids,
+    const std::map<std::int64_t, acquisition::ScanSource>& sources) {
+  std::string common;
+  std::int64_t from = 0;
+  for (const std::int64_t id : ids) {
+    const auto source = sources.find(id);
+    if (source == sources.end() || source->second.coordinate_metadata.empty()) continue;
+    if (!common.empty() && source->second.coordinate_metadata != common) {
+      throw core::InputError(project.path().string(), {{}, {}, "scan " + std::to_string(id)},
+                             "comes from a file in another coordinate system than scan " +
+                                 std::to_string(from) + " (\"" +
+                                 source->second.coordinate_metadata + "\" and \"" + common +
+                                 "\"); export them apart with --scan");
+    }
+    common = source->second.coordinate_metadata;
+    from = id;
+  }
+  return common;
+}
+
+// The scans as E57 data3D entries with their guids (kept from an E57
+// import) and images; the images tied to no scan go with a whole-project
+// export only.
+void write_e57(const store::Project& project, const std::vector<std::int64_t>& ids,
+               const std::vector<acquisition::Scan>& scans,
+               const std::vector<const std::vector<std::uint8_t>*>& keep,
+               const ExportSettings& settings) {
+  const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
+  std::vector<store::StoredImage> images = project.images(true);
+  std::vector<acquisition::E57ScanOutput> outputs(scans.size());
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    outputs[s].scan = &scans[s];
+    if (const auto source = sources.find(ids[s]); source != sources.end()) {
+      outputs[s].guid = source->second.guid;
+    }
+    if (!keep.empty()) outputs[s].keep = keep[s];
+    for (store::StoredImage& stored : images) {
+      if (stored.scan_id == ids[s]) outputs[s].images.push_back(std::move(stored.image));
+    }
+  }
+  std::vector<acquisition::ScanImage> loose;
+  if (!settings.scan_id) {
+    for (store::StoredImage& stored : images) {
+      if (!stored.scan_id) loose.push_back(std::move(stored.image));
+    }
+  }
+  acquisition::write_e57(settings.output, outputs, loose,
+                         common_coordinate_metadata(project, ids, sources));
+}
+
+// The scans' ids as LAS point source ids (16 bits).
+std::vector<std::uint16_t> point_source_ids(const store::Project& project,
+                                            const std::vector<std::int64_t>& ids) {
+  std::vector<std::uint16_t> out;
+  for (const std::int64_t id : ids) {
+    if (id > std::numeric_limits<std::uint16_t>::max()) {
+      throw core::InputError(project.path().string(), {{}, {}, "scan " + std::to_string(id)},
+                             "a LAS point source id holds scan ids up to 65535");
+    }
+    out.push_back(static_cast<std::uint16_t>(id));
+  }
+  return out;
+}
+
+std::size_t count_points(const std::vector<acquisition::Scan>& scans,
+                         const std::vector<std::vector<std::uint8_t>>& keep) {
+  std::size_t points = 0;
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    const std::vector<std::uint8_t>& counted = keep.empty() ? scans[s].valid : keep[s];
+    for (const std::uint8_t flag : counted) points += flag != 0 ? 1 : 0;
+  }
+  return points;
+}
+
+// The files a scan imported before sources were recorded names: its path as
+// typed then (perhaps relative), taken from the current folder and from the
+// project's.
+std::vector<acquisition::SourceFile> recorded_source_files(const store::Project& project,
+                                                           const std::string& source_file) {
+  const std::filesystem::path path(source_file);
+  if (path.empty()) return {};
+  if (path.is_absolute()) return {acquisition::identify_source_file(path)};
+  return {acquisition::identify_source_file(path),
+          acquisition::identify_source_file(project.path().parent_path() / path)};
+}
+
+// Refuses `output` when it names a file a scan of the project was imported
+// from.
+void refuse_a_source_file(const store::Project& project,
+                          const std::map<std::int64_t, acquisition::ScanSource>& sources,
+                          const std::filesystem::path& output) {
+  for (const store::StoredScanSummary& scan : project.scans()) {
+    const auto source = sources.find(scan.id);
+    const std::vector<acquisition::SourceFile> files =
+        source != sources.end() && !source->second.files.empty()
+            ? source->second.files
+            : recorded_source_files(project, scan.summary.scanner.source_file);
+    for (const acquisition::SourceFile& file : files) {
+      if (!acquisition::names_source_file(output, file)) continue;
+      throw core::InputError(output.string(), {},
+                             "is a file scan " + std::to_string(scan.id) + " was imported from (" +
+                                 file.path +
+                                 "); an output never replaces an input of the project, --force "
+                                 "or not");
+    }
+  }
+}
+
+}  // namespace
+
+void refuse_to_replace_inputs(const store::Project& project,
+                              std::span<const std::filesystem::path> outputs,
+                              bool replace_existing) {
+  const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
+  for (const std::filesystem::path& output : outputs) {
+    std::error_code error;
+    // SQLite's companion files hold the project's latest changes.
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(output, error);
+    const std::string project_path = std::filesystem::weakly_canonical(project.path(), error);
+    for (const char* suffix : {"-wal", "-shm", "-journal"}) {
+      if (canonical == project_path + suffix) {
+        throw core::InputError(output.string(), {},
+                               "is a file of the project being exported; an export never "
+                               "replaces its input");
+      }
+    }
+    if (!std::filesystem::exists(std::filesystem::symlink_status(output, error))) continue;
+    if (std::filesystem::equivalent(output, project.path(), error)) {
+      throw core::InputError(output.string(), {},
+                             "is the project being exported; an export never replaces its input");
+    }
+    refuse_a_source_file(project, sources, output);
+    // Folders, devices and projects get the output file's own refusal.
+    const bool replaceable =
+        std::filesystem::is_regular_file(output, error) && !core::is_project_file(output);
+    if (replaceable && !replace_existing) {
+      throw core::InputError(output.string(), {}, "exists; --force replaces it");
+    }
+  }
+}
+
+ExportResult export_project(const store::Project& project, const ExportSettings& settings) {
+  // Masks, poses and channels from one state, whatever commits meanwhile.
+  const store::Project::ReadSnapshot snapshot = project.read_snapshot();
+  const std::vector<std::int64_t> ids = exported_ids(project, settings);
+  const std::vector<std::vector<std::uint8_t>> keep = keep_masks(project, settings, ids);
+  std::vector<acquisition::Scan> scans;
+  std::vector<std::optional<acquisition::ScanGeometry>> geometry;
+  for (const std::int64_t id : ids) {
+    scans.push_back(project.load_scan(id));
+    geometry.push_back(store::load_geometry(project, id));
+  }
+  const std::vector<std::filesystem::path> outputs =
+      settings.format == ExportFormat::kTriplet && scans.size() == 1
+          ? acquisition::triplet_files(scans.front(), settings.output)
+          : std::vector<std::filesystem::path>{settings.output};
+  refuse_to_replace_inputs(project, outputs, settings.replace_existing);
+  std::vector<const acquisition::ScanGeometry*> geometry_of;
+  for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
+  std::vector<const std::vector<std::uint8_t>*> keep_of;
+  for (const auto& mask : keep) keep_of.push_back(&mask);
+  switch (settings.format) {
+    case ExportFormat::kPtx:
+      acquisition::write_ptx(settings.output, scans);
+      break;
+    case ExportFormat::kPly:
+      acquisition::write_ply(settings.output, scans, geometry_of, keep_of);
+      break;
+    case ExportFormat::kCsv:
+      acquisition::write_csv(settings.output, scans, geometry_of, keep_of);
+      break;
+    case ExportFormat::kTriplet:
+      write_triplet(project, scans, settings);
+      break;
+    case ExportFormat::kLas:
+      acquisition::write_las(settings.output, scans, point_source_ids(project, ids), geometry_of,
+                             keep_of);
+      break;
+    case ExportFormat::kE57:
+      write_e57(project, ids, scans, keep_of, settings);
+      break;
+  }
+  // The point formats leave mixed pixels out; the grid formats keep every
+  // pixel, the valid ones (or with `merged` the kept ones) counted.
+  const bool point_list = settings.format == ExportFormat::kPly ||
+                          settings.format == ExportFormat::kCsv ||
+                          settings.format == ExportFormat::kLas;
+  return {scans.size(), point_list ? acquisition::count_exported_points(scans, geometry_of, keep_of)
+                                   : count_points(scans, keep)};
+}
+
+}  // namespace scanbench::modeling

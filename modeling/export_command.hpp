@@ -1,0 +1,68 @@
+// Exporting a project's scans or its merged model to the interchange formats
+// (acquisition/ writes the files; this decides what goes into them).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+
+#include "modeling/store/project.hpp"
+
+namespace scanbench::modeling {
+
+enum class ExportFormat {
+  kPtx,      // scan frame + pose, lossless
+  kPly,      // binary PLY, world coordinates, with normals and footprints after geometry
+  kCsv,      // text, world coordinates
+  kTriplet,  // range/colour/intensity images and a JSON sidecar; one spherical scan
+  kLas,      // LAS 1.4, point format 7, world coordinates at 0.1 mm; scan id as point source
+  kE57,      // ASTM E57: structured scans in spherical coordinates + pose, with their images
+};
+
+struct ExportSettings {
+  ExportFormat format = ExportFormat::kPly;
+  std::optional<std::int64_t> scan_id;  // only this scan; all scans when empty
+  // Only the points of the merged model (`scanbench merge`); PLY, CSV, LAS
+  // and E57 (whose grids keep every pixel, the others marked invalid).
+  bool merged = false;
+  std::filesystem::path output;  // the file (triplet: the .json sidecar)
+  // Replace an existing output file (--force). A project, or a file a scan
+  // was imported from, is never replaced.
+  bool replace_existing = false;
+};
+
+struct ExportResult {
+  std::size_t scans = 0;
+  // The points written: valid (point formats: not mixed) or, with `merged`,
+  // kept ones.
+  std::size_t points = 0;
+};
+
+// Writes the project's scans as the settings say, all read from one state of
+// the project (Project::read_snapshot). Outputs are checked first
+// (refuse_to_replace_inputs): core::InputError, nothing written. Where a scan has geometry,
+// the point formats leave its mixed pixels out and PLY carries its normals
+// and footprints. Throws core::InputError (naming the project and, where it
+// applies, the scan) for: no such scan, `merged` with a scan-grid format or
+// before a merge, a triplet of several scans or of a per-pixel scan, LAS of
+// a scan whose id does not fit a point source id (above 65535). Output
+// is all-or-nothing (acquisition/formats/output_file.hpp); write failures throw
+// std::runtime_error naming the file.
+ExportResult export_project(const store::Project& project, const ExportSettings& settings);
+
+// Refuses (core::InputError naming the output, nothing written) an output
+// that would replace an input of the project: the project itself or one of
+// its files, by any path (a symlink, a hard link, "./"), or a file one of
+// its scans was imported from (by path, or renamed or linked, by identity:
+// acquisition::names_source_file), whatever `replace_existing` says; and,
+// unless `replace_existing`, any file that exists. Any other project is
+// refused by the output file itself (acquisition/formats/output_file.hpp). Every
+// command that writes a file from a project checks its outputs with it
+// first.
+void refuse_to_replace_inputs(const store::Project& project,
+                              std::span<const std::filesystem::path> outputs,
+                              bool replace_existing);
+
+}  // namespace scanbench::modeling

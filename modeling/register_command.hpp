@@ -1,0 +1,54 @@
+// The register command: align every scan of a project (registration/
+// register_scans.hpp) and store the poses with a report, as the command
+// "register".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "modeling/store/project.hpp"
+#include "registration/register_scans.hpp"
+
+namespace scanbench::modeling {
+
+// Picked point pairs between two scans of the project, named by id.
+struct ProjectPicks {
+  std::int64_t source_id = 0;
+  std::int64_t target_id = 0;
+  std::vector<registration::PointPair> pairs;  // each point in its own scan frame [m]
+};
+
+struct RegisterCommandSettings {
+  registration::RegistrationSettings registration;
+  // For CoarseMethod::kPointPairs: for every scan but the first (in id
+  // order), one entry with that scan as source and an earlier scan as target.
+  std::vector<ProjectPicks> picks;
+};
+
+struct RegisterCommandResult {
+  std::int64_t command_id = 0;    // the journal entry
+  std::vector<std::int64_t> ids;  // scan ids, in the order of the result's scans
+  std::vector<std::string> names;
+  registration::RegistrationResult result;
+  std::string report_json;  // as stored in the journal (the command's result)
+};
+
+// Registers every scan of the project (the first scan by id is the
+// reference and keeps its pose), then as one command stores the new poses
+// (earlier poses stay in the history), the report as the command's result,
+// and removes the now stale merge keep masks. A failed pair is reported, and
+// its scan keeps its pose relative to its target. Throws core::InputError
+// for a damaged project, a project without scans, a scan without geometry
+// ("run scanbench geometry first"), or picks that do not name the project's scans as the settings
+// require; core::RuntimeFailure when another process changed the project
+// meanwhile; core::Cancelled when cancelled. The project is then unchanged.
+RegisterCommandResult register_project(store::Project& project,
+                                       const RegisterCommandSettings& settings,
+                                       core::Progress& progress);
+
+}  // namespace scanbench::modeling

@@ -1,0 +1,287 @@
+#include "modeling/selection_commands.hpp"
+
+#include <algorithm>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <unordered_set>
+
+#include "core/errors.hpp"
+#include "modeling/node_tree.hpp"
+#include "modeling/store/typed_layers.hpp"
+#include "segmentation/pixel_set.hpp"
+
+namespace scanbench::modeling {
+
+namespace {
+
+// "`base` N", `base` cut (between UTF-8 characters) so that the name fits
+// kMaxNodeNameBytes.
+std::string numbered_name(const std::string& base, std::size_t number) {
+  const std::string digits = std::to_string(number);
+  std::size_t keep = std::min(base.size(), store::kMaxNodeNameBytes - 1 - digits.size());
+  while (keep > 0 && keep < base.size() && (static_cast<unsigned char>(base[keep]) & 0xC0) == 0x80)
+    --keep;
+  // Appended apart: GCC 12 warns falsely on chains of std::string operator+ at -O3.
+  std::string name(base, 0, keep);
+  name += ' ';
+  name += digits;
+  return name;
+}
+
+segmentation::PixelSet load_selection(const store::Project& project, std::int64_t scan_id) {
+  const auto stored =
+      project.load_layer<std::uint8_t>(scan_id, store::layer::kSelection, store::ElementType::kU8);
+  return stored ? segmentation::from_mask(*stored) : segmentation::PixelSet{};
+}
+
+void put_selection(store::Project& project, store::Project::Edit& edit, std::int64_t scan_id,
+                   const segmentation::GridShape& shape, const segmentation::PixelSet& selection) {
+  if (selection.empty()) {
+    project.remove_layer(edit, scan_id, store::layer::kSelection);
+    return;
+  }
+  const std::vector<std::uint8_t> mask = segmentation::to_mask(shape, selection);
+  project.put_layer(
+      edit, scan_id,
+      store::encode_layer<std::uint8_t>(store::layer::kSelection, store::ElementType::kU8, mask));
+}
+
+nlohmann::json polyline_json(const segmentation::Polyline& line) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Eigen::Vector2d& v : line) out.push_back({v.x(), v.y()});
+  return out;
+}
+
+nlohmann::json select_json(const SelectSettings& s) {
+  nlohmann::json barriers = nlohmann::json::array();
+  for (const segmentation::Polyline& line : s.constraints.barriers)
+    barriers.push_back(polyline_json(line));
+  constexpr const char* kModes[] = {"replace", "add", "subtract"};
+  return {{"scan", s.scan_id},
+          {"seed", {s.seed_row, s.seed_col}},
+          {"mode", kModes[static_cast<int>(s.mode)]},
+          {"channel", segmentation::channel_name(s.grow.channel)},
+          {"tolerance", s.grow.tolerance},
+          {"mean_factor", s.grow.mean_factor},
+          {"plane_footprints", s.grow.plane_footprints},
+          {"continuity_footprints", s.grow.continuity_footprints},
+          {"max_pixels", s.grow.max_pixels},
+          {"lasso", polyline_json(s.constraints.lasso)},
+          {"barriers", barriers},
+          {"range_noise",
+           {{"noise_m", s.range_noise.noise_m}, {"noise_per_m", s.range_noise.noise_per_m}}}};
+}
+
+store::StoredScanSummary require_scan(const store::Project& project, std::int64_t scan_id) {
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    if (stored.id == scan_id) return stored;
+  }
+  refuse("scan " + std::to_string(scan_id), "no such scan");
+}
+
+// 1 where an object owns the pixel or it is deleted: closed to growing.
+std::vector<std::uint8_t> taken_mask(const std::vector<std::uint32_t>& membership) {
+  std::vector<std::uint8_t> taken(membership.size());
+  for (std::size_t i = 0; i < taken.size(); ++i) taken[i] = membership[i] != 0;
+  return taken;
+}
+
+// The scan, its geometry (refused when missing) and the grid a region grows on.
+struct Prepared {
+  acquisition::Scan scan;
+  acquisition::ScanGeometry geometry;
+  segmentation::SegmentationGrid grid;
+};
+
+Prepared prepare(const store::Project& project, std::int64_t scan_id,
+                 const acquisition::RangeNoise& noise) {
+  Prepared p;
+  p.scan = project.load_scan(scan_id);
+  std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, scan_id);
+  if (!geometry) {
+    refuse("scan " + std::to_string(scan_id), "has no geometry: run `scanbench geometry` first");
+  }
+  p.geometry = std::move(*geometry);
+  segmentation::GridSettings settings;
+  settings.range_noise = noise;
+  p.grid = segmentation::prepare_grid(p.scan, p.geometry, settings);
+  return p;
+}
+
+}  // namespace
+
+SeparateResult separate_object(store::Project& project, const SeparateSettings& settings) {
+  const std::int64_t revision = project.revision();
+  Tree tree = load_tree(project);
+  const store::ObjectNode object = require_node(tree, settings.node);
+  if (object.kind != store::NodeKind::kObject) {
+    refuse("node " + std::to_string(settings.node), "is a group: only objects own pixels");
+  }
+  const acquisition::Scan scan = project.load_scan(settings.scan_id);
+  std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, scan.pixel_count());
+  segmentation::PixelSet owned;
+  for (std::size_t i = 0; i < membership.size(); ++i) {
+    if (membership[i] == static_cast<std::uint32_t>(object.id))
+      owned.push_back(static_cast<std::uint32_t>(i));
+  }
+  const std::vector<segmentation::PixelSet> parts =
+      segmentation::separate(segmentation::grid_shape(scan), owned);
+  SeparateResult result;
+  result.nodes.push_back(object.id);
+  std::vector<store::ObjectNode> made;
+  std::int64_t next = fresh_ids(project, parts.empty() ? 0 : parts.size() - 1);
+  for (std::size_t k = 1; k < parts.size(); ++k) {
+    store::ObjectNode part = object;
+    part.id = next++;
+    part.name = numbered_name(object.name, k + 1);
+    for (const std::uint32_t p : parts[k]) membership[p] = static_cast<std::uint32_t>(part.id);
+    tree.emplace(part.id, part);
+    made.push_back(part);
+    result.nodes.push_back(part.id);
+  }
+  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
+  store::Project::Edit edit = project.begin_command(
+      "separate", dump({{"node", settings.node}, {"scan", settings.scan_id}}), revision);
+  for (const store::ObjectNode& part : made) project.put_node(edit, part);
+  if (!made.empty()) put_membership(project, edit, settings.scan_id, membership);
+  refresh_figures(project, edit, tree, figures);
+  result.command_id = edit.command_id();
+  edit.commit(dump({{"nodes", result.nodes}}));
+  return result;
+}
+
+SeparateResult propose_objects(store::Project& project, const ProposeSettings& settings) {
+  const std::int64_t revision = project.revision();
+  require_name(settings.group_name);
+  Tree tree = load_tree(project);
+  require_group(tree, settings.parent);
+  const Prepared p = prepare(project, settings.scan_id, settings.range_noise);
+  std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, p.scan.pixel_count());
+  const std::vector<std::uint8_t> open =
+      segmentation::open_pixels(p.grid, {}, taken_mask(membership));
+  const segmentation::ProposalResult proposed =
+      segmentation::propose_regions(p.grid, open, p.geometry.confidence, settings.proposals);
+  store::ObjectNode group;
+  group.id = fresh_ids(project, 1 + proposed.regions.size());
+  group.name = settings.group_name;
+  group.kind = store::NodeKind::kGroup;
+  group.parent = settings.parent;
+  tree.emplace(group.id, group);
+  SeparateResult result;
+  std::vector<store::ObjectNode> made;
+  for (std::size_t k = 0; k < proposed.regions.size(); ++k) {
+    store::ObjectNode object;
+    object.id = group.id + 1 + static_cast<std::int64_t>(k);
+    object.name = "proposal " + std::to_string(k + 1);
+    object.parent = group.id;
+    for (const std::uint32_t px : proposed.regions[k])
+      membership[px] = static_cast<std::uint32_t>(object.id);
+    tree.emplace(object.id, object);
+    made.push_back(object);
+    result.nodes.push_back(object.id);
+  }
+  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
+  store::Project::Edit edit = project.begin_command(
+      "propose",
+      dump({{"scan", settings.scan_id},
+            {"group", settings.group_name},
+            {"parent", parent_json(settings.parent)},
+            {"channel", segmentation::channel_name(settings.proposals.grow.channel)},
+            {"tolerance", settings.proposals.grow.tolerance},
+            {"min_pixels", settings.proposals.min_pixels}}),
+      revision);
+  project.put_node(edit, group);
+  for (const store::ObjectNode& object : made) project.put_node(edit, object);
+  if (!made.empty()) put_membership(project, edit, settings.scan_id, membership);
+  refresh_figures(project, edit, tree, figures);
+  result.command_id = edit.command_id();
+  edit.commit(dump({{"group", group.id}, {"proposals", made.size()}, {"pixels", proposed.pixels}}));
+  return result;
+}
+
+SelectResult select_region(store::Project& project, const SelectSettings& settings) {
+  const std::int64_t revision = project.revision();
+  const std::string where = "scan " + std::to_string(settings.scan_id);
+  const store::StoredScanSummary summary = require_scan(project, settings.scan_id);
+  const int rows = summary.summary.rows, columns = summary.summary.columns;
+  if (settings.seed_row < 0 || settings.seed_row >= rows || settings.seed_col < 0 ||
+      settings.seed_col >= columns) {
+    refuse(where, "seed (" + std::to_string(settings.seed_row) + ", " +
+                      std::to_string(settings.seed_col) + ") is outside the " +
+                      std::to_string(rows) + " × " + std::to_string(columns) + " grid");
+  }
+  const Prepared prepared = prepare(project, settings.scan_id, settings.range_noise);
+  const acquisition::Scan& scan = prepared.scan;
+  const segmentation::SegmentationGrid& grid = prepared.grid;
+  const std::vector<std::uint8_t> open = segmentation::open_pixels(
+      grid, settings.constraints,
+      taken_mask(load_membership(project, settings.scan_id, scan.pixel_count())));
+  segmentation::RegionGrower grower(grid);
+  const segmentation::GrowResult grown =
+      grower.grow(scan.index(settings.seed_row, settings.seed_col), settings.grow, open);
+  const segmentation::PixelSet before = load_selection(project, settings.scan_id);
+  segmentation::PixelSet selection;
+  switch (settings.mode) {
+    case SelectMode::kReplace:
+      selection = grown.pixels;
+      break;
+    case SelectMode::kAdd:
+      selection = segmentation::unite(before, grown.pixels);
+      break;
+    case SelectMode::kSubtract:
+      selection = segmentation::subtract(before, grown.pixels);
+      break;
+  }
+  store::Project::Edit edit =
+      project.begin_command("select", dump(select_json(settings)), revision);
+  put_selection(project, edit, settings.scan_id, grid.shape, selection);
+  SelectResult result{edit.command_id(), grown.pixels.size(), selection.size(), grown.seed_open};
+  edit.commit(dump({{"region_pixels", result.region_pixels},
+                    {"selected_pixels", result.selected_pixels},
+                    {"seed_open", result.seed_open}}));
+  return result;
+}
+
+NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings) {
+  const std::int64_t revision = project.revision();
+  const std::string where = "scan " + std::to_string(settings.scan_id);
+  require_name(settings.name);
+  Tree tree = load_tree(project);
+  require_group(tree, settings.parent);
+  // The grid's size from the summary: compute_figures decodes the scan itself.
+  const store::StoredScanSummary stored = require_scan(project, settings.scan_id);
+  const segmentation::PixelSet selection = load_selection(project, settings.scan_id);
+  std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id,
+                      static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns);
+  store::ObjectNode node;
+  node.id = fresh_ids(project, 1);
+  node.name = settings.name;
+  node.parent = settings.parent;
+  std::size_t taken = 0;
+  for (const std::uint32_t p : selection) {
+    if (membership[p] != 0) continue;  // another object's since the selection grew
+    membership[p] = static_cast<std::uint32_t>(node.id);
+    ++taken;
+  }
+  if (taken == 0) refuse(where, "the selection is empty: grow a region first");
+  tree.emplace(node.id, node);
+  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
+  store::Project::Edit edit =
+      project.begin_command("commit",
+                            dump({{"scan", settings.scan_id},
+                                  {"name", settings.name},
+                                  {"parent", parent_json(settings.parent)}}),
+                            revision);
+  project.put_node(edit, node);
+  put_membership(project, edit, settings.scan_id, membership);
+  project.remove_layer(edit, settings.scan_id, store::layer::kSelection);
+  refresh_figures(project, edit, tree, figures);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"node", node.id}, {"points", taken}}));
+  return {command_id, node.id};
+}
+
+}  // namespace scanbench::modeling

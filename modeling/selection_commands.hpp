@@ -1,0 +1,94 @@
+// The segmentation's commands (seed 004 §4.1): a region grown from a seed
+// into a scan's selection, the selection committed as an object of the
+// tree, an object separated into its parts, and automatic proposals. Each
+// is one journaled command (store/project.hpp) that reads and computes
+// first, then writes in one Edit. Regions grow only through pixels still
+// to be segmented; a scan's "selection" layer (u8) is the region being
+// grown.
+//
+// Errors: a scan or node that does not exist, a seed outside the grid, a
+// scan without geometry, an empty selection, a bad name (tree_commands.hpp):
+// core::InputError naming it, and nothing written.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "acquisition/range_noise.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/tree_commands.hpp"
+#include "segmentation/constraints.hpp"
+#include "segmentation/proposals.hpp"
+#include "segmentation/region_grow.hpp"
+
+namespace scanbench::modeling {
+
+enum class SelectMode {
+  kReplace,   // the region becomes the selection
+  kAdd,       // the region joins the selection
+  kSubtract,  // the region leaves the selection
+};
+
+struct SelectSettings {
+  std::int64_t scan_id = 0;
+  int seed_row = 0;
+  int seed_col = 0;
+  SelectMode mode = SelectMode::kReplace;
+  segmentation::GrowSettings grow;
+  segmentation::Constraints constraints;  // image coordinates (constraints.hpp)
+  acquisition::RangeNoise range_noise;    // the scanner's
+};
+
+struct SelectResult {
+  std::int64_t command_id = 0;
+  std::size_t region_pixels = 0;    // grown from the seed
+  std::size_t selected_pixels = 0;  // in the selection afterwards
+  bool seed_open = false;           // the seed could grow (usable, open, still to be segmented)
+};
+
+// Grows a region from the seed and combines it with the scan's selection.
+SelectResult select_region(store::Project& project, const SelectSettings& settings);
+
+struct CommitSettings {
+  std::int64_t scan_id = 0;
+  std::string name;                    // the new object's
+  std::optional<std::int64_t> parent;  // a group; none: a root
+};
+
+// Makes the scan's selection a new object: its pixels leave the pool still
+// to be segmented, the selection is emptied, and the object and its
+// ancestors get their point count, mean footprint and world bounding box.
+NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings);
+
+struct SeparateSettings {
+  std::int64_t node = 0;     // an object
+  std::int64_t scan_id = 0;  // the scan whose pixels are split
+};
+
+struct SeparateResult {
+  std::int64_t command_id = 0;
+  std::vector<std::int64_t> nodes;  // the object (its largest part) first, then the new ones
+};
+
+// Splits an object's pixels in one scan into their 8-connected parts: the
+// largest stays the object, each other part becomes a new object beside it
+// ("NAME 2", "NAME 3", …), with all its figures.
+SeparateResult separate_object(store::Project& project, const SeparateSettings& settings);
+
+struct ProposeSettings {
+  std::int64_t scan_id = 0;
+  std::string group_name = "proposals";  // the group that receives them
+  std::optional<std::int64_t> parent;    // of that group; none: a root
+  segmentation::ProposalSettings proposals;
+  acquisition::RangeNoise range_noise;
+};
+
+// Automatic proposals (segmentation/proposals.hpp) on the scan's pixels still
+// to be segmented, each committed as an object "proposal K" in a new group,
+// for the user to accept (rename, reparent), merge (merge_objects) or reject
+// (delete back to the pool). One command: undo takes them all back.
+SeparateResult propose_objects(store::Project& project, const ProposeSettings& settings);
+
+}  // namespace scanbench::modeling

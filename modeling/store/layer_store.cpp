@@ -1,0 +1,220 @@
+// The scan_layers table: versioned per-pixel layers (layers.hpp, project.hpp).
+#include "modeling/store/layer_store.hpp"
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+
+#include "core/errors.hpp"
+#include "core/memory.hpp"
+#include "modeling/store/checksummed_rows.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/store/sqlite_statement.hpp"
+#include "modeling/store/zstd_blob.hpp"
+
+namespace scanbench::store {
+namespace {
+
+struct TypeInfo {
+  ElementType type;
+  const char* name;
+  std::size_t size;
+};
+
+constexpr std::array<TypeInfo, 5> kTypes = {{{ElementType::kU8, "u8", 1},
+                                             {ElementType::kU8x3, "u8x3", 3},
+                                             {ElementType::kU32, "u32", 4},
+                                             {ElementType::kF32, "f32", 4},
+                                             {ElementType::kF32x3, "f32x3", 12}}};
+
+const TypeInfo& info(ElementType type) {
+  for (const TypeInfo& t : kTypes) {
+    if (t.type == type) return t;
+  }
+  assert(false && "unknown ElementType");
+  return kTypes[0];
+}
+
+// The current version of layer (scan, name): the row of the newest done
+// command, in journal order.
+const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data
+FROM scan_layers l JOIN commands c ON c.id = l.command_id
+WHERE l.scan_id = ?1 AND l.name = ?2 AND c.state = 'done'
+ORDER BY c.seq DESC LIMIT 1)sql"});
+
+// The layers whose name fixes their type (layers.hpp).
+struct KnownLayer {
+  const char* name;
+  ElementType type;
+};
+constexpr std::array<KnownLayer, 12> kKnownLayers = {{{layer::kRange, ElementType::kF32},
+                                                      {layer::kValid, ElementType::kU8},
+                                                      {layer::kIntensity, ElementType::kF32},
+                                                      {layer::kRgb, ElementType::kU8x3},
+                                                      {layer::kDirections, ElementType::kF32x3},
+                                                      {layer::kFootprint, ElementType::kF32},
+                                                      {layer::kNormal, ElementType::kF32x3},
+                                                      {layer::kConfidence, ElementType::kF32},
+                                                      {layer::kGeometryFlags, ElementType::kU8},
+                                                      {layer::kKeep, ElementType::kU8},
+                                                      {layer::kSelection, ElementType::kU8},
+                                                      {layer::kMembership, ElementType::kU32}}};
+
+[[maybe_unused]] bool has_its_type(const EncodedLayer& layer) {
+  for (const KnownLayer& known : kKnownLayers) {
+    if (layer.name == known.name) return layer.type == known.type;
+  }
+  return true;
+}
+
+[[noreturn]] void damaged(const std::string& file, std::int64_t id, std::string_view name,
+                          const std::string& problem) {
+  core::FilePosition position;
+  position.detail = "scan " + std::to_string(id) + ", layer " + std::string(name);
+  throw core::InputError(file, position, "project is damaged: " + problem);
+}
+
+}  // namespace
+
+const char* element_type_name(ElementType type) {
+  return info(type).name;
+}
+
+std::optional<ElementType> element_type_from_name(std::string_view name) {
+  for (const TypeInfo& t : kTypes) {
+    if (name == t.name) return t.type;
+  }
+  return std::nullopt;
+}
+
+std::size_t element_size(ElementType type) {
+  return info(type).size;
+}
+
+EncodedLayer encode_layer_bytes(std::string name, ElementType type,
+                                std::span<const std::byte> bytes) {
+  assert(bytes.size() % element_size(type) == 0 && "a layer holds whole elements");
+  EncodedLayer layer;
+  layer.name = std::move(name);
+  layer.type = type;
+  layer.element_count = bytes.size() / element_size(type);
+  layer.blob = compress(bytes);
+  return layer;
+}
+
+namespace {
+
+// Writes (or replaces, within one command) the row of a layer version, with
+// its checksum; `blob` empty for a removal.
+void write_layer_row(sqlite3* db, const std::string& file, const LayerFields& fields,
+                     std::span<const std::uint8_t> blob) {
+  sqlite::Statement insert(db, R"sql(
+INSERT OR REPLACE INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec,
+                                    data, checksum)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8))sql",
+                           file);
+  insert.bind_int(1, fields.scan_id).bind_text(2, fields.name).bind_int(3, fields.command_id);
+  insert.bind_text(4, fields.element_type).bind_int(5, fields.element_count);
+  insert.bind_text(6, fields.codec);
+  if (fields.codec == "removed") {
+    insert.bind_null(7);
+  } else {
+    insert.bind_blob(7, blob);
+  }
+  insert.bind_int(8, checksum(fields)).run();
+}
+
+// A layer row read back, refused unless it passes its checksum.
+LayerFields verified(const sqlite::Statement& row, const std::string& file) {
+  auto [fields, stored] = read_layer_fields(row, 0);
+  if (checksum(fields) != stored) {
+    damaged(file, fields.scan_id, fields.name,
+            "the layer's row fails its checksum (changed outside scanbench?)");
+  }
+  return std::move(fields);
+}
+
+}  // namespace
+
+void Project::put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer) {
+  check_edit(edit);
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);
+  assert(layer.element_count == n && "a layer holds one element per pixel");
+  assert(has_its_type(layer) && "a layer named in layers.hpp has the type listed there");
+  write_layer_row(db(), file_name(),
+                  {id, layer.name, edit.command_id(), element_type_name(layer.type),
+                   static_cast<std::int64_t>(layer.element_count), "zstd"},
+                  layer.blob);
+}
+
+void Project::remove_layer(Edit& edit, std::int64_t id, std::string_view name) {
+  check_edit(edit);
+  static_cast<void>(stored_pixel_count(id, &edit));  // no such scan: InputError
+  const std::vector<std::string> present = layer_names(id);
+  if (std::find(present.begin(), present.end(), name) == present.end()) return;
+  write_layer_row(db(), file_name(), {id, std::string(name), edit.command_id(), "u8", 0, "removed"},
+                  {});
+}
+
+bool Project::read_layer(
+    std::int64_t id, std::string_view name, std::optional<ElementType> expected,
+    const std::function<std::span<std::byte>(std::size_t bytes)>& allocate) const {
+  const std::size_t n = stored_pixel_count(id);
+  sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
+  select.bind_int(1, id).bind_text(2, name);
+  if (!select.step()) return false;
+  const LayerFields fields = verified(select, file_name());
+  if (fields.codec == "removed") return false;
+  if (fields.codec != "zstd") damaged(file_name(), id, name, "unknown codec");
+  const std::optional<ElementType> stored = element_type_from_name(fields.element_type);
+  if (!stored) damaged(file_name(), id, name, "unknown element type " + fields.element_type);
+  if (expected && *stored != *expected) {
+    damaged(file_name(), id, name,
+            "holds " + fields.element_type + " elements, expected " + element_type_name(*expected));
+  }
+  const ElementType type = *stored;
+  if (fields.element_count != static_cast<std::int64_t>(n)) {
+    damaged(file_name(), id, name,
+            "has " + std::to_string(fields.element_count) + " elements, expected " +
+                std::to_string(n) + " (one per pixel)");
+  }
+  const BlobContext context{file_name(),
+                            "scan " + std::to_string(id) + ", layer " + std::string(name)};
+  // The frame must hold what the grid needs before a buffer is made for it.
+  const std::span<const std::uint8_t> blob = select.column_blob(7);
+  check_blob_size(blob, n * element_size(type), context);
+  core::check_memory(n * element_size(type), file_name());
+  decompress_into(blob, allocate(n * element_size(type)), context);
+  return true;
+}
+
+void Project::verify_current_layer(std::int64_t id, std::string_view name) const {
+  std::vector<std::byte> values;
+  read_layer(id, name, std::nullopt, [&values](std::size_t bytes) {
+    values.resize(bytes);
+    return std::span<std::byte>(values);
+  });
+}
+
+std::vector<std::string> Project::layer_names(std::int64_t id) const {
+  const std::string sql = sql_of({R"sql(
+SELECT )sql",
+                                  kLayerColumns, R"sql( FROM (
+  SELECT l.*, row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
+  FROM scan_layers l JOIN commands c ON c.id = l.command_id
+  WHERE l.scan_id = ?1 AND c.state = 'done') l
+WHERE newest = 1
+ORDER BY name)sql"});
+  sqlite::Statement select(db(), sql.c_str(), file_name());
+  select.bind_int(1, id);
+  std::vector<std::string> names;
+  while (select.step()) {
+    const LayerFields fields = verified(select, file_name());
+    if (fields.codec != "removed") names.push_back(fields.name);
+  }
+  return names;
+}
+
+}  // namespace scanbench::store

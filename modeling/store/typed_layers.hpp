@@ -1,0 +1,27 @@
+// The layers the pipeline's stages write, as the types the algorithms use:
+// geometry (footprint, normal, confidence, flags) and the merge's keep mask.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "acquisition/geometry/scan_geometry.hpp"
+#include "modeling/store/project.hpp"
+
+namespace scanbench::store {
+
+// The four geometry layers of `geometry` (layers.hpp).
+std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& geometry);
+
+// The stored geometry of scan `id`, or none when `scanbench geometry` has
+// not run on it (or was undone). Throws core::InputError naming the scan
+// when only some of the four layers are there or one is damaged.
+std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, std::int64_t id);
+
+// The merge's keep mask of scan `id` (one byte per pixel, 1 = in the merged
+// model), or none when `scanbench merge` has not run since the scan's pose
+// or geometry last changed.
+std::optional<std::vector<std::uint8_t>> load_keep_mask(const Project& project, std::int64_t id);
+
+}  // namespace scanbench::store
