@@ -1,5 +1,5 @@
 // The render device: whatever gives the renderer a current OpenGL 4.5 core
-// context. The renderer draws into its own offscreen target (frame_target.hpp)
+// context. The renderer draws into framebuffers of its own (gl_objects.hpp)
 // either way, so the same code serves the headless device below and a
 // window backend (GLFW, which only that backend includes) that shows the
 // target on screen.

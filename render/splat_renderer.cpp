@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "render/gl_objects.hpp"
+#include "render/gl_state.hpp"
 #include "render/splat_shaders.hpp"
 
 namespace scanbench::render {
@@ -233,6 +234,7 @@ SplatRenderer::~SplatRenderer() = default;
 
 FrameResult SplatRenderer::draw(const RenderView& picture_view, const RenderSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
+  const GlStateGuard keep;  // the caller's state, given back whatever the draw changes
   const RenderView view = with_guard_band(picture_view, kGuardBandPixels);
   FrameResult result;
   result.plan = plan_frame(model_, view, settings.culling);

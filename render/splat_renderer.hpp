@@ -87,10 +87,9 @@ class SplatRenderer {
   SplatRenderer& operator=(const SplatRenderer&) = delete;
 
   // Draws a frame into the offscreen target (the view's size and a guard
-  // band round it). Leaves the context's GL state as drawing needs it
-  // (zero-to-one clip control, program point size, this renderer's program
-  // and vertex arrays bound): a caller drawing more (the workbench's UI)
-  // sets its own state.
+  // band round it). Leaves the context's GL state as it found it
+  // (gl_state.hpp), so a caller drawing more (the workbench's UI) needs no
+  // repair.
   FrameResult draw(const RenderView& view, const RenderSettings& settings);
 
   // The last frame, without its guard band. Asserts that a frame was drawn.

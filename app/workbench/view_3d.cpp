@@ -1,5 +1,3 @@
-#include <epoxy/gl.h>
-
 #include <cstdint>
 #include <memory>
 
@@ -23,12 +21,7 @@ void redraw(WorkbenchState& s, int width, int height) {
       render::make_render_view(s.navigation.camera(width, height), s.session.render_model().origin);
   const render::FrameResult frame = s.renderer->draw(view, s.settings);
   s.last_plan = frame.plan;
-  s.last_draw_ms = frame.frame_ms;
-  // Back to the state ImGui's renderer expects.
-  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
-  glDisable(GL_PROGRAM_POINT_SIZE);
-  glDisable(GL_DEPTH_TEST);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  s.last_draw_ms = frame.frame_ms;  // the renderer gives ImGui its GL state back
   s.view_dirty = false;
 }
 

@@ -1,11 +1,13 @@
 // The splat renderer on the headless device (llvmpipe in CI): raw points
 // leave holes that splats close, each half of the wall keeps its colour,
 // hidden objects are not drawn, and every kernel and colour mode draws.
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <memory>
 
 #include "render/device.hpp"
+#include "render/object_palette.hpp"
 #include "render/splat_renderer.hpp"
 #include "wall_model.hpp"
 
@@ -68,6 +70,38 @@ RenderedImage render(const RenderModel& model, const RenderSettings& settings,
   SplatRenderer renderer(model);
   renderer.draw(make_render_view(test::camera_at(eye, 640, 480), kOrigin), settings);
   return renderer.read_image();
+}
+
+TEST(SplatRenderer, ADrawLeavesTheGlStateAsItFoundIt) {
+  device();
+  const RenderModel model = test::wall_model();  // the renderer keeps a reference
+  SplatRenderer renderer(model);
+  // A host's state, ImGui's for instance: none of what drawing splats needs.
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_PROGRAM_POINT_SIZE);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glUseProgram(0);
+  glViewport(1, 2, 3, 4);
+  renderer.draw(make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 64, 48), kOrigin), {});
+  GLint origin = 0, framebuffer = -1, program = -1, source = 0;
+  std::array<GLint, 4> viewport{};
+  glGetIntegerv(GL_CLIP_ORIGIN, &origin);
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
+  glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+  glGetIntegerv(GL_BLEND_SRC_RGB, &source);
+  glGetIntegerv(GL_VIEWPORT, viewport.data());
+  EXPECT_EQ(origin, GL_LOWER_LEFT);
+  EXPECT_FALSE(glIsEnabled(GL_DEPTH_TEST));
+  EXPECT_FALSE(glIsEnabled(GL_PROGRAM_POINT_SIZE));
+  EXPECT_TRUE(glIsEnabled(GL_BLEND));
+  EXPECT_EQ(source, GL_SRC_ALPHA);
+  EXPECT_EQ(framebuffer, 0);
+  EXPECT_EQ(program, 0);
+  EXPECT_EQ(viewport, (std::array<GLint, 4>{1, 2, 3, 4}));
+  glDisable(GL_BLEND);
 }
 
 TEST(SplatRenderer, TheHeadlessDeviceIsOpenGl45) {
@@ -163,6 +197,10 @@ TEST(SplatRenderer, ColourModesDrawWhatTheyName) {
     return Eigen::Vector3i(p[0], p[1], p[2]);
   };
   EXPECT_NE(pixel(objects, 200, 240), pixel(objects, 440, 240));  // objects 1 and 2
+  // The shaders' palette is object_palette.hpp's, as the panorama shows it.
+  const std::array<std::uint8_t, 3> one = object_color(1);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(pixel(objects, 200, 240)[c], one[static_cast<std::size_t>(c)], 1);
   settings.color = ColorMode::kIntensity;
   EXPECT_EQ(pixel(render(model, settings), 200, 240), Eigen::Vector3i(128, 128, 128));
   settings.color = ColorMode::kNormal;  // (−1, 0, 0) → (0, 0.5, 0.5)
