@@ -6,6 +6,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::filesystem::path path = scanbench::fuzz::write_input(data, size, "ops.json");
   scanbench::fuzz::expect_refusal_or_success(
-      [&] { scanbench::modeling::read_segment_script(path); });
+      [&] { scanbench::app::read_segment_script(path); });
   return 0;
 }

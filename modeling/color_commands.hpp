@@ -3,8 +3,8 @@
 // object, a region of a scan, or one colour (`clone`). Each is one journaled
 // command writing a new version of the target node, so undo restores the
 // earlier edit exactly. The scans' colours are never changed
-// (color_edits.hpp); scan-level corrections are the harmonize stage's
-// (registration_stage.hpp).
+// (modeling/color_pipeline.hpp); scan-level corrections are the harmonize
+// command's (harmonize_command.hpp).
 //
 // Errors: a node or scan that does not exist, parameters out of range, a
 // region outside the scan, a source or target without coloured points:

@@ -9,8 +9,6 @@
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
 #include "modeling/loaded_scans.hpp"
-#include "modeling/settings_json.hpp"
-#include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
 

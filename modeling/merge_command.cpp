@@ -1,13 +1,7 @@
 #include "modeling/merge_command.hpp"
 
-#include <algorithm>
-#include <cassert>
-#include <chrono>
-#include <map>
 #include <nlohmann/json.hpp>
 
-#include "acquisition/color_space.hpp"
-#include "core/errors.hpp"
 #include "modeling/loaded_scans.hpp"
 #include "modeling/settings_json.hpp"
 #include "modeling/store/typed_layers.hpp"

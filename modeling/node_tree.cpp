@@ -186,4 +186,11 @@ std::map<std::int64_t, std::vector<std::uint32_t>> reassign_pixels(
   return changed;
 }
 
+std::vector<store::ObjectNode> node_figures_after_moving(
+    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses) {
+  const Tree tree = load_tree(project);
+  if (tree.empty()) return {};
+  return with_new_figures(tree, compute_figures(project, tree, {}, poses));
+}
+
 }  // namespace scanbench::modeling

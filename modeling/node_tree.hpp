@@ -1,7 +1,8 @@
-// What the selection and tree commands share (internal to modeling/): the
-// object tree as a map they edit, the checks every command makes before it
-// writes, the membership layers, and the nodes' figures (point count, mean
-// footprint, world bounding box) computed from the pixels of every scan.
+// What the commands that change the object tree or its pixels share
+// (internal to modeling/: selection, tree and register): the tree as a map
+// they edit, the checks they make before they write, the membership layers,
+// and the nodes' figures (point count, mean footprint, world bounding box)
+// computed from the pixels of every scan.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -95,5 +96,12 @@ std::int64_t fresh_ids(const store::Project& project, std::size_t count);
 std::map<std::int64_t, std::vector<std::uint32_t>> reassign_pixels(
     const store::Project& project, const std::unordered_set<std::uint32_t>& owners,
     std::uint32_t replacement);
+
+// The nodes whose figures change when the scans of `poses` move there,
+// each with its new figures: what a command that moves scans (register)
+// writes with put_node in its own Edit, so the tree's boxes follow the
+// scans and undo with them.
+std::vector<store::ObjectNode> node_figures_after_moving(
+    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses);
 
 }  // namespace scanbench::modeling

@@ -1,17 +1,14 @@
 #include "modeling/register_command.hpp"
 
 #include <algorithm>
-#include <cassert>
-#include <chrono>
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
 #include "modeling/loaded_scans.hpp"
+#include "modeling/node_tree.hpp"
 #include "modeling/settings_json.hpp"
 #include "modeling/store/typed_layers.hpp"
-#include "modeling/tree_commands.hpp"
 
 namespace scanbench::modeling {
 namespace {

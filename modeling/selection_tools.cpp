@@ -59,6 +59,7 @@ void SelectionTools::clear() {
 SelectSettings SelectionTools::select_at(std::int64_t scan_id, const Eigen::Vector2d& xy,
                                          SelectMode mode,
                                          const segmentation::GrowSettings& grow) const {
+  assert((!scan_ || *scan_ == scan_id) && "a lasso or barriers of another scan");
   SelectSettings settings;
   settings.scan_id = scan_id;
   const segmentation::GridPixel pixel = segmentation::nearest_pixel(xy);

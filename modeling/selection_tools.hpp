@@ -49,6 +49,8 @@ class SelectionTools {
 
   // select_region's settings for a seed at image point `xy` of scan
   // `scan_id`: the nearest pixel, the lasso when it is closed, the barriers.
+  // Asserts the lasso and barriers, if any, were drawn on `scan_id` (the
+  // caller refuses or clears them otherwise).
   SelectSettings select_at(std::int64_t scan_id, const Eigen::Vector2d& xy, SelectMode mode,
                            const segmentation::GrowSettings& grow) const;
 

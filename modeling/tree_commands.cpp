@@ -74,13 +74,6 @@ NodeCommandResult edit_node(store::Project& project, const NodeEdit& change) {
   return {command_id, node.id};
 }
 
-std::vector<store::ObjectNode> node_figures_after_moving(
-    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses) {
-  const Tree tree = load_tree(project);
-  if (tree.empty()) return {};
-  return with_new_figures(tree, compute_figures(project, tree, {}, poses));
-}
-
 UngroupResult ungroup_node(store::Project& project, std::int64_t group) {
   const std::int64_t revision = project.revision();
   Tree tree = load_tree(project);

@@ -81,11 +81,4 @@ struct MergeSettings {
 // user merges proposals).
 NodeCommandResult merge_objects(store::Project& project, const MergeSettings& settings);
 
-// The nodes whose figures (point count, mean footprint, world bounding box)
-// change when the scans of `poses` move there, each with its new figures:
-// what a command that moves scans (the register stage) writes with put_node
-// in its own Edit, so the tree's boxes follow the scans and undo with them.
-std::vector<store::ObjectNode> node_figures_after_moving(
-    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses);
-
 }  // namespace scanbench::modeling

@@ -24,6 +24,9 @@ GlStateGuard::GlStateGuard() {
   point_size_ = enabled(GL_PROGRAM_POINT_SIZE);
   depth_test_ = enabled(GL_DEPTH_TEST);
   blend_ = enabled(GL_BLEND);
+  scissor_test_ = enabled(GL_SCISSOR_TEST);
+  cull_face_ = enabled(GL_CULL_FACE);
+  stencil_test_ = enabled(GL_STENCIL_TEST);
   glGetBooleanv(GL_DEPTH_WRITEMASK, &depth_mask_);
   glGetIntegerv(GL_DEPTH_FUNC, &depth_func_);
   glGetIntegerv(GL_BLEND_SRC_RGB, &blend_func_[0]);
@@ -59,9 +62,15 @@ GlStateGuard::~GlStateGuard() {
   glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
   glUseProgram(static_cast<GLuint>(program_));
   glBindVertexArray(static_cast<GLuint>(vertex_array_));
-  for (GLuint unit = 0; unit < textures_.size(); ++unit)
-    glBindTextureUnit(unit, static_cast<GLuint>(textures_[unit]));
+  // Only the 2D target of each unit: glBindTextureUnit would reset the others.
+  for (GLuint unit = 0; unit < textures_.size(); ++unit) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(textures_[unit]));
+  }
   glActiveTexture(static_cast<GLenum>(active_texture_));
+  set_enabled(GL_SCISSOR_TEST, scissor_test_);
+  set_enabled(GL_CULL_FACE, cull_face_);
+  set_enabled(GL_STENCIL_TEST, stencil_test_);
 }
 
 }  // namespace scanbench::render

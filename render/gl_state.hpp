@@ -12,7 +12,8 @@ namespace scanbench::render {
 class GlStateGuard {
  public:
   // Saves what the splat renderer changes: clip control, the enables it
-  // toggles (program point size, depth test, blending), depth mask and
+  // toggles (program point size, depth, blending, scissor, culling,
+  // stencil), depth mask and
   // function, blend function, colour mask, framebuffer bindings, viewport,
   // program, vertex array, and the textures of units 0 and 1.
   GlStateGuard();
@@ -24,6 +25,7 @@ class GlStateGuard {
  private:
   GLint clip_origin_ = 0, clip_depth_ = 0;
   GLboolean point_size_ = GL_FALSE, depth_test_ = GL_FALSE, blend_ = GL_FALSE;
+  GLboolean scissor_test_ = GL_FALSE, cull_face_ = GL_FALSE, stencil_test_ = GL_FALSE;
   GLboolean depth_mask_ = GL_TRUE;
   GLint depth_func_ = 0;
   std::array<GLint, 4> blend_func_{};  // source and destination, RGB then alpha

@@ -39,7 +39,8 @@ struct RenderPoints {
   std::vector<Eigen::Vector3f> major_axis;  // unit, world frame; zero: round (radii equal)
   std::vector<std::array<std::uint8_t, 4>>
       rgba;  // shown colour: the scan's, its correction and its object's edit
-             // applied (color_edits.hpp); grey from intensity without; alpha 255
+             // applied (store/color_edit.hpp, modeling/color_pipeline.hpp); grey from intensity
+             // without; alpha 255
   std::vector<float> intensity;     // [0, 1]: the scan's 2nd–98th percentile spread
   std::vector<std::uint32_t> node;  // the owning object, 0 for none
 

@@ -113,6 +113,13 @@ struct SplatRenderer::Gpu {
   // The planned tiles into the splat target: one opaque pass, or the
   // visibility and accumulation passes of blending.
   void draw_splats(const RenderModel& model, const FramePlan& plan, DrawMode mode) const {
+    // Whatever state the host left (its blending, scissor, culling, stencil,
+    // colour mask), the passes set what they rely on.
+    glDisable(GL_BLEND);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_STENCIL_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glEnable(GL_DEPTH_TEST);

@@ -43,6 +43,7 @@ void check_vertices(const GridShape& shape, const Polyline& line,
 }  // namespace
 
 GridPixel nearest_pixel(const Eigen::Vector2d& xy) {
+  assert(xy.allFinite() && "a finite image point");
   const auto index = [](double v) {
     return static_cast<int>(std::llround(std::clamp(v, -1.0, 1e9)));
   };

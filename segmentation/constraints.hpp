@@ -29,9 +29,10 @@ struct GridPixel {
 };
 
 // The pixel whose centre is nearest image point `xy` (x = column, y = row):
-// the one place image coordinates become (row, col). Coordinates are
-// clamped to [-1, 10^9] first, so that a point far off the grid stays off
-// it instead of wrapping.
+// the one place a click becomes (row, col). Coordinates are clamped to
+// [-1, 10^9] first, so that a point far off the grid stays off it instead of
+// wrapping. Asserts `xy` is finite. (Lines drawn on the grid round their
+// vertices themselves: a seam-crossing barrier's x runs past the grid.)
 GridPixel nearest_pixel(const Eigen::Vector2d& xy);
 
 // Whether vertex `v` is finite and within one grid size of the grid (the

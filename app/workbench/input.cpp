@@ -68,8 +68,8 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
   const auto [x, y] = s.cursor;
   if (s.panorama.contains(x, y)) {
     if (button == 0) {
-      const auto [col, row] = s.panorama_pixel(x, y);
-      s.session.click(col, row);
+      const auto [image_x, image_y] = s.panorama_pixel(x, y);
+      s.session.click(image_x, image_y);
     } else {
       s.drag = Drag::kPanPanorama;
     }
@@ -86,11 +86,11 @@ void WorkbenchInput::scrolled(double, double dy) {
   const auto [x, y] = s.cursor;
   if (s.panorama.contains(x, y)) {
     // Zoom about the cursor: the pixel under it stays under it.
-    const auto [col, row] = s.panorama_pixel(x, y);
+    const auto [image_x, image_y] = s.panorama_pixel(x, y);
     s.zoom = std::clamp(s.zoom * static_cast<float>(std::pow(1.25, dy)), 1.0f, 64.0f);
-    const float scale = s.panorama_scale();
-    s.pan[0] = static_cast<float>(x) - s.panorama.x - static_cast<float>(col + 0.5) * scale;
-    s.pan[1] = static_cast<float>(y) - s.panorama.y - static_cast<float>(row + 0.5) * scale;
+    const ImVec2 moved = s.panorama_screen({image_x, image_y});  // where the new zoom put it
+    s.pan[0] += static_cast<float>(x) - moved.x;
+    s.pan[1] += static_cast<float>(y) - moved.y;
   } else if (s.view3d.contains(x, y)) {
     s.navigation.zoom(dy);
     s.view_dirty = true;

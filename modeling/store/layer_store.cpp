@@ -1,4 +1,4 @@
-// The scan_layers table: versioned per-pixel layers (layers.hpp, project.hpp).
+// The scan_layers table: versioned per-pixel layers (layer_store.hpp, project.hpp).
 #include "modeling/store/layer_store.hpp"
 
 #include <sqlite3.h>
@@ -44,7 +44,7 @@ FROM scan_layers l JOIN commands c ON c.id = l.command_id
 WHERE l.scan_id = ?1 AND l.name = ?2 AND c.state = 'done'
 ORDER BY c.seq DESC LIMIT 1)sql"});
 
-// The layers whose name fixes their type (layers.hpp).
+// The layers whose name fixes their type (layer_store.hpp).
 struct KnownLayer {
   const char* name;
   ElementType type;
@@ -142,7 +142,7 @@ void Project::put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer) 
   check_edit(edit);
   [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);
   assert(layer.element_count == n && "a layer holds one element per pixel");
-  assert(has_its_type(layer) && "a layer named in layers.hpp has the type listed there");
+  assert(has_its_type(layer) && "a layer named in layer_store.hpp has the type listed there");
   write_layer_row(db(), file_name(),
                   {id, layer.name, edit.command_id(), element_type_name(layer.type),
                    static_cast<std::int64_t>(layer.element_count), "zstd"},

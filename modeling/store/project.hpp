@@ -72,7 +72,7 @@ inline constexpr int kBusyTimeoutMs = 5000;
 enum class NodeKind { kGroup, kObject };
 
 // The longest name a user may give a node [bytes of UTF-8]. Names hold no
-// control characters (modeling/tree_commands.hpp refuses them).
+// control characters (the commands refuse them: modeling/node_tree.hpp).
 inline constexpr std::size_t kMaxNodeNameBytes = 256;
 
 // A node of the object tree (site → building → wall …). Objects own pixels
@@ -87,7 +87,7 @@ struct ObjectNode {
   std::int64_t points = 0;
   std::optional<double> mean_footprint_m;         // [m]; none without points
   std::optional<Eigen::AlignedBox3d> bbox_world;  // [m]; none without points
-  ColorEdit color;  // what the node itself sets (color_edits.hpp); the rest it inherits
+  ColorEdit color;  // what the node itself sets (color_edit.hpp); the rest it inherits
 };
 
 // An image stored with the scans (E57 images2D).
@@ -236,7 +236,7 @@ class Project {
 
   // Writes a new version of layer `layer.name` of scan `id` as part of
   // `edit`. Asserts the layer has one element per pixel of the scan and,
-  // for the names layers.hpp lists, their type; throws core::InputError when
+  // for the names layer_store.hpp lists, their type; throws core::InputError when
   // there is no such scan.
   void put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer);
 
@@ -296,7 +296,7 @@ class Project {
   // brings it back). No effect on a node that is not live.
   void remove_node(Edit& edit, std::int64_t id);
 
-  // ---- Colour corrections of scans (color_edits.hpp) -----------------------
+  // ---- Colour corrections of scans (color_edit.hpp) --------------------------
 
   // The current correction of every live scan that has one, by scan id.
   // Throws core::InputError naming the scan when its row is damaged.

@@ -1,6 +1,6 @@
 // The scan_colors table: Project::scan_color_corrections and
 // put_scan_color_correction. Versioned like poses (project.hpp),
-// checksummed like every record (records.hpp).
+// checksummed like every record (checksummed_rows.hpp).
 #include <sqlite3.h>
 
 #include <stdexcept>

@@ -1,6 +1,6 @@
 // The object_nodes table: Project::object_tree, object_nodes, nodes_named,
 // new_node_id, put_node, remove_node. Versioned like poses (project.hpp),
-// checksummed like every record (records.hpp); the connection keeps the
+// checksummed like every record (checksummed_rows.hpp); the connection keeps the
 // tree between commands (object_tree_cache.hpp).
 #include <sqlite3.h>
 

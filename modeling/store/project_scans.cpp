@@ -1,6 +1,6 @@
 // The scans and scan_poses tables: encode_scan, Project::insert_scan,
 // set_pose, scans, load_scan. Every record is checksummed when written and
-// verified when read (records.hpp).
+// verified when read (checksummed_rows.hpp).
 #include <sqlite3.h>
 
 #include <array>

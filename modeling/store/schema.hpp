@@ -12,7 +12,7 @@
 //   7  scan_sources, scan_images.
 //   8  indexes of the commands that are undone or pending.
 // To change the schema: bump kProjectSchemaVersion and add a case to
-// migrate_step() in project_schema.cpp that upgrades from the previous
+// migrate_step() in schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by
 // it followed by every migration step.
 #pragma once

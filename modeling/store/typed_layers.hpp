@@ -11,7 +11,7 @@
 
 namespace scanbench::store {
 
-// The four geometry layers of `geometry` (layers.hpp).
+// The four geometry layers of `geometry` (layer_store.hpp).
 std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& geometry);
 
 // The stored geometry of scan `id`, or none when `scanbench geometry` has

@@ -3,7 +3,7 @@
 // A blob is one zstd frame whose header records the decompressed size and
 // which ends in a content checksum, so damage is detected on reading. The
 // raw bytes are the array's in-memory representation, which on the supported
-// platforms is little-endian IEEE-754 (static_assert in blob_codec.cpp), so a
+// platforms is little-endian IEEE-754 (static_assert in zstd_blob.cpp), so a
 // project file written on one machine reads bit for bit on another.
 // Eigen::Vector3f arrays are stored as x, y, z floats per element.
 #pragma once

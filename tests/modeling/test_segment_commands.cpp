@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "modeling/node_tree.hpp"
 #include "modeling/selection_commands.hpp"
 #include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"

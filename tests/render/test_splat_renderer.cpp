@@ -76,16 +76,24 @@ TEST(SplatRenderer, ADrawLeavesTheGlStateAsItFoundIt) {
   device();
   const RenderModel model = test::wall_model();  // the renderer keeps a reference
   SplatRenderer renderer(model);
+  const RenderView view = make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 64, 48), kOrigin);
+  renderer.draw(view, {});
+  const RenderedImage clean = renderer.read_image();
   // A host's state, ImGui's for instance: none of what drawing splats needs.
   glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_PROGRAM_POINT_SIZE);
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, 0, 1, 1);
+  glColorMask(GL_TRUE, GL_FALSE, GL_TRUE, GL_TRUE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glUseProgram(0);
   glViewport(1, 2, 3, 4);
-  renderer.draw(make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 64, 48), kOrigin), {});
+  renderer.draw(view, {});
+  // The same picture: the passes set their own state.
+  EXPECT_EQ(renderer.read_image().rgba, clean.rgba);
   GLint origin = 0, framebuffer = -1, program = -1, source = 0;
   std::array<GLint, 4> viewport{};
   glGetIntegerv(GL_CLIP_ORIGIN, &origin);
@@ -101,7 +109,13 @@ TEST(SplatRenderer, ADrawLeavesTheGlStateAsItFoundIt) {
   EXPECT_EQ(framebuffer, 0);
   EXPECT_EQ(program, 0);
   EXPECT_EQ(viewport, (std::array<GLint, 4>{1, 2, 3, 4}));
+  EXPECT_TRUE(glIsEnabled(GL_SCISSOR_TEST));
+  std::array<GLboolean, 4> mask{};
+  glGetBooleanv(GL_COLOR_WRITEMASK, mask.data());
+  EXPECT_EQ(mask, (std::array<GLboolean, 4>{GL_TRUE, GL_FALSE, GL_TRUE, GL_TRUE}));
   glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
 TEST(SplatRenderer, TheHeadlessDeviceIsOpenGl45) {
