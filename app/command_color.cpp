@@ -2,7 +2,7 @@
 //                           [--saturation S] [--reset] [--json]
 // scanbench recolor PROJECT --to ID (--clone SRC_ID | --clone-region SCAN:ROW0:COL0:ROW1:COL1 |
 //                           --paint-color '#RRGGBB') [--paint] [--json]
-// scanbench harmonize PROJECT [--model gain-offset|matrix] [--threads N] [--json]
+// scanbench harmonize PROJECT [--model gain-offset|matrix] [--settings FILE] [--threads N] [--json]
 #include <fmt/core.h>
 
 #include <charconv>
@@ -143,16 +143,23 @@ void run_recolor(const RecolorOptions& options) {
 struct HarmonizeOptions {
   std::string project;
   modeling::HarmonizeCommandSettings settings;
+  std::string settings_file;
+  int threads = 0;
   bool json = false;
 };
 
 void run_harmonize(const HarmonizeOptions& options) {
+  modeling::HarmonizeCommandSettings settings =
+      options.settings_file.empty()
+          ? options.settings
+          : read_settings_file<modeling::HarmonizeCommandSettings>(options.settings_file);
+  settings.pairs.threads = settings.solve.threads = options.threads;
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
   const modeling::HarmonizeCommandResult out =
-      modeling::harmonize_project(project, options.settings, progress);
+      modeling::harmonize_project(project, settings, progress);
   if (options.json) {
-    fmt::print("{}\n", modeling::harmonize_result_json(out));
+    fmt::print("{}\n", modeling::result_json(out));
     return;
   }
   fmt::print("{:>4}  {:<24} {:>9} {:>10} {:>9}  {}\n", "id", "name", "pairs", "ΔE before",
@@ -225,6 +232,7 @@ void add_harmonize_command(CLI::App& app) {
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
+  CLI::Option* settings = add_settings_option(command, options->settings_file);
   command
       ->add_option("--model", options->settings.solve.model,
                    "gain-offset (per channel) or matrix (3 × 3 and offset)")
@@ -233,14 +241,11 @@ void add_harmonize_command(CLI::App& app) {
               {"gain-offset", registration::ColorModel::kGainOffset},
               {"matrix", registration::ColorModel::kMatrix}},
           CLI::ignore_case))
-      ->default_str("gain-offset");
-  add_threads_option(command, options->settings.pairs.threads);
+      ->default_str("gain-offset")
+      ->excludes(settings);
+  add_threads_option(command, options->threads);
   command->add_flag("--json", options->json, "Print one JSON object");
-  command->callback([options] {
-    HarmonizeOptions run = *options;
-    run.settings.solve.threads = run.settings.pairs.threads;
-    run_harmonize(run);
-  });
+  command->callback([options] { run_harmonize(*options); });
 }
 
 }  // namespace scanbench::app

@@ -1,4 +1,5 @@
-// scanbench geometry PROJECT [--window R] [--edge-window R] [--no-mixed-pixels] [--threads N]
+// scanbench geometry PROJECT [--window R] [--edge-window R] [--no-mixed-pixels]
+//                            [--settings FILE] [--threads N]
 #include <fmt/core.h>
 
 #include <memory>
@@ -15,14 +16,20 @@ struct GeometryOptions {
   std::string project;
   acquisition::GeometrySettings geometry;
   bool no_mixed_pixels = false;
+  std::string settings_file;
 };
 
 void run_geometry(GeometryOptions& options) {
-  const acquisition::GeometrySettings& g = options.geometry;
-  if (g.edge_window_radius > g.window_radius) {
+  acquisition::GeometrySettings& g = options.geometry;
+  if (!options.settings_file.empty()) {
+    const int threads = g.threads;
+    g = read_settings_file<acquisition::GeometrySettings>(options.settings_file);
+    g.threads = threads;
+  } else if (g.edge_window_radius > g.window_radius) {
     throw CLI::ValidationError("--edge-window", "must not exceed --window");
+  } else {
+    g.flag_mixed_pixels = !options.no_mixed_pixels;
   }
-  options.geometry.flag_mixed_pixels = !options.no_mixed_pixels;
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
   const modeling::GeometryCommandResult result =
@@ -50,15 +57,19 @@ void add_geometry_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   acquisition::GeometrySettings& g = options->geometry;
+  CLI::Option* settings = add_settings_option(command, options->settings_file);
   command->add_option("--window", g.window_radius, "Radius of the widest fitting window [pixels]")
       ->check(CLI::Range(1, acquisition::kMaxWindowRadius))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->excludes(settings);
   command
       ->add_option("--edge-window", g.edge_window_radius,
                    "Radius of the window near edges [pixels]")
       ->check(CLI::Range(1, acquisition::kMaxWindowRadius))
-      ->capture_default_str();
-  command->add_flag("--no-mixed-pixels", options->no_mixed_pixels, "Do not flag mixed pixels");
+      ->capture_default_str()
+      ->excludes(settings);
+  command->add_flag("--no-mixed-pixels", options->no_mixed_pixels, "Do not flag mixed pixels")
+      ->excludes(settings);
   add_threads_option(command, g.threads);
   command->callback([options] { run_geometry(*options); });
 }

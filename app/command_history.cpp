@@ -1,8 +1,10 @@
-// scanbench undo PROJECT, scanbench redo PROJECT, scanbench history PROJECT [--json]
+// scanbench undo PROJECT, scanbench redo PROJECT,
+// scanbench history PROJECT [--json | --settings ID]
 #include <fmt/core.h>
 
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "app/commands.hpp"
@@ -15,6 +17,7 @@ namespace {
 struct HistoryOptions {
   std::string project;
   bool json = false;
+  std::optional<std::int64_t> settings_of;
 };
 
 const char* state_name(store::CommandState state) {
@@ -116,6 +119,16 @@ nlohmann::json to_json(const store::CommandRecord& c) {
 void run_history(const HistoryOptions& options) {
   const store::Project project = store::Project::open_for_reading(options.project);
   const std::vector<store::CommandRecord> history = project.history();
+  if (options.settings_of) {
+    for (const store::CommandRecord& c : history) {
+      if (c.id != *options.settings_of) continue;
+      fmt::print("{}\n",
+                 parsed(c.settings).dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
+      return;
+    }
+    throw core::InputError(options.project, {},
+                           "has no command " + std::to_string(*options.settings_of));
+  }
   if (options.json) {
     nlohmann::json commands = nlohmann::json::array();
     for (const store::CommandRecord& c : history) commands.push_back(to_json(c));
@@ -169,7 +182,12 @@ void add_history_commands(CLI::App& app) {
   CLI::App* history = app.add_subcommand(
       "history", "List the project's commands, oldest first, with their settings and results.");
   add_project(history, options->project);
-  history->add_flag("--json", options->json, "Print one JSON object");
+  CLI::Option* json = history->add_flag("--json", options->json, "Print one JSON object");
+  history
+      ->add_option("--settings", options->settings_of,
+                   "Print only the settings of command ID, as `--settings FILE` of geometry, "
+                   "register, merge and harmonize reads them")
+      ->excludes(json);
   history->callback([options] { run_history(*options); });
 
   auto undo_project = std::make_shared<std::string>();

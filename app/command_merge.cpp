@@ -1,4 +1,4 @@
-// scanbench merge PROJECT [--threads N] [--json]
+// scanbench merge PROJECT [--settings FILE] [--threads N] [--json]
 #include <fmt/core.h>
 
 #include <memory>
@@ -16,16 +16,21 @@ namespace {
 struct MergeOptions {
   std::string project;
   registration::MergeSettings settings;
+  std::string settings_file;
   bool json = false;
 };
 
 void run_merge(const MergeOptions& options) {
+  registration::MergeSettings settings = options.settings;
+  if (!options.settings_file.empty()) {
+    settings = read_settings_file<registration::MergeSettings>(options.settings_file);
+    settings.threads = options.settings.threads;
+  }
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::MergeCommandResult out =
-      modeling::merge_project(project, options.settings, progress);
+  const modeling::MergeCommandResult out = modeling::merge_project(project, settings, progress);
   if (options.json) {
-    fmt::print("{}\n", modeling::merge_result_json(out));
+    fmt::print("{}\n", modeling::result_json(out));
     return;
   }
   std::size_t kept = 0;
@@ -51,6 +56,7 @@ void add_merge_command(CLI::App& app) {
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
+  add_settings_option(command, options->settings_file);
   add_threads_option(command, options->settings.threads);
   command->add_flag("--json", options->json, "Print one JSON object");
   command->callback([options] { run_merge(*options); });

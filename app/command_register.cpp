@@ -1,5 +1,5 @@
 // scanbench register PROJECT [--coarse features|pairs|none] [--pairs FILE] [--unlevelled]
-//                            [--no-global] [--threads N] [--json]
+//                            [--no-global] [--settings FILE] [--threads N] [--json]
 #include <fmt/core.h>
 
 #include <map>
@@ -23,6 +23,7 @@ struct RegisterOptions {
   std::string pairs_file;
   bool unlevelled = false;
   bool no_global = false;
+  std::string settings_file;
   int threads = 0;
   bool json = false;
 };
@@ -47,7 +48,8 @@ void print_table(const modeling::RegisterCommandResult& out) {
              r.converged ? "converged" : "NOT converged", r.seconds);
 }
 
-void run_register(const RegisterOptions& options) {
+// The settings the options give.
+modeling::RegisterCommandSettings settings_of(const RegisterOptions& options) {
   modeling::RegisterCommandSettings settings;
   registration::RegistrationSettings& s = settings.registration;
   s.coarse = options.coarse;
@@ -62,13 +64,22 @@ void run_register(const RegisterOptions& options) {
   }
   s.features.levelled = !options.unlevelled;
   s.refine_globally = !options.no_global;
+  return settings;
+}
+
+void run_register(const RegisterOptions& options) {
+  modeling::RegisterCommandSettings settings =
+      options.settings_file.empty()
+          ? settings_of(options)
+          : read_settings_file<modeling::RegisterCommandSettings>(options.settings_file);
+  registration::RegistrationSettings& s = settings.registration;
   s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
   const modeling::RegisterCommandResult out =
       modeling::register_project(project, settings, progress);
   if (options.json) {
-    fmt::print("{}\n", out.report_json);
+    fmt::print("{}\n", modeling::result_json(out));
   } else {
     print_table(out);
   }
@@ -91,17 +102,23 @@ void add_register_command(CLI::App& app) {
       {"pairs", registration::CoarseMethod::kPointPairs},
       {"point_pairs", registration::CoarseMethod::kPointPairs},
       {"none", registration::CoarseMethod::kNone}};
+  CLI::Option* settings = add_settings_option(command, options->settings_file);
   command
       ->add_option("--coarse", options->coarse, "Coarse stage: features (default), pairs or none")
-      ->transform(CLI::CheckedTransformer(coarse_methods, CLI::ignore_case));
+      ->transform(CLI::CheckedTransformer(coarse_methods, CLI::ignore_case))
+      ->excludes(settings);
   command
       ->add_option("--pairs", options->pairs_file,
                    "Picked point pairs (JSON, see docs/registration.md); implies --coarse pairs")
-      ->check(CLI::ExistingFile);
-  command->add_flag("--unlevelled", options->unlevelled,
-                    "The scanner was not levelled on site: feature poses from three matches each "
-                    "instead of one");
-  command->add_flag("--no-global", options->no_global, "Skip the global refinement");
+      ->check(CLI::ExistingFile)
+      ->excludes(settings);
+  command
+      ->add_flag("--unlevelled", options->unlevelled,
+                 "The scanner was not levelled on site: feature poses from three matches each "
+                 "instead of one")
+      ->excludes(settings);
+  command->add_flag("--no-global", options->no_global, "Skip the global refinement")
+      ->excludes(settings);
   add_threads_option(command, options->threads);
   command->add_flag("--json", options->json, "Print the report as one JSON object");
   command->callback([options] { run_register(*options); });

@@ -6,8 +6,10 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 
+#include "acquisition/formats/json_input.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
+#include "modeling/command_json.hpp"
 
 namespace scanbench::app {
 
@@ -45,6 +47,28 @@ inline void add_threads_option(CLI::App* command, int& threads) {
                    "Worker threads: 0 = all cores (the default), at most " +
                        std::to_string(core::kMaxThreads) + "; more than the cores run as many")
       ->check(CLI::Range(0, core::kMaxThreads));
+}
+
+// The --settings option of the batch commands (geometry, register, merge,
+// harmonize): run with the settings of an earlier command, as `scanbench
+// history PROJECT --settings ID` prints them. The options that change
+// settings are then refused: they are in the file.
+inline CLI::Option* add_settings_option(CLI::App* command, std::string& file) {
+  return command
+      ->add_option("--settings", file,
+                   "Run with these settings (JSON, as `scanbench history PROJECT --settings ID` "
+                   "prints a command's); missing keys take the defaults")
+      ->check(CLI::ExistingFile);
+}
+
+// Reads a --settings file. Throws core::InputError naming the file and the
+// key when it is not JSON, has a key the settings do not, a value of the
+// wrong type or outside its range (modeling::SettingsSource::kUser).
+template <typename Settings>
+Settings read_settings_file(const std::string& file) {
+  constexpr std::uintmax_t kMaxBytes = 1 << 20;
+  return modeling::settings_from_json<Settings>(acquisition::read_json_file(file, kMaxBytes), file,
+                                                modeling::SettingsSource::kUser);
 }
 
 // Runs `work`, a command of modeling/, and names `project` in a refusal that

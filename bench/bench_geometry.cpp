@@ -37,7 +37,7 @@
 #include "acquisition/simulation/virtual_scanner.hpp"
 #include "bench/pcl_normals.hpp"
 #include "core/parallel.hpp"
-#include "modeling/settings_json.hpp"
+#include "modeling/command_json.hpp"
 
 namespace scanbench::bench {
 namespace {

@@ -7,6 +7,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
+#include "modeling/command_json.hpp"
 #include "modeling/store/layer_store.hpp"
 #include "modeling/store/typed_layers.hpp"
 
@@ -157,10 +158,6 @@ ColorPipeline pipeline_of(const store::Project& project,
 nlohmann::json edit_json(const store::ColorEdit& edit) {
   const std::string text = to_json(edit);
   return text.empty() ? nlohmann::json::object() : nlohmann::json::parse(text);
-}
-
-std::string dump(const nlohmann::json& json) {
-  return json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace

@@ -1,29 +1,16 @@
 #include "modeling/geometry_command.hpp"
 
 #include <chrono>
-#include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
-#include "modeling/settings_json.hpp"
+#include "modeling/command_json.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
 namespace {
 
 constexpr const char* kStage = "geometry";
-
-std::string result_json(const GeometryCommandResult& result) {
-  nlohmann::json scans = nlohmann::json::array();
-  for (const GeometryCommandScan& s : result.scans) {
-    scans.push_back({{"id", s.id},
-                     {"valid_points", s.valid_points},
-                     {"normals", s.normals},
-                     {"mixed_pixels", s.mixed_pixels},
-                     {"edge_pixels", s.edge_pixels}});
-  }
-  return nlohmann::json{{"scans", scans}, {"seconds", result.seconds}}.dump();
-}
 
 }  // namespace
 

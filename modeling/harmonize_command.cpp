@@ -4,10 +4,10 @@
 #include <cassert>
 #include <chrono>
 #include <map>
-#include <nlohmann/json.hpp>
 
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
+#include "modeling/command_json.hpp"
 #include "modeling/loaded_scans.hpp"
 
 namespace scanbench::modeling {
@@ -74,17 +74,6 @@ HarmonizeCommandResult harmonize_outcome(
   return out;
 }
 
-std::string harmonize_settings_json(const HarmonizeCommandSettings& settings) {
-  return nlohmann::json{{"model", registration::color_model_name(settings.solve.model)},
-                        {"loss_scale", settings.solve.loss_scale},
-                        {"stride", settings.pairs.stride},
-                        {"max_distance_m", settings.pairs.max_distance_m},
-                        {"max_normal_angle_deg", settings.pairs.max_normal_angle_deg},
-                        {"max_local_step", settings.pairs.max_local_step},
-                        {"max_pairs_per_overlap", settings.pairs.max_pairs_per_overlap}}
-      .dump();
-}
-
 }  // namespace
 
 HarmonizeCommandResult harmonize_project(store::Project& project,
@@ -110,40 +99,12 @@ HarmonizeCommandResult harmonize_project(store::Project& project,
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.throw_if_cancelled(kStage);
 
-  store::Project::Edit edit =
-      project.begin_command(kStage, harmonize_settings_json(settings), revision);
+  store::Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
   out.command_id = edit.command_id();
   for (const HarmonizeCommandScan& scan : out.scans)
     project.put_scan_color_correction(edit, scan.id, scan.correction);
-  edit.commit(harmonize_result_json(out));
+  edit.commit(result_json(out));
   return out;
-}
-
-std::string harmonize_result_json(const HarmonizeCommandResult& out) {
-  nlohmann::json scans = nlohmann::json::array();
-  for (const HarmonizeCommandScan& s : out.scans) {
-    nlohmann::json matrix = nlohmann::json::array();
-    for (int r = 0; r < 3; ++r)
-      matrix.push_back(
-          {s.correction.matrix(r, 0), s.correction.matrix(r, 1), s.correction.matrix(r, 2)});
-    scans.push_back(
-        {{"id", s.id},
-         {"name", s.name},
-         {"reference", s.reference ? nlohmann::json(*s.reference) : nlohmann::json()},
-         {"pairs", s.pairs},
-         {"delta_e_before", s.delta_e_before},
-         {"delta_e_after", s.delta_e_after},
-         {"matrix", matrix},
-         {"offset", {s.correction.offset.x(), s.correction.offset.y(), s.correction.offset.z()}}});
-  }
-  return nlohmann::json{{"scans", scans},
-                        {"pairs", out.pairs},
-                        {"delta_e_before", out.delta_e_before},
-                        {"delta_e_after", out.delta_e_after},
-                        {"iterations", out.iterations},
-                        {"converged", out.converged},
-                        {"seconds", out.seconds}}
-      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace scanbench::modeling

@@ -63,10 +63,4 @@ HarmonizeCommandResult harmonize_project(store::Project& project,
                                          const HarmonizeCommandSettings& settings,
                                          core::Progress& progress);
 
-// The harmonisation's result as the JSON object the journal keeps and
-// `scanbench harmonize --json` prints: {"scans":[{"id","name","reference",
-// "pairs","delta_e_before","delta_e_after","matrix","offset"}],"pairs",
-// "delta_e_before","delta_e_after","iterations","converged","seconds"}.
-std::string harmonize_result_json(const HarmonizeCommandResult& result);
-
 }  // namespace scanbench::modeling

@@ -7,22 +7,20 @@
 #include "core/errors.hpp"
 #include "core/memory.hpp"
 #include "core/timing.hpp"
-#include "modeling/settings_json.hpp"
+#include "modeling/command_json.hpp"
 
 namespace scanbench::modeling {
 namespace {
 
 constexpr const char* kStage = "import";
 
+// The settings and the files they read.
 std::string settings_json(std::span<const std::filesystem::path> files,
                           const ImportSettings& settings) {
-  nlohmann::json names = nlohmann::json::array();
-  for (const std::filesystem::path& file : files) names.push_back(file.string());
-  const nlohmann::json document = {
-      {"files", names},
-      {"readers", nlohmann::json::parse(settings_to_json(settings.readers))},
-      {"allow_duplicates", settings.allow_duplicates}};
-  return document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  nlohmann::json document = nlohmann::json::parse(settings_to_json(settings));
+  document["files"] = nlohmann::json::array();
+  for (const std::filesystem::path& file : files) document["files"].push_back(file.string());
+  return dump(document);
 }
 
 // A scan that is already in the project, or earlier in this import.
@@ -211,7 +209,7 @@ ImportResult store_checked_scans(store::Project& project, const CheckedImport& c
   for (const store::StoredScanSummary& stored : project.scans()) {
     project.remove_layer(finish, stored.id, store::layer::kKeep);
   }
-  finish.commit(nlohmann::json{{"scans", result.scan_ids}}.dump());
+  finish.commit(result_json(result));
   return result;
 }
 

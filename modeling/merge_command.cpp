@@ -1,9 +1,7 @@
 #include "modeling/merge_command.hpp"
 
-#include <nlohmann/json.hpp>
-
+#include "modeling/command_json.hpp"
 #include "modeling/loaded_scans.hpp"
-#include "modeling/settings_json.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
@@ -35,24 +33,8 @@ MergeCommandResult merge_project(store::Project& project,
   out.command_id = edit.command_id();
   for (std::size_t k = 0; k < loaded.ids.size(); ++k)
     project.put_layer(edit, loaded.ids[k], masks[k]);
-  edit.commit(merge_result_json(out));
+  edit.commit(result_json(out));
   return out;
-}
-
-std::string merge_result_json(const MergeCommandResult& out) {
-  std::size_t kept = 0;
-  nlohmann::json scans = nlohmann::json::array();
-  for (const MergeCommandScan& s : out.scans) {
-    kept += s.counts.kept;
-    scans.push_back({{"id", s.id},
-                     {"name", s.name},
-                     {"in_model", s.counts.in_model},
-                     {"kept", s.counts.kept},
-                     {"redundant", s.counts.redundant}});
-  }
-  return nlohmann::json{
-      {"scans", scans}, {"points", out.points}, {"kept", kept}, {"seconds", out.seconds}}
-      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace scanbench::modeling

@@ -36,9 +36,4 @@ MergeCommandResult merge_project(store::Project& project,
                                  const registration::MergeSettings& settings,
                                  core::Progress& progress);
 
-// The merge's result as the JSON object the journal keeps and `scanbench
-// merge --json` prints: {"scans":[{"id","name","in_model","kept","redundant"}],
-// "points","kept","seconds"}.
-std::string merge_result_json(const MergeCommandResult& result);
-
 }  // namespace scanbench::modeling

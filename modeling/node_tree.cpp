@@ -14,10 +14,6 @@ namespace scanbench::modeling {
   throw core::InputError("", position, problem);
 }
 
-std::string dump(const nlohmann::json& json) {
-  return json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 Tree load_tree(const store::Project& project) {
   return project.object_tree();
 }

@@ -14,6 +14,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "modeling/command_json.hpp"
 #include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
@@ -38,9 +39,6 @@ struct Figures {
 // Throws core::InputError naming `where` ("node 4", "name") and no file:
 // the CLI and the scripts add theirs.
 [[noreturn]] void refuse(const std::string& where, const std::string& problem);
-
-// A command's settings or result as stored in the journal.
-std::string dump(const nlohmann::json& json);
 
 // The live nodes by id (Project::object_tree).
 Tree load_tree(const store::Project& project);

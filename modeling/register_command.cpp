@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <map>
-#include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "modeling/command_json.hpp"
 #include "modeling/loaded_scans.hpp"
 #include "modeling/node_tree.hpp"
-#include "modeling/settings_json.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
@@ -49,72 +48,6 @@ std::vector<registration::PickedPairs> picks_by_index(const RegisterCommandSetti
   return picks;
 }
 
-nlohmann::json pose_json(const Eigen::Isometry3d& T) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) {
-    rows.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
-  }
-  return rows;
-}
-
-nlohmann::json pair_json(const registration::PairReport& p, const std::vector<std::int64_t>& ids) {
-  const auto id = [&ids](int k) { return ids[static_cast<std::size_t>(k)]; };
-  return {{"source", id(p.source)},
-          {"target", id(p.target)},
-          {"registered", p.registered},
-          {"failure", p.failure},
-          {"start", registration::icp_start_name(p.start)},
-          {"coarse",
-           {{"method", registration::coarse_method_name(p.coarse.method)},
-            {"success", p.coarse.success},
-            {"inlier_ratio", p.coarse.inlier_ratio},
-            {"overlap", p.coarse.overlap},
-            {"free_space_violation", p.coarse.free_space_violation},
-            {"count", p.coarse.count},
-            {"rms_m", p.coarse.rms_m},
-            {"seconds", p.coarse.seconds},
-            {"failure", p.coarse.failure}}},
-          {"rms_m", p.icp.rms_m},
-          {"overlap", p.icp.overlap},
-          {"free_space_violation", p.icp.free_space_violation},
-          {"inliers", p.icp.correspondences},
-          {"iterations", p.icp.iterations},
-          {"converged", p.icp.converged},
-          {"seconds", p.seconds}};
-}
-
-std::string report_json(const registration::RegistrationResult& r,
-                        const std::vector<std::int64_t>& ids,
-                        const std::vector<acquisition::Scan>& scans) {
-  nlohmann::json report;
-  report["pairs"] = nlohmann::json::array();
-  for (const auto& pair : r.pairs) report["pairs"].push_back(pair_json(pair, ids));
-  report["global"] = {{"rounds", r.global.rounds},
-                      {"converged", r.global.converged},
-                      {"inliers", r.global.correspondences},
-                      {"seconds", r.global.seconds}};
-  report["edges"] = nlohmann::json::array();
-  for (const auto& e : r.edges) {
-    report["edges"].push_back({{"source", ids[static_cast<std::size_t>(e.source)]},
-                               {"target", ids[static_cast<std::size_t>(e.target)]},
-                               {"rms_m", e.quality.rms_m},
-                               {"overlap", e.quality.overlap},
-                               {"free_space_violation", e.quality.free_space_violation},
-                               {"inliers", e.quality.correspondences}});
-  }
-  report["overall"] = {
-      {"rms_m", r.rms_m},           {"overlap", r.overlap},     {"inliers", r.correspondences},
-      {"iterations", r.iterations}, {"converged", r.converged}, {"seconds", r.seconds}};
-  report["poses"] = nlohmann::json::array();
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    report["poses"].push_back({{"scan", ids[k]},
-                               {"name", scans[k].name},
-                               {"initial_T_world_scan", pose_json(scans[k].T_world_scan)},
-                               {"T_world_scan", pose_json(r.T_world_scan[k])}});
-  }
-  return report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 }  // namespace
 
 RegisterCommandResult register_project(store::Project& project,
@@ -127,12 +60,14 @@ RegisterCommandResult register_project(store::Project& project,
   if (run.coarse == registration::CoarseMethod::kPointPairs) {
     run.picks = picks_by_index(settings, loaded.ids, project.path().string());
   }
-  std::vector<Eigen::Isometry3d> initial;
-  for (const acquisition::Scan& scan : loaded.scans) initial.push_back(scan.T_world_scan);
   RegisterCommandResult out;
   out.ids = loaded.ids;
-  out.result = registration::register_scans(loaded.prepared, initial, run, &progress);
-  out.report_json = report_json(out.result, loaded.ids, loaded.scans);
+  for (const acquisition::Scan& scan : loaded.scans) {
+    out.names.push_back(scan.name);
+    out.initial_T_world_scan.push_back(scan.T_world_scan);
+  }
+  out.result =
+      registration::register_scans(loaded.prepared, out.initial_T_world_scan, run, &progress);
   progress.throw_if_cancelled(kStage);
   std::map<std::int64_t, Eigen::Isometry3d> moved;
   for (std::size_t k = 0; k < loaded.ids.size(); ++k)
@@ -143,12 +78,11 @@ RegisterCommandResult register_project(store::Project& project,
   out.command_id = edit.command_id();
   for (const store::ObjectNode& node : refigured) project.put_node(edit, node);
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
-    out.names.push_back(loaded.scans[k].name);
     loaded.scans[k].T_world_scan = out.result.T_world_scan[k];
     project.set_pose(edit, loaded.ids[k], loaded.scans[k]);
     project.remove_layer(edit, loaded.ids[k], store::layer::kKeep);
   }
-  edit.commit(out.report_json);
+  edit.commit(result_json(out));
   return out;
 }
 

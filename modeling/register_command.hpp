@@ -34,8 +34,8 @@ struct RegisterCommandResult {
   std::int64_t command_id = 0;    // the journal entry
   std::vector<std::int64_t> ids;  // scan ids, in the order of the result's scans
   std::vector<std::string> names;
+  std::vector<Eigen::Isometry3d> initial_T_world_scan;  // the poses it started from
   registration::RegistrationResult result;
-  std::string report_json;  // as stored in the journal (the command's result)
 };
 
 // Registers every scan of the project (the first scan by id is the

@@ -6,6 +6,7 @@
 #include <unordered_set>
 
 #include "core/errors.hpp"
+#include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/store/typed_layers.hpp"
 #include "segmentation/pixel_set.hpp"
@@ -44,32 +45,6 @@ void put_selection(store::Project& project, store::Project::Edit& edit, std::int
   project.put_layer(
       edit, scan_id,
       store::encode_layer<std::uint8_t>(store::layer::kSelection, store::ElementType::kU8, mask));
-}
-
-nlohmann::json polyline_json(const segmentation::Polyline& line) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const Eigen::Vector2d& v : line) out.push_back({v.x(), v.y()});
-  return out;
-}
-
-nlohmann::json select_json(const SelectSettings& s) {
-  nlohmann::json barriers = nlohmann::json::array();
-  for (const segmentation::Polyline& line : s.constraints.barriers)
-    barriers.push_back(polyline_json(line));
-  constexpr const char* kModes[] = {"replace", "add", "subtract"};
-  return {{"scan", s.scan_id},
-          {"seed", {s.seed_row, s.seed_col}},
-          {"mode", kModes[static_cast<int>(s.mode)]},
-          {"channel", segmentation::channel_name(s.grow.channel)},
-          {"tolerance", s.grow.tolerance},
-          {"mean_factor", s.grow.mean_factor},
-          {"plane_footprints", s.grow.plane_footprints},
-          {"continuity_footprints", s.grow.continuity_footprints},
-          {"max_pixels", s.grow.max_pixels},
-          {"lasso", polyline_json(s.constraints.lasso)},
-          {"barriers", barriers},
-          {"range_noise",
-           {{"noise_m", s.range_noise.noise_m}, {"noise_per_m", s.range_noise.noise_per_m}}}};
 }
 
 store::StoredScanSummary require_scan(const store::Project& project, std::int64_t scan_id) {
@@ -234,13 +209,10 @@ SelectResult select_region(store::Project& project, const SelectSettings& settin
       selection = segmentation::subtract(before, grown.pixels);
       break;
   }
-  store::Project::Edit edit =
-      project.begin_command("select", dump(select_json(settings)), revision);
+  store::Project::Edit edit = project.begin_command("select", settings_to_json(settings), revision);
   put_selection(project, edit, settings.scan_id, grid.shape, selection);
   SelectResult result{edit.command_id(), grown.pixels.size(), selection.size(), grown.seed_open};
-  edit.commit(dump({{"region_pixels", result.region_pixels},
-                    {"selected_pixels", result.selected_pixels},
-                    {"seed_open", result.seed_open}}));
+  edit.commit(result_json(result));
   return result;
 }
 
