@@ -9,6 +9,8 @@
 #include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/store/typed_layers.hpp"
+#include "registration/label_transfer.hpp"
+#include "registration/prepared_scan.hpp"
 #include "segmentation/pixel_set.hpp"
 
 namespace scanbench::modeling {
@@ -216,6 +218,46 @@ SelectResult select_region(store::Project& project, const SelectSettings& settin
   return result;
 }
 
+// The memberships of the other scans with geometry, each with its points
+// that sample the surface of object `node` (its pixels in `membership` of
+// scan `drawn`) added where they were still to be segmented; scans gaining
+// none are left out. `carried` counts the points added. One other scan is
+// decoded at a time.
+std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
+    const store::Project& project, std::int64_t drawn, const std::vector<std::uint32_t>& membership,
+    std::uint32_t node, std::size_t& carried) {
+  std::map<std::int64_t, std::vector<std::uint32_t>> out;
+  const std::optional<acquisition::ScanGeometry> drawn_geometry =
+      store::load_geometry(project, drawn);
+  if (!drawn_geometry) return out;
+  const acquisition::Scan drawn_scan = project.load_scan(drawn);
+  const registration::PreparedScan source =
+      registration::prepare_scan(drawn_scan, *drawn_geometry, 0);
+  std::vector<std::uint32_t> labels(membership.size(), 0);
+  for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = membership[i] == node ? 1 : 0;
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    if (stored.id == drawn) continue;
+    const std::optional<acquisition::ScanGeometry> geometry =
+        store::load_geometry(project, stored.id);
+    if (!geometry) continue;
+    const acquisition::Scan scan = project.load_scan(stored.id);
+    const registration::PreparedScan target = registration::prepare_scan(scan, *geometry, 0);
+    const std::vector<std::uint32_t> joins = registration::transfer_labels(
+        source, labels, target, drawn_scan.T_world_scan.inverse() * scan.T_world_scan, {});
+    std::vector<std::uint32_t> other = load_membership(project, stored.id, scan.pixel_count());
+    std::size_t added = 0;
+    for (std::size_t q = 0; q < other.size(); ++q) {
+      if (joins[q] == 0 || other[q] != 0) continue;
+      other[q] = node;
+      ++added;
+    }
+    if (added == 0) continue;
+    carried += added;
+    out.emplace(stored.id, std::move(other));
+  }
+  return out;
+}
+
 NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings) {
   const std::int64_t revision = project.revision();
   const std::string where = "scan " + std::to_string(settings.scan_id);
@@ -240,19 +282,26 @@ NodeCommandResult commit_selection(store::Project& project, const CommitSettings
   }
   if (taken == 0) refuse(where, "the selection is empty: grow a region first");
   tree.emplace(node.id, node);
-  const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
-  store::Project::Edit edit =
-      project.begin_command("commit",
-                            dump({{"scan", settings.scan_id},
-                                  {"name", settings.name},
-                                  {"parent", parent_json(settings.parent)}}),
-                            revision);
+  std::size_t carried = 0;
+  std::map<std::int64_t, std::vector<std::uint32_t>> changed =
+      settings.other_scans ? carried_into_other_scans(project, settings.scan_id, membership,
+                                                      static_cast<std::uint32_t>(node.id), carried)
+                           : std::map<std::int64_t, std::vector<std::uint32_t>>{};
+  changed[settings.scan_id] = std::move(membership);
+  const auto figures = compute_figures(project, tree, changed);
+  store::Project::Edit edit = project.begin_command("commit",
+                                                    dump({{"scan", settings.scan_id},
+                                                          {"name", settings.name},
+                                                          {"parent", parent_json(settings.parent)},
+                                                          {"other_scans", settings.other_scans}}),
+                                                    revision);
   project.put_node(edit, node);
-  put_membership(project, edit, settings.scan_id, membership);
+  for (const auto& [scan_id, scan_membership] : changed)
+    put_membership(project, edit, scan_id, scan_membership);
   project.remove_layer(edit, settings.scan_id, store::layer::kSelection);
   refresh_figures(project, edit, tree, figures);
   const std::int64_t command_id = edit.command_id();
-  edit.commit(dump({{"node", node.id}, {"points", taken}}));
+  edit.commit(dump({{"node", node.id}, {"points", taken}, {"other_scans_points", carried}}));
   return {command_id, node.id};
 }
 

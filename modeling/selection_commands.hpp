@@ -55,11 +55,18 @@ struct CommitSettings {
   std::int64_t scan_id = 0;
   std::string name;                    // the new object's
   std::optional<std::int64_t> parent;  // a group; none: a root
+  // The points of the other scans that sample the object's surface join it
+  // too, where they are still to be segmented: an object covers the model,
+  // not only the scan it was drawn in.
+  bool other_scans = true;
 };
 
 // Makes the scan's selection a new object: its pixels leave the pool still
 // to be segmented, the selection is emptied, and the object and its
 // ancestors get their point count, mean footprint and world bounding box.
+// With other_scans, every other scan with geometry, at its stored pose,
+// gives the object its points on the same surface as the selection's
+// (registration/label_transfer.hpp), in the same command.
 NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings);
 
 struct SeparateSettings {

@@ -84,14 +84,11 @@ bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Ei
   const std::int64_t pixel = o.scan->grid ? o.scan->grid->pixel_of(p) : associate(*o.scan, p);
   if (pixel < 0) return false;
   const auto k = static_cast<std::size_t>(pixel);
-  if (!o.scan->in_model[k]) return false;
-  const float range_o = o.scan->scan->range_m[k];
   const float sigma = std::sqrt(sigma_p * sigma_p + sigma_s * sigma_s);
-  const float tolerance = t.range_sigmas * sigma + o.scan->geometry->footprint_m[k];
-  if (std::abs(range_o - range_p) > tolerance) return false;
-  if (s.usable[i] && o.scan->usable[k]) {
-    const Eigen::Vector3f n = o.R_o_s * s.geometry->normal[i];
-    if (n.dot(o.scan->geometry->normal[k]) < t.min_normal_cos) return false;
+  const Eigen::Vector3f* normal = s.usable[i] ? &s.geometry->normal[i] : nullptr;
+  if (!same_surface(*o.scan, k, range_p, sigma, normal, o.R_o_s, t.range_sigmas,
+                    t.min_normal_cos)) {
+    return false;
   }
   const float area_s = s.sample_area_m2[i];
   const float area_o = o.scan->sample_area_m2[k];

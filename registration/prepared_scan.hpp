@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -48,5 +49,23 @@ PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::Scan
 // (projective association, O(1)), otherwise the nearest usable point. -1 when
 // there is none. The pixel may be unusable; callers check.
 std::int64_t associate(const PreparedScan& target, const Eigen::Vector3f& p_target);
+
+// The same-surface test of seed 004 §4.3, shared by the merge and the
+// transfer of labels: pixel k of scan o sampled the surface of a point p of
+// another scan when o's range there agrees with p's range from o, range_p,
+// within range_sigmas · sigma (the two measurements' combined noise) plus
+// o's footprint at k (the beam centre and p may be a pixel apart on a
+// slanted surface), and, where both have a normal, the normals agree
+// within acos(min_normal_cos). normal_p is p's normal in its own scan's
+// frame (nullptr: none), R_o_p the rotation from that frame into o's.
+inline bool same_surface(const PreparedScan& o, std::size_t k, float range_p, float sigma,
+                         const Eigen::Vector3f* normal_p, const Eigen::Matrix3f& R_o_p,
+                         float range_sigmas, float min_normal_cos) {
+  if (!o.in_model[k]) return false;
+  const float tolerance = range_sigmas * sigma + o.geometry->footprint_m[k];
+  if (std::abs(o.scan->range_m[k] - range_p) > tolerance) return false;
+  if (normal_p == nullptr || !o.usable[k]) return true;
+  return (R_o_p * *normal_p).dot(o.geometry->normal[k]) >= min_normal_cos;
+}
 
 }  // namespace scanbench::registration

@@ -84,6 +84,79 @@ TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
   EXPECT_FALSE(select_region(project, select_at(scan, -20, 0)).seed_open);
 }
 
+// An object drawn in one scan covers the surface in every scan that saw it:
+// a second setup at the same spot gives the wall its points, in the same
+// command; a setup 100 m away sees other surfaces and gives none; points an
+// object of the other scan owns stay its own.
+TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t first = store_room(project);
+  const std::int64_t second = store_room(project);
+  const std::int64_t far = store_room(project);
+  acquisition::Scan moved = test::shared_room().scan;
+  moved.T_world_scan.translation() = Eigen::Vector3d(100.0, 0.0, 0.0);
+  {
+    store::Project::Edit edit = project.begin_command("register", "{}");
+    project.set_pose(edit, far, moved);
+    edit.commit("{}");
+  }
+  // The poster, flush with the wall, is already an object of the second scan.
+  ASSERT_TRUE(select_region(project, select_at(second, 31, 0, SelectMode::kReplace,
+                                               segmentation::Channel::kColor))
+                  .seed_open);
+  CommitSettings poster{second, "poster", std::nullopt};
+  poster.other_scans = false;
+  const NodeCommandResult poster_node = commit_selection(project, poster);
+  const std::size_t poster_pixels =
+      count_owned(project, second, static_cast<std::uint32_t>(poster_node.node_id));
+  ASSERT_GT(poster_pixels, 100u);
+
+  const SelectResult selected = select_region(project, select_at(first, 20, 0));
+  const NodeCommandResult wall = commit_selection(project, {first, "wall +x", std::nullopt});
+  const auto id = static_cast<std::uint32_t>(wall.node_id);
+  const std::size_t in_first = count_owned(project, first, id);
+  EXPECT_EQ(in_first, selected.selected_pixels);
+  // The same pixels of the second scan join, but those the poster owns.
+  const auto layer = [&](std::int64_t scan) {
+    return *project.load_layer<std::uint32_t>(scan, store::layer::kMembership,
+                                              store::ElementType::kU32);
+  };
+  const std::vector<std::uint32_t> drawn = layer(first), other = layer(second);
+  std::size_t expected = 0, poster_kept = 0;
+  for (std::size_t i = 0; i < drawn.size(); ++i) {
+    if (drawn[i] != id) continue;
+    expected += other[i] == id;
+    poster_kept += other[i] == static_cast<std::uint32_t>(poster_node.node_id);
+  }
+  EXPECT_EQ(expected + poster_kept, in_first);
+  EXPECT_GT(poster_kept, 0u);  // the wall's region holds the poster, flush with it
+  EXPECT_EQ(count_owned(project, second, id), expected);
+  EXPECT_EQ(count_owned(project, far, id), 0u);
+  for (const store::ObjectNode& node : project.object_nodes()) {
+    if (node.id != wall.node_id) continue;
+    EXPECT_EQ(node.points, static_cast<std::int64_t>(in_first + expected));
+  }
+  const std::vector<store::CommandRecord> history = project.history();
+  EXPECT_THAT(history.back().result,
+              HasSubstr("\"other_scans_points\":" + std::to_string(expected)));
+  // One command: undo takes the wall out of both scans.
+  project.undo();
+  EXPECT_EQ(count_owned(project, first, id), 0u);
+  EXPECT_EQ(count_owned(project, second, id), 0u);
+  EXPECT_EQ(count_owned(project, second, static_cast<std::uint32_t>(poster_node.node_id)),
+            poster_pixels);
+  // Asked to stay in its scan, it does.
+  project.redo();
+  project.undo();
+  ASSERT_TRUE(select_region(project, select_at(first, 20, 0)).seed_open);
+  CommitSettings alone{first, "wall +x", std::nullopt};
+  alone.other_scans = false;
+  const auto only = static_cast<std::uint32_t>(commit_selection(project, alone).node_id);
+  EXPECT_EQ(count_owned(project, first, only), in_first);
+  EXPECT_EQ(count_owned(project, second, only), 0u);
+}
+
 TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
   const ScratchDir dir;
   std::int64_t scan = 0;

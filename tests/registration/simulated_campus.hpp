@@ -27,6 +27,7 @@ struct SimulatedCampus {
   std::vector<Eigen::Isometry3d> true_poses = site.scan_poses;  // T_world_scan
   // The first scans of the campaign, as many as were asked for so far.
   std::vector<acquisition::Scan> scans;
+  std::vector<acquisition::sim::ScanTruth> truth;
   std::vector<acquisition::ScanGeometry> geometry;
   std::vector<PreparedScan> prepared;
 
@@ -68,6 +69,7 @@ inline const SimulatedCampus& campus(int count = SimulatedCampus::kScans) {
                            sim::random_lighting(seed), seed);
     built.geometry.push_back(acquisition::compute_geometry(simulated.scan).geometry);
     built.scans.push_back(std::move(simulated.scan));
+    built.truth.push_back(std::move(simulated.truth));
     built.prepared.push_back(prepare_scan(built.scans.back(), built.geometry.back(), 0));
   }
   return built;
