@@ -11,6 +11,7 @@
 #include "modeling/harmonize_command.hpp"
 #include "modeling/import_command.hpp"
 #include "modeling/merge_command.hpp"
+#include "modeling/node_tree.hpp"
 #include "modeling/register_command.hpp"
 #include "modeling/selection_commands.hpp"
 #include "registration/merge.hpp"
@@ -143,6 +144,33 @@ segmentation::Polyline polyline_from(const nlohmann::json& j) {
   return line;
 }
 
+// A region's grow settings, flat: the keys of select and commit.
+nlohmann::json grow_json(const segmentation::GrowSettings& g) {
+  return {{"channel", segmentation::channel_name(g.channel)},
+          {"tolerance", g.tolerance},
+          {"mean_factor", g.mean_factor},
+          {"plane_footprints", g.plane_footprints},
+          {"continuity_footprints", g.continuity_footprints},
+          {"max_pixels", g.max_pixels}};
+}
+
+segmentation::GrowSettings grow_from(const nlohmann::json& j,
+                                     const segmentation::GrowSettings& defaults) {
+  segmentation::GrowSettings g;
+  const std::string channel =
+      j.value("channel", std::string(segmentation::channel_name(defaults.channel)));
+  const std::optional<segmentation::Channel> named = segmentation::channel_from_name(channel);
+  if (!named)
+    throw core::InputError("", {{}, {}, "key \"channel\""}, "unknown channel '" + channel + "'");
+  g.channel = *named;
+  g.tolerance = j.value("tolerance", defaults.tolerance);
+  g.mean_factor = j.value("mean_factor", defaults.mean_factor);
+  g.plane_footprints = j.value("plane_footprints", defaults.plane_footprints);
+  g.continuity_footprints = j.value("continuity_footprints", defaults.continuity_footprints);
+  g.max_pixels = j.value("max_pixels", defaults.max_pixels);
+  return g;
+}
+
 }  // namespace
 
 static void to_json(nlohmann::json& j, const SelectSettings& s) {
@@ -152,15 +180,10 @@ static void to_json(nlohmann::json& j, const SelectSettings& s) {
   j = {{"scan", s.scan_id},
        {"seed", {s.seed_row, s.seed_col}},
        {"mode", kModes[static_cast<int>(s.mode)]},
-       {"channel", segmentation::channel_name(s.grow.channel)},
-       {"tolerance", s.grow.tolerance},
-       {"mean_factor", s.grow.mean_factor},
-       {"plane_footprints", s.grow.plane_footprints},
-       {"continuity_footprints", s.grow.continuity_footprints},
-       {"max_pixels", s.grow.max_pixels},
        {"lasso", polyline_json(s.constraints.lasso)},
        {"barriers", barriers},
        {"range_noise", s.range_noise}};
+  j.update(grow_json(s.grow));
 }
 static void from_json(const nlohmann::json& j, SelectSettings& s) {
   const SelectSettings defaults;
@@ -176,21 +199,34 @@ static void from_json(const nlohmann::json& j, SelectSettings& s) {
     known = true;
   }
   if (!known) throw core::InputError("", {{}, {}, "key \"mode\""}, "unknown mode '" + mode + "'");
-  const std::string channel =
-      j.value("channel", std::string(segmentation::channel_name(defaults.grow.channel)));
-  const std::optional<segmentation::Channel> named = segmentation::channel_from_name(channel);
-  if (!named)
-    throw core::InputError("", {{}, {}, "key \"channel\""}, "unknown channel '" + channel + "'");
-  s.grow.channel = *named;
-  s.grow.tolerance = j.value("tolerance", defaults.grow.tolerance);
-  s.grow.mean_factor = j.value("mean_factor", defaults.grow.mean_factor);
-  s.grow.plane_footprints = j.value("plane_footprints", defaults.grow.plane_footprints);
-  s.grow.continuity_footprints =
-      j.value("continuity_footprints", defaults.grow.continuity_footprints);
-  s.grow.max_pixels = j.value("max_pixels", defaults.grow.max_pixels);
+  s.grow = grow_from(j, defaults.grow);
   s.constraints.lasso = polyline_from(j.value("lasso", nlohmann::json::array()));
   for (const nlohmann::json& line : j.value("barriers", nlohmann::json::array()))
     s.constraints.barriers.push_back(polyline_from(line));
+  s.range_noise = j.value("range_noise", defaults.range_noise);
+}
+
+// Commit: the grow settings (null: none) nested, since they are optional.
+static void to_json(nlohmann::json& j, const CommitSettings& s) {
+  j = {{"scan", s.scan_id},
+       {"name", s.name},
+       {"parent", parent_json(s.parent)},
+       {"other_scans", s.other_scans},
+       {"grow", s.grow ? grow_json(*s.grow) : nlohmann::json(nullptr)},
+       {"range_noise", s.range_noise}};
+}
+static void from_json(const nlohmann::json& j, CommitSettings& s) {
+  const CommitSettings defaults;
+  s.scan_id = j.value("scan", defaults.scan_id);
+  s.name = j.value("name", defaults.name);
+  const nlohmann::json parent = j.value("parent", nlohmann::json(nullptr));
+  s.parent = parent.is_null() ? std::nullopt : std::optional<std::int64_t>(parent.get<std::int64_t>());
+  s.other_scans = j.value("other_scans", defaults.other_scans);
+  const nlohmann::json grow = j.value("grow", nlohmann::json(nullptr));
+  s.grow = grow.is_null() ? std::nullopt
+                          : std::optional<segmentation::GrowSettings>(grow_from(
+                                grow, segmentation::default_grow_settings(
+                                          segmentation::Channel::kNormal)));
   s.range_noise = j.value("range_noise", defaults.range_noise);
 }
 
@@ -333,11 +369,20 @@ void check(const HarmonizeCommandSettings& s, const Bounds& b) {
   b.in(s.solve.max_iterations, 1, kMaxIterations, "max_iterations");
 }
 
+void check(const segmentation::GrowSettings& g, const Bounds& b, const std::string& prefix) {
+  b.in(g.tolerance, 0, 1e6, prefix + "tolerance");
+  b.in(g.mean_factor, 0, kMaxRatio, prefix + "mean_factor");
+  b.in(g.plane_footprints, 0, kMaxRatio, prefix + "plane_footprints");
+  b.in(g.continuity_footprints, 0, kMaxRatio, prefix + "continuity_footprints");
+}
+
 void check(const SelectSettings& s, const Bounds& b) {
-  b.in(s.grow.tolerance, 0, 1e6, "tolerance");
-  b.in(s.grow.mean_factor, 0, kMaxRatio, "mean_factor");
-  b.in(s.grow.plane_footprints, 0, kMaxRatio, "plane_footprints");
-  b.in(s.grow.continuity_footprints, 0, kMaxRatio, "continuity_footprints");
+  check(s.grow, b, "");
+  check(s.range_noise, b, "range_noise.");
+}
+
+void check(const CommitSettings& s, const Bounds& b) {
+  if (s.grow) check(*s.grow, b, "grow.");
   check(s.range_noise, b, "range_noise.");
 }
 
@@ -435,6 +480,7 @@ SCANBENCH_SETTINGS_JSON(registration::MergeSettings)
 SCANBENCH_SETTINGS_JSON(RegisterCommandSettings)
 SCANBENCH_SETTINGS_JSON(HarmonizeCommandSettings)
 SCANBENCH_SETTINGS_JSON(SelectSettings)
+SCANBENCH_SETTINGS_JSON(CommitSettings)
 #undef SCANBENCH_SETTINGS_JSON
 
 template std::string settings_to_json<acquisition::ScanFileSettings>(

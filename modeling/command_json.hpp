@@ -23,7 +23,8 @@ std::string dump(const nlohmann::json& json);
 // Instantiated for the settings of import (ImportSettings; the command adds
 // its files), geometry (acquisition::GeometrySettings), register
 // (RegisterCommandSettings), merge (registration::MergeSettings), harmonize
-// (HarmonizeCommandSettings) and select (SelectSettings), and for their
+// (HarmonizeCommandSettings), select (SelectSettings) and commit
+// (CommitSettings), and for their
 // parts acquisition::ScanFileSettings and registration::RegistrationSettings.
 template <typename Settings>
 std::string settings_to_json(const Settings& settings);
@@ -43,7 +44,8 @@ enum class SettingsSource {
 // Reads the settings in `json`. Throws core::InputError naming `origin`
 // (a file, or "command 7") and the key at fault when `json` is not an
 // object, a value has the wrong type, or (kUser) the rules above refuse it.
-// Instantiated for import, geometry, register, merge, harmonize and select.
+// Instantiated for import, geometry, register, merge, harmonize, select and
+// commit.
 template <typename Settings>
 Settings settings_from_json(const nlohmann::json& json, const std::string& origin,
                             SettingsSource source);
@@ -65,7 +67,8 @@ Settings settings_from_json(const std::string& json, const std::string& origin,
 // - HarmonizeCommandResult: {"scans": [{"id", "name", "reference", "pairs",
 //   "delta_e_before", "delta_e_after", "matrix", "offset"}], "pairs",
 //   "delta_e_before", "delta_e_after", "iterations", "converged", "seconds"};
-// - SelectResult: {"region_pixels", "selected_pixels", "seed_open"}.
+// - SelectResult: {"region_pixels", "selected_pixels", "seed_open",
+//   "refused"} (refused: null, or why the seed could not grow).
 // The tree and colour commands store small results ({"node": id}) made
 // where they are computed.
 template <typename Result>

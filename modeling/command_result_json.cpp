@@ -136,7 +136,8 @@ nlohmann::json to_report(const HarmonizeCommandResult& out) {
 nlohmann::json to_report(const SelectResult& r) {
   return {{"region_pixels", r.region_pixels},
           {"selected_pixels", r.selected_pixels},
-          {"seed_open", r.seed_open}};
+          {"seed_open", r.seed_open},
+          {"refused", r.refused.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.refused)}};
 }
 
 }  // namespace

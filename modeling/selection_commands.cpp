@@ -8,8 +8,8 @@
 #include "core/errors.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
+#include "modeling/object_carry.hpp"
 #include "modeling/store/typed_layers.hpp"
-#include "registration/label_transfer.hpp"
 #include "registration/prepared_scan.hpp"
 #include "segmentation/pixel_set.hpp"
 
@@ -178,6 +178,29 @@ SeparateResult propose_objects(store::Project& project, const ProposeSettings& s
   return result;
 }
 
+// Why the seed of `settings` cannot grow a region: the first condition that
+// closes it, in the words of the tools.
+std::string seed_refusal(const segmentation::SegmentationGrid& grid, const SelectSettings& settings,
+                         const std::vector<std::uint32_t>& membership, std::size_t seed,
+                         const segmentation::GrowResult& grown) {
+  if (!grid.usable[seed]) return "the scan has no usable point there (no return, or a mixed pixel)";
+  if (membership[seed] != 0) return "object " + std::to_string(membership[seed]) + " owns it";
+  if (segmentation::open_pixels(grid, {settings.constraints.lasso, {}}, {})[seed] == 0)
+    return "it lies outside the lasso";
+  if (!grown.seed_open) return "it lies on a barrier";
+  switch (settings.grow.channel) {
+    case segmentation::Channel::kNormal:
+      return "it has no normal (an edge or a crease): click beside it, or grow on range";
+    case segmentation::Channel::kColor:
+      return "the scan has no colour";
+    case segmentation::Channel::kIntensity:
+      return "it has no intensity";
+    case segmentation::Channel::kRange:
+      break;
+  }
+  return "it cannot grow on " + std::string(segmentation::channel_name(settings.grow.channel));
+}
+
 SelectResult select_region(store::Project& project, const SelectSettings& settings) {
   const std::int64_t revision = project.revision();
   const std::string where = "scan " + std::to_string(settings.scan_id);
@@ -192,12 +215,20 @@ SelectResult select_region(store::Project& project, const SelectSettings& settin
   const Prepared prepared = prepare(project, settings.scan_id, settings.range_noise);
   const acquisition::Scan& scan = prepared.scan;
   const segmentation::SegmentationGrid& grid = prepared.grid;
-  const std::vector<std::uint8_t> open = segmentation::open_pixels(
-      grid, settings.constraints,
-      taken_mask(load_membership(project, settings.scan_id, scan.pixel_count())));
+  const std::vector<std::uint32_t> membership =
+      load_membership(project, settings.scan_id, scan.pixel_count());
+  const std::vector<std::uint8_t> open =
+      segmentation::open_pixels(grid, settings.constraints, taken_mask(membership));
   segmentation::RegionGrower grower(grid);
-  const segmentation::GrowResult grown =
-      grower.grow(scan.index(settings.seed_row, settings.seed_col), settings.grow, open);
+  const std::size_t seed = scan.index(settings.seed_row, settings.seed_col);
+  const segmentation::GrowResult grown = grower.grow(seed, settings.grow, open);
+  SelectResult result{0, grown.pixels.size(), 0, grown.seed_open && !grown.seed_lacks_channel, {}};
+  if (!result.seed_open) {
+    // Nothing is written: the selection and the redo chain stay as they were.
+    result.refused = seed_refusal(grid, settings, membership, seed, grown);
+    result.selected_pixels = load_selection(project, settings.scan_id).size();
+    return result;
+  }
   const segmentation::PixelSet before = load_selection(project, settings.scan_id);
   segmentation::PixelSet selection;
   switch (settings.mode) {
@@ -213,19 +244,22 @@ SelectResult select_region(store::Project& project, const SelectSettings& settin
   }
   store::Project::Edit edit = project.begin_command("select", settings_to_json(settings), revision);
   put_selection(project, edit, settings.scan_id, grid.shape, selection);
-  SelectResult result{edit.command_id(), grown.pixels.size(), selection.size(), grown.seed_open};
+  result.command_id = edit.command_id();
+  result.selected_pixels = selection.size();
   edit.commit(result_json(result));
   return result;
 }
 
 // The memberships of the other scans with geometry, each with its points
 // that sample the surface of object `node` (its pixels in `membership` of
-// scan `drawn`) added where they were still to be segmented; scans gaining
-// none are left out. `carried` counts the points added. One other scan is
-// decoded at a time.
+// scan `drawn`), and with `grow` those it grows to there, added where they
+// were still to be segmented (object_carry.hpp); scans gaining none are
+// left out. `carried` counts the points added. One other scan is decoded at
+// a time.
 std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
     const store::Project& project, std::int64_t drawn, const std::vector<std::uint32_t>& membership,
-    std::uint32_t node, std::size_t& carried) {
+    std::uint32_t node, const std::optional<segmentation::GrowSettings>& grow,
+    const acquisition::RangeNoise& noise, std::size_t& carried) {
   std::map<std::int64_t, std::vector<std::uint32_t>> out;
   const std::optional<acquisition::ScanGeometry> drawn_geometry =
       store::load_geometry(project, drawn);
@@ -235,6 +269,10 @@ std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
       registration::prepare_scan(drawn_scan, *drawn_geometry, 0);
   std::vector<std::uint32_t> labels(membership.size(), 0);
   for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = membership[i] == node ? 1 : 0;
+  CarrySettings settings;
+  settings.transfer.noise = noise;
+  settings.grow = grow;
+  const DrawnObject object{&source, drawn_scan.T_world_scan, labels};
   for (const store::StoredScanSummary& stored : project.scans()) {
     if (stored.id == drawn) continue;
     const std::optional<acquisition::ScanGeometry> geometry =
@@ -242,17 +280,20 @@ std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
     if (!geometry) continue;
     const acquisition::Scan scan = project.load_scan(stored.id);
     const registration::PreparedScan target = registration::prepare_scan(scan, *geometry, 0);
-    const std::vector<std::uint32_t> joins = registration::transfer_labels(
-        source, labels, target, drawn_scan.T_world_scan.inverse() * scan.T_world_scan, {});
-    std::vector<std::uint32_t> other = load_membership(project, stored.id, scan.pixel_count());
-    std::size_t added = 0;
-    for (std::size_t q = 0; q < other.size(); ++q) {
-      if (joins[q] == 0 || other[q] != 0) continue;
-      other[q] = node;
-      ++added;
+    std::optional<segmentation::SegmentationGrid> grid;
+    if (grow) {
+      segmentation::GridSettings grid_settings;
+      grid_settings.range_noise = noise;
+      grid = segmentation::prepare_grid(scan, *geometry, grid_settings);
     }
-    if (added == 0) continue;
-    carried += added;
+    std::vector<std::uint32_t> other = load_membership(project, stored.id, scan.pixel_count());
+    std::vector<std::uint8_t> open = taken_mask(other);
+    for (std::uint8_t& o : open) o = !o;
+    const segmentation::PixelSet joins = carry_object(
+        object, {&target, scan.T_world_scan, grid ? &*grid : nullptr, open}, settings);
+    if (joins.empty()) continue;
+    for (const std::uint32_t q : joins) other[q] = node;
+    carried += joins.size();
     out.emplace(stored.id, std::move(other));
   }
   return out;
@@ -284,17 +325,15 @@ NodeCommandResult commit_selection(store::Project& project, const CommitSettings
   tree.emplace(node.id, node);
   std::size_t carried = 0;
   std::map<std::int64_t, std::vector<std::uint32_t>> changed =
-      settings.other_scans ? carried_into_other_scans(project, settings.scan_id, membership,
-                                                      static_cast<std::uint32_t>(node.id), carried)
-                           : std::map<std::int64_t, std::vector<std::uint32_t>>{};
+      settings.other_scans
+          ? carried_into_other_scans(project, settings.scan_id, membership,
+                                     static_cast<std::uint32_t>(node.id), settings.grow,
+                                     settings.range_noise, carried)
+          : std::map<std::int64_t, std::vector<std::uint32_t>>{};
   changed[settings.scan_id] = std::move(membership);
   const auto figures = compute_figures(project, tree, changed);
-  store::Project::Edit edit = project.begin_command("commit",
-                                                    dump({{"scan", settings.scan_id},
-                                                          {"name", settings.name},
-                                                          {"parent", parent_json(settings.parent)},
-                                                          {"other_scans", settings.other_scans}}),
-                                                    revision);
+  store::Project::Edit edit =
+      project.begin_command("commit", settings_to_json(settings), revision);
   project.put_node(edit, node);
   for (const auto& [scan_id, scan_membership] : changed)
     put_membership(project, edit, scan_id, scan_membership);

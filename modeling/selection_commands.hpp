@@ -42,13 +42,18 @@ struct SelectSettings {
 };
 
 struct SelectResult {
-  std::int64_t command_id = 0;
+  std::int64_t command_id = 0;      // 0 when the seed could not grow: nothing was written
   std::size_t region_pixels = 0;    // grown from the seed
   std::size_t selected_pixels = 0;  // in the selection afterwards
-  bool seed_open = false;           // the seed could grow (usable, open, still to be segmented)
+  // The seed could grow: usable, open (still to be segmented, inside the
+  // lasso, off the barriers) and with a value on the channel.
+  bool seed_open = false;
+  std::string refused;  // why it could not ("it lies outside the lasso"); empty when it grew
 };
 
 // Grows a region from the seed and combines it with the scan's selection.
+// A seed that cannot grow writes nothing (no journal entry: the redo chain
+// stays) and says why in `refused`.
 SelectResult select_region(store::Project& project, const SelectSettings& settings);
 
 struct CommitSettings {
@@ -59,14 +64,22 @@ struct CommitSettings {
   // too, where they are still to be segmented: an object covers the model,
   // not only the scan it was drawn in.
   bool other_scans = true;
+  // Where the drawn scan never saw the object's surface, its points in the
+  // other scans grow on from those it carried, with these settings (the
+  // channel and tolerance the selection was grown with) and within the
+  // object's box (object_carry.hpp). None: only the points on the surfaces
+  // the selection covers.
+  std::optional<segmentation::GrowSettings> grow = std::nullopt;
+  acquisition::RangeNoise range_noise = {};  // the scanner's
 };
 
 // Makes the scan's selection a new object: its pixels leave the pool still
 // to be segmented, the selection is emptied, and the object and its
 // ancestors get their point count, mean footprint and world bounding box.
 // With other_scans, every other scan with geometry, at its stored pose,
-// gives the object its points on the same surface as the selection's
-// (registration/label_transfer.hpp), in the same command.
+// gives the object its points on the same surface as the selection's, and
+// with grow the points it grows to where the drawn scan saw nothing
+// (object_carry.hpp), in the same command.
 NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings);
 
 struct SeparateSettings {

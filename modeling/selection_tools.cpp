@@ -58,7 +58,7 @@ void SelectionTools::clear() {
 
 SelectSettings SelectionTools::select_at(std::int64_t scan_id, const Eigen::Vector2d& xy,
                                          SelectMode mode,
-                                         const segmentation::GrowSettings& grow) const {
+                                         const segmentation::GrowSettings& grow) {
   assert((!scan_ || *scan_ == scan_id) && "a lasso or barriers of another scan");
   SelectSettings settings;
   settings.scan_id = scan_id;
@@ -69,6 +69,18 @@ SelectSettings SelectionTools::select_at(std::int64_t scan_id, const Eigen::Vect
   settings.grow = grow;
   if (lasso_closed_) settings.constraints.lasso = lasso_;
   settings.constraints.barriers = barriers_;
+  if (mode != SelectMode::kSubtract) grown_with_[scan_id] = grow;
+  return settings;
+}
+
+CommitSettings SelectionTools::commit_of(std::int64_t scan_id, std::string name,
+                                         std::optional<std::int64_t> parent) const {
+  CommitSettings settings;
+  settings.scan_id = scan_id;
+  settings.name = std::move(name);
+  settings.parent = parent;
+  if (const auto grown = grown_with_.find(scan_id); grown != grown_with_.end())
+    settings.grow = grown->second;
   return settings;
 }
 

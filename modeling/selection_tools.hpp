@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
+#include <string>
 #include <optional>
 #include <vector>
 
@@ -50,9 +52,16 @@ class SelectionTools {
   // select_region's settings for a seed at image point `xy` of scan
   // `scan_id`: the nearest pixel, the lasso when it is closed, the barriers.
   // Asserts the lasso and barriers, if any, were drawn on `scan_id` (the
-  // caller refuses or clears them otherwise).
+  // caller refuses or clears them otherwise). A grow that replaces or adds
+  // to the selection is remembered for the scan's commit.
   SelectSettings select_at(std::int64_t scan_id, const Eigen::Vector2d& xy, SelectMode mode,
-                           const segmentation::GrowSettings& grow) const;
+                           const segmentation::GrowSettings& grow);
+
+  // commit_selection's settings for the selection of scan `scan_id`: it
+  // grows on in the other scans with the settings of the last grow that
+  // replaced or added to it in this session (none before any).
+  CommitSettings commit_of(std::int64_t scan_id, std::string name,
+                           std::optional<std::int64_t> parent) const;
 
  private:
   void draw_on(std::int64_t scan_id);
@@ -63,6 +72,7 @@ class SelectionTools {
   std::vector<segmentation::Polyline> barriers_;
   bool drawing_barrier_ = false;
   std::optional<Eigen::Vector2d> seed_;
+  std::map<std::int64_t, segmentation::GrowSettings> grown_with_;  // per scan
 };
 
 }  // namespace scanbench::modeling

@@ -24,12 +24,37 @@ struct LabelTransferSettings {
   int threads = 0;  // 0 = all cores; results do not depend on it
 };
 
+// How a target point appears from the source scan, on the source pixel
+// whose beam it lies on.
+enum class Sighting : std::uint8_t {
+  // The source did not sample this place: no pixel there (outside its grid,
+  // or not in the model), or its range there is shorter (a nearer surface
+  // hides the point) or longer (its beam passed the point's place).
+  kUnseen,
+  // The source pixel sampled this place (the range agrees) but on another
+  // surface: the normals disagree.
+  kPlace,
+  // The source pixel sampled the same surface (same_surface()).
+  kSurface,
+};
+
+// Per target pixel, row-major: the source pixel its point lies on (-1 where
+// none, or the target pixel is not in the model) and what that pixel saw.
+struct Sightings {
+  std::vector<std::int64_t> pixel;
+  std::vector<Sighting> sighting;
+};
+
+// What `source` saw of every point of `target`. T_source_target maps the
+// target's scan frame into the source's.
+Sightings sight_in_source(const PreparedScan& source, const PreparedScan& target,
+                          const Eigen::Isometry3d& T_source_target,
+                          const LabelTransferSettings& settings);
+
 // For every pixel of `target`, row-major: the label of the pixel of
-// `source` whose surface it samples, 0 where there is none (the target
-// pixel is not in the model, falls outside the source's grid or on another
-// surface, or the source pixel's label is 0). `labels` has one entry per
-// source pixel (asserted). T_source_target maps the target's scan frame
-// into the source's.
+// `source` whose surface it samples (Sighting::kSurface), 0 where there is
+// none or the source pixel's label is 0. `labels` has one entry per source
+// pixel (asserted).
 std::vector<std::uint32_t> transfer_labels(const PreparedScan& source,
                                            std::span<const std::uint32_t> labels,
                                            const PreparedScan& target,

@@ -126,9 +126,14 @@ nlohmann::json Runner::apply_pixels(const ScriptOp& op, const std::string& at) {
                                                        : modeling::SelectMode::kSubtract;
   const modeling::SelectResult r = modeling::select_region(
       project_, tools_.select_at(scan.id, op.has_seed ? op.seed : *tools_.seed(), mode, op.grow));
-  return made(r.command_id, {{"region_pixels", r.region_pixels},
-                             {"selected_pixels", r.selected_pixels},
-                             {"seed_open", r.seed_open}});
+  nlohmann::json done = made(r.command_id, {{"region_pixels", r.region_pixels},
+                                            {"selected_pixels", r.selected_pixels},
+                                            {"seed_open", r.seed_open}});
+  if (!r.seed_open) {
+    done["command"] = nullptr;  // nothing was written
+    done["result"]["refused"] = r.refused;
+  }
+  return done;
 }
 
 nlohmann::json Runner::apply_proposals(const ScriptOp& op, std::int64_t scan_id,
@@ -147,7 +152,7 @@ nlohmann::json Runner::apply_tree(const ScriptOp& op, const std::string& at) {
   if (op.name == "commit") {
     const std::optional<std::int64_t> parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
     const modeling::NodeCommandResult r =
-        modeling::commit_selection(project_, {scan_of(op, at).id, op.text, parent});
+        modeling::commit_selection(project_, tools_.commit_of(scan_of(op, at).id, op.text, parent));
     return made(r.command_id, {{"node", r.node_id}});
   }
   if (op.name == "group") {

@@ -70,6 +70,24 @@ TEST(SettingsJson, SelectRoundTrips) {
   EXPECT_EQ(back.constraints.lasso, settings.constraints.lasso);
 }
 
+TEST(SettingsJson, CommitRoundTripsWithAndWithoutItsGrowSettings) {
+  CommitSettings settings;
+  settings.scan_id = 4;
+  settings.name = "wall";
+  settings.parent = 12;
+  settings.grow = segmentation::default_grow_settings(segmentation::Channel::kColor);
+  expect_every_field_round_trips(settings);
+  const CommitSettings back = settings_from_json<CommitSettings>(settings_to_json(settings), "t");
+  ASSERT_TRUE(back.grow.has_value());
+  EXPECT_EQ(back.grow->channel, segmentation::Channel::kColor);
+  EXPECT_EQ(back.parent, std::optional<std::int64_t>(12));
+  settings.grow.reset();
+  settings.parent.reset();
+  const CommitSettings none = settings_from_json<CommitSettings>(settings_to_json(settings), "t");
+  EXPECT_FALSE(none.grow.has_value());
+  EXPECT_FALSE(none.parent.has_value());
+}
+
 TEST(SettingsJson, MergeRoundTrips) {
   expect_every_field_round_trips<registration::MergeSettings>();
 }
@@ -209,6 +227,9 @@ TEST(SettingsJson, WhatTheJournalStoresReadsBackAsAUserFile) {
   matrix.solve.model = registration::ColorModel::kMatrix;
   expect_journal_settings_read_as_a_user_file(matrix);
   expect_journal_settings_read_as_a_user_file(SelectSettings{});
+  CommitSettings commit;
+  commit.grow = segmentation::default_grow_settings(segmentation::Channel::kRange);
+  expect_journal_settings_read_as_a_user_file(commit);
 }
 
 TEST(SettingsJson, AUserFileIsRefusedForKeysAndValuesThatDoNotReadBack) {

@@ -12,6 +12,7 @@
 #include "core/errors.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/selection_commands.hpp"
+#include "modeling/selection_tools.hpp"
 #include "modeling/store/typed_layers.hpp"
 #include "project_test_support.hpp"
 #include "room_project.hpp"
@@ -56,6 +57,40 @@ std::string state_of(const store::Project& project) {
   return out.str();
 }
 
+// A commit carries the object into the other scans with the settings its
+// selection was grown with in this session: the last grow that replaced or
+// added to it (a subtraction's do not count), and none before any.
+TEST(SegmentCommands, ACommitGrowsOnWithTheSettingsItsSelectionWasGrownWith) {
+  SelectionTools tools;
+  EXPECT_FALSE(tools.commit_of(1, "wall", std::nullopt).grow.has_value());
+  segmentation::GrowSettings colour =
+      segmentation::default_grow_settings(segmentation::Channel::kColor);
+  colour.tolerance = 9.0;
+  tools.select_at(1, {3.0, 4.0}, SelectMode::kReplace, colour);
+  tools.select_at(1, {5.0, 4.0}, SelectMode::kSubtract,
+                  segmentation::default_grow_settings(segmentation::Channel::kRange));
+  const CommitSettings commit = tools.commit_of(1, "wall", 7);
+  EXPECT_EQ(commit.scan_id, 1);
+  EXPECT_EQ(commit.name, "wall");
+  EXPECT_EQ(commit.parent, std::optional<std::int64_t>(7));
+  ASSERT_TRUE(commit.grow.has_value());
+  EXPECT_EQ(commit.grow->channel, segmentation::Channel::kColor);
+  EXPECT_EQ(commit.grow->tolerance, 9.0);
+  EXPECT_FALSE(tools.commit_of(2, "wall", std::nullopt).grow.has_value());
+
+  // The journal keeps them with the commit.
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const SelectSettings wall = select_at(scan, 20, 0);
+  const Eigen::Vector2d seed(wall.seed_col, wall.seed_row);
+  select_region(project, tools.select_at(scan, seed, SelectMode::kReplace,
+                                         segmentation::default_grow_settings(
+                                             segmentation::Channel::kNormal)));
+  commit_selection(project, tools.commit_of(scan, "wall", std::nullopt));
+  EXPECT_THAT(project.history().back().settings, HasSubstr("\"grow\":{\"channel\":\"normal\""));
+}
+
 TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
@@ -80,8 +115,17 @@ TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
             selected.selected_pixels);
   EXPECT_FALSE(
       project.load_layer<std::uint8_t>(scan, store::layer::kSelection, store::ElementType::kU8));
-  // The wall's pixels are no longer in the pool: a click on them grows nothing.
-  EXPECT_FALSE(select_region(project, select_at(scan, -20, 0)).seed_open);
+  // The wall's pixels are no longer in the pool: a click on them grows
+  // nothing, says why, and writes nothing, so an undone click stays redoable.
+  ASSERT_TRUE(select_region(project, select_at(scan, 0, -45)).seed_open);  // the floor
+  ASSERT_TRUE(project.undo().has_value());
+  const std::size_t journal = project.history().size();
+  const SelectResult refused = select_region(project, select_at(scan, -20, 0));
+  EXPECT_FALSE(refused.seed_open);
+  EXPECT_EQ(refused.command_id, 0);
+  EXPECT_THAT(refused.refused, HasSubstr("owns it"));
+  EXPECT_EQ(project.history().size(), journal);
+  EXPECT_TRUE(project.redo().has_value());  // the redo chain is whole
 }
 
 // An object drawn in one scan covers the surface in every scan that saw it:
