@@ -28,18 +28,33 @@ void add_workbench_command(CLI::App& app) {
                       "Save the window as PNG: after the replay, or after the first frame");
   command->add_option("--layout", options->layout,
                       "Write where the widgets and views are (JSON), for writing replays");
-  command->add_option("--size", options->width, "Window width [pixels]")
-      ->check(CLI::Range(960, 4096))
-      ->capture_default_str();
+  command->add_option("--record", options->record,
+                      "Record the session's mouse and key input as a replay file (JSON), "
+                      "written when the window closes");
+  command->add_flag("--read-only", options->read_only,
+                    "Look without changing the project: every edit is refused, nothing is "
+                    "journaled (automatic when the file cannot be written)");
+  command
+      ->add_option("--size", options->width,
+                   "Window width [pixels], the height 5/8 of it (default: fill the screen; "
+                   "1280 with --replay)")
+      ->check(CLI::Range(960, 4096));
   command->callback([options] {
     if (!options->screenshot.empty() && options->screenshot.extension() != ".png")
       throw CLI::ValidationError("--screenshot", "must name a .png file");
+    if (!options->record.empty() && options->record.extension() != ".json")
+      throw CLI::ValidationError("--record", "must name a .json file");
+    if (!options->record.empty() && std::filesystem::exists(options->record))
+      throw CLI::ValidationError("--record", options->record.string() +
+                                                 " exists: name a new file, or remove it first");
     for (const auto& [option, file] :
-         {std::pair{"--screenshot", options->screenshot}, std::pair{"--layout", options->layout}}) {
+         {std::pair{"--screenshot", options->screenshot}, std::pair{"--layout", options->layout},
+          std::pair{"--record", options->record}}) {
       const std::filesystem::path folder = file.parent_path().empty() ? "." : file.parent_path();
       if (!file.empty() && !std::filesystem::is_directory(folder))
         throw CLI::ValidationError(option, "the folder " + folder.string() + " does not exist");
     }
+    if (options->width == 0 && !options->replay.empty()) options->width = 1280;
     options->height = options->width * 5 / 8;
     workbench::run_workbench(*options);
   });

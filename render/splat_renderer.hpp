@@ -64,6 +64,9 @@ struct RenderSettings {
 struct FrameResult {
   FramePlan plan;
   double frame_ms = 0.0;  // CPU wall time of the frame, finished on the device
+  // The device's own time for the frame's commands (a GL_TIME_ELAPSED
+  // query); negative where the device cannot say.
+  double gpu_ms = -1.0;
 };
 
 // An RGBA8 picture, top row first; alpha 0 where nothing was drawn.

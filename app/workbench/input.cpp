@@ -114,17 +114,17 @@ void WorkbenchInput::key(int key, bool pressed, int mods) {
 
 void WorkbenchInput::shortcut(int key, int mods) {
   WorkbenchState& s = state_;
+  if (s.question) return;  // answered first, in its window
   // Undo and redo work wherever the keyboard is, text fields excepted
   // (they have their own).
   const bool control = (mods & keys::kModControl) != 0;
   const bool shift = (mods & keys::kModShift) != 0;
   if (control && (key == 'Z' || key == 'Y')) {
     if (key == 'Z' && !shift) {
-      s.session.undo();
+      s.undo();
     } else {
-      s.session.redo();
+      s.redo();
     }
-    s.after_command();
     return;
   }
   // Letter shortcuts act unless a text field has the keyboard (not "any

@@ -15,8 +15,15 @@ Eigen::Vector3d Navigation::forward() const {
   return {std::cos(pitch_) * std::cos(yaw_), std::cos(pitch_) * std::sin(yaw_), std::sin(pitch_)};
 }
 
-void Navigation::frame(const Eigen::AlignedBox3d& box) {
+void Navigation::frame(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& facing) {
   if (box.isEmpty()) return;
+  if (facing.norm() > 0.0) {
+    // Look against `facing`, from a little above it.
+    const Eigen::Vector3d look = -facing.normalized();
+    yaw_ = std::atan2(look.y(), look.x());
+    pitch_ = std::clamp(std::asin(std::clamp(look.z(), -1.0, 1.0)) - 0.25, -kMaxPitch, kMaxPitch);
+    if (std::hypot(look.x(), look.y()) < 1e-3) yaw_ = 0.0;  // straight down or up
+  }
   const double diagonal = std::max(box.diagonal().norm(), 1.0);
   target_ = box.center();
   distance_ = 0.5 * diagonal / std::tan(0.5 * fov_deg_ * kPi / 180.0) * 1.1;

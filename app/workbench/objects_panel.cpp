@@ -109,10 +109,7 @@ void objects_panel(WorkbenchState& s) {
   if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n) s.session.set_hidden(n->id, !n->hidden);
   s.probe("hide");
   ImGui::SameLine();
-  if (ImGui::Button("Delete") && p) {
-    s.session.remove(*p);
-    s.selected.clear();
-  }
+  if (ImGui::Button("Delete")) s.remove_selected();
   s.probe("delete");
   ImGui::SameLine();
   if (ImGui::Button("Separate") && p) s.session.separate(*p);

@@ -1,6 +1,7 @@
 #include <epoxy/gl.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "app/workbench/panels.hpp"
@@ -39,12 +40,18 @@ void polyline(const WorkbenchState& s, ImDrawList* draw, const segmentation::Pol
 }  // namespace
 
 void panorama_view(WorkbenchState& s) {
-  refresh_texture(s);
   ImDrawList* draw = ImGui::GetBackgroundDrawList();
   const ImVec2 low(s.panorama.x, s.panorama.y),
       high(s.panorama.x + s.panorama.w, s.panorama.y + s.panorama.h);
   draw->PushClipRect(low, high, true);
   draw->AddRectFilled(low, high, IM_COL32(20, 20, 24, 255));
+  const std::string missing = s.session.missing();
+  if (!s.session.has_scan()) {
+    draw->AddText(ImVec2(low.x + 12, low.y + 10), IM_COL32(255, 200, 120, 255), missing.c_str());
+    draw->PopClipRect();
+    return;
+  }
+  refresh_texture(s);
   const acquisition::Scan& scan = s.session.scan();
   draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(s.panorama_texture)),
                  s.panorama_screen({-0.5, -0.5}),
@@ -52,6 +59,13 @@ void panorama_view(WorkbenchState& s) {
   polyline(s, draw, s.session.lasso(), IM_COL32(80, 220, 255, 255), s.session.lasso_closed());
   for (const segmentation::Polyline& b : s.session.barriers())
     polyline(s, draw, b, IM_COL32(255, 70, 70, 255), false);
+  if (!missing.empty()) {
+    const ImVec2 at(low.x + 12, high.y - 24);
+    const ImVec2 size = ImGui::CalcTextSize(missing.c_str());
+    draw->AddRectFilled(ImVec2(at.x - 4, at.y - 2), ImVec2(at.x + size.x + 4, at.y + size.y + 2),
+                        IM_COL32(0, 0, 0, 200));
+    draw->AddText(at, IM_COL32(255, 200, 120, 255), missing.c_str());
+  }
   draw->PopClipRect();
 }
 

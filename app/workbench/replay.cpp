@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string_view>
 
@@ -48,19 +49,11 @@ struct Reader {
   }
 
   int key(const json& j) const {
-    namespace k = render::keys;
-    static const std::map<std::string, int> names = {
-        {"Enter", k::kEnter},         {"Escape", k::kEscape}, {"Tab", k::kTab},
-        {"Backspace", k::kBackspace}, {"Delete", k::kDelete}, {"Left", k::kLeft},
-        {"Right", k::kRight},         {"Up", k::kUp},         {"Down", k::kDown},
-        {"Home", k::kHome},           {"End", k::kEnd},       {"Space", k::kSpace}};
     if (!j.is_string()) refuse("a key is a name such as \"Z\" or \"Enter\"");
     const std::string name = j.get<std::string>();
-    if (name.size() == 1 &&
-        ((name[0] >= 'A' && name[0] <= 'Z') || (name[0] >= '0' && name[0] <= '9')))
-      return name[0];
-    if (!names.count(name)) refuse("unknown key \"" + name + "\"");
-    return names.at(name);
+    const std::optional<int> code = key_code(name);
+    if (!code) refuse("unknown key \"" + name + "\"");
+    return *code;
   }
 
   int mods(const json& event) const {
@@ -96,6 +89,8 @@ struct Reader {
         {"drag", {"drag", "button", "steps", "mods"}},
         {"scroll", {"scroll", "at", "mods"}},
         {"key", {"key", "mods"}},
+        {"key_down", {"key_down", "mods"}},
+        {"key_up", {"key_up", "mods"}},
         {"hold", {"hold", "frames", "mods"}},
         {"text", {"text", "mods"}},
         {"wait", {"wait", "mods"}},
@@ -220,6 +215,9 @@ void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& ou
     const int key = reader.key(e["key"]);
     add_key(out, key, true, mods);
     add_key(out, key, false, mods);
+  } else if (e.contains("key_down") || e.contains("key_up")) {
+    const bool down = e.contains("key_down");
+    add_key(out, reader.key(down ? e["key_down"] : e["key_up"]), down, mods);
   } else if (e.contains("hold")) {
     const int key = reader.key(e["hold"]);
     add_key(out, key, true, mods);
@@ -252,6 +250,39 @@ void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& ou
 }
 
 }  // namespace
+
+namespace {
+
+// The named keys; letters and digits are named by themselves.
+const std::map<std::string, int>& named_keys() {
+  namespace k = render::keys;
+  static const std::map<std::string, int> names = {
+      {"Enter", k::kEnter},         {"Escape", k::kEscape}, {"Tab", k::kTab},
+      {"Backspace", k::kBackspace}, {"Delete", k::kDelete}, {"Left", k::kLeft},
+      {"Right", k::kRight},         {"Up", k::kUp},         {"Down", k::kDown},
+      {"Home", k::kHome},           {"End", k::kEnd},       {"Space", k::kSpace}};
+  return names;
+}
+
+}  // namespace
+
+std::optional<int> key_code(const std::string& name) {
+  if (name.size() == 1 &&
+      ((name[0] >= 'A' && name[0] <= 'Z') || (name[0] >= '0' && name[0] <= '9')))
+    return name[0];
+  const auto found = named_keys().find(name);
+  if (found == named_keys().end()) return std::nullopt;
+  return found->second;
+}
+
+std::optional<std::string> key_name(int code) {
+  if ((code >= 'A' && code <= 'Z') || (code >= '0' && code <= '9'))
+    return std::string(1, static_cast<char>(code));
+  for (const auto& [name, value] : named_keys()) {
+    if (value == code) return name;
+  }
+  return std::nullopt;
+}
 
 std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
   Reader reader{file, ""};

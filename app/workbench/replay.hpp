@@ -9,6 +9,7 @@
 //     {"drag": [[x0, y0], [x1, y1]], "button": "left", "steps": 10},
 //     {"scroll": 1.0, "at": [x, y]},             wheel steps (positive: away from the user)
 //     {"key": "Z", "mods": ["ctrl"]},           press and release; names below
+//     {"key_down": "W"}, {"key_up": "W"},        press or release alone
 //     {"hold": "W", "frames": 20},               held down for that many frames
 //     {"text": "north wall"},                    typed characters
 //     {"wait": 3},                               frames without input
@@ -19,8 +20,12 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "render/window/window_device.hpp"
 
 namespace scanbench::app::workbench {
 
@@ -42,5 +47,44 @@ struct ReplayEvent {
 // release; a drag its moves in between). Throws core::InputError naming the
 // file, the event ("events[3]") and the problem.
 std::vector<ReplayEvent> read_replay(const std::filesystem::path& file);
+
+// A key's code (render::keys) by its name above, and back; none for keys
+// the format does not name.
+std::optional<int> key_code(const std::string& name);
+std::optional<std::string> key_name(int code);
+
+// Records what reaches the window's input listener as a replay file
+// (`scanbench workbench --record FILE`), passing every event on to
+// `inner`. Each frame's events are written in order, and the frames between
+// them as waits, so that the file replayed feeds the same input in the same
+// order (a replay feeds one event a frame; of a frame's cursor moves only
+// the last is kept). Modifier keys and keys the format does not name are
+// not written: every event carries its modifiers.
+class ReplayRecorder final : public render::WindowInput {
+ public:
+  ReplayRecorder(render::WindowInput& inner, std::filesystem::path file);
+
+  // A frame has ended.
+  void next_frame() { ++frames_since_event_; }
+  // Writes the file, whole or not at all. Throws core::RuntimeFailure when
+  // it cannot be written.
+  void save() const;
+
+  void cursor_moved(double x, double y) override;
+  void button(int button, bool pressed, int mods) override;
+  void scrolled(double dx, double dy) override;
+  void key(int key, bool pressed, int mods) override;
+  void text(unsigned codepoint) override;
+
+ private:
+  // Appends an event, after a wait for the frames since the last one.
+  void add(nlohmann::json event, int mods);
+
+  render::WindowInput& inner_;
+  std::filesystem::path file_;
+  nlohmann::json events_ = nlohmann::json::array();
+  int frames_since_event_ = 0;
+  bool moved_this_frame_ = false;
+};
 
 }  // namespace scanbench::app::workbench

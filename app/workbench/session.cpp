@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/errors.hpp"
 #include "modeling/store/layer_store.hpp"
@@ -9,10 +11,46 @@
 
 namespace scanbench::app::workbench {
 
-Session::Session(const std::filesystem::path& project) : project_(store::Project::open(project)) {
+namespace {
+
+// The stages the command line runs over whole scans. The workbench's undo
+// stops before them and asks (Session::undo).
+bool is_batch_stage(std::string_view name) {
+  for (const char* stage : {"import", "geometry", "register", "merge", "harmonize", "migrate"})
+    if (name == stage) return true;
+  return false;
+}
+
+}  // namespace
+
+bool Session::cannot_write(const std::filesystem::path& file) {
+  // access() says yes to root whatever the mode, so the mode bits count too:
+  // a file nobody may write is opened read-only, root's session included.
+  struct stat info {};
+  if (::stat(file.c_str(), &info) != 0) return false;  // opening it will say what is wrong
+  if ((info.st_mode & 0222) == 0 || ::access(file.c_str(), W_OK) != 0) return true;
+  const std::filesystem::path folder = file.parent_path().empty() ? "." : file.parent_path();
+  return ::access(folder.c_str(), W_OK) != 0;
+}
+
+Session::Session(const std::filesystem::path& project, bool read_only)
+    : project_(read_only ? store::Project::open_read_only(project) : store::Project::open(project)),
+      read_only_(read_only) {
+  show_first_scan();
+  if (read_only_)
+    status_ = "read-only: you can look, select nodes and frame them; nothing is written";
+}
+
+void Session::show_first_scan() {
   scans_ = project_.scans();
-  if (scans_.empty())
-    throw core::InputError(project.string(), {}, "the project has no scans: import some first");
+  if (scans_.empty()) {
+    scan_ = {};
+    scan_id_ = 0;
+    normal_.clear();
+    clear_constraints();
+    reload();
+    return;
+  }
   open_scan(scans_.front().id);
 }
 
@@ -25,8 +63,21 @@ void Session::open_scan(std::int64_t id) {
   reload();
 }
 
+std::string Session::missing() const {
+  if (scans_.empty())
+    return "the project has no scans: import some with `scanbench import`, or redo (Ctrl+Y) an "
+           "undone import";
+  if (normal_.empty())
+    return "this scan has no geometry: run `scanbench geometry`, or redo (Ctrl+Y) an undone one";
+  return "";
+}
+
 template <typename Action>
 bool Session::act(const std::string& what, Action&& action, bool changes_model) {
+  if (read_only_) {
+    status_ = "refused: the project is open read-only (nothing is written)";
+    return false;
+  }
   try {
     action();
     status_ = what;
@@ -46,13 +97,18 @@ bool Session::act(const std::string& what, Action&& action, bool changes_model) 
 void Session::reload() {
   scans_ = project_.scans();
   nodes_ = project_.object_nodes();
-  membership_ =
-      project_
-          .load_layer<std::uint32_t>(scan_id_, store::layer::kMembership, store::ElementType::kU32)
-          .value_or(std::vector<std::uint32_t>{});
-  selection_ =
-      project_.load_layer<std::uint8_t>(scan_id_, store::layer::kSelection, store::ElementType::kU8)
-          .value_or(std::vector<std::uint8_t>{});
+  membership_.clear();
+  selection_.clear();
+  if (has_scan()) {
+    membership_ = project_
+                      .load_layer<std::uint32_t>(scan_id_, store::layer::kMembership,
+                                                 store::ElementType::kU32)
+                      .value_or(std::vector<std::uint32_t>{});
+    selection_ = project_
+                     .load_layer<std::uint8_t>(scan_id_, store::layer::kSelection,
+                                               store::ElementType::kU8)
+                     .value_or(std::vector<std::uint8_t>{});
+  }
   selected_ = static_cast<std::size_t>(std::count(selection_.begin(), selection_.end(), 1));
   ++revision_;
 }
@@ -88,7 +144,7 @@ void Session::click(double x, double y) {
     status_ = result.seed_open
                   ? "grew " + std::to_string(result.region_pixels) + " pixels; selection " +
                         std::to_string(result.selected_pixels)
-                  : "the seed cannot grow there (no normal, taken, or outside the lasso)";
+                  : "the seed cannot grow there: " + result.refused;
   }
 }
 
@@ -107,7 +163,7 @@ void Session::clear_constraints() {
 
 bool Session::commit(const std::string& name, std::optional<std::int64_t> parent) {
   return act("committed \"" + name + "\"", [&] {
-    modeling::commit_selection(project_, {scan_id_, name, parent});
+    modeling::commit_selection(project_, tools_.commit_of(scan_id_, name, parent));
   });
 }
 
@@ -169,18 +225,55 @@ bool Session::clone(std::int64_t source, std::int64_t target) {
   return act("cloned the colours", [&] { modeling::clone_color(project_, settings); });
 }
 
-bool Session::undo() {
+std::optional<store::CommandRecord> Session::undo(bool stages, std::optional<std::int64_t> only) {
+  if (read_only_) {
+    status_ = "refused: the project is open read-only (nothing is written)";
+    return std::nullopt;
+  }
+  std::optional<store::CommandRecord> newest;
+  for (const store::CommandRecord& record : project_.history()) {
+    if (record.state == store::CommandState::kDone) newest = record;
+  }
+  if (!newest || !newest->undoable) {
+    status_ = "nothing to undo";
+    return std::nullopt;
+  }
+  if (only && newest->id != *only) {
+    status_ = "nothing undone: another process changed the journal meanwhile";
+    return std::nullopt;
+  }
+  if (is_batch_stage(newest->name) && !stages) {
+    status_ = "undo stopped at \"" + newest->name + "\", a batch stage";
+    return newest;
+  }
   std::optional<store::CommandRecord> undone;
-  act("", [&] { undone = project_.undo(); });
-  status_ = undone ? "undid " + undone->name : "nothing to undo";
-  return undone.has_value();
+  act("", [&] { undone = project_.undo(newest->id); });
+  if (undone && is_batch_stage(undone->name)) show_first_scan_again();
+  if (status_.empty()) status_ = undone ? "undid " + undone->name : "nothing to undo";
+  return std::nullopt;
 }
 
 bool Session::redo() {
   std::optional<store::CommandRecord> redone;
   act("", [&] { redone = project_.redo(); });
-  status_ = redone ? "redid " + redone->name : "nothing to redo";
+  if (redone && is_batch_stage(redone->name)) show_first_scan_again();
+  if (status_.empty()) status_ = redone ? "redid " + redone->name : "nothing to redo";
   return redone.has_value();
+}
+
+void Session::show_first_scan_again() {
+  const std::string said = status_;
+  scans_ = project_.scans();
+  const bool still_there = std::any_of(scans_.begin(), scans_.end(), [&](const auto& scan) {
+    return scan.id == scan_id_;
+  });
+  if (still_there) {
+    open_scan(scan_id_);  // its geometry may have come or gone
+  } else {
+    show_first_scan();
+  }
+  ++model_changes_;
+  status_ = said;
 }
 
 render::Picture Session::panorama(render::PanoramaChannel channel) const {
@@ -189,7 +282,15 @@ render::Picture Session::panorama(render::PanoramaChannel channel) const {
 
 const render::RenderModel& Session::render_model() {
   if (!model_ || model_revision_ != model_changes_) {
-    model_ = render::build_render_model(project_, {});
+    model_problem_.clear();
+    try {
+      model_ = render::build_render_model(project_, {});
+    } catch (const core::InputError& e) {
+      // A scan without geometry: the 3D view says so and stays empty.
+      model_ = render::RenderModel{};
+      const std::string& where = e.position().detail;
+      model_problem_ = (where.empty() ? "" : where + " ") + e.problem();
+    }
     model_revision_ = model_changes_;
   }
   return *model_;

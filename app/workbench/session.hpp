@@ -28,14 +28,26 @@ enum class Tool { kSeed, kLasso, kBarrier };
 
 class Session {
  public:
-  // Opens the project (Project::open: throws as it does) and its first scan.
-  explicit Session(const std::filesystem::path& project);
+  // Opens the project (Project::open, or open_read_only: throws as they do)
+  // and its first scan, if it has any: the workbench opens in every state of
+  // a project. Read-only, every command is refused before it computes.
+  Session(const std::filesystem::path& project, bool read_only);
+
+  // Whether `file` must be opened read-only: it or its folder cannot be
+  // written, or no one has write permission on it (root included).
+  static bool cannot_write(const std::filesystem::path& file);
+  bool read_only() const { return read_only_; }
 
   store::Project& project() { return project_; }
   const std::vector<store::StoredScanSummary>& scans() const { return scans_; }
   std::int64_t scan_id() const { return scan_id_; }
+  // The scan shown: empty (0 × 0, id 0) while the project has none.
   const acquisition::Scan& scan() const { return scan_; }
+  bool has_scan() const { return scan_id_ != 0; }
   void open_scan(std::int64_t id);
+  // What the panoramic tools lack, and how to get it: no scans, or no
+  // geometry for the scan shown; empty when nothing is missing.
+  std::string missing() const;
 
   // ---- Tools (image coordinates: x = column, y = row, pixel centres at
   // integers: segmentation/constraints.hpp) --------------------------------
@@ -65,7 +77,13 @@ class Session {
   bool propose();
   bool recolor(std::int64_t node, const store::ColorEdit& set, bool reset);
   bool clone(std::int64_t source, std::int64_t target);
-  bool undo();
+  // Takes back the newest command. A batch stage (import, geometry,
+  // register, merge, harmonize: run from the command line over whole scans)
+  // is taken back only with `stages`; without, nothing changes and the stage
+  // is returned, for the caller to ask the user first. With `only`, nothing
+  // is undone unless the newest command is that one.
+  std::optional<store::CommandRecord> undo(bool stages = false,
+                                           std::optional<std::int64_t> only = std::nullopt);
   bool redo();
 
   const std::vector<store::ObjectNode>& nodes() const { return nodes_; }
@@ -80,6 +98,8 @@ class Session {
   // after a selection, which it does not show).
   const render::RenderModel& render_model();
   bool render_model_stale() const { return !model_ || model_revision_ != model_changes_; }
+  // Why the 3D view is empty (a scan without geometry); empty when it is not.
+  const std::string& render_model_problem() const { return model_problem_; }
 
  private:
   // Runs a command; a refusal becomes status() and false. After it, the
@@ -87,8 +107,13 @@ class Session {
   template <typename Action>
   bool act(const std::string& what, Action&& action, bool changes_model = true);
   void reload();
+  void show_first_scan();
+  // After a batch stage was undone or redone: the scan shown again (or the
+  // first, when it is gone), with its geometry as it now is.
+  void show_first_scan_again();
 
   store::Project project_;
+  bool read_only_ = false;
   std::vector<store::StoredScanSummary> scans_;
   std::int64_t scan_id_ = 0;
   acquisition::Scan scan_;
@@ -103,6 +128,7 @@ class Session {
   std::optional<render::RenderModel> model_;
   std::int64_t model_revision_ = -1;
   std::int64_t model_changes_ = 0;  // commands that changed what the 3D view shows
+  std::string model_problem_;
 };
 
 }  // namespace scanbench::app::workbench

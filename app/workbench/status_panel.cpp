@@ -1,3 +1,6 @@
+#include <cstdio>
+#include <string>
+
 #include "app/workbench/panels.hpp"
 
 namespace scanbench::app::workbench {
@@ -8,13 +11,23 @@ void status_panel(WorkbenchState& s) {
   ImGui::Begin("Status", nullptr,
                kFixedWindow | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar);
   const render::FramePlan& plan = s.last_plan;
+  // The device's time where it reports one, beside the wall time; the rate
+  // once two frames have passed.
+  const std::string gpu =
+      s.last_gpu_ms >= 0.0 ? std::to_string(static_cast<int>(s.last_gpu_ms + 0.5)) + " ms device, "
+                           : std::string();
+  char rate[32] = "-";
+  if (s.frame_seconds > 0.0) std::snprintf(rate, sizeof rate, "%.1f", 1.0 / s.frame_seconds);
+  if (s.session.read_only()) {
+    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "READ-ONLY");
+    ImGui::SameLine();
+  }
   ImGui::Text(
-      "%s | selection %zu px | 3D: %zu of %zu points drawn (frustum %zu, backface %zu, "
-      "detail/budget %zu) in %.0f ms | %.1f frames/s",
+      "%s | selection %zu px | 3D %zu of %zu points (culled: frustum %zu, back %zu, detail %zu) | "
+      "draw %s%.0f ms wall | %s frames/s",
       s.session.status().empty() ? "ready" : s.session.status().c_str(),
       s.session.selected_pixels(), plan.submitted, plan.points, plan.culled_frustum,
-      plan.culled_backface, plan.culled_budget, s.last_draw_ms,
-      s.frame_seconds > 0 ? 1.0 / s.frame_seconds : 0.0);
+      plan.culled_backface, plan.culled_budget, gpu.c_str(), s.last_draw_ms, rate);
   ImGui::End();
 }
 

@@ -58,29 +58,28 @@ void commands_row(WorkbenchState& s) {
     s.commit();
   s.probe("name");
   ImGui::SameLine();
-  ImGui::BeginDisabled(s.session.selected_pixels() == 0);
+  const bool read_only = s.session.read_only();
+  ImGui::BeginDisabled(s.session.selected_pixels() == 0 || read_only);
   if (ImGui::Button("Commit (C)")) s.commit();
   s.probe("commit");
   ImGui::EndDisabled();
   ImGui::SameLine();
+  ImGui::BeginDisabled(read_only || !s.session.missing().empty());
   if (ImGui::Button("Automatic proposals")) s.session.propose();
   s.probe("propose");
+  ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::SetNextItemWidth(110);
   ImGui::Combo("view", &s.panorama_channel, "colour\0range\0intensity\0normals\0");
   s.probe("panorama channel");
   ImGui::SameLine();
-  if (ImGui::Button("Undo")) {
-    s.session.undo();
-    s.after_command();
-  }
+  ImGui::BeginDisabled(read_only);
+  if (ImGui::Button("Undo")) s.undo();
   s.probe("undo");
   ImGui::SameLine();
-  if (ImGui::Button("Redo")) {
-    s.session.redo();
-    s.after_command();
-  }
+  if (ImGui::Button("Redo")) s.redo();
   s.probe("redo");
+  ImGui::EndDisabled();
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "app/workbench/panels.hpp"
 #include "render/render_view.hpp"
@@ -22,6 +23,7 @@ void redraw(WorkbenchState& s, int width, int height) {
   const render::FrameResult frame = s.renderer->draw(view, s.settings);
   s.last_plan = frame.plan;
   s.last_draw_ms = frame.frame_ms;  // the renderer gives ImGui its GL state back
+  s.last_gpu_ms = frame.gpu_ms;
   s.view_dirty = false;
 }
 
@@ -41,6 +43,11 @@ void view_3d(WorkbenchState& s) {
   draw->AddText(ImVec2(r.x + 8, r.y + 6), IM_COL32(255, 255, 255, 200),
                 s.fly ? "walk/fly: W A S D Q E, drag to look"
                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
+  const std::string& problem = s.session.render_model_problem();
+  if (!problem.empty()) {
+    const std::string text = "nothing to draw: " + problem;
+    draw->AddText(ImVec2(r.x + 8, r.y + 26), IM_COL32(255, 200, 120, 255), text.c_str());
+  }
 }
 
 }  // namespace scanbench::app::workbench

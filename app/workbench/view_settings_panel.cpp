@@ -19,6 +19,11 @@ void view_settings_panel(WorkbenchState& s) {
   int color = static_cast<int>(settings.color);
   changed |= ImGui::Combo("colour", &color, "colour\0intensity\0height\0normal\0object\0");
   settings.color = static_cast<render::ColorMode>(color);
+  changed |= ImGui::Checkbox("headlight", &settings.lighting);
+  s.probe("headlight");
+  ImGui::SameLine();
+  changed |= ImGui::Checkbox("eye-dome lighting", &settings.eye_dome);
+  s.probe("eye dome");
   int navigation = s.fly ? 1 : 0;
   ImGui::RadioButton("orbit", &navigation, 0);
   s.probe("orbit");

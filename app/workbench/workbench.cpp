@@ -12,6 +12,7 @@
 #include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "acquisition/formats/picture_file.hpp"
@@ -55,14 +56,21 @@ class Workbench {
 
   render::WindowInput& input() { return input_; }
 
-  // One frame of `seconds`: the panels and views, then ImGui's draw.
+  // One frame that advances the input's clock by `seconds` (a replay's
+  // fixed step, or the real interval live): the panels and views, then
+  // ImGui's draw. The frame rate shown is measured from real intervals.
   void frame(double seconds) {
     WorkbenchState& s = state_;
     ImGuiIO& io = ImGui::GetIO();
     const auto [width, height] = s.window.framebuffer_size();
     io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
     io.DeltaTime = static_cast<float>(std::max(seconds, 1e-4));
-    s.frame_seconds = s.frames == 0 ? seconds : 0.9 * s.frame_seconds + 0.1 * seconds;
+    const auto now = std::chrono::steady_clock::now();
+    if (s.frames > 0) {
+      const double real = std::chrono::duration<double>(now - s.last_frame).count();
+      s.frame_seconds = s.frames == 1 ? real : 0.8 * s.frame_seconds + 0.2 * real;
+    }
+    s.last_frame = now;
     s.layout(width, height);
     input_.fly_keys(seconds);
     ImGui_ImplOpenGL3_NewFrame();
@@ -72,6 +80,7 @@ class Workbench {
     panorama_view(s);
     view_3d(s);
     status_panel(s);
+    questions_panel(s);
     ImGui::Render();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, width, height);
@@ -134,14 +143,17 @@ class Workbench {
   WorkbenchInput input_;
 };
 
-// Feeds the events, a frame each, then takes the screenshot and layout asked for.
+// Feeds the events, a frame each, to `input` (the workbench's, or a
+// recorder in front of it), then takes the screenshot and layout asked for.
 void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions& options,
-            const std::vector<ReplayEvent>& events) {
+            const std::vector<ReplayEvent>& events, render::WindowInput& input,
+            ReplayRecorder* recorder) {
   bench.frame(kReplayFrameSeconds);  // the first frame lays the panels out
   window.swap_buffers();
   for (const ReplayEvent& e : events) {
-    feed(bench.input(), e);
+    feed(input, e);
     bench.frame(kReplayFrameSeconds);
+    if (recorder) recorder->next_frame();
     if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
     window.swap_buffers();
   }
@@ -151,13 +163,15 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
 }
 
 // Frames until the window closes (or, with a screenshot asked for, one).
-void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions& options) {
+void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions& options,
+          ReplayRecorder* recorder) {
   auto last = std::chrono::steady_clock::now();
   bool layout_written = false;
   while (!window.close_requested()) {
     window.poll_events();
     const auto now = std::chrono::steady_clock::now();
     bench.frame(std::chrono::duration<double>(now - last).count());
+    if (recorder) recorder->next_frame();
     last = now;
     if (!layout_written && !options.layout.empty()) {
       bench.write_layout(options.layout);
@@ -180,16 +194,20 @@ void run_workbench(const WorkbenchOptions& options) {
   render::WindowDevice window(options.width, options.height, "scanbench workbench");
   const ImGuiScope imgui;
   Workbench bench(options, window);
-  window.set_input(&bench.input());
+  std::optional<ReplayRecorder> recorder;
+  if (!options.record.empty()) recorder.emplace(bench.input(), options.record);
+  render::WindowInput& input = recorder ? *recorder : bench.input();
+  window.set_input(&input);
   struct Detach {
     render::WindowDevice& window;
     ~Detach() { window.set_input(nullptr); }
   } detach{window};
   if (options.replay.empty()) {
-    live(bench, window, options);
+    live(bench, window, options, recorder ? &*recorder : nullptr);
   } else {
-    replay(bench, window, options, events);
+    replay(bench, window, options, events, input, recorder ? &*recorder : nullptr);
   }
+  if (recorder) recorder->save();
 }
 
 }  // namespace scanbench::app::workbench

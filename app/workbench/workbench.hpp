@@ -14,8 +14,14 @@ struct WorkbenchOptions {
   std::filesystem::path replay;      // events to feed, then exit (replay.hpp); empty: live
   std::filesystem::path screenshot;  // the window after the replay (.png); empty: none
   std::filesystem::path layout;      // where to write the widgets' centres (JSON); empty: none
-  int width = 1280;
-  int height = 800;
+  // Nothing is written (also when the file cannot be written: Session::cannot_write).
+  bool read_only = false;
+  // Where to record the session's input as a replay file; empty: nowhere.
+  std::filesystem::path record;
+  // The window's size [pixels]; 0: the screen's work area (a replay's
+  // default is 1280 × 800, where its positions were recorded).
+  int width = 0;
+  int height = 0;
 };
 
 // Runs the workbench until its window closes or the replay ends. Throws

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <vector>
 
 namespace scanbench::app::workbench {
 
 WorkbenchState::WorkbenchState(const WorkbenchOptions& options, render::WindowDevice& window)
-    : options(options), window(window), session(options.project) {
+    : options(options),
+      window(window),
+      session(options.project, options.read_only || Session::cannot_write(options.project)) {
   settings.culling.budget = 1'500'000;
 }
 
@@ -50,6 +53,17 @@ std::optional<std::int64_t> WorkbenchState::primary() const {
   return primary_id;
 }
 
+std::set<std::int64_t> WorkbenchState::subtree(std::int64_t id) const {
+  std::set<std::int64_t> inside = {id};
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const store::ObjectNode& m : session.nodes()) {
+      if (m.parent && inside.count(*m.parent) && inside.insert(m.id).second) grew = true;
+    }
+  }
+  return inside;
+}
+
 std::optional<store::ObjectNode> WorkbenchState::node(std::int64_t id) const {
   for (const store::ObjectNode& n : session.nodes())
     if (n.id == id) return n;
@@ -78,6 +92,57 @@ void WorkbenchState::load_color_editor() {
 void WorkbenchState::after_command() {
   if (selected.size() == 1 && !node(*selected.begin())) selected.clear();
   load_color_editor();
+}
+
+void WorkbenchState::undo() {
+  const std::optional<store::CommandRecord> stage = session.undo();
+  after_command();
+  if (!stage) return;
+  const std::int64_t id = stage->id;
+  const std::string name = stage->name;
+  question = Question{
+      "Undo a batch stage?",
+      "The newest command is \"" + name + "\" (command " + std::to_string(id) + ", " +
+          stage->created_at +
+          "), a batch stage run over whole scans, not an edit made here.\nUndoing it takes back "
+          "its work on every scan; Ctrl+Y or `scanbench redo` brings it back.",
+      "Undo " + name, [this, id] {
+        session.undo(true, id);
+        after_command();
+        view_dirty = true;
+      }};
+}
+
+void WorkbenchState::redo() {
+  session.redo();
+  after_command();
+  view_dirty = true;
+}
+
+void WorkbenchState::remove_selected() {
+  const auto p = primary();
+  const std::optional<store::ObjectNode> n = p ? node(*p) : std::nullopt;
+  if (!n) return;
+  const auto remove = [this, id = n->id] {
+    session.remove(id);
+    selected.clear();
+    after_command();
+  };
+  if (n->kind != store::NodeKind::kGroup) {
+    remove();
+    return;
+  }
+  const std::size_t descendants = subtree(n->id).size() - 1;
+  if (descendants == 0) {
+    remove();
+    return;
+  }
+  question = Question{"Delete a group?",
+                      "\"" + n->name + "\" holds " + std::to_string(descendants) +
+                          " node(s). Deleting it deletes them too: their points return to the "
+                          "pool to be segmented again. Ctrl+Z brings them back.",
+                      "Delete \"" + n->name + "\" and its " + std::to_string(descendants),
+                      remove};
 }
 
 void WorkbenchState::commit() {
@@ -120,12 +185,21 @@ void WorkbenchState::frame_whole_model() {
 void WorkbenchState::frame_selection() {
   const auto p = primary();
   const std::optional<store::ObjectNode> n = p ? node(*p) : std::nullopt;
-  if (n && n->bbox_world) {
-    navigation.frame(*n->bbox_world);
-    view_dirty = true;
-  } else {
+  if (!n || !n->bbox_world) {
     frame_whole_model();
+    return;
   }
+  // The side the node's points were seen from: their normals point towards
+  // their scanners, so their sum points out of its visible side.
+  const std::set<std::int64_t> inside = subtree(n->id);
+  const render::RenderPoints& points = session.render_model().points;
+  Eigen::Vector3d facing = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (points.node[k] != 0 && inside.count(points.node[k]))
+      facing += points.normal[k].cast<double>();
+  }
+  navigation.frame(*n->bbox_world, facing);
+  view_dirty = true;
 }
 
 }  // namespace scanbench::app::workbench

@@ -9,8 +9,10 @@
 #include <imgui.h>
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -43,6 +45,15 @@ struct Rect {
 // What a mouse drag moves.
 enum class Drag { kNone, kOrbit, kPan3d, kPanPanorama };
 
+// A question the workbench asks before an action it cannot simply take
+// back, answered in a modal window (questions_panel).
+struct Question {
+  std::string title;
+  std::string text;
+  std::string yes;  // the action's button: "Undo geometry", "Delete"
+  std::function<void()> on_yes;
+};
+
 // The colour editor's sliders.
 struct ColorSliders {
   float brightness = 0.0f, contrast = 1.0f, gamma = 1.0f, hue = 0.0f, saturation = 1.0f;
@@ -60,7 +71,8 @@ struct WorkbenchState {
   render::RenderSettings settings;
   std::unique_ptr<render::SplatRenderer> renderer;
   render::FramePlan last_plan;
-  double last_draw_ms = 0.0;
+  double last_draw_ms = 0.0;  // the last 3D draw: wall time, finished on the device
+  double last_gpu_ms = -1.0;  // ... and the device's own time (negative: unknown)
   bool view_dirty = true;
   bool fly = false;
 
@@ -90,8 +102,11 @@ struct WorkbenchState {
 
   // ---- Replays and the status bar ----------------------------------------
   std::map<std::string, std::array<float, 2>> probes;  // widgets' centres by name
+  // The window's frames: real intervals between them (live or replayed),
+  // smoothed, for the frame rate the status bar shows.
   double frame_seconds = 0.0;
   std::int64_t frames = 0;
+  std::chrono::steady_clock::time_point last_frame;
 
   std::string name_text() const { return std::string(name.data()); }
 
@@ -114,10 +129,22 @@ struct WorkbenchState {
   // A copy of node `id`: a command reloads the tree, so pointers into it do
   // not outlive one.
   std::optional<store::ObjectNode> node(std::int64_t id) const;
+  // Node `id` and every node below it.
+  std::set<std::int64_t> subtree(std::int64_t id) const;
   void select_only(std::int64_t id);
   void load_color_editor();
   // After undo or redo: a selection that is gone is dropped.
   void after_command();
+
+  // The question being asked, if any; the panels are inert until answered.
+  std::optional<Question> question;
+
+  // Ctrl+Z: takes back the workbench's own edits; before a batch stage
+  // (import, geometry, register, merge, harmonize) it asks.
+  void undo();
+  void redo();
+  // Deletes the selected node; a group with descendants only after asking.
+  void remove_selected();
 
   // A new object from the selection, in the selected group if one is; a
   // group of the selected nodes.

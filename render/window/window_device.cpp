@@ -65,7 +65,15 @@ WindowDevice::WindowDevice(int width, int height, const std::string& title)
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
+  if (width <= 0 || height <= 0) {
+    // The work area of the screen it opens on (the primary one), maximised.
+    int x = 0, y = 0;
+    width = 1280, height = 800;
+    if (GLFWmonitor* monitor = glfwGetPrimaryMonitor())
+      glfwGetMonitorWorkarea(monitor, &x, &y, &width, &height);
+    glfwWindowHint(GLFW_MAXIMIZED, GLFW_TRUE);
+  }
   window_->handle = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
   if (window_->handle == nullptr) {
     const std::string problem = glfw_error();

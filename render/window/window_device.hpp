@@ -50,9 +50,10 @@ class WindowInput {
 
 class WindowDevice final : public RenderDevice {
  public:
-  // Opens a window of width × height pixels with a 4.5 core context, made
-  // current. Throws core::RuntimeFailure when there is no display (set
-  // DISPLAY, or run under xvfb-run) or no such context.
+  // Opens a resizable window of width × height pixels (either 0: the work
+  // area of the primary screen) with a 4.5 core context, made current.
+  // Throws core::RuntimeFailure when there is no display (set DISPLAY, or
+  // run under xvfb-run) or no such context.
   WindowDevice(int width, int height, const std::string& title);
   ~WindowDevice() override;
   WindowDevice(const WindowDevice&) = delete;

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "acquisition/formats/image_decoder.hpp"
 #include "cli_runner.hpp"
 #include "support/test_support.hpp"
 
@@ -183,10 +184,254 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
       run("reparent_out", {{{"drag", {grouped.widget("node wall south"), empty}}}, {{"wait", 2}}});
   tree = nodes(dir, project);
   EXPECT_TRUE(tree[1]["parent"].is_null());
-  run("reparent_in",
-      {{{"drag", {out.widget("node wall south"), out.widget("node keller hall")}}}, {{"wait", 2}}});
+  const Layout in = run("reparent_in", {{{"drag", {out.widget("node wall south"),
+                                                    out.widget("node keller hall")}}},
+                                         {{"wait", 2}}});
   tree = nodes(dir, project);
   EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
+
+  // Deleting the group asks first: cancelled, nothing changes; confirmed,
+  // the group goes with its walls.
+  const json ask = {{{"click", in.widget("node keller hall")}},
+                    {{"click", in.widget("delete")}},
+                    {{"wait", 2}}};
+  const Layout asked = run("delete_group", ask);
+  EXPECT_EQ(nodes(dir, project).size(), 3u);
+  json cancel = ask;
+  cancel.push_back({{"click", asked.widget("question no")}});
+  cancel.push_back({{"wait", 2}});
+  run("delete_group_cancel", cancel);
+  EXPECT_EQ(nodes(dir, project).size(), 3u);
+  json confirm = ask;
+  confirm.push_back({{"click", asked.widget("question yes")}});
+  confirm.push_back({{"wait", 2}});
+  run("delete_group_confirm", confirm);
+  EXPECT_TRUE(nodes(dir, project).empty());
+}
+
+// The share of the pixels of a window region (x, y, w, h) that the second
+// screenshot shows darker than the first, by more than 30 of 255 in every
+// channel, of those that are not the 3D view's black background in both.
+double darkened_share(const std::filesystem::path& before, const std::filesystem::path& after,
+                      int x0, int y0, int w, int h) {
+  const acquisition::DecodedImage a = acquisition::decode_image(before, 800, 1280);
+  const acquisition::DecodedImage b = acquisition::decode_image(after, 800, 1280);
+  EXPECT_TRUE(a.problem.empty() && b.problem.empty()) << a.problem << b.problem;
+  if (!a.problem.empty() || !b.problem.empty()) return 0.0;
+  std::size_t drawn = 0, darker = 0;
+  const auto background = [](const cv::Vec3b& p) { return p[0] < 30 && p[1] < 30 && p[2] < 30; };
+  for (int y = y0; y < y0 + h; ++y) {
+    for (int x = x0; x < x0 + w; ++x) {
+      const cv::Vec3b& p = a.pixels.at<cv::Vec3b>(y, x);
+      const cv::Vec3b& q = b.pixels.at<cv::Vec3b>(y, x);
+      if (background(p) && background(q)) continue;
+      ++drawn;
+      darker += p[0] > q[0] + 30 && p[1] > q[1] + 30 && p[2] > q[2] + 30;
+    }
+  }
+  return drawn == 0 ? 0.0 : static_cast<double>(darker) / static_cast<double>(drawn);
+}
+
+// A wall segmented in scan 1 of a two-scan campus takes its points in scan
+// 2 too (the merge keeps many of scan 2's), so recolouring it recolours the
+// wall the 3D view shows, not only scan 1's share of it.
+TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
+  const ScratchDir dir;
+  const std::filesystem::path project = dir / "campus2.sbproj";
+  const std::vector<std::vector<std::string>> steps = {
+      {"simulate", "--site", "campus", "--scans", "2", "--columns", "900", "--rows", "225", "--out",
+       (dir / "sim").string()},
+      {"import", project.string(), (dir / "sim" / "campus_scan_01.json").string(),
+       (dir / "sim" / "campus_scan_02.json").string()},
+      {"geometry", project.string()},
+      {"merge", project.string()}};
+  for (const std::vector<std::string>& step : steps) {
+    const CliResult result = run_cli(dir, step);
+    ASSERT_EQ(result.exit_code, 0) << step.front() << ": " << result.err;
+  }
+  const std::filesystem::path layout = dir / "layout.json";
+  const auto run = [&](const std::string& stage, const json& list) {
+    const CliResult result = run_on_display(
+        dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
+              "--layout", layout.string()});
+    EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
+    return Layout{read_json(layout)};
+  };
+  const Layout start = run("carry_open", json::array());
+  const Layout committed = run("carry_commit", {{{"click", start.pixel(654, 116)}},
+                                                {{"wait", 2}},
+                                                {{"click", start.widget("name")}},
+                                                {{"key", "A"}, {"mods", {"ctrl"}}},
+                                                {{"text", "wall west"}},
+                                                {{"key", "Enter"}},
+                                                {{"wait", 2}}});
+  const json tree = nodes(dir, project);
+  ASSERT_EQ(tree.size(), 1u);
+  const json commit = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
+  const json& result = commit["commands"].back()["result"];
+  EXPECT_GT(result["other_scans_points"].get<int>(), result["points"].get<int>() / 2);
+  // Brightness near its lowest (−50), clicked at the slider's left end.
+  json brightness = committed.widget("brightness");
+  brightness[0] = brightness[0].get<double>() - 105.0;
+  run("carry_recolor", {{{"click", committed.widget("node wall west")}},
+                        {{"wait", 1}},
+                        {{"key", "F"}},
+                        {{"wait", 3}},
+                        {{"screenshot", "workbench_carry_before.png"}},
+                        {{"click", brightness}},
+                        {{"click", committed.widget("apply colour")}},
+                        {{"wait", 3}},
+                        {{"screenshot", "workbench_carry_after.png"}}});
+  keep_screenshot(dir / "workbench_carry_before.png");
+  keep_screenshot(dir / "workbench_carry_after.png");
+  // Frame puts the wall at the 3D view's centre, filling its middle: there
+  // nearly every pixel darkens (had the object only scan 1's points, the
+  // merge's share of scan 2 would stay as it was). The view's left edge
+  // shows another building, which keeps its colour.
+  const json& v = committed.data["view3d"];
+  const int x = v[0].get<int>(), y = v[1].get<int>(), w = v[2].get<int>(), h = v[3].get<int>();
+  const std::filesystem::path before = dir / "workbench_carry_before.png";
+  const std::filesystem::path after = dir / "workbench_carry_after.png";
+  EXPECT_GT(darkened_share(before, after, x + w * 43 / 100, y + h * 35 / 100, w * 14 / 100,
+                           h * 30 / 100),
+            0.8);
+  EXPECT_LT(darkened_share(before, after, x, y + h / 4, w / 10, h / 2), 0.05);
+}
+
+// The states of the journal's commands, oldest first.
+std::vector<std::string> journal(const ScratchDir& dir, const std::filesystem::path& project) {
+  const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
+  std::vector<std::string> out;
+  for (const json& c : history["commands"])
+    out.push_back(c["name"].get<std::string>() + " " + c["state"].get<std::string>());
+  return out;
+}
+
+// Ctrl+Z takes back the workbench's own edits, then stops before a batch
+// stage and asks; cancelled, nothing changes; confirmed, the stage is undone
+// and the workbench stays open without geometry, and then without scans.
+TEST(Workbench, CtrlZStopsBeforeABatchStageAndAsks) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const std::filesystem::path layout = dir / "layout.json";
+  const auto run = [&](const std::string& stage, const json& list) {
+    const std::filesystem::path shot = dir / ("workbench_" + stage + ".png");
+    const CliResult result = run_on_display(
+        dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
+              "--screenshot", shot.string(), "--layout", layout.string()});
+    EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
+    keep_screenshot(shot);
+    return Layout{read_json(layout)};
+  };
+  const Layout start = run("undo_open", json::array());
+  const json undo = {{"key", "Z"}, {"mods", {"ctrl"}}};
+  const Layout asked =
+      run("undo_question", {{{"click", start.pixel(654, 116)}}, {{"wait", 2}}, undo, undo,
+                            {{"wait", 2}}});
+  const std::vector<std::string> after_click = {"import done", "geometry done", "select undone"};
+  EXPECT_EQ(journal(dir, project), after_click);
+  run("undo_cancel", {undo, {{"wait", 2}}, {{"click", asked.widget("question no")}}, {{"wait", 1}}});
+  EXPECT_EQ(journal(dir, project), after_click);
+  run("undo_geometry",
+      {undo, {{"wait", 2}}, {{"click", asked.widget("question yes")}}, {{"wait", 2}}});
+  EXPECT_EQ(journal(dir, project),
+            (std::vector<std::string>{"import done", "geometry undone", "select undone"}));
+  // With the import undone too the project has no scans; it still opens.
+  ASSERT_EQ(run_cli(dir, {"undo", project.string()}).exit_code, 0);
+  const std::filesystem::path shot = dir / "workbench_no_scans.png";
+  const CliResult empty = run_on_display(dir, {project.string(), "--screenshot", shot.string()});
+  EXPECT_EQ(empty.exit_code, 0) << empty.err;
+  keep_screenshot(shot);
+  // Ctrl+Y there brings the import back.
+  run("redo_import", {{{"key", "Y"}, {"mods", {"ctrl"}}}, {{"wait", 2}}});
+  EXPECT_EQ(journal(dir, project).front(), "import done");
+}
+
+// A session recorded with --record and replayed on a copy of the project
+// as it was leaves the same journal: every command, its settings and state.
+TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const std::filesystem::path copy = dir / "copy.sbproj";
+  std::filesystem::copy_file(project, copy);
+  const std::filesystem::path layout = dir / "layout.json";
+  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
+                                 events(dir, "look.json", json::array()).string(), "--layout",
+                                 layout.string()})
+                .exit_code,
+            0);
+  const Layout start{read_json(layout)};
+  const json session = {{{"click", start.pixel(654, 116)}},
+                        {{"wait", 2}},
+                        {{"click", start.widget("name")}},
+                        {{"key", "A"}, {"mods", {"ctrl"}}},
+                        {{"text", "wall west"}},
+                        {{"key", "Enter"}},
+                        {{"wait", 2}},
+                        {{"click", start.pixel(617, 82)}},
+                        {{"wait", 2}},
+                        {{"key", "C"}},
+                        {{"wait", 2}},
+                        {{"key", "Z"}, {"mods", {"ctrl"}}},
+                        {{"wait", 2}}};
+  const std::filesystem::path record = dir / "recorded.json";
+  const CliResult recorded =
+      run_on_display(dir, {project.string(), "--replay", events(dir, "session.json", session).string(),
+                           "--record", record.string()});
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
+  ASSERT_TRUE(std::filesystem::exists(record));
+  const CliResult replayed =
+      run_on_display(dir, {copy.string(), "--replay", record.string()});
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  const auto commands = [&](const std::filesystem::path& file) {
+    json out = json::array();
+    const json history = json::parse(run_cli(dir, {"history", file.string(), "--json"}).out);
+    for (const json& c : history["commands"])
+      out.push_back({c["name"], c["state"], c["settings"], c["result"]});
+    return out;
+  };
+  const json original = commands(project);
+  EXPECT_EQ(original.size(), 6u);  // import, geometry, select, commit, select, commit (undone)
+  EXPECT_EQ(commands(copy), original);
+  // An existing file is never replaced by a recording.
+  const CliResult again = run_on_display(dir, {project.string(), "--record", record.string()});
+  EXPECT_EQ(again.exit_code, 2);
+  EXPECT_THAT(again.err, HasSubstr("exists"));
+}
+
+// Read-only, by flag or because nobody may write the file (root included):
+// clicks and Ctrl+Z are refused and the journal stays as it was.
+TEST(Workbench, ReadOnlyWritesNothing) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const std::filesystem::path layout = dir / "layout.json";
+  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
+                                 events(dir, "look.json", json::array()).string(), "--layout",
+                                 layout.string()})
+                .exit_code,
+            0);
+  const Layout start{read_json(layout)};
+  const json edits = {{{"click", start.pixel(654, 116)}},
+                      {{"wait", 2}},
+                      {{"key", "Z"}, {"mods", {"ctrl"}}},
+                      {{"wait", 1}}};
+  const std::vector<std::string> before = journal(dir, project);
+  const std::filesystem::path shot = dir / "workbench_read_only.png";
+  const CliResult flagged = run_on_display(
+      dir, {project.string(), "--read-only", "--replay", events(dir, "edits.json", edits).string(),
+            "--screenshot", shot.string()});
+  EXPECT_EQ(flagged.exit_code, 0) << flagged.err;
+  keep_screenshot(shot);
+  EXPECT_EQ(journal(dir, project), before);
+  std::filesystem::permissions(project, std::filesystem::perms::owner_read |
+                                            std::filesystem::perms::group_read |
+                                            std::filesystem::perms::others_read);
+  const CliResult protected_file = run_on_display(
+      dir, {project.string(), "--replay", events(dir, "edits2.json", edits).string()});
+  EXPECT_EQ(protected_file.exit_code, 0) << protected_file.err;
+  std::filesystem::permissions(project, std::filesystem::perms::owner_write,
+                               std::filesystem::perm_options::add);
+  EXPECT_EQ(journal(dir, project), before);
 }
 
 // Clicking another scan in the Scans panel opens it: the panel's list,
