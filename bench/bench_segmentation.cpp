@@ -319,6 +319,28 @@ constexpr const char* kProtocol =
     "segment (one segment may match several objects). Latency: the sessions' clicks and 400 "
     "random clicks on all channels, one thread, split at regions of 1 M pixels.";
 
+// Our sessions on scan 1 and the clicks' latency.
+nlohmann::json ours_json(const Sessions& sessions, const Clicks& clicks, double prepare_seconds) {
+  std::vector<double> all_clicks = clicks.milliseconds;
+  all_clicks.insert(all_clicks.end(), clicks.over_goal_milliseconds.begin(),
+                    clicks.over_goal_milliseconds.end());
+  return {{"objects", sessions.objects},
+          {"mean_iou", sessions.mean_iou},
+          {"objects_at_least_0_95", sessions.reached},
+          {"mean_model_iou", sessions.mean_model_iou},
+          {"mean_model_iou_transfer_only", sessions.mean_model_iou_transfer_only},
+          {"objects_model_iou_at_least_0_9", sessions.model_reached},
+          {"click_latency_ms_p50", percentile(clicks.milliseconds, 0.5)},
+          {"click_latency_ms_p95", percentile(clicks.milliseconds, 0.95)},
+          {"clicks", clicks.milliseconds.size()},
+          {"clicks_over_1m_pixels", clicks.over_goal_milliseconds.size()},
+          {"click_latency_ms_p95_over_1m_pixels",
+           percentile(clicks.over_goal_milliseconds, 0.95)},
+          {"click_latency_ms_p95_all", percentile(all_clicks, 0.95)},
+          {"largest_region_pixels", clicks.largest_region},
+          {"prepare_seconds", prepare_seconds}};
+}
+
 }  // namespace
 
 nlohmann::json run_segmentation_bench(const BenchOptions& options) {
@@ -340,24 +362,7 @@ nlohmann::json run_segmentation_bench(const BenchOptions& options) {
   segmentation::RegionGrower grower(grid);
   random_clicks(grid, grower, options.smoke ? 20 : 400, clicks);
   const double p95 = percentile(clicks.milliseconds, 0.95);
-  std::vector<double> all_clicks = clicks.milliseconds;
-  all_clicks.insert(all_clicks.end(), clicks.over_goal_milliseconds.begin(),
-                    clicks.over_goal_milliseconds.end());
-  const nlohmann::json ours = {
-      {"objects", sessions.objects},
-      {"mean_iou", sessions.mean_iou},
-      {"objects_at_least_0_95", sessions.reached},
-      {"mean_model_iou", sessions.mean_model_iou},
-      {"mean_model_iou_transfer_only", sessions.mean_model_iou_transfer_only},
-      {"objects_model_iou_at_least_0_9", sessions.model_reached},
-      {"click_latency_ms_p50", percentile(clicks.milliseconds, 0.5)},
-      {"click_latency_ms_p95", p95},
-      {"clicks", clicks.milliseconds.size()},
-      {"clicks_over_1m_pixels", clicks.over_goal_milliseconds.size()},
-      {"click_latency_ms_p95_over_1m_pixels", percentile(clicks.over_goal_milliseconds, 0.95)},
-      {"click_latency_ms_p95_all", percentile(all_clicks, 0.95)},
-      {"largest_region_pixels", clicks.largest_region},
-      {"prepare_seconds", prepare_seconds}};
+  const nlohmann::json ours = ours_json(sessions, clicks, prepare_seconds);
 
   const segmentation::SegmentationGrid held_out_grid = prepare_one_thread(site, 1);
   const Sessions held_out =

@@ -55,6 +55,10 @@ struct Walk {
       plan.hidden += points_below(index);
       return;
     }
+    if (settings.clipping.excludes(node.box)) {
+      plan.culled_clip += points_below(index);
+      return;
+    }
     if (settings.frustum && !node.box.isEmpty() && outside_frustum(planes, node.box)) {
       plan.culled_frustum += points_below(index);
       return;
@@ -65,6 +69,10 @@ struct Walk {
 
   void visit_tile(std::size_t t) {
     const RenderTile& tile = model.tiles[t];
+    if (settings.clipping.excludes(tile.box)) {
+      plan.culled_clip += tile.count;
+      return;
+    }
     if (settings.frustum && outside_frustum(planes, tile.box)) {
       plan.culled_frustum += tile.count;
       return;
@@ -82,6 +90,22 @@ struct Walk {
 };
 
 }  // namespace
+
+bool Clipping::keeps(const Eigen::Vector3f& p) const {
+  if (!box.isEmpty() && !box.contains(p)) return false;
+  return section_half_width <= 0.0f ||
+         std::abs(section_normal.dot(p) - section_offset) <= section_half_width;
+}
+
+bool Clipping::excludes(const Eigen::AlignedBox3f& b) const {
+  if (b.isEmpty()) return false;
+  if (!box.isEmpty() && !box.intersects(b)) return true;
+  if (section_half_width <= 0.0f) return false;
+  // The box's extent along the normal against the slab.
+  const float centre = section_normal.dot(b.center()) - section_offset;
+  const float reach = 0.5f * section_normal.cwiseAbs().dot(b.sizes());
+  return centre - reach > section_half_width || centre + reach < -section_half_width;
+}
 
 FramePlan plan_frame(const RenderModel& model, const RenderView& view,
                      const CullSettings& settings) {

@@ -3,7 +3,8 @@
 // it culls everything below the node) and by their normal cones (a tile all
 // of whose points face away), thinned by level of detail where their points
 // would be denser than the screen's pixels, cut to a point budget, and drawn
-// front to back. No OpenGL here: the plan is plain data, tested on its own.
+// front to back. The user's clipping box and slice cull whole nodes and
+// tiles here, and single points in the shaders. No OpenGL here: the plan is plain data, tested on its own.
 #pragma once
 
 #include <cstddef>
@@ -15,7 +16,23 @@
 
 namespace scanbench::render {
 
+// What the user limits the drawing to, in the model's frame (metres from
+// its origin): a clipping box, and a section plane with a thickness (a
+// slice). A point is drawn when it lies in both.
+struct Clipping {
+  Eigen::AlignedBox3f box;  // empty (the default): no box
+  Eigen::Vector3f section_normal = Eigen::Vector3f::UnitZ();  // unit
+  float section_offset = 0.0f;      // the plane: normal · p = offset
+  float section_half_width = 0.0f;  // the slice's half thickness; 0: no plane
+
+  bool active() const { return !box.isEmpty() || section_half_width > 0.0f; }
+  bool keeps(const Eigen::Vector3f& p) const;
+  // No point of `b` can be kept.
+  bool excludes(const Eigen::AlignedBox3f& b) const;
+};
+
 struct CullSettings {
+  Clipping clipping;
   bool frustum = true;
   bool backface = true;         // by tile normal cones (per point: the shaders)
   bool level_of_detail = true;  // thin tiles whose points are finer than lod_pixels
@@ -34,6 +51,7 @@ struct FramePlan {
   std::vector<TileDraw> draws;  // front to back
   std::size_t points = 0;       // in the model
   std::size_t submitted = 0;    // drawn
+  std::size_t culled_clip = 0;  // outside the clipping box or the slice
   std::size_t culled_frustum = 0;
   std::size_t culled_backface = 0;
   std::size_t culled_budget = 0;  // thinned by level of detail or the budget

@@ -72,6 +72,7 @@ Picture panorama_picture(const acquisition::Scan& scan, const PanoramaOverlays& 
   const std::array<float, 2> span =
       channel == PanoramaChannel::kRange ? range_span(scan) : std::array<float, 2>{0.0f, 1.0f};
   constexpr std::array<std::uint8_t, 3> kYellow = {255, 230, 40};
+  constexpr std::array<std::uint8_t, 3> kCyan = {40, 230, 255};
   for (std::size_t i = 0; i < n; ++i) {
     std::uint8_t* p = &out.rgba[4 * i];
     p[3] = 255;
@@ -81,7 +82,9 @@ Picture panorama_picture(const acquisition::Scan& scan, const PanoramaOverlays& 
     }
     channel_of(scan, overlays, channel, span, i, p);
     const std::uint32_t owner = overlays.membership.empty() ? 0 : overlays.membership[i];
-    if (owner != 0 && owner != store::kDeletedPoints) {
+    if (owner != 0 && owner == overlays.highlight) {
+      for (std::size_t c = 0; c < 3; ++c) p[c] = blend(p[c], kCyan[c], 0.7f);
+    } else if (owner != 0 && owner != store::kDeletedPoints) {
       const std::array<std::uint8_t, 3> tint = object_color(owner);
       for (std::size_t c = 0; c < 3; ++c) p[c] = blend(p[c], tint[c], 0.45f);
     }

@@ -1,7 +1,7 @@
 // A scan's panoramic image as the workbench shows it (seed 004 Fig. 2(i)):
 // one channel (colour, range, intensity or normals) with each object's
-// pixels tinted by its palette colour (object_palette.hpp) and the
-// selection being grown in yellow.
+// pixels tinted by its palette colour (object_palette.hpp), the selection
+// being grown in yellow, and one node the user picked in cyan.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,6 +27,7 @@ struct PanoramaOverlays {
   std::span<const Eigen::Vector3f> normals;   // scan frame; zero where none
   std::span<const std::uint32_t> membership;  // the owning node (0: none)
   std::span<const std::uint8_t> selection;    // non-zero: selected
+  std::uint32_t highlight = 0;  // a node whose pixels stand out (cyan); 0: none
 };
 
 // `scan`'s `channel`, scan.columns × scan.rows. Invalid pixels are dark

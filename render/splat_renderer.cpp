@@ -108,6 +108,18 @@ struct SplatRenderer::Gpu {
     uniform("u_kernel", static_cast<int>(settings.kernel));
     uniform("u_oriented", settings.oriented ? 1 : 0);
     uniform("u_depth_offset", settings.depth_offset);
+    const Clipping& clip = settings.culling.clipping;
+    uniform("u_clip_box", clip.box.isEmpty() ? 0 : 1);
+    if (!clip.box.isEmpty()) {
+      glProgramUniform3fv(program, glGetUniformLocation(program, "u_clip_min"), 1,
+                          clip.box.min().data());
+      glProgramUniform3fv(program, glGetUniformLocation(program, "u_clip_max"), 1,
+                          clip.box.max().data());
+    }
+    glProgramUniform4f(program, glGetUniformLocation(program, "u_section"),
+                       clip.section_normal.x(), clip.section_normal.y(), clip.section_normal.z(),
+                       clip.section_offset);
+    uniform("u_section_half_width", clip.section_half_width);
   }
 
   // The planned tiles into the splat target: one opaque pass, or the

@@ -29,6 +29,11 @@ uniform int u_backface;
 uniform int u_color_mode;
 uniform int u_lighting;
 uniform vec2 u_height_range;
+uniform int u_clip_box;
+uniform vec3 u_clip_min;
+uniform vec3 u_clip_max;
+uniform vec4 u_section;  // normal, offset
+uniform float u_section_half_width;  // 0: no slice
 
 out vec3 v_color;
 flat out vec3 v_center;
@@ -48,7 +53,11 @@ vec3 ramp(float t) {  // blue, cyan, green, yellow, red
 const char* const kSplatVertexBody = R"glsl(
 void main() {
   bool has_normal = dot(a_normal, a_normal) > 0.25;
-  if (u_backface == 1 && has_normal && dot(a_normal, u_eye - a_position) < 0.0) {
+  bool clipped = u_clip_box == 1 && (any(lessThan(a_position, u_clip_min)) ||
+                                     any(greaterThan(a_position, u_clip_max)));
+  clipped = clipped || (u_section_half_width > 0.0 &&
+                        abs(dot(u_section.xyz, a_position) - u_section.w) > u_section_half_width);
+  if (clipped || (u_backface == 1 && has_normal && dot(a_normal, u_eye - a_position) < 0.0)) {
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     gl_PointSize = 1.0;
     return;

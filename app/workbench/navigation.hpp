@@ -30,6 +30,7 @@ class Navigation {
   acquisition::CameraView camera(int width, int height) const;
   double speed_m_per_s() const { return speed_; }
   const Eigen::Vector3d& eye() const { return eye_; }
+  const Eigen::Vector3d& target() const { return target_; }
 
  private:
   Eigen::Vector3d forward() const;

@@ -78,7 +78,7 @@ void tree(WorkbenchState& s) {
       roots.push_back(&n);
     }
   }
-  ImGui::BeginChild("tree", ImVec2(0, 190), true);
+  ImGui::BeginChild("tree", ImVec2(0, 150), true);
   if (roots.empty()) ImGui::TextDisabled("no objects yet: click a seed, then Commit");
   for (const store::ObjectNode* root : roots) node_tree(s, *root, children);
   ImGui::EndChild();

@@ -13,6 +13,7 @@ namespace scanbench::app::workbench {
 // The project panel's sections, inside its window (workbench.cpp):
 void scans_panel(WorkbenchState& s);          // the scans; the shown one's pose
 void objects_panel(WorkbenchState& s);        // the object tree and its commands
+void proposals_panel(WorkbenchState& s);      // automatic proposals under review
 void color_panel(WorkbenchState& s);          // the selected object's colour edit
 void view_settings_panel(WorkbenchState& s);  // how the 3D view draws
 

@@ -10,13 +10,15 @@ namespace scanbench::app::workbench {
 
 namespace {
 
-// Uploads the panorama when the project, the channel or the scan changed.
+// Uploads the panorama when the project, the channel, the scan or the
+// selected node changed.
 void refresh_texture(WorkbenchState& s) {
-  const std::array<std::int64_t, 3> key = {s.session.revision(), s.panorama_channel,
-                                           s.session.scan_id()};
+  const std::int64_t highlight = s.primary().value_or(0);
+  const std::array<std::int64_t, 4> key = {s.session.revision(), s.panorama_channel,
+                                           s.session.scan_id(), highlight};
   if (key == s.panorama_key) return;
   const render::Picture picture =
-      s.session.panorama(static_cast<render::PanoramaChannel>(s.panorama_channel));
+      s.session.panorama(static_cast<render::PanoramaChannel>(s.panorama_channel), highlight);
   glBindTexture(GL_TEXTURE_2D, s.panorama_texture);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);

@@ -207,11 +207,24 @@ bool Session::separate(std::int64_t node) {
   });
 }
 
-bool Session::propose() {
+std::optional<std::int64_t> Session::propose() {
   modeling::ProposeSettings settings;
   settings.scan_id = scan_id_;
-  return act("proposed objects for the rest of the scan",
-             [&] { modeling::propose_objects(project_, settings); });
+  modeling::SeparateResult result;
+  if (!act("", [&] { result = modeling::propose_objects(project_, settings); })) return std::nullopt;
+  status_ = std::to_string(result.nodes.size()) +
+            " proposals for the rest of the scan: review them in Proposals";
+  // The group is the newest node that is not one of them.
+  std::optional<std::int64_t> group;
+  for (const store::ObjectNode& n : nodes_) {
+    if (n.kind == store::NodeKind::kGroup && (!group || n.id > *group)) group = n.id;
+  }
+  return group;
+}
+
+bool Session::merge(const std::vector<std::int64_t>& objects) {
+  return act("merged " + std::to_string(objects.size()) + " objects",
+             [&] { modeling::merge_objects(project_, {objects}); });
 }
 
 bool Session::recolor(std::int64_t node, const store::ColorEdit& set, bool reset) {
@@ -276,8 +289,9 @@ void Session::show_first_scan_again() {
   status_ = said;
 }
 
-render::Picture Session::panorama(render::PanoramaChannel channel) const {
-  return render::panorama_picture(scan_, {normal_, membership_, selection_}, channel);
+render::Picture Session::panorama(render::PanoramaChannel channel, std::int64_t highlight) const {
+  return render::panorama_picture(
+      scan_, {normal_, membership_, selection_, static_cast<std::uint32_t>(highlight)}, channel);
 }
 
 const render::RenderModel& Session::render_model() {

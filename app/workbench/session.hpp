@@ -74,7 +74,11 @@ class Session {
   bool reparent(std::int64_t node, std::optional<std::int64_t> parent);
   bool remove(std::int64_t node);
   bool separate(std::int64_t node);
-  bool propose();
+  // Automatic proposals for the rest of the shown scan: the group that
+  // holds them, none when refused.
+  std::optional<std::int64_t> propose();
+  // Merges objects into the first (modeling::merge_objects).
+  bool merge(const std::vector<std::int64_t>& objects);
   bool recolor(std::int64_t node, const store::ColorEdit& set, bool reset);
   bool clone(std::int64_t source, std::int64_t target);
   // Takes back the newest command. A batch stage (import, geometry,
@@ -92,8 +96,9 @@ class Session {
   // Changes with every change of the project the views show.
   std::int64_t revision() const { return revision_; }
 
-  // The scan's channel with the objects and the selection laid over it.
-  render::Picture panorama(render::PanoramaChannel channel) const;
+  // The scan's channel with the objects and the selection laid over it,
+  // node `highlight` (0: none) standing out.
+  render::Picture panorama(render::PanoramaChannel channel, std::int64_t highlight) const;
   // The model as the 3D view draws it, rebuilt after changes to it (not
   // after a selection, which it does not show).
   const render::RenderModel& render_model();

@@ -23,10 +23,10 @@ void status_panel(WorkbenchState& s) {
     ImGui::SameLine();
   }
   ImGui::Text(
-      "%s | selection %zu px | 3D %zu of %zu points (culled: frustum %zu, back %zu, detail %zu) | "
-      "draw %s%.0f ms wall | %s frames/s",
+      "%s | selection %zu px | 3D %zu of %zu points (culled: clip %zu, frustum %zu, back %zu, "
+      "detail %zu) | draw %s%.0f ms wall | %s frames/s",
       s.session.status().empty() ? "ready" : s.session.status().c_str(),
-      s.session.selected_pixels(), plan.submitted, plan.points, plan.culled_frustum,
+      s.session.selected_pixels(), plan.submitted, plan.points, plan.culled_clip, plan.culled_frustum,
       plan.culled_backface, plan.culled_budget, gpu.c_str(), s.last_draw_ms, rate);
   ImGui::End();
 }

@@ -65,7 +65,10 @@ void commands_row(WorkbenchState& s) {
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(read_only || !s.session.missing().empty());
-  if (ImGui::Button("Automatic proposals")) s.session.propose();
+  if (ImGui::Button("Automatic proposals")) {
+    s.review_group = s.session.propose();
+    s.after_command();
+  }
   s.probe("propose");
   ImGui::EndDisabled();
   ImGui::SameLine();

@@ -17,6 +17,7 @@ void redraw(WorkbenchState& s, int width, int height) {
     s.renderer = std::make_unique<render::SplatRenderer>(s.session.render_model());
     s.view_dirty = true;
   }
+  s.apply_clipping();
   if (!s.view_dirty) return;
   const render::RenderView view =
       render::make_render_view(s.navigation.camera(width, height), s.session.render_model().origin);

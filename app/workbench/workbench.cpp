@@ -134,6 +134,7 @@ class Workbench {
     ImGui::Begin("Project", nullptr, kFixedWindow);
     scans_panel(state_);
     objects_panel(state_);
+    proposals_panel(state_);
     color_panel(state_);
     view_settings_panel(state_);
     ImGui::End();

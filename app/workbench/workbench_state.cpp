@@ -12,6 +12,11 @@ WorkbenchState::WorkbenchState(const WorkbenchOptions& options, render::WindowDe
       window(window),
       session(options.project, options.read_only || Session::cannot_write(options.project)) {
   settings.culling.budget = 1'500'000;
+  // Proposals left in their group by an earlier session are still to review.
+  const std::string proposals = modeling::ProposeSettings{}.group_name;
+  for (const store::ObjectNode& n : session.nodes()) {
+    if (n.kind == store::NodeKind::kGroup && n.name == proposals) review_group = n.id;
+  }
 }
 
 void WorkbenchState::layout(int width, int height) {
@@ -199,6 +204,43 @@ void WorkbenchState::frame_selection() {
       facing += points.normal[k].cast<double>();
   }
   navigation.frame(*n->bbox_world, facing);
+  view_dirty = true;
+}
+
+void WorkbenchState::clip_to_selection() {
+  const auto p = primary();
+  const std::optional<store::ObjectNode> n = p ? node(*p) : std::nullopt;
+  if (!n || !n->bbox_world) return;
+  const Eigen::Vector3d margin = 0.05 * n->bbox_world->sizes();
+  for (int a = 0; a < 3; ++a) {
+    clip_min[static_cast<std::size_t>(a)] = n->bbox_world->min()[a] - margin[a];
+    clip_max[static_cast<std::size_t>(a)] = n->bbox_world->max()[a] + margin[a];
+  }
+  clip_on = true;
+  view_dirty = true;
+}
+
+void WorkbenchState::apply_clipping() {
+  const Eigen::Vector3d origin = session.render_model().origin;
+  render::Clipping clipping;
+  if (clip_on) {
+    const Eigen::Vector3d low(clip_min[0], clip_min[1], clip_min[2]);
+    const Eigen::Vector3d high(clip_max[0], clip_max[1], clip_max[2]);
+    clipping.box = Eigen::AlignedBox3f((low - origin).cast<float>(), (high - origin).cast<float>());
+  }
+  if (slice_on) {
+    clipping.section_normal = Eigen::Vector3f::Unit(slice_axis);
+    clipping.section_offset = static_cast<float>(slice_at - origin[slice_axis]);
+    clipping.section_half_width = 0.5f * std::max(slice_thickness, 0.001f);
+  }
+  render::Clipping& current = settings.culling.clipping;
+  const bool same = current.box.min() == clipping.box.min() &&
+                    current.box.max() == clipping.box.max() &&
+                    current.section_normal == clipping.section_normal &&
+                    current.section_offset == clipping.section_offset &&
+                    current.section_half_width == clipping.section_half_width;
+  if (same) return;
+  current = clipping;
   view_dirty = true;
 }
 

@@ -76,6 +76,15 @@ struct WorkbenchState {
   bool view_dirty = true;
   bool fly = false;
 
+  // ---- What the 3D view draws: a clipping box and a slice (world [m]) ----
+  bool clip_on = false;
+  std::array<double, 3> clip_min = {0.0, 0.0, 0.0};
+  std::array<double, 3> clip_max = {0.0, 0.0, 0.0};
+  bool slice_on = false;
+  int slice_axis = 2;  // across x, y or z
+  double slice_at = 0.0;
+  float slice_thickness = 0.5f;
+
   // ---- Layout and the panoramic view ------------------------------------
   Rect panorama;
   Rect view3d;
@@ -83,7 +92,7 @@ struct WorkbenchState {
   std::array<float, 2> pan = {0.0f, 0.0f};
   int panorama_channel = 0;  // PanoramaChannel
   unsigned panorama_texture = 0;
-  std::array<std::int64_t, 3> panorama_key = {-1, -1, -1};  // what the texture shows
+  std::array<std::int64_t, 4> panorama_key = {-1, -1, -1, -1};  // what the texture shows
 
   // ---- Input --------------------------------------------------------------
   std::set<int> held;  // keys down
@@ -136,6 +145,9 @@ struct WorkbenchState {
   // After undo or redo: a selection that is gone is dropped.
   void after_command();
 
+  // The group of automatic proposals under review (proposals_panel).
+  std::optional<std::int64_t> review_group;
+
   // The question being asked, if any; the panels are inert until answered.
   std::optional<Question> question;
 
@@ -157,6 +169,11 @@ struct WorkbenchState {
   void frame_whole_model();
   // Frames the selected node, or the whole model.
   void frame_selection();
+  // The clipping box around the selected node (5 % wider), switched on.
+  void clip_to_selection();
+  // The box and slice above into the renderer's settings, relative to the
+  // model's origin (the 3D view calls it once its model is current).
+  void apply_clipping();
 };
 
 }  // namespace scanbench::app::workbench

@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -90,19 +91,26 @@ void keep_screenshot(const std::filesystem::path& file) {
                              std::filesystem::copy_options::overwrite_existing);
 }
 
+// Replays `list` on `project` as stage `stage`: its screenshot
+// (workbench_STAGE.png, kept for the user guide) and the layout it leaves.
+Layout run_stage(const ScratchDir& dir, const std::filesystem::path& project,
+                 const std::string& stage, const json& list) {
+  const std::filesystem::path layout = dir / ("layout_" + stage + ".json");
+  const std::filesystem::path shot = dir / ("workbench_" + stage + ".png");
+  const CliResult result = run_on_display(
+      dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
+            "--screenshot", shot.string(), "--layout", layout.string()});
+  EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
+  EXPECT_TRUE(std::filesystem::exists(shot)) << stage;
+  keep_screenshot(shot);
+  return Layout{read_json(layout)};
+}
+
 TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
   const auto run = [&](const std::string& stage, const json& list) {
-    const std::filesystem::path layout = dir / ("layout_" + stage + ".json");
-    const std::filesystem::path shot = dir / ("workbench_" + stage + ".png");
-    const CliResult result = run_on_display(
-        dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
-              "--screenshot", shot.string(), "--layout", layout.string()});
-    EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
-    EXPECT_TRUE(std::filesystem::exists(shot)) << stage;
-    keep_screenshot(shot);
-    return Layout{read_json(layout)};
+    return run_stage(dir, project, stage, list);
   };
 
   // Opening the project: the panels and views laid out.
@@ -209,9 +217,14 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_TRUE(nodes(dir, project).empty());
 }
 
+// Whether a screenshot's pixel (B, G, R) is the 3D view's background.
+bool background(const cv::Vec3b& p) {
+  return std::abs(p[0] - 36) <= 3 && std::abs(p[1] - 31) <= 3 && std::abs(p[2] - 28) <= 3;
+}
+
 // The share of the pixels of a window region (x, y, w, h) that the second
 // screenshot shows darker than the first, by more than 30 of 255 in every
-// channel, of those that are not the 3D view's black background in both.
+// channel, of those that are not the 3D view's background in both.
 double darkened_share(const std::filesystem::path& before, const std::filesystem::path& after,
                       int x0, int y0, int w, int h) {
   const acquisition::DecodedImage a = acquisition::decode_image(before, 800, 1280);
@@ -219,7 +232,6 @@ double darkened_share(const std::filesystem::path& before, const std::filesystem
   EXPECT_TRUE(a.problem.empty() && b.problem.empty()) << a.problem << b.problem;
   if (!a.problem.empty() || !b.problem.empty()) return 0.0;
   std::size_t drawn = 0, darker = 0;
-  const auto background = [](const cv::Vec3b& p) { return p[0] < 30 && p[1] < 30 && p[2] < 30; };
   for (int y = y0; y < y0 + h; ++y) {
     for (int x = x0; x < x0 + w; ++x) {
       const cv::Vec3b& p = a.pixels.at<cv::Vec3b>(y, x);
@@ -230,6 +242,21 @@ double darkened_share(const std::filesystem::path& before, const std::filesystem
     }
   }
   return drawn == 0 ? 0.0 : static_cast<double>(darker) / static_cast<double>(drawn);
+}
+
+// The share of a window region's pixels the 3D view drew (not its
+// background).
+double drawn_share(const std::filesystem::path& picture, int x0, int y0, int w, int h) {
+  const acquisition::DecodedImage a = acquisition::decode_image(picture, 800, 1280);
+  EXPECT_TRUE(a.problem.empty()) << a.problem;
+  if (!a.problem.empty()) return 0.0;
+  std::size_t drawn = 0;
+  for (int y = y0; y < y0 + h; ++y) {
+    for (int x = x0; x < x0 + w; ++x) {
+      drawn += !background(a.pixels.at<cv::Vec3b>(y, x));
+    }
+  }
+  return static_cast<double>(drawn) / static_cast<double>(w * h);
 }
 
 // A wall segmented in scan 1 of a two-scan campus takes its points in scan
@@ -249,13 +276,8 @@ TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
     const CliResult result = run_cli(dir, step);
     ASSERT_EQ(result.exit_code, 0) << step.front() << ": " << result.err;
   }
-  const std::filesystem::path layout = dir / "layout.json";
   const auto run = [&](const std::string& stage, const json& list) {
-    const CliResult result = run_on_display(
-        dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
-              "--layout", layout.string()});
-    EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
-    return Layout{read_json(layout)};
+    return run_stage(dir, project, stage, list);
   };
   const Layout start = run("carry_open", json::array());
   const Layout committed = run("carry_commit", {{{"click", start.pixel(654, 116)}},
@@ -296,6 +318,19 @@ TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
                            h * 30 / 100),
             0.8);
   EXPECT_LT(darkened_share(before, after, x, y + h / 4, w / 10, h / 2), 0.05);
+
+  // The clipping box around the wall leaves the other building out.
+  const Layout clipped = run("carry_clip", {{{"click", committed.widget("node wall west")}},
+                                            {{"wait", 1}},
+                                            {{"key", "F"}},
+                                            {{"click", committed.widget("clip to selection")}},
+                                            {{"wait", 3}},
+                                            {{"screenshot", "workbench_clip.png"}}});
+  keep_screenshot(dir / "workbench_clip.png");
+  const std::filesystem::path clip = dir / "workbench_clip.png";
+  EXPECT_GT(drawn_share(after, x, y + h / 4, w / 10, h / 2), 0.5);
+  EXPECT_LT(drawn_share(clip, x, y + h / 4, w / 10, h / 2), 0.02);
+  EXPECT_GT(drawn_share(clip, x + w * 43 / 100, y + h * 35 / 100, w * 14 / 100, h * 30 / 100), 0.9);
 }
 
 // The states of the journal's commands, oldest first.
@@ -313,15 +348,8 @@ std::vector<std::string> journal(const ScratchDir& dir, const std::filesystem::p
 TEST(Workbench, CtrlZStopsBeforeABatchStageAndAsks) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const std::filesystem::path layout = dir / "layout.json";
   const auto run = [&](const std::string& stage, const json& list) {
-    const std::filesystem::path shot = dir / ("workbench_" + stage + ".png");
-    const CliResult result = run_on_display(
-        dir, {project.string(), "--replay", events(dir, stage + ".json", list).string(),
-              "--screenshot", shot.string(), "--layout", layout.string()});
-    EXPECT_EQ(result.exit_code, 0) << stage << ": " << result.err;
-    keep_screenshot(shot);
-    return Layout{read_json(layout)};
+    return run_stage(dir, project, stage, list);
   };
   const Layout start = run("undo_open", json::array());
   const json undo = {{"key", "Z"}, {"mods", {"ctrl"}}};
@@ -345,6 +373,47 @@ TEST(Workbench, CtrlZStopsBeforeABatchStageAndAsks) {
   // Ctrl+Y there brings the import back.
   run("redo_import", {{{"key", "Y"}, {"mods", {"ctrl"}}}, {{"wait", 2}}});
   EXPECT_EQ(journal(dir, project).front(), "import done");
+}
+
+// Automatic proposals open as a list to review: one accepted under a name,
+// one rejected (its points back to the pool), two merged.
+TEST(Workbench, ProposalsAreReviewedOneByOne) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const auto run = [&](const std::string& stage, const json& list) {
+    return run_stage(dir, project, stage, list);
+  };
+  const auto count = [&] { return nodes(dir, project).size(); };
+  const Layout start = run("proposals_open", json::array());
+  const Layout proposed =
+      run("proposals", {{{"click", start.widget("propose")}}, {{"wait", 3}}});
+  const std::size_t made = count();
+  ASSERT_GE(made, 5u);  // the group and its proposals
+  const Layout accepted = run("proposal_accept", {{{"click", proposed.widget("proposal proposal 1")}},
+                                                  {{"wait", 2}},
+                                                  {{"click", proposed.widget("name")}},
+                                                  {{"key", "A"}, {"mods", {"ctrl"}}},
+                                                  {{"text", "north hall"}},
+                                                  {{"click", proposed.widget("accept proposal")}},
+                                                  {{"wait", 2}}});
+  json tree = nodes(dir, project);
+  const auto accepted_node = std::find_if(tree.begin(), tree.end(),
+                                 [](const json& n) { return n["name"] == "north hall"; });
+  ASSERT_NE(accepted_node, tree.end());
+  EXPECT_TRUE((*accepted_node)["parent"].is_null());
+  EXPECT_EQ(count(), made);
+  const Layout rejected = run("proposal_reject", {{{"click", accepted.widget("proposal proposal 2")}},
+                                                  {{"wait", 2}},
+                                                  {{"click", accepted.widget("reject proposal")}},
+                                                  {{"wait", 2}}});
+  EXPECT_EQ(count(), made - 1);
+  run("proposal_merge", {{{"click", rejected.widget("proposal proposal 3")}},
+                         {{"wait", 1}},
+                         {{"click", rejected.widget("proposal proposal 4")}, {"mods", {"ctrl"}}},
+                         {{"wait", 1}},
+                         {{"click", rejected.widget("merge proposals")}},
+                         {{"wait", 2}}});
+  EXPECT_EQ(count(), made - 2);
 }
 
 // A session recorded with --record and replayed on a copy of the project

@@ -44,6 +44,35 @@ TEST(FramePlan, BehindTheCameraOrFacingAwayIsCulled) {
       4800u);
 }
 
+// A clipping box or slice away from the wall culls all of it, counted as
+// clipped; one across it keeps the tiles it touches; a point's own test
+// decides at the box's faces and the slab's.
+TEST(FramePlan, TheClippingBoxAndSliceCullWhatLiesOutside) {
+  const RenderModel model = test::wall_model();
+  const RenderView view =
+      make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 640, 480), kOrigin);
+  CullSettings away;
+  away.clipping.box = Eigen::AlignedBox3f(Eigen::Vector3f(20, -5, -5), Eigen::Vector3f(30, 5, 5));
+  FramePlan plan = plan_frame(model, view, away);
+  EXPECT_EQ(plan.culled_clip, 4800u);
+  EXPECT_TRUE(plan.draws.empty());
+  CullSettings slice;
+  slice.clipping.section_offset = 10.0f;  // z = 10 m, far above the 3 m wall
+  slice.clipping.section_half_width = 0.5f;
+  EXPECT_EQ(plan_frame(model, view, slice).culled_clip, 4800u);
+  CullSettings across;
+  across.clipping.box = Eigen::AlignedBox3f(Eigen::Vector3f(9, 0, -1), Eigen::Vector3f(11, 3, 4));
+  plan = plan_frame(model, view, across);
+  EXPECT_GT(plan.culled_clip, 0u);
+  EXPECT_LT(plan.culled_clip, 4800u);
+  EXPECT_EQ(plan.culled_clip + plan.submitted, 4800u);
+  EXPECT_TRUE(across.clipping.keeps({10.0f, 1.0f, 1.0f}));
+  EXPECT_FALSE(across.clipping.keeps({10.0f, -1.0f, 1.0f}));
+  slice.clipping.section_offset = 1.5f;
+  EXPECT_TRUE(slice.clipping.keeps({10.0f, 0.0f, 1.9f}));
+  EXPECT_FALSE(slice.clipping.keeps({10.0f, 0.0f, 2.1f}));
+}
+
 TEST(FramePlan, HiddenObjectsAreSkippedAndCounted) {
   const RenderModel model = test::wall_model(true);
   const FramePlan plan =

@@ -188,6 +188,37 @@ TEST(SplatRenderer, HiddenObjectsAreNotDrawn) {
   EXPECT_GT(inside_the_wall(image).red_left, 0.99);
 }
 
+// A clipping box around the left half draws only it; a slice 1 m thick
+// through the wall's middle draws only that band (the wall spans 3 m, rows
+// 106…374: the band lies within rows 150…330).
+TEST(SplatRenderer, AClippingBoxAndASliceLimitWhatIsDrawn) {
+  const RenderModel model = test::wall_model();
+  RenderSettings boxed;
+  boxed.culling.clipping.box = Eigen::AlignedBox3f(Eigen::Vector3f(9.0f, 0.0f, -1.0f),
+                                                   Eigen::Vector3f(11.0f, 3.0f, 4.0f));
+  const RenderedImage left = render(model, boxed);
+  std::size_t right = 0;
+  for (int y = 116; y < 364; ++y) {
+    for (int x = 340; x < 489; ++x) right += left.covered(x, y);
+  }
+  EXPECT_EQ(right, 0u);
+  EXPECT_GT(inside_the_wall(left).red_left, 0.99);
+
+  RenderSettings sliced;
+  sliced.culling.clipping.section_normal = Eigen::Vector3f::UnitZ();
+  sliced.culling.clipping.section_offset = 1.5f;
+  sliced.culling.clipping.section_half_width = 0.5f;
+  const RenderedImage band = render(model, sliced);
+  std::size_t outside = 0, inside = 0, pixels = 0;
+  for (int x = 151; x < 489; ++x) {
+    for (int y = 116; y < 140; ++y) outside += band.covered(x, y);
+    for (int y = 360; y < 364; ++y) outside += band.covered(x, y);
+    for (int y = 200; y < 280; ++y, ++pixels) inside += band.covered(x, y);
+  }
+  EXPECT_EQ(outside, 0u);
+  EXPECT_EQ(inside, pixels);
+}
+
 TEST(SplatRenderer, TheBackOfTheWallIsCulledUnlessAskedFor) {
   const RenderModel model = test::wall_model();
   const Eigen::Vector3d behind(1020.0, 2000.0, 1.5);
