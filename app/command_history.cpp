@@ -99,6 +99,11 @@ std::string summary(const store::CommandRecord& c) {
     return fmt::format("{} colour pairs, mean ΔE {:.2f} → {:.2f}", result.value("pairs", 0),
                        result.value("delta_e_before", 0.0), result.value("delta_e_after", 0.0));
   }
+  if (c.name == "measure" && result.contains("measurements")) {
+    return fmt::format("{}: {} measurement(s)",
+                       core::one_line(settings.value("what", ""), core::kMaxMessagePart),
+                       result["measurements"].size());
+  }
   if (c.name == "delete" && result.contains("nodes")) {
     return fmt::format("{} node(s), points to the {}", result["nodes"].size(),
                        settings.value("points", "pool") == "pool" ? "pool" : "deleted");

@@ -32,6 +32,7 @@ void add_merge_command(CLI::App& app);
 void add_history_commands(CLI::App& app);
 void add_check_command(CLI::App& app);
 void add_objects_command(CLI::App& app);
+void add_measurements_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_recolor_command(CLI::App& app);

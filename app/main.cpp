@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
   sb::add_render_command(app);
   sb::add_workbench_command(app);
   sb::add_objects_command(app);
+  sb::add_measurements_command(app);
   sb::add_check_command(app);
   sb::add_simulate_command(app);
 #ifdef SCANBENCH_WITH_BENCH

@@ -61,7 +61,11 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
   set_mods(pressed ? mods : 0);
   if (button >= 0 && button < 5) io.MouseDown[button] = pressed;
   if (!pressed) {
+    // Measuring, a left click that did not drag picks a point.
+    const bool clicked = s.drag == Drag::kOrbit && button == 0 &&
+                         std::hypot(s.cursor[0] - s.press_at[0], s.cursor[1] - s.press_at[1]) < 3.0;
     s.drag = Drag::kNone;
+    if (clicked && s.measuring && !s.fly) s.pick_at(s.cursor[0], s.cursor[1]);
     return;
   }
   if (io.WantCaptureMouse) return;  // the panels have it
@@ -75,6 +79,7 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
     }
   } else if (s.view3d.contains(x, y)) {
     s.drag = button == 0 ? Drag::kOrbit : Drag::kPan3d;
+    s.press_at = s.cursor;
   }
 }
 
@@ -141,6 +146,7 @@ void WorkbenchInput::shortcut(int key, int mods) {
       s.session.tool = Tool::kBarrier;
       break;
     case keys::kEnter:
+      if (s.measuring) s.finish_measurement();
       s.session.finish_polyline();
       break;
     case keys::kEscape:
@@ -154,6 +160,10 @@ void WorkbenchInput::shortcut(int key, int mods) {
       break;
     case 'F':
       s.frame_selection();
+      break;
+    case 'M':
+      s.measuring = !s.measuring;
+      s.picks.clear();
       break;
     case 'V':
       s.fly = !s.fly;

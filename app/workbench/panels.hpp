@@ -16,6 +16,7 @@ void objects_panel(WorkbenchState& s);        // the object tree and its command
 void proposals_panel(WorkbenchState& s);      // automatic proposals under review
 void color_panel(WorkbenchState& s);          // the selected object's colour edit
 void view_settings_panel(WorkbenchState& s);  // how the 3D view draws
+void measure_panel(WorkbenchState& s);        // clip box, slice; measurements: picks, list, CSV
 
 // Windows of their own:
 void toolbar_panel(WorkbenchState& s);  // tools, channel, tolerance, name, commit, undo
@@ -26,6 +27,8 @@ void questions_panel(WorkbenchState& s);  // the question being asked, modal
 // want it (input.hpp).
 void panorama_view(WorkbenchState& s);
 void view_3d(WorkbenchState& s);
+// The measurements and the points being picked, over the 3D view.
+void measurement_overlay(WorkbenchState& s, ImDrawList* draw);
 
 // A fixed window at (x, y) of w × h pixels.
 inline void place_window(float x, float y, float w, float h) {

@@ -5,7 +5,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
+#include "modeling/export_command.hpp"
 #include "modeling/store/layer_store.hpp"
 #include "modeling/store/typed_layers.hpp"
 
@@ -97,6 +99,7 @@ bool Session::act(const std::string& what, Action&& action, bool changes_model) 
 void Session::reload() {
   scans_ = project_.scans();
   nodes_ = project_.object_nodes();
+  measurements_ = modeling::load_measurements(project_);
   membership_.clear();
   selection_.clear();
   if (has_scan()) {
@@ -220,6 +223,31 @@ std::optional<std::int64_t> Session::propose() {
     if (n.kind == store::NodeKind::kGroup && (!group || n.id > *group)) group = n.id;
   }
   return group;
+}
+
+bool Session::save_measurements(const std::vector<modeling::Measurement>& list,
+                                const std::string& what) {
+  return act(what, [&] { modeling::save_measurements(project_, list, what); }, false);
+}
+
+bool Session::export_measurements(const std::filesystem::path& file) {
+  try {
+    // The project and its scans' sources are never replaced; an earlier
+    // export is (the field names it).
+    const std::filesystem::path outputs[] = {file};
+    modeling::refuse_to_replace_inputs(project_, outputs, true);
+    acquisition::OutputFile out(file);
+    out.write(modeling::measurements_csv(measurements_));
+    out.commit();
+  } catch (const core::InputError& e) {
+    status_ = "refused: " + e.problem();
+    return false;
+  } catch (const core::RuntimeFailure& e) {
+    status_ = "failed: " + e.problem();
+    return false;
+  }
+  status_ = "wrote " + std::to_string(measurements_.size()) + " measurements to " + file.string();
+  return true;
 }
 
 bool Session::merge(const std::vector<std::int64_t>& objects) {

@@ -14,6 +14,7 @@
 
 #include "acquisition/scan.hpp"
 #include "modeling/color_commands.hpp"
+#include "modeling/measurements.hpp"
 #include "modeling/selection_commands.hpp"
 #include "modeling/selection_tools.hpp"
 #include "modeling/store/project.hpp"
@@ -90,6 +91,14 @@ class Session {
                                            std::optional<std::int64_t> only = std::nullopt);
   bool redo();
 
+  // The project's measurements (modeling/measurements.hpp), and a new list
+  // of them saved as one command; false (and status()) when refused.
+  const std::vector<modeling::Measurement>& measurements() const { return measurements_; }
+  bool save_measurements(const std::vector<modeling::Measurement>& list, const std::string& what);
+  // Writes them as CSV (modeling::measurements_csv) to `file`, whole or not
+  // at all; false (and status()) when it cannot.
+  bool export_measurements(const std::filesystem::path& file);
+
   const std::vector<store::ObjectNode>& nodes() const { return nodes_; }
   // What the last action did or why it was refused.
   const std::string& status() const { return status_; }
@@ -103,6 +112,12 @@ class Session {
   // after a selection, which it does not show).
   const render::RenderModel& render_model();
   bool render_model_stale() const { return !model_ || model_revision_ != model_changes_; }
+  // The model's origin without building it (the 3D view builds it), for
+  // drawing over the view.
+  bool has_render_model() const { return model_.has_value(); }
+  Eigen::Vector3d render_model_origin() const {
+    return model_ ? model_->origin : Eigen::Vector3d::Zero();
+  }
   // Why the 3D view is empty (a scan without geometry); empty when it is not.
   const std::string& render_model_problem() const { return model_problem_; }
 
@@ -128,6 +143,7 @@ class Session {
   std::size_t selected_ = 0;
   modeling::SelectionTools tools_;
   std::vector<store::ObjectNode> nodes_;
+  std::vector<modeling::Measurement> measurements_;
   std::string status_;
   std::int64_t revision_ = 0;
   std::optional<render::RenderModel> model_;

@@ -44,6 +44,9 @@ void view_3d(WorkbenchState& s) {
   draw->AddText(ImVec2(r.x + 8, r.y + 6), IM_COL32(255, 255, 255, 200),
                 s.fly ? "walk/fly: W A S D Q E, drag to look"
                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
+  draw->PushClipRect(ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h), true);
+  measurement_overlay(s, draw);
+  draw->PopClipRect();
   const std::string& problem = s.session.render_model_problem();
   if (!problem.empty()) {
     const std::string text = "nothing to draw: " + problem;

@@ -2,41 +2,9 @@
 
 namespace scanbench::app::workbench {
 
-namespace {
-
-// The clipping box and the slice, in world coordinates.
-void clip_settings(WorkbenchState& s) {
-  ImGui::Checkbox("clip box", &s.clip_on);
-  s.probe("clip box");
-  ImGui::SameLine();
-  ImGui::BeginDisabled(!s.primary());
-  if (ImGui::Button("to selection")) s.clip_to_selection();
-  s.probe("clip to selection");
-  ImGui::EndDisabled();
-  if (s.clip_on) {
-    ImGui::DragScalarN("min", ImGuiDataType_Double, s.clip_min.data(), 3, 0.05f, nullptr, nullptr,
-                       "%.2f");
-    ImGui::DragScalarN("max", ImGuiDataType_Double, s.clip_max.data(), 3, 0.05f, nullptr, nullptr,
-                       "%.2f");
-  }
-  if (ImGui::Checkbox("slice", &s.slice_on) && s.slice_on)
-    s.slice_at = s.navigation.target()[s.slice_axis];
-  s.probe("slice");
-  if (s.slice_on) {
-    ImGui::SameLine();
-    ImGui::SetNextItemWidth(60);
-    ImGui::Combo("across", &s.slice_axis, "x\0y\0z\0");
-    ImGui::DragScalar("at [m]", ImGuiDataType_Double, &s.slice_at, 0.05f, nullptr, nullptr,
-                      "%.2f");
-    ImGui::SliderFloat("thickness [m]", &s.slice_thickness, 0.05f, 20.0f, "%.2f",
-                       ImGuiSliderFlags_Logarithmic);
-  }
-}
-
-}  // namespace
-
 void view_settings_panel(WorkbenchState& s) {
-  if (!ImGui::CollapsingHeader("3D view", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  // Closed at first: the sections below it stay in a 800-pixel window.
+  if (!ImGui::CollapsingHeader("3D view")) return;
   render::RenderSettings& settings = s.settings;
   bool changed = false;
   int kernel = static_cast<int>(settings.kernel);
@@ -66,7 +34,6 @@ void view_settings_panel(WorkbenchState& s) {
   s.fly = navigation == 1;
   ImGui::Text("speed %.1f m/s", s.navigation.speed_m_per_s());
   if (changed) s.view_dirty = true;
-  clip_settings(s);
 }
 
 }  // namespace scanbench::app::workbench

@@ -137,6 +137,7 @@ class Workbench {
     proposals_panel(state_);
     color_panel(state_);
     view_settings_panel(state_);
+    measure_panel(state_);
     ImGui::End();
   }
 

@@ -5,6 +5,8 @@
 #include <set>
 #include <vector>
 
+#include "render/pick.hpp"
+
 namespace scanbench::app::workbench {
 
 WorkbenchState::WorkbenchState(const WorkbenchOptions& options, render::WindowDevice& window)
@@ -242,6 +244,46 @@ void WorkbenchState::apply_clipping() {
   if (same) return;
   current = clipping;
   view_dirty = true;
+}
+
+void WorkbenchState::pick_at(double x, double y) {
+  const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
+  const render::RenderModel& model = session.render_model();
+  const render::RenderView view =
+      render::make_render_view(navigation.camera(w, h), model.origin);
+  const std::optional<render::Pick> pick =
+      render::pick_point(model, view.eye, render::pixel_ray(view, x - view3d.x, y - view3d.y),
+                         settings.culling.clipping, settings.splat_scale);
+  if (!pick) return;
+  picks.push_back(model.origin + pick->position.cast<double>());
+  const auto kind = static_cast<modeling::MeasureKind>(measure_kind);
+  if (!modeling::takes_more_points(kind) && picks.size() >= modeling::points_needed(kind))
+    finish_measurement();
+}
+
+void WorkbenchState::finish_measurement() {
+  const auto kind = static_cast<modeling::MeasureKind>(measure_kind);
+  if (picks.size() < modeling::points_needed(kind)) return;
+  std::vector<modeling::Measurement> list = session.measurements();
+  std::size_t same_kind = 1;
+  for (const modeling::Measurement& m : list) same_kind += m.kind == kind;
+  const std::string name =
+      std::string(modeling::measure_kind_name(kind)) + " " + std::to_string(same_kind);
+  list.push_back({name, kind, picks});
+  picks.clear();
+  session.save_measurements(list, "measured " + name);
+}
+
+std::optional<ImVec2> WorkbenchState::screen_of(const Eigen::Vector3d& p) const {
+  const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
+  if (w <= 0 || h <= 0 || !session.has_render_model()) return std::nullopt;
+  const render::RenderView view =
+      render::make_render_view(navigation.camera(w, h), session.render_model_origin());
+  const Eigen::Vector4f model((p - session.render_model_origin()).cast<float>().homogeneous());
+  const Eigen::Vector4f clip = view.projection * view.view * model;
+  if (clip.w() <= 1e-6f) return std::nullopt;
+  const float nx = clip.x() / clip.w(), ny = clip.y() / clip.w();
+  return ImVec2(view3d.x + 0.5f * (nx + 1.0f) * view3d.w, view3d.y + 0.5f * (1.0f - ny) * view3d.h);
 }
 
 }  // namespace scanbench::app::workbench

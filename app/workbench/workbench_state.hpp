@@ -19,6 +19,7 @@
 #include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "app/workbench/navigation.hpp"
 #include "app/workbench/session.hpp"
@@ -84,6 +85,13 @@ struct WorkbenchState {
   int slice_axis = 2;  // across x, y or z
   double slice_at = 0.0;
   float slice_thickness = 0.5f;
+
+  // ---- Measuring: left clicks in the 3D view pick points ----------------
+  bool measuring = false;
+  int measure_kind = 1;  // modeling::MeasureKind
+  std::vector<Eigen::Vector3d> picks;  // world [m], of the measurement being taken
+  std::array<double, 2> press_at = {0.0, 0.0};  // where the left button went down
+  std::array<char, 260> csv_path{};             // where Export CSV writes
 
   // ---- Layout and the panoramic view ------------------------------------
   Rect panorama;
@@ -169,6 +177,14 @@ struct WorkbenchState {
   void frame_whole_model();
   // Frames the selected node, or the whole model.
   void frame_selection();
+  // Measuring: the point of the model drawn under window point (x, y) of
+  // the 3D view joins the measurement being taken, which is saved once it
+  // has its points (an area: on finish_measurement).
+  void pick_at(double x, double y);
+  void finish_measurement();
+  // Window point of world point `p` in the 3D view; none behind the eye.
+  std::optional<ImVec2> screen_of(const Eigen::Vector3d& p) const;
+
   // The clipping box around the selected node (5 % wider), switched on.
   void clip_to_selection();
   // The box and slice above into the renderer's settings, relative to the

@@ -416,6 +416,60 @@ TEST(Workbench, ProposalsAreReviewedOneByOne) {
   EXPECT_EQ(count(), made - 2);
 }
 
+// Measuring: with "measure" on, two clicks in the 3D view pick two points
+// of the model and save a distance; the project keeps it (a "measure"
+// command), and Export CSV writes it.
+TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const Layout start = run_stage(dir, project, "measure_open", json::array());
+  const json centre = start.view3d_centre();
+  const json aside = {centre[0].get<double>() + 80.0, centre[1].get<double>() + 40.0};
+  run_stage(dir, project, "measure",
+                                    {{{"click", start.widget("measure")}},
+                                     {{"wait", 1}},
+                                     {{"click", centre}},
+                                     {{"wait", 2}},
+                                     {{"click", aside}},
+                                     {{"wait", 2}}});
+  const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
+  const json& last = history["commands"].back();
+  ASSERT_EQ(last["name"], "measure");
+  const json& list = last["result"]["measurements"];
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_EQ(list[0]["kind"], "distance");
+  ASSERT_EQ(list[0]["points"].size(), 2u);
+  double squared = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = list[0]["points"][1][a].get<double>() - list[0]["points"][0][a].get<double>();
+    squared += d * d;
+  }
+  EXPECT_GT(std::sqrt(squared), 0.5);  // two points of the campus, apart
+  // Export CSV to the file the field names (by default beside the project).
+  const Layout listed = run_stage(dir, project, "measure_list", json::array());
+  run_stage(dir, project, "measure_csv",
+            {{{"click", listed.widget("export csv")}}, {{"wait", 1}}});
+  std::filesystem::path written = project;
+  written.replace_extension();
+  written += "_measurements.csv";
+  ASSERT_TRUE(std::filesystem::exists(written));
+  std::ifstream in(written);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_THAT(text, HasSubstr("\"distance 1\",distance,"));
+  // The command line lists them and writes the CSV too, never over the project.
+  const json listed_json =
+      json::parse(run_cli(dir, {"measurements", project.string(), "--json"}).out);
+  ASSERT_EQ(listed_json["measurements"].size(), 1u);
+  EXPECT_NEAR(listed_json["measurements"][0]["value"].get<double>(), std::sqrt(squared), 1e-9);
+  EXPECT_EQ(run_cli(dir, {"measurements", project.string(), "--csv", (dir / "m.csv").string()})
+                .exit_code,
+            0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "m.csv"));
+  const CliResult over_project = run_cli(
+      dir, {"measurements", project.string(), "--csv", project.string(), "--force"});
+  EXPECT_NE(over_project.exit_code, 0);
+}
+
 // A session recorded with --record and replayed on a copy of the project
 // as it was leaves the same journal: every command, its settings and state.
 TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {

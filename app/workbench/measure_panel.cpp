@@ -1,0 +1,134 @@
+#include <fmt/format.h>
+
+#include <string>
+#include <vector>
+
+#include "app/workbench/panels.hpp"
+
+namespace scanbench::app::workbench {
+
+namespace {
+
+std::string describe(const modeling::Measurement& m) {
+  return fmt::format("{}: {:.3f} {}", m.name, modeling::measured_value(m),
+                     modeling::measured_unit(m.kind));
+}
+
+// The list, each with its value, its coordinates on hover, and a button
+// that removes it.
+void measurement_list(WorkbenchState& s) {
+  const std::vector<modeling::Measurement> list = s.session.measurements();
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    ImGui::TextUnformatted(describe(list[k]).c_str());
+    if (ImGui::IsItemHovered()) {
+      std::string points;
+      for (const Eigen::Vector3d& p : list[k].points)
+        points += fmt::format("{:.3f}, {:.3f}, {:.3f}\n", p.x(), p.y(), p.z());
+      ImGui::SetTooltip("%s", points.c_str());
+    }
+    ImGui::SameLine();
+    if (ImGui::SmallButton(("remove##m" + std::to_string(k)).c_str())) {
+      std::vector<modeling::Measurement> rest = list;
+      rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
+      s.session.save_measurements(rest, "removed " + list[k].name);
+    }
+    s.probe("remove " + list[k].name);
+  }
+}
+
+// The clipping box and the slice, in world coordinates.
+void clip_settings(WorkbenchState& s) {
+  ImGui::Checkbox("clip box", &s.clip_on);
+  s.probe("clip box");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!s.primary());
+  if (ImGui::Button("to selection")) s.clip_to_selection();
+  s.probe("clip to selection");
+  ImGui::EndDisabled();
+  if (s.clip_on) {
+    ImGui::DragScalarN("min", ImGuiDataType_Double, s.clip_min.data(), 3, 0.05f, nullptr, nullptr,
+                       "%.2f");
+    ImGui::DragScalarN("max", ImGuiDataType_Double, s.clip_max.data(), 3, 0.05f, nullptr, nullptr,
+                       "%.2f");
+  }
+  if (ImGui::Checkbox("slice", &s.slice_on) && s.slice_on)
+    s.slice_at = s.navigation.target()[s.slice_axis];
+  s.probe("slice");
+  if (s.slice_on) {
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(60);
+    ImGui::Combo("across", &s.slice_axis, "x\0y\0z\0");
+    ImGui::DragScalar("at [m]", ImGuiDataType_Double, &s.slice_at, 0.05f, nullptr, nullptr,
+                      "%.2f");
+    ImGui::SliderFloat("thickness [m]", &s.slice_thickness, 0.05f, 20.0f, "%.2f",
+                       ImGuiSliderFlags_Logarithmic);
+  }
+}
+
+}  // namespace
+
+void measure_panel(WorkbenchState& s) {
+  if (!ImGui::CollapsingHeader("Clip and measure", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  clip_settings(s);
+  ImGui::Separator();
+  if (ImGui::Checkbox("pick in the 3D view (M)", &s.measuring)) s.picks.clear();
+  s.probe("measure");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  if (ImGui::Combo("##kind", &s.measure_kind, "point\0distance\0height\0angle\0area\0"))
+    s.picks.clear();
+  s.probe("measure kind");
+  const auto kind = static_cast<modeling::MeasureKind>(s.measure_kind);
+  if (s.measuring) {
+    ImGui::Text("%zu of %s%zu points picked", s.picks.size(),
+                modeling::takes_more_points(kind) ? "at least " : "",
+                modeling::points_needed(kind));
+    if (modeling::takes_more_points(kind)) {
+      ImGui::SameLine();
+      ImGui::BeginDisabled(s.picks.size() < modeling::points_needed(kind));
+      if (ImGui::Button("Finish (Enter)")) s.finish_measurement();
+      s.probe("finish measurement");
+      ImGui::EndDisabled();
+    }
+  }
+  measurement_list(s);
+  if (s.csv_path[0] == '\0') {
+    std::filesystem::path csv = s.session.project().path();
+    csv.replace_extension();
+    const std::string text = csv.string() + "_measurements.csv";
+    text.copy(s.csv_path.data(), s.csv_path.size() - 1);
+  }
+  ImGui::SetNextItemWidth(220);
+  ImGui::InputText("##csv", s.csv_path.data(), s.csv_path.size());
+  ImGui::SameLine();
+  ImGui::BeginDisabled(s.session.measurements().empty());
+  if (ImGui::Button("Export CSV")) s.session.export_measurements(s.csv_path.data());
+  s.probe("export csv");
+  ImGui::EndDisabled();
+}
+
+void measurement_overlay(WorkbenchState& s, ImDrawList* draw) {
+  const auto path = [&](const std::vector<Eigen::Vector3d>& points, bool closed, ImU32 colour) {
+    std::vector<ImVec2> screen;
+    for (const Eigen::Vector3d& p : points) {
+      const std::optional<ImVec2> at = s.screen_of(p);
+      if (!at) return std::optional<ImVec2>{};
+      screen.push_back(*at);
+    }
+    if (screen.empty()) return std::optional<ImVec2>{};
+    draw->AddPolyline(screen.data(), static_cast<int>(screen.size()), colour,
+                      closed ? ImDrawFlags_Closed : 0, 2.0f);
+    for (const ImVec2& p : screen) draw->AddCircleFilled(p, 4.0f, colour);
+    return std::optional<ImVec2>(screen.back());
+  };
+  for (const modeling::Measurement& m : s.session.measurements()) {
+    const bool area = m.kind == modeling::MeasureKind::kArea;
+    if (const std::optional<ImVec2> label = path(m.points, area, IM_COL32(255, 120, 255, 255))) {
+      draw->AddText(ImVec2(label->x + 6, label->y - 16), IM_COL32(255, 255, 255, 255),
+                    describe(m).c_str());
+    }
+  }
+  path(s.picks, false, IM_COL32(255, 230, 40, 255));
+}
+
+}  // namespace scanbench::app::workbench

@@ -1,0 +1,79 @@
+#include "render/pick.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace scanbench::render {
+
+namespace {
+
+// Whether the ray meets `box` (grown by `margin`) at a distance ≥ 0 (slab test).
+bool ray_meets(const Eigen::AlignedBox3f& box, float margin, const Eigen::Vector3f& origin,
+               const Eigen::Vector3f& direction) {
+  if (box.isEmpty()) return false;
+  float near = 0.0f, far = std::numeric_limits<float>::max();
+  for (int a = 0; a < 3; ++a) {
+    const float low = box.min()[a] - margin, high = box.max()[a] + margin;
+    if (std::abs(direction[a]) < 1e-12f) {
+      if (origin[a] < low || origin[a] > high) return false;
+      continue;
+    }
+    float t0 = (low - origin[a]) / direction[a], t1 = (high - origin[a]) / direction[a];
+    if (t0 > t1) std::swap(t0, t1);
+    near = std::max(near, t0);
+    far = std::min(far, t1);
+    if (near > far) return false;
+  }
+  return true;
+}
+
+// The largest splat radius of a tile's points.
+float largest_radius(const RenderPoints& points, const RenderTile& tile) {
+  float r = 0.0f;
+  for (std::uint32_t k = tile.first; k < tile.first + tile.count; ++k)
+    r = std::max(r, points.radii_m[k].maxCoeff());
+  return r;
+}
+
+}  // namespace
+
+Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y) {
+  // Normalised device coordinates, then back through the projection and the view.
+  const float ndc_x = static_cast<float>(2.0 * x / view.width - 1.0);
+  const float ndc_y = static_cast<float>(1.0 - 2.0 * y / view.height);
+  const Eigen::Vector4f eye_dir =
+      view.projection.inverse() * Eigen::Vector4f(ndc_x, ndc_y, 0.5f, 1.0f);
+  const Eigen::Vector3f in_eye = (eye_dir.head<3>() / eye_dir.w()).normalized();
+  const Eigen::Matrix3f eye_to_model = view.view.topLeftCorner<3, 3>().transpose();
+  return (eye_to_model * in_eye).normalized();
+}
+
+std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
+                               const Eigen::Vector3f& direction, const Clipping& clipping,
+                               float splat_scale) {
+  const RenderPoints& points = model.points;
+  std::optional<Pick> best;
+  for (const RenderNode& node : model.nodes) {
+    if (!node.shown) continue;
+    for (const std::size_t t : node.tiles) {
+      const RenderTile& tile = model.tiles[t];
+      const float reach = largest_radius(points, tile) * splat_scale;
+      if (clipping.excludes(tile.box) || !ray_meets(tile.box, reach, origin, direction)) continue;
+      for (std::uint32_t k = tile.first; k < tile.first + tile.count; ++k) {
+        const Eigen::Vector3f& p = points.position[k];
+        const Eigen::Vector3f to = p - origin;
+        const float along = to.dot(direction);
+        if (along <= 0.0f || (best && along >= best->distance_m)) continue;
+        const float radius = points.radii_m[k].maxCoeff() * splat_scale;
+        if ((to - along * direction).squaredNorm() > radius * radius) continue;
+        const Eigen::Vector3f& n = points.normal[k];
+        if (n.squaredNorm() > 0.25f && n.dot(-to) < 0.0f) continue;  // faces away
+        if (clipping.active() && !clipping.keeps(p)) continue;
+        best = Pick{k, along, p};
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace scanbench::render

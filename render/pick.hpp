@@ -1,0 +1,34 @@
+// Picking in the 3D view: the point a ray through a pixel meets first, as
+// the view draws the model. What the view does not draw is not picked:
+// hidden objects, points outside the clipping box or slice, and points
+// facing away (the view culls them).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <optional>
+
+#include "render/frame_plan.hpp"
+#include "render/render_model.hpp"
+#include "render/render_view.hpp"
+
+namespace scanbench::render {
+
+struct Pick {
+  std::size_t point = 0;     // into RenderModel::points
+  float distance_m = 0.0f;   // from the ray's origin, along it
+  Eigen::Vector3f position;  // the point's own position, model frame
+};
+
+// The ray from the eye of `view` through pixel (x, y) (window pixels from
+// the top left; pixel centres at +0.5) as a unit direction, model frame.
+Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y);
+
+// The nearest point whose splat (its larger radius × splat_scale) the ray
+// from `origin` along unit `direction` passes through; none when it meets
+// none. Walks only the tiles whose box the ray crosses.
+std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
+                               const Eigen::Vector3f& direction, const Clipping& clipping,
+                               float splat_scale);
+
+}  // namespace scanbench::render
