@@ -37,7 +37,7 @@ void add_workbench_command(CLI::App& app) {
   command
       ->add_option("--size", options->width,
                    "Window width [pixels], the height 5/8 of it (default: fill the screen; "
-                   "1280 with --replay)")
+                   "1280 with --replay or --record)")
       ->check(CLI::Range(960, 4096));
   command->callback([options] {
     if (!options->screenshot.empty() && options->screenshot.extension() != ".png")
@@ -54,7 +54,10 @@ void add_workbench_command(CLI::App& app) {
       if (!file.empty() && !std::filesystem::is_directory(folder))
         throw CLI::ValidationError(option, "the folder " + folder.string() + " does not exist");
     }
-    if (options->width == 0 && !options->replay.empty()) options->width = 1280;
+    // A replay's positions hold for the window size it was recorded at:
+    // replays and recordings open at 1280 × 800 unless --size says otherwise.
+    if (options->width == 0 && (!options->replay.empty() || !options->record.empty()))
+      options->width = 1280;
     options->height = options->width * 5 / 8;
     workbench::run_workbench(*options);
   });

@@ -223,10 +223,15 @@ static void from_json(const nlohmann::json& j, CommitSettings& s) {
   s.parent = parent.is_null() ? std::nullopt : std::optional<std::int64_t>(parent.get<std::int64_t>());
   s.other_scans = j.value("other_scans", defaults.other_scans);
   const nlohmann::json grow = j.value("grow", nlohmann::json(nullptr));
-  s.grow = grow.is_null() ? std::nullopt
-                          : std::optional<segmentation::GrowSettings>(grow_from(
-                                grow, segmentation::default_grow_settings(
-                                          segmentation::Channel::kNormal)));
+  if (grow.is_null()) {
+    s.grow.reset();
+  } else {
+    // The defaults of the channel named (a tolerance means a different unit
+    // on each channel), then what the object sets.
+    const segmentation::GrowSettings normal =
+        segmentation::default_grow_settings(segmentation::Channel::kNormal);
+    s.grow = grow_from(grow, segmentation::default_grow_settings(grow_from(grow, normal).channel));
+  }
   s.range_noise = j.value("range_noise", defaults.range_noise);
 }
 

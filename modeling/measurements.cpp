@@ -104,25 +104,34 @@ std::string_view measured_unit(MeasureKind kind) {
 std::vector<Measurement> load_measurements(const store::Project& project) {
   const std::optional<std::string> stored = project.latest_result(kCommand);
   if (!stored) return {};
-  const nlohmann::json j = nlohmann::json::parse(*stored, nullptr, false);
   std::vector<Measurement> out;
-  if (!j.is_object() || !j.contains("measurements")) return out;
-  for (const nlohmann::json& e : j["measurements"]) {
-    Measurement m;
-    m.name = e.value("name", std::string());
-    const std::optional<MeasureKind> kind = measure_kind_from_name(e.value("kind", std::string()));
-    if (!kind) continue;  // written by a newer scanbench
-    m.kind = *kind;
-    for (const nlohmann::json& p : e.value("points", nlohmann::json::array()))
-      m.points.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
-    out.push_back(std::move(m));
+  try {
+    const nlohmann::json j = nlohmann::json::parse(*stored);
+    for (const nlohmann::json& e : j.at("measurements")) {
+      Measurement m;
+      m.name = e.at("name").get<std::string>();
+      const std::optional<MeasureKind> kind =
+          measure_kind_from_name(e.at("kind").get<std::string>());
+      if (!kind) continue;  // a kind of a newer scanbench
+      m.kind = *kind;
+      for (const nlohmann::json& p : e.at("points"))
+        m.points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+      check(m, out.size());
+      out.push_back(std::move(m));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw core::InputError(project.path().string(), {{}, {}, "the newest measure command"},
+                           std::string("unreadable measurements: ") + e.what());
+  } catch (const core::InputError& e) {
+    throw core::InputError(project.path().string(), {{}, {}, "the newest measure command"},
+                           e.file() + " " + e.problem());
   }
   return out;
 }
 
 std::int64_t save_measurements(store::Project& project, const std::vector<Measurement>& list,
-                               const std::string& what) {
-  const std::int64_t revision = project.revision();
+                               const std::string& what, std::int64_t based_on_revision) {
+  const std::int64_t revision = based_on_revision;
   nlohmann::json all = nlohmann::json::array();
   for (std::size_t k = 0; k < list.size(); ++k) {
     check(list[k], k);

@@ -43,15 +43,20 @@ double measured_value(const Measurement& m);
 // The value's unit: "m", "deg" or "m2".
 std::string_view measured_unit(MeasureKind kind);
 
-// The project's measurements (none before the first).
+// The project's measurements (none before the first). Throws
+// core::InputError naming the project and the command when the stored list
+// is malformed.
 std::vector<Measurement> load_measurements(const store::Project& project);
 
 // Makes `list` the project's measurements in one command, `what` saying
-// why ("add distance 1"). Refuses (core::InputError, nothing written) a
-// measurement with the wrong number of points, a non-finite coordinate or
-// an empty name. Returns the command's id.
+// why ("add distance 1"). `based_on_revision` is the project's revision
+// when the list it was made from was read: another process's change since
+// refuses it (the project's concurrency rule), so no measurement is lost.
+// Refuses (core::InputError, nothing written) a measurement with the wrong
+// number of points, a non-finite coordinate or an empty name. Returns the
+// command's id.
 std::int64_t save_measurements(store::Project& project, const std::vector<Measurement>& list,
-                               const std::string& what);
+                               const std::string& what, std::int64_t based_on_revision);
 
 // The list as CSV: name (quoted), kind, value, unit, then x, y, z of each
 // point; a header line first (x1, y1, z1, … for the most points any

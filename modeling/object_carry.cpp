@@ -6,13 +6,14 @@ namespace scanbench::modeling {
 
 namespace {
 
-// The drawn object's world box, widened by `margin` of its largest extent.
+// The drawn object's box in the drawn scan's frame (near world-aligned: a
+// scanner stands level), widened by `margin` of its largest extent. Kept
+// in that frame so that float coordinates stay small at georeferenced sites.
 Eigen::AlignedBox3f growth_box(const DrawnObject& drawn, double margin) {
   const registration::PreparedScan& scan = *drawn.scan;
-  const Eigen::Isometry3f T = drawn.T_world_scan.cast<float>();
   Eigen::AlignedBox3f box;
   for (std::size_t k = 0; k < drawn.labels.size(); ++k) {
-    if (drawn.labels[k] != 0 && scan.in_model[k]) box.extend(T * scan.points[k]);
+    if (drawn.labels[k] != 0 && scan.in_model[k]) box.extend(scan.points[k]);
   }
   if (box.isEmpty()) return box;
   const float widen = static_cast<float>(margin) * box.sizes().maxCoeff();
@@ -46,12 +47,12 @@ segmentation::PixelSet carry_object(const DrawnObject& drawn, const CarryTarget&
   assert(target.grid != nullptr && "growth needs the target's grid");
   const segmentation::SegmentationGrid& grid = *target.grid;
   const Eigen::AlignedBox3f box = growth_box(drawn, settings.box_margin);
-  const Eigen::Isometry3f T_world_target = target.T_world_scan.cast<float>();
+  const Eigen::Isometry3f T_box_target = T_drawn_target.cast<float>();  // composed in double
   std::vector<std::uint8_t> may_grow(seen.sighting.size(), 0);
   for (std::size_t q = 0; q < may_grow.size(); ++q) {
     if (!target.open[q] || !grid.usable[q]) continue;
     if (seen.sighting[q] != registration::Sighting::kUnseen && !labelled(q)) continue;
-    may_grow[q] = box.contains(T_world_target * scan.points[q]) ? 1 : 0;
+    may_grow[q] = box.contains(T_box_target * scan.points[q]) ? 1 : 0;
   }
   for (const std::uint32_t q : carried) may_grow[q] = grid.usable[q];
   // A region from each carried pixel not yet reached; what a region takes is

@@ -27,8 +27,8 @@ struct CarrySettings {
   // How the object grows in the target scan; none: it takes only the points
   // on the surfaces the drawn scan segmented.
   std::optional<segmentation::GrowSettings> grow;
-  // The growth's box: the object's axis-aligned world box in the drawn scan,
-  // widened on every side by this fraction of its largest extent.
+  // The growth's box: the object's axis-aligned box in the drawn scan's
+  // frame, widened on every side by this fraction of its largest extent.
   double box_margin = 0.25;
 };
 

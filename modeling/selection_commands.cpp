@@ -184,6 +184,7 @@ std::string seed_refusal(const segmentation::SegmentationGrid& grid, const Selec
                          const std::vector<std::uint32_t>& membership, std::size_t seed,
                          const segmentation::GrowResult& grown) {
   if (!grid.usable[seed]) return "the scan has no usable point there (no return, or a mixed pixel)";
+  if (membership[seed] == store::kDeletedPoints) return "its point was deleted";
   if (membership[seed] != 0) return "object " + std::to_string(membership[seed]) + " owns it";
   if (segmentation::open_pixels(grid, {settings.constraints.lasso, {}}, {})[seed] == 0)
     return "it lies outside the lasso";
@@ -226,6 +227,7 @@ SelectResult select_region(store::Project& project, const SelectSettings& settin
   if (!result.seed_open) {
     // Nothing is written: the selection and the redo chain stay as they were.
     result.refused = seed_refusal(grid, settings, membership, seed, grown);
+    result.region_pixels = 0;
     result.selected_pixels = load_selection(project, settings.scan_id).size();
     return result;
   }

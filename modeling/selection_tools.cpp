@@ -58,7 +58,7 @@ void SelectionTools::clear() {
 
 SelectSettings SelectionTools::select_at(std::int64_t scan_id, const Eigen::Vector2d& xy,
                                          SelectMode mode,
-                                         const segmentation::GrowSettings& grow) {
+                                         const segmentation::GrowSettings& grow) const {
   assert((!scan_ || *scan_ == scan_id) && "a lasso or barriers of another scan");
   SelectSettings settings;
   settings.scan_id = scan_id;
@@ -69,8 +69,11 @@ SelectSettings SelectionTools::select_at(std::int64_t scan_id, const Eigen::Vect
   settings.grow = grow;
   if (lasso_closed_) settings.constraints.lasso = lasso_;
   settings.constraints.barriers = barriers_;
-  if (mode != SelectMode::kSubtract) grown_with_[scan_id] = grow;
   return settings;
+}
+
+void SelectionTools::grew(const SelectSettings& settings) {
+  if (settings.mode != SelectMode::kSubtract) grown_with_[settings.scan_id] = settings.grow;
 }
 
 CommitSettings SelectionTools::commit_of(std::int64_t scan_id, std::string name,

@@ -52,10 +52,12 @@ class SelectionTools {
   // select_region's settings for a seed at image point `xy` of scan
   // `scan_id`: the nearest pixel, the lasso when it is closed, the barriers.
   // Asserts the lasso and barriers, if any, were drawn on `scan_id` (the
-  // caller refuses or clears them otherwise). A grow that replaces or adds
-  // to the selection is remembered for the scan's commit.
+  // caller refuses or clears them otherwise).
   SelectSettings select_at(std::int64_t scan_id, const Eigen::Vector2d& xy, SelectMode mode,
-                           const segmentation::GrowSettings& grow);
+                           const segmentation::GrowSettings& grow) const;
+  // select_region ran `settings` and its seed grew: a grow that replaced or
+  // added to the selection is remembered for the scan's commit.
+  void grew(const SelectSettings& settings);
 
   // commit_selection's settings for the selection of scan `scan_id`: it
   // grows on in the other scans with the settings of the last grow that

@@ -30,7 +30,7 @@ Sightings sight_in_source(const PreparedScan& source, const PreparedScan& target
           const Eigen::Vector3f p = R * target.points[q] + t;
           const std::int64_t pixel = source.grid ? source.grid->pixel_of(p) : associate(source, p);
           if (pixel < 0) continue;
-          out.pixel[q] = pixel;
+          out.pixel[q] = static_cast<std::int32_t>(pixel);  // grids hold < 2^31 pixels
           const auto k = static_cast<std::size_t>(pixel);
           const float range = p.norm();
           const float sigma_p = noise.sigma(range);

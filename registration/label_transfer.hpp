@@ -41,7 +41,7 @@ enum class Sighting : std::uint8_t {
 // Per target pixel, row-major: the source pixel its point lies on (-1 where
 // none, or the target pixel is not in the model) and what that pixel saw.
 struct Sightings {
-  std::vector<std::int64_t> pixel;
+  std::vector<std::int32_t> pixel;  // 5 bytes a pixel with the sighting
   std::vector<Sighting> sighting;
 };
 

@@ -27,14 +27,6 @@ bool ray_meets(const Eigen::AlignedBox3f& box, float margin, const Eigen::Vector
   return true;
 }
 
-// The largest splat radius of a tile's points.
-float largest_radius(const RenderPoints& points, const RenderTile& tile) {
-  float r = 0.0f;
-  for (std::uint32_t k = tile.first; k < tile.first + tile.count; ++k)
-    r = std::max(r, points.radii_m[k].maxCoeff());
-  return r;
-}
-
 }  // namespace
 
 Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y) {
@@ -57,7 +49,7 @@ std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& 
     if (!node.shown) continue;
     for (const std::size_t t : node.tiles) {
       const RenderTile& tile = model.tiles[t];
-      const float reach = largest_radius(points, tile) * splat_scale;
+      const float reach = tile.max_radius_m * splat_scale;
       if (clipping.excludes(tile.box) || !ray_meets(tile.box, reach, origin, direction)) continue;
       for (std::uint32_t k = tile.first; k < tile.first + tile.count; ++k) {
         const Eigen::Vector3f& p = points.position[k];

@@ -237,7 +237,10 @@ RenderTile make_tile(std::int64_t owner, const RenderPoints& from, std::vector<s
   tile.node = owner;
   tile.first = static_cast<std::uint32_t>(out.size());
   tile.count = static_cast<std::uint32_t>(part.size());
-  for (const std::uint32_t k : part) tile.box.extend(from.position[k]);
+  for (const std::uint32_t k : part) {
+    tile.box.extend(from.position[k]);
+    tile.max_radius_m = std::max(tile.max_radius_m, from.radii_m[k].maxCoeff());
+  }
   tile.cone = normal_cone(from.normal, part);
   tile.level_ends = order_for_level_of_detail(from.position, part, tile.box);
   for (std::uint32_t& end : tile.level_ends) end += tile.first;

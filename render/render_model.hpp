@@ -52,6 +52,7 @@ struct RenderTile {
   std::uint32_t first = 0;  // into RenderPoints
   std::uint32_t count = 0;
   Eigen::AlignedBox3f box;  // from the origin
+  float max_radius_m = 0.0f;  // the largest splat radius of its points
   NormalCone cone;
   // Level-of-detail order (order_for_level_of_detail): the first
   // level_ends[L] points are one per occupied cell of edge lod_cube_m / 2^L.

@@ -124,8 +124,10 @@ nlohmann::json Runner::apply_pixels(const ScriptOp& op, const std::string& at) {
   const modeling::SelectMode mode = op.name == "grow"  ? modeling::SelectMode::kReplace
                                     : op.name == "add" ? modeling::SelectMode::kAdd
                                                        : modeling::SelectMode::kSubtract;
-  const modeling::SelectResult r = modeling::select_region(
-      project_, tools_.select_at(scan.id, op.has_seed ? op.seed : *tools_.seed(), mode, op.grow));
+  const modeling::SelectSettings settings =
+      tools_.select_at(scan.id, op.has_seed ? op.seed : *tools_.seed(), mode, op.grow);
+  const modeling::SelectResult r = modeling::select_region(project_, settings);
+  if (r.seed_open) tools_.grew(settings);
   nlohmann::json done = made(r.command_id, {{"region_pixels", r.region_pixels},
                                             {"selected_pixels", r.selected_pixels},
                                             {"seed_open", r.seed_open}});

@@ -57,7 +57,8 @@ void clip_settings(WorkbenchState& s) {
   if (s.slice_on) {
     ImGui::SameLine();
     ImGui::SetNextItemWidth(60);
-    ImGui::Combo("across", &s.slice_axis, "x\0y\0z\0");
+    if (ImGui::Combo("across", &s.slice_axis, "x\0y\0z\0"))
+      s.slice_at = s.navigation.target()[s.slice_axis];  // a coordinate of the new axis
     ImGui::DragScalar("at [m]", ImGuiDataType_Double, &s.slice_at, 0.05f, nullptr, nullptr,
                       "%.2f");
     ImGui::SliderFloat("thickness [m]", &s.slice_thickness, 0.05f, 20.0f, "%.2f",

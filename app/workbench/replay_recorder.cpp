@@ -1,9 +1,13 @@
+#include <algorithm>
+
 #include "acquisition/formats/output_file.hpp"
 #include "app/workbench/replay.hpp"
 
 namespace scanbench::app::workbench {
 
 namespace {
+
+constexpr int kMaxWait = 100000;  // the replay reader's bound on one wait
 
 nlohmann::json mods_json(int mods) {
   nlohmann::json out = nlohmann::json::array();
@@ -47,7 +51,9 @@ void ReplayRecorder::add(nlohmann::json event, int mods) {
   if (frames_since_event_ > 0) {
     moved_this_frame_ = false;
     // The event itself takes one of the frames a replay feeds.
-    if (frames_since_event_ > 1) events_.push_back({{"wait", frames_since_event_ - 1}});
+    // In waits a replay reads (at most 100 000 frames each).
+    for (int idle = frames_since_event_ - 1; idle > 0; idle -= kMaxWait)
+      events_.push_back({{"wait", std::min(idle, kMaxWait)}});
     frames_since_event_ = 0;
   }
   if (mods != 0) event["mods"] = mods_json(mods);

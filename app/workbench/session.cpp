@@ -98,8 +98,19 @@ bool Session::act(const std::string& what, Action&& action, bool changes_model) 
 
 void Session::reload() {
   scans_ = project_.scans();
+  if (has_scan() && std::none_of(scans_.begin(), scans_.end(),
+                                 [&](const auto& scan) { return scan.id == scan_id_; })) {
+    show_first_scan();  // its import was undone, here or by another process
+    return;
+  }
   nodes_ = project_.object_nodes();
-  measurements_ = modeling::load_measurements(project_);
+  try {
+    measurements_ = modeling::load_measurements(project_);
+    measurements_revision_ = project_.revision();
+  } catch (const core::InputError& e) {
+    measurements_.clear();
+    status_ = "the project's measurements are unreadable: " + e.problem();
+  }
   membership_.clear();
   selection_.clear();
   if (has_scan()) {
@@ -140,7 +151,9 @@ void Session::click(double x, double y) {
   act(
       "",
       [&] {
-        result = modeling::select_region(project_, tools_.select_at(scan_id_, xy, mode, grow));
+        const modeling::SelectSettings settings = tools_.select_at(scan_id_, xy, mode, grow);
+        result = modeling::select_region(project_, settings);
+        if (result.seed_open) tools_.grew(settings);
       },
       false);
   if (status_.empty()) {
@@ -227,7 +240,9 @@ std::optional<std::int64_t> Session::propose() {
 
 bool Session::save_measurements(const std::vector<modeling::Measurement>& list,
                                 const std::string& what) {
-  return act(what, [&] { modeling::save_measurements(project_, list, what); }, false);
+  return act(
+      what, [&] { modeling::save_measurements(project_, list, what, measurements_revision_); },
+      false);
 }
 
 bool Session::export_measurements(const std::filesystem::path& file) {
@@ -334,6 +349,7 @@ const render::RenderModel& Session::render_model() {
       model_problem_ = (where.empty() ? "" : where + " ") + e.problem();
     }
     model_revision_ = model_changes_;
+    ++model_generation_;
   }
   return *model_;
 }

@@ -112,6 +112,9 @@ class Session {
   // after a selection, which it does not show).
   const render::RenderModel& render_model();
   bool render_model_stale() const { return !model_ || model_revision_ != model_changes_; }
+  // Changes each time render_model() builds the model anew: a renderer built
+  // from another generation draws buffers of a model that is gone.
+  std::int64_t render_model_generation() const { return model_generation_; }
   // The model's origin without building it (the 3D view builds it), for
   // drawing over the view.
   bool has_render_model() const { return model_.has_value(); }
@@ -150,6 +153,8 @@ class Session {
   std::int64_t model_revision_ = -1;
   std::int64_t model_changes_ = 0;  // commands that changed what the 3D view shows
   std::string model_problem_;
+  std::int64_t model_generation_ = 0;  // models built so far
+  std::int64_t measurements_revision_ = 0;  // the project's revision they were read at
 };
 
 }  // namespace scanbench::app::workbench

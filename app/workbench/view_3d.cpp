@@ -12,9 +12,11 @@ namespace {
 // Draws the model into the renderer's picture when the view or the model
 // changed.
 void redraw(WorkbenchState& s, int width, int height) {
-  if (s.session.render_model_stale() || !s.renderer) {
+  const render::RenderModel& model = s.session.render_model();  // built anew when stale
+  if (!s.renderer || s.renderer_generation != s.session.render_model_generation()) {
     s.renderer.reset();
-    s.renderer = std::make_unique<render::SplatRenderer>(s.session.render_model());
+    s.renderer = std::make_unique<render::SplatRenderer>(model);
+    s.renderer_generation = s.session.render_model_generation();
     s.view_dirty = true;
   }
   s.apply_clipping();

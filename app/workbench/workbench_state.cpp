@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 #include <vector>
 
@@ -226,8 +227,10 @@ void WorkbenchState::apply_clipping() {
   const Eigen::Vector3d origin = session.render_model().origin;
   render::Clipping clipping;
   if (clip_on) {
-    const Eigen::Vector3d low(clip_min[0], clip_min[1], clip_min[2]);
-    const Eigen::Vector3d high(clip_max[0], clip_max[1], clip_max[2]);
+    // Corners dragged past each other still make a box.
+    const Eigen::Vector3d a(clip_min[0], clip_min[1], clip_min[2]);
+    const Eigen::Vector3d b(clip_max[0], clip_max[1], clip_max[2]);
+    const Eigen::Vector3d low = a.cwiseMin(b), high = a.cwiseMax(b);
     clipping.box = Eigen::AlignedBox3f((low - origin).cast<float>(), (high - origin).cast<float>());
   }
   if (slice_on) {
@@ -265,10 +268,14 @@ void WorkbenchState::finish_measurement() {
   const auto kind = static_cast<modeling::MeasureKind>(measure_kind);
   if (picks.size() < modeling::points_needed(kind)) return;
   std::vector<modeling::Measurement> list = session.measurements();
-  std::size_t same_kind = 1;
-  for (const modeling::Measurement& m : list) same_kind += m.kind == kind;
-  const std::string name =
-      std::string(modeling::measure_kind_name(kind)) + " " + std::to_string(same_kind);
+  // "distance N", N one above the highest of the list: never a name twice.
+  const std::string prefix = std::string(modeling::measure_kind_name(kind)) + " ";
+  long next = 1;
+  for (const modeling::Measurement& m : list) {
+    if (m.name.rfind(prefix, 0) != 0) continue;
+    next = std::max(next, std::strtol(m.name.c_str() + prefix.size(), nullptr, 10) + 1);
+  }
+  const std::string name = prefix + std::to_string(next);
   list.push_back({name, kind, picks});
   picks.clear();
   session.save_measurements(list, "measured " + name);

@@ -71,6 +71,7 @@ struct WorkbenchState {
   Navigation navigation;
   render::RenderSettings settings;
   std::unique_ptr<render::SplatRenderer> renderer;
+  std::int64_t renderer_generation = -1;  // of the model it was built from
   render::FramePlan last_plan;
   double last_draw_ms = 0.0;  // the last 3D draw: wall time, finished on the device
   double last_gpu_ms = -1.0;  // ... and the device's own time (negative: unknown)
@@ -91,7 +92,7 @@ struct WorkbenchState {
   int measure_kind = 1;  // modeling::MeasureKind
   std::vector<Eigen::Vector3d> picks;  // world [m], of the measurement being taken
   std::array<double, 2> press_at = {0.0, 0.0};  // where the left button went down
-  std::array<char, 260> csv_path{};             // where Export CSV writes
+  std::array<char, 4096> csv_path{};            // where Export CSV writes
 
   // ---- Layout and the panoramic view ------------------------------------
   Rect panorama;

@@ -86,6 +86,12 @@ TEST(SettingsJson, CommitRoundTripsWithAndWithoutItsGrowSettings) {
   const CommitSettings none = settings_from_json<CommitSettings>(settings_to_json(settings), "t");
   EXPECT_FALSE(none.grow.has_value());
   EXPECT_FALSE(none.parent.has_value());
+  // A channel alone takes that channel's defaults (a tolerance's unit is the channel's).
+  const CommitSettings intensity =
+      settings_from_json<CommitSettings>(R"({"grow": {"channel": "intensity"}})", "t");
+  ASSERT_TRUE(intensity.grow.has_value());
+  EXPECT_EQ(intensity.grow->tolerance,
+            segmentation::default_grow_settings(segmentation::Channel::kIntensity).tolerance);
 }
 
 TEST(SettingsJson, MergeRoundTrips) {

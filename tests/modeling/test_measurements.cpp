@@ -49,10 +49,10 @@ TEST(Measurements, TheProjectKeepsTheListAndUndoBringsTheEarlierOneBack) {
   EXPECT_TRUE(load_measurements(project).empty());
   const std::vector<Measurement> one = {
       make(MeasureKind::kDistance, {kAt, kAt + Eigen::Vector3d(1.0, 2.0, 3.0)}, "door width")};
-  save_measurements(project, one, "add distance");
+  save_measurements(project, one, "add distance", project.revision());
   std::vector<Measurement> two = one;
   two.push_back(make(MeasureKind::kPoint, {kAt}, "benchmark"));
-  save_measurements(project, two, "add point");
+  save_measurements(project, two, "add point", project.revision());
   ASSERT_EQ(load_measurements(project).size(), 2u);
   EXPECT_EQ(load_measurements(project)[1].name, "benchmark");
   EXPECT_EQ(load_measurements(project)[0].points[1], kAt + Eigen::Vector3d(1.0, 2.0, 3.0));
@@ -62,7 +62,8 @@ TEST(Measurements, TheProjectKeepsTheListAndUndoBringsTheEarlierOneBack) {
   // A malformed one refuses the whole list, and nothing is written.
   const std::size_t journal = project.history().size();
   try {
-    save_measurements(project, {make(MeasureKind::kAngle, {kAt, kAt})}, "add angle");
+    save_measurements(project, {make(MeasureKind::kAngle, {kAt, kAt})}, "add angle",
+                      project.revision());
     ADD_FAILURE() << "an angle of two points was accepted";
   } catch (const core::InputError& e) {
     EXPECT_THAT(e.problem(), HasSubstr("angle takes 3 points, not 2"));

@@ -59,16 +59,21 @@ std::string state_of(const store::Project& project) {
 
 // A commit carries the object into the other scans with the settings its
 // selection was grown with in this session: the last grow that replaced or
-// added to it (a subtraction's do not count), and none before any.
+// added to it (a subtraction's do not count, nor a grow whose seed was
+// refused), and none before any.
 TEST(SegmentCommands, ACommitGrowsOnWithTheSettingsItsSelectionWasGrownWith) {
   SelectionTools tools;
   EXPECT_FALSE(tools.commit_of(1, "wall", std::nullopt).grow.has_value());
   segmentation::GrowSettings colour =
       segmentation::default_grow_settings(segmentation::Channel::kColor);
   colour.tolerance = 9.0;
-  tools.select_at(1, {3.0, 4.0}, SelectMode::kReplace, colour);
-  tools.select_at(1, {5.0, 4.0}, SelectMode::kSubtract,
-                  segmentation::default_grow_settings(segmentation::Channel::kRange));
+  tools.grew(tools.select_at(1, {3.0, 4.0}, SelectMode::kReplace, colour));
+  tools.grew(tools.select_at(1, {5.0, 4.0}, SelectMode::kSubtract,
+                             segmentation::default_grow_settings(segmentation::Channel::kRange)));
+  // A grow whose seed was refused is not remembered: select_region said so
+  // and the caller does not report it.
+  tools.select_at(1, {6.0, 4.0}, SelectMode::kAdd,
+                  segmentation::default_grow_settings(segmentation::Channel::kIntensity));
   const CommitSettings commit = tools.commit_of(1, "wall", 7);
   EXPECT_EQ(commit.scan_id, 1);
   EXPECT_EQ(commit.name, "wall");
@@ -84,9 +89,11 @@ TEST(SegmentCommands, ACommitGrowsOnWithTheSettingsItsSelectionWasGrownWith) {
   const std::int64_t scan = store_room(project);
   const SelectSettings wall = select_at(scan, 20, 0);
   const Eigen::Vector2d seed(wall.seed_col, wall.seed_row);
-  select_region(project, tools.select_at(scan, seed, SelectMode::kReplace,
-                                         segmentation::default_grow_settings(
-                                             segmentation::Channel::kNormal)));
+  const SelectSettings grown = tools.select_at(
+      scan, seed, SelectMode::kReplace,
+      segmentation::default_grow_settings(segmentation::Channel::kNormal));
+  ASSERT_TRUE(select_region(project, grown).seed_open);
+  tools.grew(grown);
   commit_selection(project, tools.commit_of(scan, "wall", std::nullopt));
   EXPECT_THAT(project.history().back().settings, HasSubstr("\"grow\":{\"channel\":\"normal\""));
 }

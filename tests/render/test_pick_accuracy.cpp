@@ -1,7 +1,9 @@
-// Picking on a simulated scan against the virtual scanner's truth: a picked
-// point is a measured sample, so its coordinates are off by the scanner's
-// range noise (σ = 5 mm + 5·10⁻⁵ · range) and no more, and a distance
-// between two picks by at most √2 times that.
+// Picking on a simulated scan against the virtual scanner's truth. A pick
+// is the first sample the ray meets, within its splat of the ray (never one
+// behind the surface aimed at); being a measured sample, its coordinates
+// are off the truth by the scanner's range noise (σ = 5 mm + 5·10⁻⁵ ·
+// range), within 4 σ, and a distance between two picks by 4 times their
+// combined σ at most.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -67,6 +69,12 @@ TEST(PickAccuracy, PickedPointsAndDistancesAreWithinTheScannersNoise) {
     const Eigen::Vector3f target = model.points.position[any(random)];
     const std::optional<Pick> pick = pick_point(model, eye, (target - eye).normalized(), {}, 1.0f);
     if (!pick) continue;
+    // Where the ray was aimed, or in front of it, and on the ray.
+    const float aimed = (target - eye).norm();
+    const float radius = model.points.radii_m[pick->point].maxCoeff();
+    EXPECT_LE(pick->distance_m, aimed + 4.0f * noise.sigma(aimed));
+    EXPECT_LE((pick->position - eye - pick->distance_m * (target - eye).normalized()).norm(),
+              radius + 1e-4f);
     const auto pixel = static_cast<std::size_t>(model.points.intensity[pick->point]);
     if (campus(1).truth[0].mixed[pixel]) continue;  // a blend of two surfaces: no single truth
     const Eigen::Vector3d measured = pick->position.cast<double>();
