@@ -288,6 +288,7 @@ Project::Edit::Edit(Edit&& other) noexcept
       command_id_(other.command_id_),
       kind_(other.kind_),
       nested_(other.nested_),
+      writes_(other.writes_),
       connection_(other.connection_) {}
 
 Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
@@ -298,6 +299,7 @@ Project::Edit& Project::Edit::operator=(Edit&& other) noexcept {
     command_id_ = other.command_id_;
     kind_ = other.kind_;
     nested_ = other.nested_;
+    writes_ = other.writes_;
     connection_ = other.connection_;
   }
   return *this;

@@ -76,12 +76,25 @@ std::int64_t read_revision(sqlite3* db, const std::string& file) {
   return select.column_int(0);
 }
 
+// The revision at which `data` last changed: 0 when no command since
+// scanbench began keeping it has written it.
+std::int64_t changed_at(sqlite3* db, const std::string& file, ProjectData data) {
+  sqlite::Statement select(db, "SELECT CAST(value AS INTEGER) FROM meta WHERE key = ?1", file);
+  select.bind_text(1, std::string("changed.") + data_key(data));
+  return select.step() ? select.column_int(0) : 0;
+}
+
+// Refuses command `name`, computed on the project as it was at revision
+// `based_on`, when a command since then changed data it read.
 void check_revision(sqlite3* db, const std::string& file, std::string_view name,
                     std::optional<std::int64_t> based_on) {
-  if (based_on && read_revision(db, file) != *based_on) {
+  if (!based_on || read_revision(db, file) == *based_on) return;
+  for (const ProjectData data : data_in(footprint_of(name).reads)) {
+    if (changed_at(db, file, data) <= *based_on) continue;
     throw core::RuntimeFailure(file, {},
-                               "the project changed while " + std::string(name) +
-                                   " was computing (another scanbench wrote to it); nothing was "
+                               "the project's " + std::string(data_name(data)) + " changed while " +
+                                   std::string(name) +
+                                   " was computing (another scanbench wrote them); nothing was "
                                    "stored: run it again");
   }
 }
@@ -134,6 +147,7 @@ std::int64_t Project::revision() const {
 Project::Edit Project::begin_command(std::string_view name, const std::string& settings_json,
                                      std::optional<std::int64_t> based_on_revision) {
   Edit edit(db(), file_name(), 0, Edit::Kind::kCommand, connection_.get());
+  edit.writes_ = footprint_of(name).writes;
   check_revision(db(), file_name(), name, based_on_revision);
   remove_abandoned(db(), file_name());
   end_redo_branch(db(), file_name());
@@ -204,6 +218,7 @@ Project::Edit Project::LongCommand::part() {
 Project::Edit Project::LongCommand::finish() {
   Edit edit = part();
   edit.kind_ = Edit::Kind::kFinal;
+  edit.writes_ = footprint_of(name_).writes;
   check_revision(db_, file_, name_, revision_);
   remove_abandoned(db_, file_);
   end_redo_branch(db_, file_);
@@ -234,6 +249,12 @@ void Project::Edit::finish_transaction() {
   if (kind_ != Kind::kPart) {
     before = read_revision(db_, file_);
     sqlite::execute(db_, kBumpRevision, file_);
+    for (const ProjectData data : data_in(writes_)) {
+      sqlite::Statement mark(db_, "INSERT OR REPLACE INTO meta (key, value) VALUES (?1, ?2)",
+                             file_);
+      mark.bind_text(1, std::string("changed.") + data_key(data));
+      mark.bind_text(2, std::to_string(*before + 1)).run();
+    }
   }
   sqlite::execute(db_, nested_ ? "RELEASE edit" : "COMMIT", file_);
   db_ = nullptr;
@@ -273,6 +294,7 @@ std::optional<CommandRecord> Project::undo(std::optional<std::int64_t> only) {
   std::optional<CommandRecord> last =
       select_one(db(), file_name(), "WHERE state = 'done' ORDER BY seq DESC LIMIT 1");
   if (!last || !last->undoable || (only && last->id != *only)) return std::nullopt;
+  journal.writes_ = footprint_of(last->name).writes;
   set_state(db(), file_name(), last->id, "undone");
   verify_current_rows(last->id);
   journal.finish_transaction();
@@ -285,6 +307,7 @@ std::optional<CommandRecord> Project::redo(std::optional<std::int64_t> only) {
   std::optional<CommandRecord> next =
       select_one(db(), file_name(), "WHERE state = 'undone' ORDER BY seq LIMIT 1");
   if (!next || (only && next->id != *only)) return std::nullopt;
+  journal.writes_ = footprint_of(next->name).writes;
   set_state(db(), file_name(), next->id, "done");
   verify_current_rows(next->id);
   journal.finish_transaction();

@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "modeling/store/command_footprint.hpp"
 #include "modeling/store/project.hpp"
 
 struct sqlite3;
@@ -52,7 +53,8 @@ class Project::Edit {
   // Batch. Asserts no other Edit is open; throws core::RuntimeFailure when
   // the lock is held too long.
   Edit(sqlite3* db, std::string file, std::int64_t command_id, Kind kind, ConnectionState* open);
-  // Advances the revision (all but parts) and commits, or releases the
+  // Advances the revision (all but parts), records it as the last change
+  // of each kind of data in writes_, and commits, or releases the
   // savepoint inside a Batch.
   void finish_transaction();
   void roll_back() noexcept;
@@ -62,6 +64,7 @@ class Project::Edit {
   std::int64_t command_id_ = 0;
   Kind kind_ = Kind::kCommand;
   bool nested_ = false;  // a savepoint of a Batch
+  ProjectDataSet writes_ = 0;  // what the command (or the one undone or redone) changes
   ConnectionState* connection_ = nullptr;
 };
 

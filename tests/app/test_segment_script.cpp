@@ -99,7 +99,7 @@ TEST(SegmentScript, AScriptIsWholeWhileAnotherProcessWrites) {
         edit_node(writer, edit);
         ++renames;
       } catch (const core::RuntimeFailure&) {
-        // "the project changed while edit was computing": nothing stored
+        // "the project's objects changed while edit was computing": nothing stored
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }

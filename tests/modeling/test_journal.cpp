@@ -129,9 +129,36 @@ TEST(Journal, ARevisionThatMovedRefusesTheWriteAndChangesNothing) {
     project.begin_command("merge", "{}", revision);
     FAIL() << "expected core::RuntimeFailure";
   } catch (const core::RuntimeFailure& error) {
-    EXPECT_THAT(error.what(), HasSubstr("the project changed while merge was computing"));
+    EXPECT_THAT(error.what(), HasSubstr("the project's geometry changed while merge was computing"));
   }
   EXPECT_EQ(project.history().size(), 2u);
+}
+
+// Another process's change voids a command only where it wrote what the
+// command read: a recolour (objects) lets a harmonize computed before it
+// land, and an undo counts as a change of what the undone command wrote.
+TEST(Journal, OnlyAChangeOfWhatACommandReadRefusesIt) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  store::Project project = store::Project::create(file);
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  std::int64_t revision = project.revision();
+  {
+    store::Project other = store::Project::open(file);
+    other.begin_command("recolor", "{}").commit("{}");
+    other.begin_command("measure", "{}").commit("{}");
+  }
+  project.begin_command("harmonize", "{}", revision).commit("{}");
+  revision = project.revision();
+  {
+    store::Project other = store::Project::open(file);
+    ASSERT_TRUE(other.undo().has_value());  // the harmonize: colour corrections change
+  }
+  EXPECT_NO_THROW(project.begin_command("measure", "{}", revision).commit("{}"));
+  EXPECT_THROW(project.begin_command("clone", "{}", revision), core::RuntimeFailure);
+  // A command scanbench does not know reads everything.
+  EXPECT_THROW(project.begin_command("from the future", "{}", revision), core::RuntimeFailure);
 }
 
 // Cancels once `after` units were reported.
