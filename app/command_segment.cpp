@@ -22,8 +22,9 @@ void run_segment(const SegmentOptions& options) {
   store::Project project = store::Project::open(options.project);
   const SegmentScriptResult result = run_segment_script(project, script);
   if (options.json) {
-    fmt::print("{}\n", nlohmann::json{{"ops", result.ops}}.dump(
-                           2, ' ', false, nlohmann::json::error_handler_t::replace));
+    nlohmann::json out = {{"ops", result.ops}, {"kept_selections", nullptr}};
+    if (result.kept_selections != 0) out["kept_selections"] = result.kept_selections;
+    fmt::print("{}\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
     return;
   }
   for (std::size_t k = 0; k < result.ops.size(); ++k) {
@@ -31,6 +32,10 @@ void run_segment(const SegmentOptions& options) {
     fmt::print("{:>4}  {:<9} {:>8}  {}\n", k + 1, op["op"].get<std::string>(),
                op["command"].is_null() ? std::string("-") : op["command"].dump(),
                op["result"].dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  }
+  if (result.kept_selections != 0) {
+    fmt::print("the selection left uncommitted is kept in the project (command {})\n",
+               result.kept_selections);
   }
   fmt::print("{} op(s) applied to {}; `scanbench objects` shows the tree\n", result.ops.size(),
              options.project);

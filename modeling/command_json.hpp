@@ -66,9 +66,7 @@ Settings settings_from_json(const std::string& json, const std::string& origin,
 //   "redundant"}], "points", "kept", "seconds"};
 // - HarmonizeCommandResult: {"scans": [{"id", "name", "reference", "pairs",
 //   "delta_e_before", "delta_e_after", "matrix", "offset"}], "pairs",
-//   "delta_e_before", "delta_e_after", "iterations", "converged", "seconds"};
-// - SelectResult: {"region_pixels", "selected_pixels", "seed_open",
-//   "refused"} (refused: null, or why the seed could not grow).
+//   "delta_e_before", "delta_e_after", "iterations", "converged", "seconds"}.
 // The tree and colour commands store small results ({"node": id}) made
 // where they are computed.
 template <typename Result>

@@ -8,7 +8,6 @@
 #include "modeling/import_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
-#include "modeling/selection_commands.hpp"
 
 namespace scanbench::modeling {
 namespace {
@@ -133,13 +132,6 @@ nlohmann::json to_report(const HarmonizeCommandResult& out) {
           {"seconds", out.seconds}};
 }
 
-nlohmann::json to_report(const SelectResult& r) {
-  return {{"region_pixels", r.region_pixels},
-          {"selected_pixels", r.selected_pixels},
-          {"seed_open", r.seed_open},
-          {"refused", r.refused.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.refused)}};
-}
-
 }  // namespace
 
 template <typename Result>
@@ -152,6 +144,5 @@ template std::string result_json<GeometryCommandResult>(const GeometryCommandRes
 template std::string result_json<RegisterCommandResult>(const RegisterCommandResult&);
 template std::string result_json<MergeCommandResult>(const MergeCommandResult&);
 template std::string result_json<HarmonizeCommandResult>(const HarmonizeCommandResult&);
-template std::string result_json<SelectResult>(const SelectResult&);
 
 }  // namespace scanbench::modeling

@@ -31,12 +31,6 @@ std::string numbered_name(const std::string& base, std::size_t number) {
   return name;
 }
 
-segmentation::PixelSet load_selection(const store::Project& project, std::int64_t scan_id) {
-  const auto stored =
-      project.load_layer<std::uint8_t>(scan_id, store::layer::kSelection, store::ElementType::kU8);
-  return stored ? segmentation::from_mask(*stored) : segmentation::PixelSet{};
-}
-
 void put_selection(store::Project& project, store::Project::Edit& edit, std::int64_t scan_id,
                    const segmentation::GridShape& shape, const segmentation::PixelSet& selection) {
   if (selection.empty()) {
@@ -202,8 +196,8 @@ std::string seed_refusal(const segmentation::SegmentationGrid& grid, const Selec
   return "it cannot grow on " + std::string(segmentation::channel_name(settings.grow.channel));
 }
 
-SelectResult select_region(store::Project& project, const SelectSettings& settings) {
-  const std::int64_t revision = project.revision();
+SelectResult select_region(const store::Project& project, const SelectSettings& settings,
+                           segmentation::PixelSet& selection) {
   const std::string where = "scan " + std::to_string(settings.scan_id);
   const store::StoredScanSummary summary = require_scan(project, settings.scan_id);
   const int rows = summary.summary.rows, columns = summary.summary.columns;
@@ -223,33 +217,53 @@ SelectResult select_region(store::Project& project, const SelectSettings& settin
   segmentation::RegionGrower grower(grid);
   const std::size_t seed = scan.index(settings.seed_row, settings.seed_col);
   const segmentation::GrowResult grown = grower.grow(seed, settings.grow, open);
-  SelectResult result{0, grown.pixels.size(), 0, grown.seed_open && !grown.seed_lacks_channel, {}};
+  SelectResult result{grown.pixels.size(), 0, grown.seed_open && !grown.seed_lacks_channel, {}};
   if (!result.seed_open) {
-    // Nothing is written: the selection and the redo chain stay as they were.
     result.refused = seed_refusal(grid, settings, membership, seed, grown);
     result.region_pixels = 0;
-    result.selected_pixels = load_selection(project, settings.scan_id).size();
+    result.selected_pixels = selection.size();
     return result;
   }
-  const segmentation::PixelSet before = load_selection(project, settings.scan_id);
-  segmentation::PixelSet selection;
   switch (settings.mode) {
     case SelectMode::kReplace:
       selection = grown.pixels;
       break;
     case SelectMode::kAdd:
-      selection = segmentation::unite(before, grown.pixels);
+      selection = segmentation::unite(selection, grown.pixels);
       break;
     case SelectMode::kSubtract:
-      selection = segmentation::subtract(before, grown.pixels);
+      selection = segmentation::subtract(selection, grown.pixels);
       break;
   }
-  store::Project::Edit edit = project.begin_command("select", settings_to_json(settings), revision);
-  put_selection(project, edit, settings.scan_id, grid.shape, selection);
-  result.command_id = edit.command_id();
   result.selected_pixels = selection.size();
-  edit.commit(result_json(result));
   return result;
+}
+
+segmentation::PixelSet kept_selection(const store::Project& project, std::int64_t scan_id) {
+  const auto stored =
+      project.load_layer<std::uint8_t>(scan_id, store::layer::kSelection, store::ElementType::kU8);
+  return stored ? segmentation::from_mask(*stored) : segmentation::PixelSet{};
+}
+
+std::int64_t keep_selections(store::Project& project,
+                             const std::map<std::int64_t, segmentation::PixelSet>& selections) {
+  std::map<std::int64_t, segmentation::GridShape> shapes;
+  nlohmann::json scans = nlohmann::json::object();
+  for (const auto& [scan_id, selection] : selections) {
+    const store::StoredScanSummary stored = require_scan(project, scan_id);
+    shapes[scan_id] = {stored.summary.rows, stored.summary.columns};
+    for (const std::uint32_t p : selection) {
+      if (p >= static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns)
+        refuse("scan " + std::to_string(scan_id), "the selection has a pixel outside the grid");
+    }
+    scans[std::to_string(scan_id)] = selection.size();
+  }
+  store::Project::Edit edit = project.begin_command("keep_selection", dump({{"scans", scans}}));
+  for (const auto& [scan_id, selection] : selections)
+    put_selection(project, edit, scan_id, shapes.at(scan_id), selection);
+  const std::int64_t command_id = edit.command_id();
+  edit.commit(dump({{"scans", scans}}));
+  return command_id;
 }
 
 // The memberships of the other scans with geometry, each with its points
@@ -301,7 +315,8 @@ std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
   return out;
 }
 
-NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings) {
+NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings,
+                                   const segmentation::PixelSet& selection) {
   const std::int64_t revision = project.revision();
   const std::string where = "scan " + std::to_string(settings.scan_id);
   require_name(settings.name);
@@ -309,7 +324,6 @@ NodeCommandResult commit_selection(store::Project& project, const CommitSettings
   require_group(tree, settings.parent);
   // The grid's size from the summary: compute_figures decodes the scan itself.
   const store::StoredScanSummary stored = require_scan(project, settings.scan_id);
-  const segmentation::PixelSet selection = load_selection(project, settings.scan_id);
   std::vector<std::uint32_t> membership =
       load_membership(project, settings.scan_id,
                       static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns);
@@ -319,6 +333,8 @@ NodeCommandResult commit_selection(store::Project& project, const CommitSettings
   node.parent = settings.parent;
   std::size_t taken = 0;
   for (const std::uint32_t p : selection) {
+    if (p >= membership.size())
+      refuse(where, "the selection has a pixel outside the grid: it was grown on another scan");
     if (membership[p] != 0) continue;  // another object's since the selection grew
     membership[p] = static_cast<std::uint32_t>(node.id);
     ++taken;

@@ -1,10 +1,12 @@
 // The segmentation's commands (seed 004 §4.1): a region grown from a seed
 // into a scan's selection, the selection committed as an object of the
-// tree, an object separated into its parts, and automatic proposals. Each
-// is one journaled command (store/project.hpp) that reads and computes
-// first, then writes in one Edit. Regions grow only through pixels still
-// to be segmented; a scan's "selection" layer (u8) is the region being
-// grown.
+// tree, an object separated into its parts, and automatic proposals.
+// Regions grow only through pixels still to be segmented. A selection is
+// session state (SelectionTools keeps it): growing one writes nothing, and
+// it is kept in the project (a scan's "selection" layer, u8) only on
+// request. Every other command here is one journaled command
+// (store/project.hpp) that reads and computes first, then writes in one
+// Edit.
 //
 // Errors: a scan or node that does not exist, a seed outside the grid, a
 // scan without geometry, an empty selection, a bad name (tree_commands.hpp):
@@ -12,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +23,7 @@
 #include "modeling/store/project.hpp"
 #include "modeling/tree_commands.hpp"
 #include "segmentation/constraints.hpp"
+#include "segmentation/pixel_set.hpp"
 #include "segmentation/proposals.hpp"
 #include "segmentation/region_grow.hpp"
 
@@ -42,7 +46,6 @@ struct SelectSettings {
 };
 
 struct SelectResult {
-  std::int64_t command_id = 0;      // 0 when the seed could not grow: nothing was written
   std::size_t region_pixels = 0;    // grown from the seed
   std::size_t selected_pixels = 0;  // in the selection afterwards
   // The seed could grow: usable, open (still to be segmented, inside the
@@ -51,10 +54,19 @@ struct SelectResult {
   std::string refused;  // why it could not ("it lies outside the lasso"); empty when it grew
 };
 
-// Grows a region from the seed and combines it with the scan's selection.
-// A seed that cannot grow writes nothing (no journal entry: the redo chain
-// stays) and says why in `refused`.
-SelectResult select_region(store::Project& project, const SelectSettings& settings);
+// Grows a region from the seed and combines it with `selection`, the
+// scan's selection so far. Writes nothing. A seed that cannot grow leaves
+// `selection` as it was and says why in `refused`.
+SelectResult select_region(const store::Project& project, const SelectSettings& settings,
+                           segmentation::PixelSet& selection);
+
+// The selection kept in the project for scan `scan_id` (empty: none).
+segmentation::PixelSet kept_selection(const store::Project& project, std::int64_t scan_id);
+
+// Keeps `selections` (scan id → its selection; an empty one removes the
+// kept one) in the project as one command, "keep_selection"; returns its id.
+std::int64_t keep_selections(store::Project& project,
+                             const std::map<std::int64_t, segmentation::PixelSet>& selections);
 
 struct CommitSettings {
   std::int64_t scan_id = 0;
@@ -73,14 +85,16 @@ struct CommitSettings {
   acquisition::RangeNoise range_noise = {};  // the scanner's
 };
 
-// Makes the scan's selection a new object: its pixels leave the pool still
-// to be segmented, the selection is emptied, and the object and its
+// Makes `selection`, of scan settings.scan_id, a new object: its pixels
+// leave the pool still to be segmented, a selection kept for the scan is
+// removed, and the object and its
 // ancestors get their point count, mean footprint and world bounding box.
 // With other_scans, every other scan with geometry, at its stored pose,
 // gives the object its points on the same surface as the selection's, and
 // with grow the points it grows to where the drawn scan saw nothing
 // (object_carry.hpp), in the same command.
-NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings);
+NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings,
+                                   const segmentation::PixelSet& selection);
 
 struct SeparateSettings {
   std::int64_t node = 0;     // an object

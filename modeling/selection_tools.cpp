@@ -1,6 +1,7 @@
 #include "modeling/selection_tools.hpp"
 
 #include <cassert>
+#include <set>
 #include <utility>
 
 namespace scanbench::modeling {
@@ -72,8 +73,36 @@ SelectSettings SelectionTools::select_at(std::int64_t scan_id, const Eigen::Vect
   return settings;
 }
 
-void SelectionTools::grew(const SelectSettings& settings) {
+const segmentation::PixelSet& SelectionTools::selection(std::int64_t scan_id) const {
+  static const segmentation::PixelSet kNone;
+  const auto found = selections_.find(scan_id);
+  return found == selections_.end() ? kNone : found->second;
+}
+
+segmentation::PixelSet& SelectionTools::selection_of(const store::Project& project,
+                                                     std::int64_t scan_id) {
+  auto found = selections_.find(scan_id);
+  if (found == selections_.end()) {
+    found = selections_.emplace(scan_id, kept_selection(project, scan_id)).first;
+  }
+  return found->second;
+}
+
+void SelectionTools::open_scan(const store::Project& project, std::int64_t scan_id) {
+  static_cast<void>(selection_of(project, scan_id));
+}
+
+SelectResult SelectionTools::select(const store::Project& project, const SelectSettings& settings) {
+  segmentation::PixelSet& selection = selection_of(project, settings.scan_id);
+  Step step{settings.scan_id, selection, {}};
+  const SelectResult result = select_region(project, settings, selection);
+  if (!result.seed_open) return result;
   if (settings.mode != SelectMode::kSubtract) grown_with_[settings.scan_id] = settings.grow;
+  step.after = selection;
+  done_.push_back(std::move(step));
+  undone_.clear();
+  grown_since_undo_ = true;
+  return result;
 }
 
 CommitSettings SelectionTools::commit_of(std::int64_t scan_id, std::string name,
@@ -85,6 +114,70 @@ CommitSettings SelectionTools::commit_of(std::int64_t scan_id, std::string name,
   if (const auto grown = grown_with_.find(scan_id); grown != grown_with_.end())
     settings.grow = grown->second;
   return settings;
+}
+
+NodeCommandResult SelectionTools::commit(store::Project& project, const CommitSettings& settings) {
+  segmentation::PixelSet& selection = selection_of(project, settings.scan_id);
+  const NodeCommandResult result = commit_selection(project, settings, selection);
+  command_ran();
+  committed_[result.command_id] = {settings.scan_id, selection, {}};
+  selection.clear();
+  return result;
+}
+
+bool SelectionTools::undo_selection() {
+  if (done_.empty()) return false;
+  selections_[done_.back().scan_id] = done_.back().before;
+  undone_.push_back(std::move(done_.back()));
+  done_.pop_back();
+  grown_since_undo_ = false;
+  return true;
+}
+
+bool SelectionTools::redo_selection() {
+  if (undone_.empty()) return false;
+  selections_[undone_.back().scan_id] = undone_.back().after;
+  done_.push_back(std::move(undone_.back()));
+  undone_.pop_back();
+  return true;
+}
+
+void SelectionTools::command_ran() {
+  done_.clear();
+  undone_.clear();
+  grown_since_undo_ = false;
+}
+
+void SelectionTools::command_undone(std::int64_t command_id) {
+  command_ran();
+  const auto commit = committed_.find(command_id);
+  if (commit != committed_.end()) selections_[commit->second.scan_id] = commit->second.before;
+}
+
+void SelectionTools::command_redone(std::int64_t command_id) {
+  command_ran();
+  const auto commit = committed_.find(command_id);
+  if (commit != committed_.end()) selections_[commit->second.scan_id].clear();
+}
+
+std::map<std::int64_t, segmentation::PixelSet> SelectionTools::unkept(
+    const store::Project& project) const {
+  std::set<std::int64_t> scans;  // a scan whose import was undone keeps nothing
+  for (const store::StoredScanSummary& stored : project.scans()) scans.insert(stored.id);
+  std::map<std::int64_t, segmentation::PixelSet> changed;
+  for (const auto& [scan_id, selection] : selections_) {
+    if (scans.count(scan_id) != 0 && kept_selection(project, scan_id) != selection)
+      changed.emplace(scan_id, selection);
+  }
+  return changed;
+}
+
+std::int64_t SelectionTools::keep(store::Project& project) {
+  const std::map<std::int64_t, segmentation::PixelSet> changed = unkept(project);
+  if (changed.empty()) return 0;
+  const std::int64_t command_id = keep_selections(project, changed);
+  command_ran();
+  return command_id;
 }
 
 }  // namespace scanbench::modeling

@@ -1,20 +1,28 @@
 // The segmentation tools between one click and the next (seed 004 §4.1,
 // Fig. 2): a lasso and barrier lines drawn on one scan, and the last seed,
 // in image coordinates (x = column, y = row, pixel centres at integers:
-// segmentation/constraints.hpp). The CLI's segment scripts and the
-// workbench each keep one, and a click becomes select_region's settings
-// through it, so that both put a click on the same pixel.
+// segmentation/constraints.hpp), and the selection of each scan. The CLI's
+// segment scripts and the workbench each keep one, and a click becomes
+// select_region's settings through it, so that both put a click on the
+// same pixel.
+//
+// Selections are session state: a grow changes them here and writes
+// nothing, so a click neither ends the project's redo chain nor collides
+// with another process's work. Undo takes the grows back one by one until
+// the last command; undoing a commit brings its selection back. keep()
+// stores them in the project, when the session ends or on request.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
-#include <string>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "modeling/selection_commands.hpp"
 #include "segmentation/constraints.hpp"
+#include "segmentation/pixel_set.hpp"
 #include "segmentation/region_grow.hpp"
 
 namespace scanbench::modeling {
@@ -55,18 +63,62 @@ class SelectionTools {
   // caller refuses or clears them otherwise).
   SelectSettings select_at(std::int64_t scan_id, const Eigen::Vector2d& xy, SelectMode mode,
                            const segmentation::GrowSettings& grow) const;
-  // select_region ran `settings` and its seed grew: a grow that replaced or
-  // added to the selection is remembered for the scan's commit.
-  void grew(const SelectSettings& settings);
+  // ---- The selections ---------------------------------------------------
+  // The selection of scan `scan_id`: the one kept in the project until
+  // this session changes it (read by open_scan, select and commit).
+  const segmentation::PixelSet& selection(std::int64_t scan_id) const;
+  // Reads the selection kept for scan `scan_id`, unless this session
+  // already has the scan's.
+  void open_scan(const store::Project& project, std::int64_t scan_id);
+
+  // Grows `settings` (from select_at) into the scan's selection
+  // (select_region). A seed that grows makes one step undo_selection takes
+  // back; a grow that replaced or added to the selection is remembered for
+  // the scan's commit.
+  SelectResult select(const store::Project& project, const SelectSettings& settings);
 
   // commit_selection's settings for the selection of scan `scan_id`: it
   // grows on in the other scans with the settings of the last grow that
   // replaced or added to it in this session (none before any).
   CommitSettings commit_of(std::int64_t scan_id, std::string name,
                            std::optional<std::int64_t> parent) const;
+  // Commits the selection of settings.scan_id (commit_selection); it is
+  // then empty, until the command is undone (command_undone).
+  NodeCommandResult commit(store::Project& project, const CommitSettings& settings);
+
+  // ---- Undo and redo ------------------------------------------------------
+  // Takes back the newest grow since the last command, or makes the newest
+  // one taken back again; false when there is none.
+  bool undo_selection();
+  bool redo_selection();
+  // A grow came after the last undo: redoing the project's commands would
+  // pass over it (the caller refuses, as a new command ends a redo chain).
+  bool grown_since_undo() const { return grown_since_undo_; }
+  // The caller ran another command: the grows before it are no longer
+  // taken back one by one.
+  void command_ran();
+  // The caller undid or redid command `command_id` in the project: the
+  // selection a commit took comes back, or goes again.
+  void command_undone(std::int64_t command_id);
+  void command_redone(std::int64_t command_id);
+
+  // ---- Keeping them -----------------------------------------------------
+  // The selections that differ from what the project keeps.
+  std::map<std::int64_t, segmentation::PixelSet> unkept(const store::Project& project) const;
+  // Stores the selections that differ from what the project keeps as one
+  // command (keep_selections); its id, 0 when none differs.
+  std::int64_t keep(store::Project& project);
 
  private:
   void draw_on(std::int64_t scan_id);
+  segmentation::PixelSet& selection_of(const store::Project& project, std::int64_t scan_id);
+
+  // One change of a scan's selection, with the selection before and after.
+  struct Step {
+    std::int64_t scan_id = 0;
+    segmentation::PixelSet before;
+    segmentation::PixelSet after;
+  };
 
   std::optional<std::int64_t> scan_;
   segmentation::Polyline lasso_;
@@ -75,6 +127,11 @@ class SelectionTools {
   bool drawing_barrier_ = false;
   std::optional<Eigen::Vector2d> seed_;
   std::map<std::int64_t, segmentation::GrowSettings> grown_with_;  // per scan
+  std::map<std::int64_t, segmentation::PixelSet> selections_;      // the scans' read so far
+  std::vector<Step> done_;                                         // grows since the last command
+  std::vector<Step> undone_;
+  bool grown_since_undo_ = false;
+  std::map<std::int64_t, Step> committed_;  // by commit command: the selection it took
 };
 
 }  // namespace scanbench::modeling

@@ -34,6 +34,9 @@ class Runner {
   void set_default_scan(std::int64_t scan) { scan_ = scan; }
 
   nlohmann::json apply(const ScriptOp& op, const std::string& at);
+  // At the script's end: the selections it left, kept in the project
+  // (SelectionTools::keep); the command's id, 0 when none changed.
+  std::int64_t keep_selections() { return tools_.keep(project_); }
 
  private:
   nlohmann::json apply_pixels(const ScriptOp& op, const std::string& at);
@@ -54,7 +57,8 @@ class Runner {
   store::Project& project_;
   std::string file_;
   std::optional<std::int64_t> scan_;
-  modeling::SelectionTools tools_;  // the lasso, the barriers and the last seed op's point
+  // The lasso, the barriers, the last seed op's point and the selections.
+  modeling::SelectionTools tools_;
 };
 
 store::StoredScanSummary Runner::scan_of(const ScriptOp& op, const std::string& at) const {
@@ -126,15 +130,14 @@ nlohmann::json Runner::apply_pixels(const ScriptOp& op, const std::string& at) {
                                                        : modeling::SelectMode::kSubtract;
   const modeling::SelectSettings settings =
       tools_.select_at(scan.id, op.has_seed ? op.seed : *tools_.seed(), mode, op.grow);
-  const modeling::SelectResult r = modeling::select_region(project_, settings);
-  if (r.seed_open) tools_.grew(settings);
-  nlohmann::json done = made(r.command_id, {{"region_pixels", r.region_pixels},
-                                            {"selected_pixels", r.selected_pixels},
-                                            {"seed_open", r.seed_open}});
-  if (!r.seed_open) {
-    done["command"] = nullptr;  // nothing was written
-    done["result"]["refused"] = r.refused;
-  }
+  const modeling::SelectResult r = tools_.select(project_, settings);
+  // A selection is session state: a grow is no command.
+  nlohmann::json done = {{"command", nullptr},
+                         {"result",
+                          {{"region_pixels", r.region_pixels},
+                           {"selected_pixels", r.selected_pixels},
+                           {"seed_open", r.seed_open}}}};
+  if (!r.seed_open) done["result"]["refused"] = r.refused;
   return done;
 }
 
@@ -154,7 +157,7 @@ nlohmann::json Runner::apply_tree(const ScriptOp& op, const std::string& at) {
   if (op.name == "commit") {
     const std::optional<std::int64_t> parent = op.parent ? parent_of(*op.parent, at) : std::nullopt;
     const modeling::NodeCommandResult r =
-        modeling::commit_selection(project_, tools_.commit_of(scan_of(op, at).id, op.text, parent));
+        tools_.commit(project_, tools_.commit_of(scan_of(op, at).id, op.text, parent));
     return made(r.command_id, {{"node", r.node_id}});
   }
   if (op.name == "group") {
@@ -194,15 +197,31 @@ nlohmann::json Runner::apply_tree(const ScriptOp& op, const std::string& at) {
 
 nlohmann::json Runner::apply_journal(const ScriptOp& op, const std::string& at) {
   const bool undo = op.name == "undo";
+  // The grows since the last command first: they are the script's own state.
+  if (undo ? tools_.undo_selection() : tools_.redo_selection())
+    return {{"command", nullptr}, {"result", {{undo ? "undid" : "redid", "grow"}}}};
+  if (!undo && tools_.grown_since_undo())
+    refuse(file_, at, "nothing to redo: the selection grew since the undo");
   const std::optional<store::CommandRecord> changed = undo ? project_.undo() : project_.redo();
   if (!changed) refuse(file_, at, undo ? "nothing to undo" : "nothing to redo");
+  if (undo) {
+    tools_.command_undone(changed->id);
+  } else {
+    tools_.command_redone(changed->id);
+  }
   return {{"command", changed->id}, {"result", {{undo ? "undid" : "redid", changed->name}}}};
 }
 
 nlohmann::json Runner::apply(const ScriptOp& op, const std::string& at) {
   if (op.name == "undo" || op.name == "redo") return apply_journal(op, at);
-  if (is_pixel_op(op.name)) return apply_pixels(op, at);
-  return apply_tree(op, at);
+  if (is_pixel_op(op.name)) {
+    nlohmann::json done = apply_pixels(op, at);
+    if (!done["command"].is_null()) tools_.command_ran();  // proposals
+    return done;
+  }
+  nlohmann::json done = apply_tree(op, at);
+  if (op.name != "commit") tools_.command_ran();
+  return done;
 }
 
 }  // namespace
@@ -239,6 +258,8 @@ SegmentScriptResult run_segment_script(store::Project& project, const SegmentScr
       throw core::RuntimeFailure(error.file(), position, error.problem() + kNothingStored);
     }
   }
+  // A selection left uncommitted stays for the next script or the workbench.
+  result.kept_selections = runner.keep_selections();
   batch.commit();
   return result;
 }

@@ -21,6 +21,10 @@ namespace scanbench::app {
 struct SegmentScriptResult {
   // One entry per op: {"op", "command" (its journal id, or null), "result"}.
   nlohmann::json ops = nlohmann::json::array();
+  // The command keeping the selections the script left uncommitted in the
+  // project (they are the next script's and the workbench's to go on
+  // with); 0 when none changed.
+  std::int64_t kept_selections = 0;
 };
 
 // Plays `script` (read_segment_script) on `project`.

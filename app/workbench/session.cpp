@@ -40,7 +40,8 @@ Session::Session(const std::filesystem::path& project, bool read_only)
       read_only_(read_only) {
   show_first_scan();
   if (read_only_)
-    status_ = "read-only: you can look, select nodes and frame them; nothing is written";
+    status_ = "read-only: you can look, grow selections, select nodes and frame them; nothing is "
+               "written";
 }
 
 void Session::show_first_scan() {
@@ -62,6 +63,7 @@ void Session::open_scan(std::int64_t id) {
   const std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project_, id);
   normal_ = geometry ? geometry->normal : std::vector<Eigen::Vector3f>{};
   clear_constraints();
+  tools_.open_scan(project_, id);
   reload();
 }
 
@@ -91,6 +93,7 @@ bool Session::act(const std::string& what, Action&& action, bool changes_model) 
     status_ = "failed: " + e.problem();
     return false;
   }
+  tools_.command_ran();
   if (changes_model) ++model_changes_;
   reload();
   return true;
@@ -112,18 +115,21 @@ void Session::reload() {
     status_ = "the project's measurements are unreadable: " + e.problem();
   }
   membership_.clear();
-  selection_.clear();
   if (has_scan()) {
     membership_ = project_
                       .load_layer<std::uint32_t>(scan_id_, store::layer::kMembership,
                                                  store::ElementType::kU32)
                       .value_or(std::vector<std::uint32_t>{});
-    selection_ = project_
-                     .load_layer<std::uint8_t>(scan_id_, store::layer::kSelection,
-                                               store::ElementType::kU8)
-                     .value_or(std::vector<std::uint8_t>{});
   }
-  selected_ = static_cast<std::size_t>(std::count(selection_.begin(), selection_.end(), 1));
+  show_selection();
+}
+
+void Session::show_selection() {
+  selection_.clear();
+  const segmentation::PixelSet& selection = tools_.selection(scan_id_);
+  if (has_scan() && !selection.empty())
+    selection_ = segmentation::to_mask({scan_.rows, scan_.columns, false}, selection);
+  selected_ = selection.size();
   ++revision_;
 }
 
@@ -147,21 +153,21 @@ void Session::click(double x, double y) {
   }
   segmentation::GrowSettings grow = segmentation::default_grow_settings(channel);
   grow.tolerance = tolerance;
-  modeling::SelectResult result;
-  act(
-      "",
-      [&] {
-        const modeling::SelectSettings settings = tools_.select_at(scan_id_, xy, mode, grow);
-        result = modeling::select_region(project_, settings);
-        if (result.seed_open) tools_.grew(settings);
-      },
-      false);
-  if (status_.empty()) {
+  // The selection is session state: growing it writes nothing, read-only too.
+  try {
+    const modeling::SelectResult result =
+        tools_.select(project_, tools_.select_at(scan_id_, xy, mode, grow));
     status_ = result.seed_open
                   ? "grew " + std::to_string(result.region_pixels) + " pixels; selection " +
                         std::to_string(result.selected_pixels)
                   : "the seed cannot grow there: " + result.refused;
+  } catch (const core::InputError& e) {
+    status_ = "refused: " + e.problem();
+    if (!e.position().detail.empty()) status_ += " (" + e.position().detail + ")";
+  } catch (const core::RuntimeFailure& e) {
+    status_ = "failed: " + e.problem();
   }
+  show_selection();
 }
 
 void Session::finish_polyline() {
@@ -178,9 +184,8 @@ void Session::clear_constraints() {
 }
 
 bool Session::commit(const std::string& name, std::optional<std::int64_t> parent) {
-  return act("committed \"" + name + "\"", [&] {
-    modeling::commit_selection(project_, tools_.commit_of(scan_id_, name, parent));
-  });
+  return act("committed \"" + name + "\"",
+             [&] { tools_.commit(project_, tools_.commit_of(scan_id_, name, parent)); });
 }
 
 bool Session::group(const std::string& name, const std::vector<std::int64_t>& children) {
@@ -238,6 +243,14 @@ std::optional<std::int64_t> Session::propose() {
   return group;
 }
 
+bool Session::keep_selections() {
+  if (read_only_ || tools_.unkept(project_).empty()) return true;
+  std::int64_t command = 0;
+  if (!act("", [&] { command = tools_.keep(project_); }, false)) return false;
+  status_ = "kept the selection in the project (command " + std::to_string(command) + ")";
+  return true;
+}
+
 bool Session::save_measurements(const std::vector<modeling::Measurement>& list,
                                 const std::string& what) {
   return act(
@@ -282,6 +295,11 @@ bool Session::clone(std::int64_t source, std::int64_t target) {
 }
 
 std::optional<store::CommandRecord> Session::undo(bool stages, std::optional<std::int64_t> only) {
+  if (!only && tools_.undo_selection()) {  // session state: read-only too
+    status_ = "took back the last grow";
+    show_selection();
+    return std::nullopt;
+  }
   if (read_only_) {
     status_ = "refused: the project is open read-only (nothing is written)";
     return std::nullopt;
@@ -304,15 +322,28 @@ std::optional<store::CommandRecord> Session::undo(bool stages, std::optional<std
   }
   std::optional<store::CommandRecord> undone;
   act("", [&] { undone = project_.undo(newest->id); });
+  if (undone) tools_.command_undone(undone->id);
   if (undone && is_batch_stage(undone->name)) show_first_scan_again();
+  show_selection();
   if (status_.empty()) status_ = undone ? "undid " + undone->name : "nothing to undo";
   return std::nullopt;
 }
 
 bool Session::redo() {
+  if (tools_.redo_selection()) {
+    status_ = "grew the selection again";
+    show_selection();
+    return true;
+  }
+  if (tools_.grown_since_undo()) {
+    status_ = "nothing to redo: the selection grew since the undo";
+    return false;
+  }
   std::optional<store::CommandRecord> redone;
   act("", [&] { redone = project_.redo(); });
+  if (redone) tools_.command_redone(redone->id);
   if (redone && is_batch_stage(redone->name)) show_first_scan_again();
+  show_selection();
   if (status_.empty()) status_ = redone ? "redid " + redone->name : "nothing to redo";
   return redone.has_value();
 }

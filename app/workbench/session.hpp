@@ -2,8 +2,9 @@
 // the panoramic view with its layers, the tools (seed, lasso, barrier), and
 // the actions, each through the same commands the CLI's segment script and
 // recolor issue (modeling/selection_commands.hpp, modeling/tree_commands.hpp,
-// modeling/color_commands.hpp), so every action is one journal entry that Ctrl+Z takes back. No
-// ImGui here.
+// modeling/color_commands.hpp), so every action is one journal entry that
+// Ctrl+Z takes back. The selection is session state (SelectionTools): a grow
+// writes nothing, and Ctrl+Z takes grows back before commands. No ImGui here.
 #pragma once
 
 #include <cstdint>
@@ -66,6 +67,10 @@ class Session {
   void finish_polyline();
   void clear_constraints();
   std::size_t selected_pixels() const { return selected_; }
+  // Keeps the selections that differ from the project's in it, as one
+  // command (when the session ends, or on request); true when there was
+  // nothing to keep or they were kept. Read-only, nothing is kept.
+  bool keep_selections();
 
   // ---- Commands: each one journal entry; false (and status()) when refused
   bool commit(const std::string& name, std::optional<std::int64_t> parent);
@@ -82,7 +87,8 @@ class Session {
   bool merge(const std::vector<std::int64_t>& objects);
   bool recolor(std::int64_t node, const store::ColorEdit& set, bool reset);
   bool clone(std::int64_t source, std::int64_t target);
-  // Takes back the newest command. A batch stage (import, geometry,
+  // Takes back the newest grow since the last command (the selection is
+  // session state), else the newest command. A batch stage (import, geometry,
   // register, merge, harmonize: run from the command line over whole scans)
   // is taken back only with `stages`; without, nothing changes and the stage
   // is returned, for the caller to ask the user first. With `only`, nothing
@@ -130,6 +136,8 @@ class Session {
   template <typename Action>
   bool act(const std::string& what, Action&& action, bool changes_model = true);
   void reload();
+  // The selection of the scan shown, from tools_, as the panorama draws it.
+  void show_selection();
   void show_first_scan();
   // After a batch stage was undone or redone: the scan shown again (or the
   // first, when it is gone), with its geometry as it now is.

@@ -62,6 +62,13 @@ void commands_row(WorkbenchState& s) {
   ImGui::BeginDisabled(s.session.selected_pixels() == 0 || read_only);
   if (ImGui::Button("Commit (C)")) s.commit();
   s.probe("commit");
+  ImGui::SameLine();
+  // The selection is session state, kept when the workbench closes: Keep
+  // stores it now, for another process (a segment script) to go on with.
+  if (ImGui::Button("Keep")) s.session.keep_selections();
+  s.probe("keep selection");
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("Keep the selection in the project now (it is kept when you close)");
   ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::BeginDisabled(read_only || !s.session.missing().empty());
@@ -76,13 +83,12 @@ void commands_row(WorkbenchState& s) {
   ImGui::Combo("view", &s.panorama_channel, "colour\0range\0intensity\0normals\0");
   s.probe("panorama channel");
   ImGui::SameLine();
-  ImGui::BeginDisabled(read_only);
+  // Enabled read-only too: grows are taken back there (commands are refused).
   if (ImGui::Button("Undo")) s.undo();
   s.probe("undo");
   ImGui::SameLine();
   if (ImGui::Button("Redo")) s.redo();
   s.probe("redo");
-  ImGui::EndDisabled();
 }
 
 }  // namespace

@@ -56,6 +56,15 @@ class Workbench {
 
   render::WindowInput& input() { return input_; }
 
+  // The session ends: the selections are kept in the project
+  // (Session::keep_selections). Throws core::RuntimeFailure when they cannot be.
+  void end_session() {
+    if (!state_.session.keep_selections()) {
+      throw core::RuntimeFailure(state_.session.project().path().string(), {},
+                                 "the selection could not be kept: " + state_.session.status());
+    }
+  }
+
   // One frame that advances the input's clock by `seconds` (a replay's
   // fixed step, or the real interval live): the panels and views, then
   // ImGui's draw. The frame rate shown is measured from real intervals.
@@ -210,6 +219,7 @@ void run_workbench(const WorkbenchOptions& options) {
     replay(bench, window, options, events, input, recorder ? &*recorder : nullptr);
   }
   if (recorder) recorder->save();
+  bench.end_session();
 }
 
 }  // namespace scanbench::app::workbench

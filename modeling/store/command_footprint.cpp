@@ -13,7 +13,7 @@ using D = ProjectData;
 // where they are (an object's figures and its growth into other scans).
 constexpr ProjectDataSet kObjectInputs = D::kScans | D::kGeometry | D::kPoses | D::kObjects;
 
-constexpr std::array<std::pair<std::string_view, CommandFootprint>, 17> kFootprints = {{
+constexpr std::array<std::pair<std::string_view, CommandFootprint>, 18> kFootprints = {{
     {"import", {0, D::kScans | D::kPoses | D::kMerge}},
     {"geometry", {static_cast<ProjectDataSet>(D::kScans), D::kGeometry | D::kMerge}},
     {"register",
@@ -22,7 +22,8 @@ constexpr std::array<std::pair<std::string_view, CommandFootprint>, 17> kFootpri
     {"harmonize",
      {D::kScans | D::kGeometry | D::kPoses | D::kColorCorrections,
       static_cast<ProjectDataSet>(D::kColorCorrections)}},
-    {"select", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
+    {"select", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},  // older journals
+    {"keep_selection", {0, static_cast<ProjectDataSet>(D::kObjects)}},
     {"commit", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
     {"separate", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
     {"propose", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},

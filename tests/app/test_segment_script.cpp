@@ -74,6 +74,32 @@ TEST(SegmentScript, ARefusedScriptThatBeganWithUndoKeepsTheUndoneCommandRedoable
   EXPECT_EQ(project.object_nodes().size(), 1u);
 }
 
+// In a script as in the workbench, a grow is session state: undo takes it
+// back before any command, and the selection the script leaves is kept in
+// the project, for the next script to commit.
+TEST(SegmentScript, UndoTakesBackAGrowAndTheLeftSelectionIsKept) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  store_room(project);
+  run_segment_script(project, write_script(dir, R"({"ops": [{"op": "group", "name": "trees"}]})"));
+  const SegmentScriptResult grown = run_segment_script(project, write_script(dir, R"({"ops": [
+      {"op": "grow", "seed": [600, 100]},
+      {"op": "add", "seed": [100, 100]},
+      {"op": "undo"}]})"));
+  ASSERT_EQ(grown.ops.size(), 3u);
+  EXPECT_TRUE(grown.ops[2]["command"].is_null());
+  EXPECT_EQ(grown.ops[2]["result"]["undid"], "grow");
+  EXPECT_EQ(project.object_nodes().size(), 1u);  // the group stays
+  ASSERT_NE(grown.kept_selections, 0);
+  EXPECT_EQ(project.history().back().name, "keep_selection");
+  const SegmentScriptResult committed = run_segment_script(
+      project, write_script(dir, R"({"ops": [{"op": "commit", "name": "wall"}]})"));
+  EXPECT_EQ(committed.kept_selections, 0);
+  const std::vector<store::ObjectNode> nodes = project.object_nodes();
+  ASSERT_EQ(nodes.size(), 2u);
+  EXPECT_EQ(nodes[1].points, grown.ops[0]["result"]["selected_pixels"].get<std::int64_t>());
+}
+
 TEST(SegmentScript, AScriptIsWholeWhileAnotherProcessWrites) {
   const ScratchDir dir;
   const std::filesystem::path file = dir / "p.sbproj";
@@ -124,7 +150,9 @@ TEST(SegmentScript, AScriptIsWholeWhileAnotherProcessWrites) {
   // The script's commands follow each other in the journal, with no other
   // command between them.
   std::vector<std::int64_t> script_commands;
-  for (const nlohmann::json& op : result.ops) script_commands.push_back(op["command"]);
+  for (const nlohmann::json& op : result.ops) {
+    if (!op["command"].is_null()) script_commands.push_back(op["command"]);  // a grow is none
+  }
   const std::vector<store::CommandRecord> history = project.history();
   const auto first =
       std::find_if(history.begin(), history.end(),

@@ -11,6 +11,7 @@
 #include "modeling/harmonize_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
+#include "modeling/selection_tools.hpp"
 #include "render/render_model.hpp"
 #include "room_project.hpp"
 #include "support/test_support.hpp"
@@ -30,13 +31,14 @@ struct RoomObjects {
 };
 
 RoomObjects segment_room(store::Project& project) {
+  SelectionTools tools;  // the selections: session state
   RoomObjects out;
   out.scan = store_room(project);
   out.room = group_nodes(project, {"room", std::nullopt, {}}).node_id;
-  select_region(project, select_at(out.scan, 0, -45));
-  out.floor = commit_selection(project, {out.scan, "floor", out.room}).node_id;
-  select_region(project, select_at(out.scan, -20, 0));
-  out.wall = commit_selection(project, {out.scan, "wall", out.room}).node_id;
+  tools.select(project, select_at(out.scan, 0, -45));
+  out.floor = tools.commit(project, {out.scan, "floor", out.room}).node_id;
+  tools.select(project, select_at(out.scan, -20, 0));
+  out.wall = tools.commit(project, {out.scan, "wall", out.room}).node_id;
   return out;
 }
 
@@ -230,6 +232,7 @@ std::pair<double, double> lightness(const render::RenderModel& model, std::uint3
 // has a spread of lightness. A clone maps the target's mean and spread
 // onto the source's: an inverted ratio or a wrong offset shows.
 TEST(Clone, TheTargetTakesTheSourcesMeanAndSpread) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   test::RoomScan room = test::shared_room();
@@ -244,10 +247,10 @@ TEST(Clone, TheTargetTakesTheSourcesMeanAndSpread) {
   for (const store::EncodedLayer& layer : store::encode_geometry(room.geometry))
     project.put_layer(edit, scan, layer);
   edit.commit("{}");
-  select_region(project, select_at(scan, 0, -45));
-  const std::int64_t floor = commit_selection(project, {scan, "floor", std::nullopt}).node_id;
-  select_region(project, select_at(scan, -20, 0));
-  const std::int64_t wall = commit_selection(project, {scan, "wall", std::nullopt}).node_id;
+  tools.select(project, select_at(scan, 0, -45));
+  const std::int64_t floor = tools.commit(project, {scan, "floor", std::nullopt}).node_id;
+  tools.select(project, select_at(scan, -20, 0));
+  const std::int64_t wall = tools.commit(project, {scan, "wall", std::nullopt}).node_id;
   const auto source = lightness(model_of(project), static_cast<std::uint32_t>(wall));
   const auto before = lightness(model_of(project), static_cast<std::uint32_t>(floor));
   ASSERT_GT(std::abs(source.second - before.second), 1.0);  // the spreads differ

@@ -60,53 +60,46 @@ std::string state_of(const store::Project& project) {
 // A commit carries the object into the other scans with the settings its
 // selection was grown with in this session: the last grow that replaced or
 // added to it (a subtraction's do not count, nor a grow whose seed was
-// refused), and none before any.
+// refused), and none before any. The journal keeps them with the commit.
 TEST(SegmentCommands, ACommitGrowsOnWithTheSettingsItsSelectionWasGrownWith) {
-  SelectionTools tools;
-  EXPECT_FALSE(tools.commit_of(1, "wall", std::nullopt).grow.has_value());
-  segmentation::GrowSettings colour =
-      segmentation::default_grow_settings(segmentation::Channel::kColor);
-  colour.tolerance = 9.0;
-  tools.grew(tools.select_at(1, {3.0, 4.0}, SelectMode::kReplace, colour));
-  tools.grew(tools.select_at(1, {5.0, 4.0}, SelectMode::kSubtract,
-                             segmentation::default_grow_settings(segmentation::Channel::kRange)));
-  // A grow whose seed was refused is not remembered: select_region said so
-  // and the caller does not report it.
-  tools.select_at(1, {6.0, 4.0}, SelectMode::kAdd,
-                  segmentation::default_grow_settings(segmentation::Channel::kIntensity));
-  const CommitSettings commit = tools.commit_of(1, "wall", 7);
-  EXPECT_EQ(commit.scan_id, 1);
-  EXPECT_EQ(commit.name, "wall");
-  EXPECT_EQ(commit.parent, std::optional<std::int64_t>(7));
-  ASSERT_TRUE(commit.grow.has_value());
-  EXPECT_EQ(commit.grow->channel, segmentation::Channel::kColor);
-  EXPECT_EQ(commit.grow->tolerance, 9.0);
-  EXPECT_FALSE(tools.commit_of(2, "wall", std::nullopt).grow.has_value());
-
-  // The journal keeps them with the commit.
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
-  const SelectSettings wall = select_at(scan, 20, 0);
-  const Eigen::Vector2d seed(wall.seed_col, wall.seed_row);
-  const SelectSettings grown = tools.select_at(
-      scan, seed, SelectMode::kReplace,
-      segmentation::default_grow_settings(segmentation::Channel::kNormal));
-  ASSERT_TRUE(select_region(project, grown).seed_open);
-  tools.grew(grown);
-  commit_selection(project, tools.commit_of(scan, "wall", std::nullopt));
-  EXPECT_THAT(project.history().back().settings, HasSubstr("\"grow\":{\"channel\":\"normal\""));
+  SelectionTools tools;
+  EXPECT_FALSE(tools.commit_of(scan, "wall", std::nullopt).grow.has_value());
+  SelectSettings range = select_at(scan, 20, 0, SelectMode::kReplace, segmentation::Channel::kRange);
+  range.grow.tolerance = 9.0;
+  ASSERT_TRUE(tools.select(project, range).seed_open);
+  ASSERT_TRUE(tools.select(project, select_at(scan, 0, -45, SelectMode::kSubtract)).seed_open);
+  SelectSettings outside_lasso =
+      select_at(scan, -20, 0, SelectMode::kAdd, segmentation::Channel::kIntensity);
+  outside_lasso.constraints.lasso = {{0.0, 0.0}, {5.0, 0.0}, {0.0, 5.0}};
+  ASSERT_FALSE(tools.select(project, outside_lasso).seed_open);
+  const CommitSettings commit = tools.commit_of(scan, "wall", 7);
+  EXPECT_EQ(commit.scan_id, scan);
+  EXPECT_EQ(commit.name, "wall");
+  EXPECT_EQ(commit.parent, std::optional<std::int64_t>(7));
+  ASSERT_TRUE(commit.grow.has_value());
+  EXPECT_EQ(commit.grow->channel, segmentation::Channel::kRange);
+  EXPECT_EQ(commit.grow->tolerance, 9.0);
+  EXPECT_FALSE(tools.commit_of(scan + 1, "wall", std::nullopt).grow.has_value());
+  tools.commit(project, tools.commit_of(scan, "wall", std::nullopt));
+  EXPECT_THAT(project.history().back().settings, HasSubstr("\"grow\":{\"channel\":\"range\""));
 }
 
 TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
+  SelectionTools tools;
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
-  const SelectResult selected = select_region(project, select_at(scan, -20, 0));
+  const std::size_t journal = project.history().size();
+  const SelectResult selected = tools.select(project, select_at(scan, -20, 0));
   ASSERT_TRUE(selected.seed_open);
   EXPECT_GT(selected.selected_pixels, 10000u);
-  const NodeCommandResult wall = commit_selection(project, {scan, "wall +x", room.node_id});
+  EXPECT_EQ(project.history().size(), journal);  // a grow is session state
+  const NodeCommandResult wall = tools.commit(project, {scan, "wall +x", room.node_id});
+  EXPECT_TRUE(tools.selection(scan).empty());
   const std::vector<store::ObjectNode> nodes = project.object_nodes();
   ASSERT_EQ(nodes.size(), 2u);
   EXPECT_EQ(nodes[1].id, wall.node_id);
@@ -120,19 +113,60 @@ TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
   EXPECT_GT(*nodes[1].mean_footprint_m, 0.0);
   EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(wall.node_id)),
             selected.selected_pixels);
-  EXPECT_FALSE(
-      project.load_layer<std::uint8_t>(scan, store::layer::kSelection, store::ElementType::kU8));
   // The wall's pixels are no longer in the pool: a click on them grows
-  // nothing, says why, and writes nothing, so an undone click stays redoable.
-  ASSERT_TRUE(select_region(project, select_at(scan, 0, -45)).seed_open);  // the floor
+  // nothing and says why. No click writes, so an undone command stays redoable.
+  group_nodes(project, {"later", std::nullopt, {}});
   ASSERT_TRUE(project.undo().has_value());
-  const std::size_t journal = project.history().size();
-  const SelectResult refused = select_region(project, select_at(scan, -20, 0));
+  const std::size_t after_undo = project.history().size();
+  ASSERT_TRUE(tools.select(project, select_at(scan, 0, -45)).seed_open);  // the floor
+  const SelectResult refused = tools.select(project, select_at(scan, -20, 0));
   EXPECT_FALSE(refused.seed_open);
-  EXPECT_EQ(refused.command_id, 0);
   EXPECT_THAT(refused.refused, HasSubstr("owns it"));
-  EXPECT_EQ(project.history().size(), journal);
+  EXPECT_EQ(project.history().size(), after_undo);
   EXPECT_TRUE(project.redo().has_value());  // the redo chain is whole
+}
+
+// Selections are session state: undo takes the grows back one by one, and
+// undoing a commit brings its selection back; keep() stores them in the
+// project for the next session, as one command, only when they changed.
+TEST(SegmentCommands, SelectionsAreSessionStateKeptOnRequest) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  SelectionTools tools;
+  const std::size_t wall = tools.select(project, select_at(scan, -20, 0)).selected_pixels;
+  const std::size_t both =
+      tools.select(project, select_at(scan, 0, -45, SelectMode::kAdd)).selected_pixels;
+  ASSERT_GT(both, wall);
+  ASSERT_TRUE(tools.undo_selection());
+  EXPECT_EQ(tools.selection(scan).size(), wall);
+  ASSERT_TRUE(tools.redo_selection());
+  EXPECT_EQ(tools.selection(scan).size(), both);
+  const NodeCommandResult committed = tools.commit(project, tools.commit_of(scan, "both", {}));
+  EXPECT_FALSE(tools.undo_selection());  // the grows before a command go with it
+  ASSERT_TRUE(project.undo().has_value());
+  tools.command_undone(committed.command_id);
+  EXPECT_EQ(tools.selection(scan).size(), both);
+  ASSERT_TRUE(project.redo().has_value());
+  tools.command_redone(committed.command_id);
+  EXPECT_TRUE(tools.selection(scan).empty());
+  ASSERT_TRUE(project.undo().has_value());
+  tools.command_undone(committed.command_id);
+
+  EXPECT_TRUE(kept_selection(project, scan).empty());
+  const std::size_t journal = project.history().size();
+  const std::int64_t kept = tools.keep(project);
+  EXPECT_GT(kept, 0);
+  // It ended the redo chain: the undone commit gave its place to it.
+  EXPECT_EQ(project.history().size(), journal);
+  EXPECT_EQ(kept_selection(project, scan), tools.selection(scan));
+  EXPECT_EQ(tools.keep(project), 0);  // nothing changed since
+  // Another session starts from the kept selection, and a commit removes it.
+  SelectionTools next;
+  next.open_scan(project, scan);
+  EXPECT_EQ(next.selection(scan).size(), both);
+  next.commit(project, next.commit_of(scan, "both", {}));
+  EXPECT_TRUE(kept_selection(project, scan).empty());
 }
 
 // An object drawn in one scan covers the surface in every scan that saw it:
@@ -140,6 +174,7 @@ TEST(SegmentCommands, AGrownWallBecomesAnObjectOfTheTree) {
 // command; a setup 100 m away sees other surfaces and gives none; points an
 // object of the other scan owns stay its own.
 TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t first = store_room(project);
@@ -153,18 +188,18 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
     edit.commit("{}");
   }
   // The poster, flush with the wall, is already an object of the second scan.
-  ASSERT_TRUE(select_region(project, select_at(second, 31, 0, SelectMode::kReplace,
+  ASSERT_TRUE(tools.select(project, select_at(second, 31, 0, SelectMode::kReplace,
                                                segmentation::Channel::kColor))
                   .seed_open);
   CommitSettings poster{second, "poster", std::nullopt};
   poster.other_scans = false;
-  const NodeCommandResult poster_node = commit_selection(project, poster);
+  const NodeCommandResult poster_node = tools.commit(project, poster);
   const std::size_t poster_pixels =
       count_owned(project, second, static_cast<std::uint32_t>(poster_node.node_id));
   ASSERT_GT(poster_pixels, 100u);
 
-  const SelectResult selected = select_region(project, select_at(first, 20, 0));
-  const NodeCommandResult wall = commit_selection(project, {first, "wall +x", std::nullopt});
+  const SelectResult selected = tools.select(project, select_at(first, 20, 0));
+  const NodeCommandResult wall = tools.commit(project, {first, "wall +x", std::nullopt});
   const auto id = static_cast<std::uint32_t>(wall.node_id);
   const std::size_t in_first = count_owned(project, first, id);
   EXPECT_EQ(in_first, selected.selected_pixels);
@@ -200,15 +235,16 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
   // Asked to stay in its scan, it does.
   project.redo();
   project.undo();
-  ASSERT_TRUE(select_region(project, select_at(first, 20, 0)).seed_open);
+  ASSERT_TRUE(tools.select(project, select_at(first, 20, 0)).seed_open);
   CommitSettings alone{first, "wall +x", std::nullopt};
   alone.other_scans = false;
-  const auto only = static_cast<std::uint32_t>(commit_selection(project, alone).node_id);
+  const auto only = static_cast<std::uint32_t>(tools.commit(project, alone).node_id);
   EXPECT_EQ(count_owned(project, first, only), in_first);
   EXPECT_EQ(count_owned(project, second, only), 0u);
 }
 
 TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   std::int64_t scan = 0;
   std::size_t wall_only = 0;
@@ -217,17 +253,17 @@ TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
   {
     store::Project project = store::Project::create(dir / "p.sbproj");
     scan = store_room(project);
-    wall_only = select_region(project, select_at(scan, -20, 0)).selected_pixels;
-    const SelectResult both = select_region(project, select_at(scan, 0, -45, SelectMode::kAdd));
+    wall_only = tools.select(project, select_at(scan, -20, 0)).selected_pixels;
+    const SelectResult both = tools.select(project, select_at(scan, 0, -45, SelectMode::kAdd));
     EXPECT_GT(both.selected_pixels, wall_only);  // the floor joined
     // The floor's region also holds the pixels on its crease with the wall.
     const SelectResult back =
-        select_region(project, select_at(scan, 0, -45, SelectMode::kSubtract));
+        tools.select(project, select_at(scan, 0, -45, SelectMode::kSubtract));
     EXPECT_LE(back.selected_pixels, wall_only);
     EXPECT_GT(back.selected_pixels, wall_only * 98 / 100);
     committed = back.selected_pixels;
     before_commit = state_of(project);
-    commit_selection(project, {scan, "wall", std::nullopt});
+    tools.commit(project, {scan, "wall", std::nullopt});
   }
   {
     store::Project project = store::Project::open(dir / "p.sbproj");
@@ -241,12 +277,13 @@ TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
 }
 
 TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
-  const std::size_t floor = select_region(project, select_at(scan, 0, -45)).selected_pixels;
-  const NodeCommandResult object = commit_selection(project, {scan, "floor", room.node_id});
+  const std::size_t floor = tools.select(project, select_at(scan, 0, -45)).selected_pixels;
+  const NodeCommandResult object = tools.commit(project, {scan, "floor", room.node_id});
   delete_node(project, {room.node_id, DeletedPoints::kDeleted});
   EXPECT_TRUE(project.object_nodes().empty());  // the group and the floor in it
   EXPECT_EQ(count_owned(project, scan, store::kDeletedPoints), floor);
@@ -255,17 +292,18 @@ TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
   delete_node(project, {object.node_id, DeletedPoints::kToPool});
   EXPECT_EQ(project.object_nodes().size(), 1u);
   EXPECT_EQ(project.object_nodes()[0].points, 0);
-  EXPECT_TRUE(select_region(project, select_at(scan, 0, -45)).seed_open);
+  EXPECT_TRUE(tools.select(project, select_at(scan, 0, -45)).seed_open);
 }
 
 TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult site = group_nodes(project, {"site", std::nullopt, {}});
   const NodeCommandResult room = group_nodes(project, {"room", site.node_id, {}});
-  select_region(project, select_at(scan, 0, -45));
-  const NodeCommandResult floor = commit_selection(project, {scan, "floor", room.node_id});
+  tools.select(project, select_at(scan, 0, -45));
+  const NodeCommandResult floor = tools.commit(project, {scan, "floor", room.node_id});
   const std::string before = state_of(project);
   const UngroupResult ungrouped = ungroup_node(project, room.node_id);
   EXPECT_EQ(ungrouped.children, std::vector<std::int64_t>{floor.node_id});
@@ -285,12 +323,13 @@ TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
 }
 
 TEST(SegmentCommands, MovingAScanMovesItsObjectsBoxes) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
-  select_region(project, select_at(scan, -20, 0));
-  commit_selection(project, {scan, "wall +x", room.node_id});
+  tools.select(project, select_at(scan, -20, 0));
+  tools.commit(project, {scan, "wall +x", room.node_id});
   const std::vector<store::ObjectNode> before = project.object_nodes();
   const Eigen::Vector3d shift(10.0, -2.0, 0.5);
   const Eigen::Isometry3d moved =
@@ -307,15 +346,16 @@ TEST(SegmentCommands, MovingAScanMovesItsObjectsBoxes) {
 }
 
 TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
-  const std::size_t pane = select_region(project, select_at(scan, 0, 8)).selected_pixels;
-  const std::size_t both = select_region(project, select_at(scan, 36, 0, SelectMode::kAdd,
+  const std::size_t pane = tools.select(project, select_at(scan, 0, 8)).selected_pixels;
+  const std::size_t both = tools.select(project, select_at(scan, 36, 0, SelectMode::kAdd,
                                                             segmentation::Channel::kColor))
                                .selected_pixels;
   const NodeCommandResult object =
-      commit_selection(project, {scan, "pane and poster", std::nullopt});
+      tools.commit(project, {scan, "pane and poster", std::nullopt});
   const SeparateResult parts = separate_object(project, {object.node_id, scan});
   ASSERT_EQ(parts.nodes.size(), 2u);
   const std::vector<store::ObjectNode> nodes = project.object_nodes();
@@ -336,11 +376,12 @@ TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
 }
 
 TEST(SegmentCommands, ProposalsCoverThePoolInOneUndoableCommand) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
-  select_region(project, select_at(scan, 0, -45));
-  const NodeCommandResult floor = commit_selection(project, {scan, "floor", std::nullopt});
+  tools.select(project, select_at(scan, 0, -45));
+  const NodeCommandResult floor = tools.commit(project, {scan, "floor", std::nullopt});
   const std::string before = state_of(project);
   ProposeSettings settings;
   settings.scan_id = scan;
@@ -357,6 +398,7 @@ TEST(SegmentCommands, ProposalsCoverThePoolInOneUndoableCommand) {
 }
 
 TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
@@ -374,9 +416,9 @@ TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
   };
   SelectSettings outside = select_at(scan, 0, 0);
   outside.seed_row = 180;
-  refused([&] { select_region(project, outside); }, "outside the 180 × 720 grid");
-  refused([&] { commit_selection(project, {scan, "wall", std::nullopt}); }, "selection is empty");
-  refused([&] { commit_selection(project, {scan, "", std::nullopt}); }, "needs a name");
+  refused([&] { tools.select(project, outside); }, "outside the 180 × 720 grid");
+  refused([&] { tools.commit(project, {scan, "wall", std::nullopt}); }, "selection is empty");
+  refused([&] { tools.commit(project, {scan, "", std::nullopt}); }, "needs a name");
   refused([&] { group_nodes(project, {"x", 99, {}}); }, "node 99");
   refused(
       [&] {
@@ -425,6 +467,7 @@ std::int64_t newest_done(const store::Project& project) {
 // The property: a long random session of every operation, then undo until
 // the session's first command is gone, leaves the state it began with.
 TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir scratch;
   // fsync is the cost of each command; tmpfs makes the thousand cheap.
   const std::filesystem::path shm = "/dev/shm";
@@ -453,12 +496,12 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
           SelectSettings s =
               select_at(scan, pick(360) - 180.0, pick(90) - 60.0, static_cast<SelectMode>(pick(3)),
                         static_cast<segmentation::Channel>(pick(4)));
-          select_region(project, s);
+          tools.select(project, s);
           break;
         }
         case 3:
           if (pick(2))
-            commit_selection(project, {scan, "object " + std::to_string(k), std::nullopt});
+            tools.commit(project, {scan, "object " + std::to_string(k), std::nullopt});
           else
             group_nodes(project, {"group " + std::to_string(k), std::nullopt, {}});
           break;

@@ -7,6 +7,7 @@
 #include "core/errors.hpp"
 #include "modeling/room_project.hpp"
 #include "modeling/selection_commands.hpp"
+#include "modeling/selection_tools.hpp"
 #include "render/render_model.hpp"
 #include "support/test_support.hpp"
 
@@ -14,14 +15,13 @@ namespace scanbench::render {
 namespace {
 
 // The segmentation's commands build the objects the model draws.
-using modeling::commit_selection;
 using modeling::delete_node;
 using modeling::DeletedPoints;
 using modeling::edit_node;
 using modeling::group_nodes;
 using modeling::NodeCommandResult;
 using modeling::select_at;
-using modeling::select_region;
+using modeling::SelectionTools;
 using modeling::store_room;
 
 using test::ScratchDir;
@@ -71,16 +71,17 @@ TEST(RenderModel, AnUnsegmentedScanIsTiledWhole) {
 }
 
 TEST(RenderModel, ObjectsAreTiledOnTheirOwnAndCullingFollowsTheTree) {
+  SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
-  const std::size_t floor_points = select_region(project, select_at(scan, 0, -45)).selected_pixels;
-  const NodeCommandResult floor = commit_selection(project, {scan, "floor", room.node_id});
-  const std::size_t wall_points = select_region(project, select_at(scan, -20, 0)).selected_pixels;
-  const NodeCommandResult wall = commit_selection(project, {scan, "wall", room.node_id});
-  const std::size_t far_points = select_region(project, select_at(scan, 90, 0)).selected_pixels;
-  const NodeCommandResult far = commit_selection(project, {scan, "far wall", std::nullopt});
+  const std::size_t floor_points = tools.select(project, select_at(scan, 0, -45)).selected_pixels;
+  const NodeCommandResult floor = tools.commit(project, {scan, "floor", room.node_id});
+  const std::size_t wall_points = tools.select(project, select_at(scan, -20, 0)).selected_pixels;
+  const NodeCommandResult wall = tools.commit(project, {scan, "wall", room.node_id});
+  const std::size_t far_points = tools.select(project, select_at(scan, 90, 0)).selected_pixels;
+  const NodeCommandResult far = tools.commit(project, {scan, "far wall", std::nullopt});
   delete_node(project, {far.node_id, DeletedPoints::kDeleted});
   edit_node(project, {room.node_id, std::nullopt, true, std::nullopt});  // hide the room
   RenderModelSettings settings;
