@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -103,7 +104,20 @@ void measure_panel(WorkbenchState& s) {
   ImGui::InputText("##csv", s.csv_path.data(), s.csv_path.size());
   ImGui::SameLine();
   ImGui::BeginDisabled(s.session.measurements().empty());
-  if (ImGui::Button("Export CSV")) s.session.export_measurements(s.csv_path.data());
+  if (ImGui::Button("Export CSV")) {
+    const std::filesystem::path file = s.csv_path.data();
+    std::error_code error;
+    if (std::filesystem::exists(file, error)) {
+      // An earlier export is replaced only once confirmed.
+      s.question = Question{"Replace the file?",
+                            file.string() + " exists. Exporting replaces it with the " +
+                                std::to_string(s.session.measurements().size()) +
+                                " measurements listed.",
+                            "Replace", [&s, file] { s.session.export_measurements(file); }};
+    } else {
+      s.session.export_measurements(file);
+    }
+  }
   s.probe("export csv");
   ImGui::EndDisabled();
 }

@@ -452,17 +452,23 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
     squared += d * d;
   }
   EXPECT_GT(std::sqrt(squared), 0.5);  // two points of the campus, apart
-  // Export CSV to the file the field names (by default beside the project).
-  const Layout listed = run_stage(dir, project, "measure_list", json::array());
-  run_stage(dir, project, "measure_csv",
-            {{{"click", listed.widget("export csv")}}, {{"wait", 1}}});
+  // Export CSV to the file the field names (by default beside the project),
+  // replacing an earlier one only once confirmed.
   std::filesystem::path written = project;
   written.replace_extension();
   written += "_measurements.csv";
-  ASSERT_TRUE(std::filesystem::exists(written));
-  std::ifstream in(written);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_THAT(text, HasSubstr("\"distance 1\",distance,"));
+  std::ofstream(written) << "an earlier export\n";
+  const auto text_of = [](const std::filesystem::path& file) {
+    std::ifstream in(file);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const Layout listed = run_stage(dir, project, "measure_list", json::array());
+  const json export_csv = {{"click", listed.widget("export csv")}};
+  const Layout asked = run_stage(dir, project, "measure_csv_asked", {export_csv, {{"wait", 1}}});
+  EXPECT_EQ(text_of(written), "an earlier export\n");
+  run_stage(dir, project, "measure_csv",
+            {export_csv, {{"wait", 1}}, {{"click", asked.widget("question yes")}}, {{"wait", 1}}});
+  EXPECT_THAT(text_of(written), HasSubstr("\"distance 1\",distance,"));
   // The command line lists them and writes the CSV too, never over the project.
   const json listed_json =
       json::parse(run_cli(dir, {"measurements", project.string(), "--json"}).out);
