@@ -89,6 +89,8 @@ nlohmann::json to_report(const RegisterCommandResult& out) {
                                {"initial_T_world_scan", pose_json(out.initial_T_world_scan[k])},
                                {"T_world_scan", pose_json(r.T_world_scan[k])}});
   }
+  report["objects"] = {{"points_released", out.object_points_released},
+                       {"points_carried", out.object_points_carried}};
   return report;
 }
 

@@ -183,10 +183,11 @@ std::map<std::int64_t, std::vector<std::uint32_t>> reassign_pixels(
 }
 
 std::vector<store::ObjectNode> node_figures_after_moving(
-    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses) {
+    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses,
+    const std::map<std::int64_t, std::vector<std::uint32_t>>& changed) {
   const Tree tree = load_tree(project);
   if (tree.empty()) return {};
-  return with_new_figures(tree, compute_figures(project, tree, {}, poses));
+  return with_new_figures(tree, compute_figures(project, tree, changed, poses));
 }
 
 }  // namespace scanbench::modeling

@@ -95,11 +95,12 @@ std::map<std::int64_t, std::vector<std::uint32_t>> reassign_pixels(
     const store::Project& project, const std::unordered_set<std::uint32_t>& owners,
     std::uint32_t replacement);
 
-// The nodes whose figures change when the scans of `poses` move there,
-// each with its new figures: what a command that moves scans (register)
-// writes with put_node in its own Edit, so the tree's boxes follow the
-// scans and undo with them.
+// The nodes whose figures change when the scans of `poses` move there (and
+// the memberships of `changed` replace the stored ones), each with its new
+// figures: what a command that moves scans (register) writes with put_node
+// in its own Edit, so the tree's boxes follow the scans and undo with them.
 std::vector<store::ObjectNode> node_figures_after_moving(
-    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses);
+    const store::Project& project, const std::map<std::int64_t, Eigen::Isometry3d>& poses,
+    const std::map<std::int64_t, std::vector<std::uint32_t>>& changed = {});
 
 }  // namespace scanbench::modeling

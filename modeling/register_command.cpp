@@ -4,6 +4,7 @@
 #include <map>
 
 #include "core/errors.hpp"
+#include "modeling/carried_objects.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/loaded_scans.hpp"
 #include "modeling/node_tree.hpp"
@@ -72,11 +73,24 @@ RegisterCommandResult register_project(store::Project& project,
   std::map<std::int64_t, Eigen::Isometry3d> moved;
   for (std::size_t k = 0; k < loaded.ids.size(); ++k)
     moved.emplace(loaded.ids[k], out.result.T_world_scan[k]);
-  const std::vector<store::ObjectNode> refigured = node_figures_after_moving(project, moved);
+  progress.update({kStage, 0, 1, "carrying the objects again"});
+  const CarriedAgain carried = carry_objects_again(project, moved);
+  out.object_points_released = carried.released;
+  out.object_points_carried = carried.carried_points;
+  const std::vector<store::ObjectNode> refigured =
+      node_figures_after_moving(project, moved, carried.memberships);
+  progress.throw_if_cancelled(kStage);
 
   store::Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
   out.command_id = edit.command_id();
   for (const store::ObjectNode& node : refigured) project.put_node(edit, node);
+  for (const auto& [scan_id, membership] : carried.memberships) {
+    put_membership(project, edit, scan_id, membership);
+    project.put_layer(edit, scan_id,
+                      store::encode_layer<std::uint8_t>(store::layer::kCarried,
+                                                        store::ElementType::kU8,
+                                                        carried.carried.at(scan_id)));
+  }
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
     loaded.scans[k].T_world_scan = out.result.T_world_scan[k];
     project.set_pose(edit, loaded.ids[k], loaded.scans[k]);

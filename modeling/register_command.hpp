@@ -36,12 +36,18 @@ struct RegisterCommandResult {
   std::vector<std::string> names;
   std::vector<Eigen::Isometry3d> initial_T_world_scan;  // the poses it started from
   registration::RegistrationResult result;
+  // The objects' points carried from other scans, carried again at the new
+  // poses (carried_objects.hpp): those that went back to the pool, and
+  // those carried now.
+  std::size_t object_points_released = 0;
+  std::size_t object_points_carried = 0;
 };
 
 // Registers every scan of the project (the first scan by id is the
 // reference and keeps its pose), then as one command stores the new poses
 // (earlier poses stay in the history), the report as the command's result,
-// and removes the now stale merge keep masks. A failed pair is reported, and
+// removes the now stale merge keep masks, and carries the objects again at
+// the new poses (a scan imported after they were drawn gets them then). A failed pair is reported, and
 // its scan keeps its pose relative to its target. Throws core::InputError
 // for a damaged project, a project without scans, a scan without geometry
 // ("run scanbench geometry first"), or picks that do not name the project's scans as the settings

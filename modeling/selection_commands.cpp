@@ -6,6 +6,7 @@
 #include <unordered_set>
 
 #include "core/errors.hpp"
+#include "modeling/carried_objects.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/object_carry.hpp"
@@ -41,6 +42,25 @@ void put_selection(store::Project& project, store::Project::Edit& edit, std::int
   project.put_layer(
       edit, scan_id,
       store::encode_layer<std::uint8_t>(store::layer::kSelection, store::ElementType::kU8, mask));
+}
+
+// Pixels of `scan_id` that a command assigned where they were drawn: no
+// longer carried. The layer as it then is, none when the scan has none.
+std::optional<std::vector<std::uint8_t>> drawn_there(const store::Project& project,
+                                                     std::int64_t scan_id,
+                                                     const segmentation::PixelSet& pixels) {
+  auto carried = project.load_layer<std::uint8_t>(scan_id, store::layer::kCarried,
+                                                  store::ElementType::kU8);
+  if (!carried) return std::nullopt;
+  for (const std::uint32_t p : pixels) (*carried)[p] = 0;
+  return carried;
+}
+
+void put_carried(store::Project& project, store::Project::Edit& edit, std::int64_t scan_id,
+                 const std::vector<std::uint8_t>& carried) {
+  project.put_layer(edit, scan_id,
+                    store::encode_layer<std::uint8_t>(store::layer::kCarried,
+                                                      store::ElementType::kU8, carried));
 }
 
 store::StoredScanSummary require_scan(const store::Project& project, std::int64_t scan_id) {
@@ -153,6 +173,11 @@ SeparateResult propose_objects(store::Project& project, const ProposeSettings& s
     made.push_back(object);
     result.nodes.push_back(object.id);
   }
+  segmentation::PixelSet proposed_pixels;
+  for (const segmentation::PixelSet& region : proposed.regions)
+    proposed_pixels.insert(proposed_pixels.end(), region.begin(), region.end());
+  const std::optional<std::vector<std::uint8_t>> drawn =
+      drawn_there(project, settings.scan_id, proposed_pixels);
   const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
   store::Project::Edit edit = project.begin_command(
       "propose",
@@ -166,6 +191,7 @@ SeparateResult propose_objects(store::Project& project, const ProposeSettings& s
   project.put_node(edit, group);
   for (const store::ObjectNode& object : made) project.put_node(edit, object);
   if (!made.empty()) put_membership(project, edit, settings.scan_id, membership);
+  if (drawn) put_carried(project, edit, settings.scan_id, *drawn);
   refresh_figures(project, edit, tree, figures);
   result.command_id = edit.command_id();
   edit.commit(dump({{"group", group.id}, {"proposals", made.size()}, {"pixels", proposed.pixels}}));
@@ -266,17 +292,17 @@ std::int64_t keep_selections(store::Project& project,
   return command_id;
 }
 
-// The memberships of the other scans with geometry, each with its points
-// that sample the surface of object `node` (its pixels in `membership` of
-// scan `drawn`), and with `grow` those it grows to there, added where they
-// were still to be segmented (object_carry.hpp); scans gaining none are
-// left out. `carried` counts the points added. One other scan is decoded at
-// a time.
-std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
-    const store::Project& project, std::int64_t drawn, const std::vector<std::uint32_t>& membership,
-    std::uint32_t node, const std::optional<segmentation::GrowSettings>& grow,
-    const acquisition::RangeNoise& noise, std::size_t& carried) {
-  std::map<std::int64_t, std::vector<std::uint32_t>> out;
+// The membership and carried layers of the other scans with geometry, each
+// with its points that sample the surface of object `node` (its pixels in
+// `membership` of scan `drawn`), and with `grow` those it grows to there,
+// added where they were still to be segmented (object_carry.hpp); scans
+// gaining none are left out. One other scan is decoded at a time.
+CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_t drawn,
+                                      const std::vector<std::uint32_t>& membership,
+                                      std::uint32_t node,
+                                      const std::optional<segmentation::GrowSettings>& grow,
+                                      const acquisition::RangeNoise& noise) {
+  CarriedAgain out;
   const std::optional<acquisition::ScanGeometry> drawn_geometry =
       store::load_geometry(project, drawn);
   if (!drawn_geometry) return out;
@@ -308,9 +334,14 @@ std::map<std::int64_t, std::vector<std::uint32_t>> carried_into_other_scans(
     const segmentation::PixelSet joins = carry_object(
         object, {&target, scan.T_world_scan, grid ? &*grid : nullptr, open}, settings);
     if (joins.empty()) continue;
-    for (const std::uint32_t q : joins) other[q] = node;
-    carried += joins.size();
-    out.emplace(stored.id, std::move(other));
+    std::vector<std::uint8_t> carried = load_carried(project, stored.id, scan.pixel_count());
+    for (const std::uint32_t q : joins) {
+      other[q] = node;
+      carried[q] = 1;
+    }
+    out.carried_points += joins.size();
+    out.memberships.emplace(stored.id, std::move(other));
+    out.carried.emplace(stored.id, std::move(carried));
   }
   return out;
 }
@@ -331,34 +362,40 @@ NodeCommandResult commit_selection(store::Project& project, const CommitSettings
   node.id = fresh_ids(project, 1);
   node.name = settings.name;
   node.parent = settings.parent;
-  std::size_t taken = 0;
+  segmentation::PixelSet taken;
   for (const std::uint32_t p : selection) {
     if (p >= membership.size())
       refuse(where, "the selection has a pixel outside the grid: it was grown on another scan");
     if (membership[p] != 0) continue;  // another object's since the selection grew
     membership[p] = static_cast<std::uint32_t>(node.id);
-    ++taken;
+    taken.push_back(p);
   }
-  if (taken == 0) refuse(where, "the selection is empty: grow a region first");
+  if (taken.empty()) refuse(where, "the selection is empty: grow a region first");
   tree.emplace(node.id, node);
-  std::size_t carried = 0;
-  std::map<std::int64_t, std::vector<std::uint32_t>> changed =
+  CarriedAgain others =
       settings.other_scans
           ? carried_into_other_scans(project, settings.scan_id, membership,
                                      static_cast<std::uint32_t>(node.id), settings.grow,
-                                     settings.range_noise, carried)
-          : std::map<std::int64_t, std::vector<std::uint32_t>>{};
+                                     settings.range_noise)
+          : CarriedAgain{};
+  std::map<std::int64_t, std::vector<std::uint32_t>>& changed = others.memberships;
   changed[settings.scan_id] = std::move(membership);
+  const std::optional<std::vector<std::uint8_t>> drawn =
+      drawn_there(project, settings.scan_id, taken);
   const auto figures = compute_figures(project, tree, changed);
   store::Project::Edit edit =
       project.begin_command("commit", settings_to_json(settings), revision);
   project.put_node(edit, node);
   for (const auto& [scan_id, scan_membership] : changed)
     put_membership(project, edit, scan_id, scan_membership);
+  for (const auto& [scan_id, carried] : others.carried) put_carried(project, edit, scan_id, carried);
+  if (drawn) put_carried(project, edit, settings.scan_id, *drawn);
   project.remove_layer(edit, settings.scan_id, store::layer::kSelection);
   refresh_figures(project, edit, tree, figures);
   const std::int64_t command_id = edit.command_id();
-  edit.commit(dump({{"node", node.id}, {"points", taken}, {"other_scans_points", carried}}));
+  edit.commit(dump({{"node", node.id},
+                    {"points", taken.size()},
+                    {"other_scans_points", others.carried_points}}));
   return {command_id, node.id};
 }
 

@@ -156,4 +156,25 @@ NodeCommandResult delete_node(store::Project& project, const DeleteSettings& set
   return {command_id, settings.node};
 }
 
+ScanCoverage scan_coverage(const store::Project& project) {
+  const Tree tree = load_tree(project);
+  ScanCoverage coverage;
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    const auto membership = project.load_layer<std::uint32_t>(
+        stored.id, store::layer::kMembership, store::ElementType::kU32);
+    if (!membership) continue;
+    std::map<std::uint32_t, std::int64_t> owned;
+    for (const std::uint32_t owner : *membership) {
+      if (owner != 0 && owner != store::kDeletedPoints) ++owned[owner];
+    }
+    for (const auto& [owner, points] : owned) {
+      // The object and each group above it.
+      for (auto node = tree.find(owner); node != tree.end();
+           node = node->second.parent ? tree.find(*node->second.parent) : tree.end())
+        coverage[node->first][stored.id] += points;
+    }
+  }
+  return coverage;
+}
+
 }  // namespace scanbench::modeling

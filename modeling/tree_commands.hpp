@@ -81,4 +81,10 @@ struct MergeSettings {
 // user merges proposals).
 NodeCommandResult merge_objects(store::Project& project, const MergeSettings& settings);
 
+// Which scans each node's points come from, and how many: node id → scan
+// id → points (a group's sum those below it; scans giving none are left
+// out). Reads only the membership layers, one scan at a time.
+using ScanCoverage = std::map<std::int64_t, std::map<std::int64_t, std::int64_t>>;
+ScanCoverage scan_coverage(const store::Project& project);
+
 }  // namespace scanbench::modeling

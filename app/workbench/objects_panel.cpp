@@ -92,6 +92,31 @@ void tree(WorkbenchState& s) {
   }
 }
 
+// The scans the selected node's points come from, with their counts: an
+// object drawn in one scan covers the others that sampled its surface. One
+// line always, so that the panels below stay where they are.
+void coverage_line(WorkbenchState& s, const std::optional<store::ObjectNode>& node) {
+  if (!node) {
+    ImGui::TextDisabled("select a node to see the scans it covers");
+    return;
+  }
+  const modeling::ScanCoverage& coverage = s.session.coverage();
+  const auto found = coverage.find(node->id);
+  if (found == coverage.end()) {
+    ImGui::TextDisabled("%s: no points", node->name.c_str());
+    return;
+  }
+  std::string text = "in scan";
+  const char* separator = " ";
+  for (const auto& [scan, points] : found->second) {
+    text += separator + std::to_string(scan) + " (" + std::to_string(points) + ")";
+    separator = ", ";
+  }
+  ImGui::TextUnformatted(text.c_str());
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("%s: points in each scan that sampled it", node->name.c_str());
+}
+
 }  // namespace
 
 void objects_panel(WorkbenchState& s) {
@@ -118,6 +143,7 @@ void objects_panel(WorkbenchState& s) {
   if (ImGui::Button("Frame")) s.frame_selection();
   s.probe("frame");
   ImGui::EndDisabled();
+  coverage_line(s, n);
 }
 
 }  // namespace scanbench::app::workbench

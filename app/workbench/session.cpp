@@ -107,6 +107,7 @@ void Session::reload() {
     return;
   }
   nodes_ = project_.object_nodes();
+  coverage_.reset();
   try {
     measurements_ = modeling::load_measurements(project_);
     measurements_revision_ = project_.revision();
@@ -361,6 +362,11 @@ void Session::show_first_scan_again() {
   }
   ++model_changes_;
   status_ = said;
+}
+
+const modeling::ScanCoverage& Session::coverage() {
+  if (!coverage_) coverage_ = modeling::scan_coverage(project_);
+  return *coverage_;
 }
 
 render::Picture Session::panorama(render::PanoramaChannel channel, std::int64_t highlight) const {

@@ -106,6 +106,9 @@ class Session {
   bool export_measurements(const std::filesystem::path& file);
 
   const std::vector<store::ObjectNode>& nodes() const { return nodes_; }
+  // Which scans each node's points come from (modeling::scan_coverage),
+  // read again after each change of the tree.
+  const modeling::ScanCoverage& coverage();
   // What the last action did or why it was refused.
   const std::string& status() const { return status_; }
   // Changes with every change of the project the views show.
@@ -154,6 +157,7 @@ class Session {
   std::size_t selected_ = 0;
   modeling::SelectionTools tools_;
   std::vector<store::ObjectNode> nodes_;
+  std::optional<modeling::ScanCoverage> coverage_;  // none: to be read again
   std::vector<modeling::Measurement> measurements_;
   std::string status_;
   std::int64_t revision_ = 0;

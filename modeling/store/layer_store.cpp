@@ -49,7 +49,7 @@ struct KnownLayer {
   const char* name;
   ElementType type;
 };
-constexpr std::array<KnownLayer, 12> kKnownLayers = {{{layer::kRange, ElementType::kF32},
+constexpr std::array<KnownLayer, 13> kKnownLayers = {{{layer::kRange, ElementType::kF32},
                                                       {layer::kValid, ElementType::kU8},
                                                       {layer::kIntensity, ElementType::kF32},
                                                       {layer::kRgb, ElementType::kU8x3},
@@ -60,7 +60,8 @@ constexpr std::array<KnownLayer, 12> kKnownLayers = {{{layer::kRange, ElementTyp
                                                       {layer::kGeometryFlags, ElementType::kU8},
                                                       {layer::kKeep, ElementType::kU8},
                                                       {layer::kSelection, ElementType::kU8},
-                                                      {layer::kMembership, ElementType::kU32}}};
+                                                      {layer::kMembership, ElementType::kU32},
+                                                      {layer::kCarried, ElementType::kU8}}};
 
 [[maybe_unused]] bool has_its_type(const EncodedLayer& layer) {
   for (const KnownLayer& known : kKnownLayers) {

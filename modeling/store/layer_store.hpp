@@ -60,6 +60,9 @@ inline constexpr const char* kGeometryFlags = "geometry_flags";
 inline constexpr const char* kKeep = "keep";
 inline constexpr const char* kSelection = "selection";
 inline constexpr const char* kMembership = "membership";
+// 1 where a commit carried the pixel into its object from another scan
+// (modeling/carried_objects.hpp); meaningful where the membership is set.
+inline constexpr const char* kCarried = "carried";
 }  // namespace layer
 
 // The membership of points the user deleted (kept in the scan, out of every

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "modeling/carried_objects.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/selection_commands.hpp"
 #include "modeling/selection_tools.hpp"
@@ -219,6 +220,11 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
   EXPECT_GT(poster_kept, 0u);  // the wall's region holds the poster, flush with it
   EXPECT_EQ(count_owned(project, second, id), expected);
   EXPECT_EQ(count_owned(project, far, id), 0u);
+  // The user sees which scans it covers.
+  const ScanCoverage coverage = scan_coverage(project);
+  const std::map<std::int64_t, std::int64_t> wall_scans = {
+      {first, static_cast<std::int64_t>(in_first)}, {second, static_cast<std::int64_t>(expected)}};
+  EXPECT_EQ(coverage.at(wall.node_id), wall_scans);
   for (const store::ObjectNode& node : project.object_nodes()) {
     if (node.id != wall.node_id) continue;
     EXPECT_EQ(node.points, static_cast<std::int64_t>(in_first + expected));
@@ -241,6 +247,51 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
   const auto only = static_cast<std::uint32_t>(tools.commit(project, alone).node_id);
   EXPECT_EQ(count_owned(project, first, only), in_first);
   EXPECT_EQ(count_owned(project, second, only), 0u);
+}
+
+// When the scans move (a re-registration), the points an object took from
+// other scans follow: those no longer on its surface go back to the pool,
+// and a scan now over it (moved there, or imported later and registered)
+// gets its points, grown with the settings of the commit.
+TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t first = store_room(project);
+  const std::int64_t second = store_room(project);
+  const std::int64_t later = store_room(project);
+  const Eigen::Isometry3d here = test::shared_room().scan.T_world_scan;
+  Eigen::Isometry3d away = here;
+  away.translation() += Eigen::Vector3d(100.0, 0.0, 0.0);
+  {
+    store::Project::Edit edit = project.begin_command("register", "{}");
+    acquisition::Scan moved = test::shared_room().scan;
+    moved.T_world_scan = away;
+    project.set_pose(edit, later, moved);
+    edit.commit("{}");
+  }
+  SelectionTools tools;
+  ASSERT_TRUE(tools.select(project, select_at(first, 20, 0)).seed_open);
+  const auto wall = static_cast<std::uint32_t>(
+      tools.commit(project, tools.commit_of(first, "wall +x", std::nullopt)).node_id);
+  const std::size_t in_second = count_owned(project, second, wall);
+  ASSERT_GT(in_second, 1000u);
+  ASSERT_EQ(count_owned(project, later, wall), 0u);
+
+  // A registration swaps them: the second scan moves away, the later one comes.
+  const CarriedAgain again = carry_objects_again(project, {{second, away}, {later, here}});
+  EXPECT_EQ(again.released, in_second);
+  EXPECT_EQ(again.carried_points, in_second);
+  EXPECT_EQ(again.memberships.count(first), 0u);  // drawn there: unchanged
+  const auto owned = [&](std::int64_t scan) {
+    const std::vector<std::uint32_t>& m = again.memberships.at(scan);
+    return static_cast<std::size_t>(std::count(m.begin(), m.end(), wall));
+  };
+  EXPECT_EQ(owned(second), 0u);
+  EXPECT_EQ(owned(later), in_second);
+  const std::vector<std::uint8_t>& carried = again.carried.at(later);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(carried.begin(), carried.end(), 1)), in_second);
+  // Nothing moved: nothing changes.
+  EXPECT_TRUE(carry_objects_again(project, {}).memberships.empty());
 }
 
 TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
@@ -304,6 +355,8 @@ TEST(SegmentCommands, UngroupMovesTheChildrenUpAndKeepsTheirPoints) {
   const NodeCommandResult room = group_nodes(project, {"room", site.node_id, {}});
   tools.select(project, select_at(scan, 0, -45));
   const NodeCommandResult floor = tools.commit(project, {scan, "floor", room.node_id});
+  const ScanCoverage coverage = scan_coverage(project);
+  EXPECT_EQ(coverage.at(site.node_id), coverage.at(floor.node_id));  // a group sums its objects
   const std::string before = state_of(project);
   const UngroupResult ungrouped = ungroup_node(project, room.node_id);
   EXPECT_EQ(ungrouped.children, std::vector<std::int64_t>{floor.node_id});

@@ -1,0 +1,40 @@
+// Objects carried again when scans move. A commit carries its object from
+// the scan it was drawn in into every other scan at the poses of the time
+// (object_carry.hpp), and marks the points it carried in the scan's
+// `carried` layer (u8). When a registration moves the scans, or registers
+// a scan imported after the objects were drawn, those points no longer
+// sample the object's surface, or the new scan has none: the carried
+// points go back to the pool and every object is carried again, at the
+// new poses, from the points drawn in each scan, with the settings its
+// commit grew with. Internal to modeling/ (register uses it).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "modeling/store/project.hpp"
+
+namespace scanbench::modeling {
+
+struct CarriedAgain {
+  // The scans whose objects changed: their membership and carried layers.
+  std::map<std::int64_t, std::vector<std::uint32_t>> memberships;
+  std::map<std::int64_t, std::vector<std::uint8_t>> carried;
+  std::size_t released = 0;  // carried points that went back to the pool
+  std::size_t carried_points = 0;  // points carried at the new poses
+};
+
+// Carries every object again with the scans at `poses` (the others where
+// they are). Scans without geometry are left out. Holds one target and
+// one source scan decoded at a time, and the changed layers.
+CarriedAgain carry_objects_again(const store::Project& project,
+                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses);
+
+// Scan `scan_id`'s carried layer; all 0 (drawn, or still to be segmented)
+// when it has none.
+std::vector<std::uint8_t> load_carried(const store::Project& project, std::int64_t scan_id,
+                                       std::size_t pixels);
+
+}  // namespace scanbench::modeling
