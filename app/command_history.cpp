@@ -64,7 +64,13 @@ std::string summary(const store::CommandRecord& c) {
   if (c.name == "merge" && result.contains("kept")) {
     return fmt::format("{} of {} points kept", result.value("kept", 0), result.value("points", 0));
   }
-  if (c.name == "select" && result.contains("selected_pixels")) {
+  if (c.name == "keep_selection" && result.contains("scans") && result["scans"].is_object()) {
+    std::string scans;
+    for (const auto& [scan, pixels] : result["scans"].items())
+      scans += fmt::format("{}scan {}: {} pixels", scans.empty() ? "" : ", ", scan, pixels.dump());
+    return "selection kept: " + scans;
+  }
+  if (c.name == "select" && result.contains("selected_pixels")) {  // in older journals
     return fmt::format("scan {}: {} pixels selected", settings.value("scan", 0),
                        result.value("selected_pixels", 0));
   }

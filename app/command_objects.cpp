@@ -26,7 +26,8 @@ std::string scan_list(const modeling::ScanCoverage& coverage, std::int64_t node)
   std::string out;
   const auto found = coverage.find(node);
   if (found == coverage.end()) return "-";
-  for (const auto& [scan, points] : found->second) out += (out.empty() ? "" : " ") + std::to_string(scan);
+  for (const auto& [scan, points] : found->second)
+    out += (out.empty() ? "" : " ") + std::to_string(scan);
   return out;
 }
 
@@ -78,8 +79,7 @@ void print_tree(const std::vector<store::ObjectNode>& nodes,
                                                                        int depth) {
     fmt::print("{:>5}  {:<7} {:>10}  {:<9}  {}{}{}{}\n", node.id,
                node.kind == store::NodeKind::kGroup ? "group" : "object", node.points,
-               scan_list(coverage, node.id),
-               std::string(static_cast<std::size_t>(2 * depth), ' '),
+               scan_list(coverage, node.id), std::string(static_cast<std::size_t>(2 * depth), ' '),
                core::one_line(node.name, core::kMaxMessagePart), node.hidden ? " (hidden)" : "",
                node.color.empty() ? "" : " (recoloured)");
     for (const store::ObjectNode* child : children[node.id]) print(*child, depth + 1);

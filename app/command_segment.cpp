@@ -22,7 +22,9 @@ void run_segment(const SegmentOptions& options) {
   store::Project project = store::Project::open(options.project);
   const SegmentScriptResult result = run_segment_script(project, script);
   if (options.json) {
-    nlohmann::json out = {{"ops", result.ops}, {"kept_selections", nullptr}};
+    nlohmann::json out = {{"ops", result.ops},
+                          {"kept_selections", nullptr},
+                          {"selections_held_back", result.selections_held_back}};
     if (result.kept_selections != 0) out["kept_selections"] = result.kept_selections;
     fmt::print("{}\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
     return;
@@ -37,6 +39,10 @@ void run_segment(const SegmentOptions& options) {
     fmt::print("the selection left uncommitted is kept in the project (command {})\n",
                result.kept_selections);
   }
+  if (result.selections_held_back) {
+    fmt::print("the selection left uncommitted is not kept: keeping it would end the redo "
+               "chain (redo, or commit it, first)\n");
+  }
   fmt::print("{} op(s) applied to {}; `scanbench objects` shows the tree\n", result.ops.size(),
              options.project);
 }
@@ -49,9 +55,9 @@ void add_segment_command(CLI::App& app) {
       "segment",
       "Segment scans into the object tree from a script of the workbench's operations (lasso, "
       "barrier, grow, add, subtract, commit, group, ungroup, merge, rename, hide, show, reparent, "
-      "delete, "
-      "separate, auto, undo, redo); each change is one undoable command. A refused script "
-      "changes nothing.");
+      "delete, separate, auto, undo, redo). Grows build the selection and write nothing; every "
+      "other change is one undoable command, and a selection left uncommitted is kept for the "
+      "next session. A refused script changes nothing.");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -6,6 +6,7 @@
 #include <set>
 #include <utility>
 
+#include "core/errors.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/object_carry.hpp"
@@ -19,16 +20,18 @@ namespace scanbench::modeling {
 namespace {
 
 // How each object's commit carried it (the channel it grew with, the
-// scanner's noise), by node id, from the journal's done commits. An object
-// no commit made (a separated part, a proposal) is carried without growing.
+// scanner's noise), by node id, from the journal's done commits that
+// carried their object. Objects no such commit made (a commit asked to
+// stay in its scan, a proposal, a separated part) are not carried.
 std::map<std::int64_t, CommitSettings> commit_settings_by_node(const store::Project& project) {
   std::map<std::int64_t, CommitSettings> out;
   for (const store::CommandRecord& c : project.history()) {
     if (c.name != "commit" || c.state != store::CommandState::kDone) continue;
     const nlohmann::json result = nlohmann::json::parse(c.result, nullptr, false);
     if (!result.is_object() || !result.contains("node")) continue;
-    out[result["node"].get<std::int64_t>()] = settings_from_json<CommitSettings>(
+    CommitSettings settings = settings_from_json<CommitSettings>(
         c.settings, "command " + std::to_string(c.id), SettingsSource::kJournal);
+    if (settings.other_scans) out[result["node"].get<std::int64_t>()] = std::move(settings);
   }
   return out;
 }
@@ -47,7 +50,14 @@ Side load_side(const store::Project& project, std::int64_t id,
   Side side;
   side.scan = project.load_scan(id);
   if (const auto pose = poses.find(id); pose != poses.end()) side.scan.T_world_scan = pose->second;
-  side.geometry = *store::load_geometry(project, id);
+  std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, id);
+  if (!geometry) {
+    core::FilePosition position;
+    position.detail = "scan " + std::to_string(id);
+    throw core::InputError(project.path().string(), position,
+                           "has a normal layer but not the rest of its geometry (damaged?)");
+  }
+  side.geometry = std::move(*geometry);
   side.prepared = registration::prepare_scan(side.scan, side.geometry, 0);
   side.membership = load_membership(project, id, side.scan.pixel_count());
   side.carried = load_carried(project, id, side.scan.pixel_count());
@@ -89,7 +99,8 @@ std::vector<std::uint8_t> load_carried(const store::Project& project, std::int64
 }
 
 CarriedAgain carry_objects_again(const store::Project& project,
-                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses) {
+                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses,
+                                 core::Progress& progress) {
   CarriedAgain out;
   std::vector<std::int64_t> scans;  // with geometry
   bool segmented = false;
@@ -104,7 +115,11 @@ CarriedAgain carry_objects_again(const store::Project& project,
   }
   if (!segmented) return out;
   const std::map<std::int64_t, CommitSettings> commits = commit_settings_by_node(project);
-  for (const std::int64_t target_id : scans) {
+  if (commits.empty()) return out;
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    const std::int64_t target_id = scans[k];
+    progress.update({"register", k, scans.size(), "carrying the objects again"});
+    progress.throw_if_cancelled("register");
     Side target = load_side(project, target_id, poses);
     const std::vector<std::uint32_t> before = target.membership;
     std::vector<std::uint8_t> open(target.membership.size());
@@ -121,20 +136,19 @@ CarriedAgain carry_objects_again(const store::Project& project,
     for (const std::int64_t source_id : scans) {
       if (source_id == target_id) continue;
       const Side source = load_side(project, source_id, poses);
-      std::set<std::uint32_t> objects;
+      std::set<std::uint32_t> objects;  // drawn there, and carried by their commit
       for (std::size_t p = 0; p < source.membership.size(); ++p) {
-        if (drawn(source, p)) objects.insert(source.membership[p]);
+        if (drawn(source, p) && commits.count(source.membership[p]) != 0)
+          objects.insert(source.membership[p]);
       }
       for (const std::uint32_t object : objects) {
         std::vector<std::uint32_t> labels(source.membership.size(), 0);
         for (std::size_t p = 0; p < labels.size(); ++p)
           labels[p] = drawn(source, p) && source.membership[p] == object ? 1 : 0;
-        const auto commit = commits.find(object);
+        const CommitSettings& commit = commits.at(object);
         CarrySettings settings;
-        if (commit != commits.end()) {
-          settings.transfer.noise = commit->second.range_noise;
-          settings.grow = commit->second.grow;
-        }
+        settings.transfer.noise = commit.range_noise;
+        settings.grow = commit.grow;
         const segmentation::SegmentationGrid* grid =
             settings.grow ? &grids.with(settings.transfer.noise) : nullptr;
         const segmentation::PixelSet joins =

@@ -6,7 +6,9 @@
 // sample the object's surface, or the new scan has none: the carried
 // points go back to the pool and every object is carried again, at the
 // new poses, from the points drawn in each scan, with the settings its
-// commit grew with. Internal to modeling/ (register uses it).
+// commit grew with. A separate marks the object's points in its scan
+// drawn: the parts stay as the user split them. Internal to modeling/
+// (register uses it).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -14,6 +16,7 @@
 #include <map>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
@@ -22,15 +25,18 @@ struct CarriedAgain {
   // The scans whose objects changed: their membership and carried layers.
   std::map<std::int64_t, std::vector<std::uint32_t>> memberships;
   std::map<std::int64_t, std::vector<std::uint8_t>> carried;
-  std::size_t released = 0;  // carried points that went back to the pool
+  std::size_t released = 0;        // carried points that went back to the pool
   std::size_t carried_points = 0;  // points carried at the new poses
 };
 
-// Carries every object again with the scans at `poses` (the others where
-// they are). Scans without geometry are left out. Holds one target and
-// one source scan decoded at a time, and the changed layers.
+// Carries every object its commit carried again, with the scans at `poses`
+// (the others where they are). Scans without geometry are left out. Holds
+// one target and one source scan decoded at a time, and the changed
+// layers. Reports progress per target scan as the "register" stage, and
+// throws core::Cancelled when cancelled.
 CarriedAgain carry_objects_again(const store::Project& project,
-                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses);
+                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses,
+                                 core::Progress& progress);
 
 // Scan `scan_id`'s carried layer; all 0 (drawn, or still to be segmented)
 // when it has none.

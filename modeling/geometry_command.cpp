@@ -41,7 +41,7 @@ GeometryCommandResult geometry_project(store::Project& project,
     progress.update({kStage, result.scans.size(), scans.size(), scan.name});
   }
   progress.throw_if_cancelled(kStage);
-  store::Project::Edit finish = command.finish();  // refuses when the project changed meanwhile
+  store::Project::Edit finish = command.finish();  // refuses when its scans changed meanwhile
   for (const store::StoredScanSummary& stored : scans) {
     project.remove_layer(finish, stored.id, store::layer::kKeep);  // decided on the old geometry
   }

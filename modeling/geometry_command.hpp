@@ -36,7 +36,7 @@ struct GeometryCommandResult {
 // (Project::LongCommand), one unit of `progress` each. Nothing becomes
 // visible on any error or when cancelled (core::Cancelled). Throws
 // core::InputError when the project has no scans, core::RuntimeFailure when
-// another process changed the project meanwhile.
+// another process changed its scans meanwhile.
 GeometryCommandResult geometry_project(store::Project& project,
                                        const acquisition::GeometrySettings& settings,
                                        core::Progress& progress);

@@ -56,7 +56,7 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
 // group of overlapping scans fixed, stored as one command ("harmonize")
 // whose undo restores the earlier corrections. Scans that overlap no other
 // keep theirs.
-// Throws as merge_project (no scans, a scan without geometry, a project
+// Throws as merge_project (no scans, a scan without geometry, data it read
 // changed meanwhile, cancelled), and core::InputError when no two scans
 // with colour overlap. The project is then unchanged.
 HarmonizeCommandResult harmonize_project(store::Project& project,

@@ -73,8 +73,7 @@ RegisterCommandResult register_project(store::Project& project,
   std::map<std::int64_t, Eigen::Isometry3d> moved;
   for (std::size_t k = 0; k < loaded.ids.size(); ++k)
     moved.emplace(loaded.ids[k], out.result.T_world_scan[k]);
-  progress.update({kStage, 0, 1, "carrying the objects again"});
-  const CarriedAgain carried = carry_objects_again(project, moved);
+  const CarriedAgain carried = carry_objects_again(project, moved, progress);
   out.object_points_released = carried.released;
   out.object_points_carried = carried.carried_points;
   const std::vector<store::ObjectNode> refigured =

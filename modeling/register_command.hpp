@@ -47,11 +47,11 @@ struct RegisterCommandResult {
 // reference and keeps its pose), then as one command stores the new poses
 // (earlier poses stay in the history), the report as the command's result,
 // removes the now stale merge keep masks, and carries the objects again at
-// the new poses (a scan imported after they were drawn gets them then). A failed pair is reported, and
-// its scan keeps its pose relative to its target. Throws core::InputError
-// for a damaged project, a project without scans, a scan without geometry
+// the new poses (a scan imported after they were drawn gets them then). A failed pair is reported,
+// and its scan keeps its pose relative to its target. Throws core::InputError for a damaged
+// project, a project without scans, a scan without geometry
 // ("run scanbench geometry first"), or picks that do not name the project's scans as the settings
-// require; core::RuntimeFailure when another process changed the project
+// require; core::RuntimeFailure when another process changed data it read
 // meanwhile; core::Cancelled when cancelled. The project is then unchanged.
 RegisterCommandResult register_project(store::Project& project,
                                        const RegisterCommandSettings& settings,

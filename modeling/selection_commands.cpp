@@ -49,8 +49,8 @@ void put_selection(store::Project& project, store::Project::Edit& edit, std::int
 std::optional<std::vector<std::uint8_t>> drawn_there(const store::Project& project,
                                                      std::int64_t scan_id,
                                                      const segmentation::PixelSet& pixels) {
-  auto carried = project.load_layer<std::uint8_t>(scan_id, store::layer::kCarried,
-                                                  store::ElementType::kU8);
+  auto carried =
+      project.load_layer<std::uint8_t>(scan_id, store::layer::kCarried, store::ElementType::kU8);
   if (!carried) return std::nullopt;
   for (const std::uint32_t p : pixels) (*carried)[p] = 0;
   return carried;
@@ -58,9 +58,9 @@ std::optional<std::vector<std::uint8_t>> drawn_there(const store::Project& proje
 
 void put_carried(store::Project& project, store::Project::Edit& edit, std::int64_t scan_id,
                  const std::vector<std::uint8_t>& carried) {
-  project.put_layer(edit, scan_id,
-                    store::encode_layer<std::uint8_t>(store::layer::kCarried,
-                                                      store::ElementType::kU8, carried));
+  project.put_layer(
+      edit, scan_id,
+      store::encode_layer<std::uint8_t>(store::layer::kCarried, store::ElementType::kU8, carried));
 }
 
 store::StoredScanSummary require_scan(const store::Project& project, std::int64_t scan_id) {
@@ -131,11 +131,16 @@ SeparateResult separate_object(store::Project& project, const SeparateSettings& 
     made.push_back(part);
     result.nodes.push_back(part.id);
   }
+  // The user split the object where it lies in this scan: its points there
+  // are drawn from now on, so a registration carries the parts as they are.
+  const std::optional<std::vector<std::uint8_t>> drawn =
+      drawn_there(project, settings.scan_id, owned);
   const auto figures = compute_figures(project, tree, {{settings.scan_id, membership}});
   store::Project::Edit edit = project.begin_command(
       "separate", dump({{"node", settings.node}, {"scan", settings.scan_id}}), revision);
   for (const store::ObjectNode& part : made) project.put_node(edit, part);
   if (!made.empty()) put_membership(project, edit, settings.scan_id, membership);
+  if (drawn) put_carried(project, edit, settings.scan_id, *drawn);
   refresh_figures(project, edit, tree, figures);
   result.command_id = edit.command_id();
   edit.commit(dump({{"nodes", result.nodes}}));
@@ -331,8 +336,8 @@ CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_
     std::vector<std::uint32_t> other = load_membership(project, stored.id, scan.pixel_count());
     std::vector<std::uint8_t> open = taken_mask(other);
     for (std::uint8_t& o : open) o = !o;
-    const segmentation::PixelSet joins = carry_object(
-        object, {&target, scan.T_world_scan, grid ? &*grid : nullptr, open}, settings);
+    const segmentation::PixelSet joins =
+        carry_object(object, {&target, scan.T_world_scan, grid ? &*grid : nullptr, open}, settings);
     if (joins.empty()) continue;
     std::vector<std::uint8_t> carried = load_carried(project, stored.id, scan.pixel_count());
     for (const std::uint32_t q : joins) {
@@ -372,23 +377,22 @@ NodeCommandResult commit_selection(store::Project& project, const CommitSettings
   }
   if (taken.empty()) refuse(where, "the selection is empty: grow a region first");
   tree.emplace(node.id, node);
-  CarriedAgain others =
-      settings.other_scans
-          ? carried_into_other_scans(project, settings.scan_id, membership,
-                                     static_cast<std::uint32_t>(node.id), settings.grow,
-                                     settings.range_noise)
-          : CarriedAgain{};
+  CarriedAgain others = settings.other_scans
+                            ? carried_into_other_scans(project, settings.scan_id, membership,
+                                                       static_cast<std::uint32_t>(node.id),
+                                                       settings.grow, settings.range_noise)
+                            : CarriedAgain{};
   std::map<std::int64_t, std::vector<std::uint32_t>>& changed = others.memberships;
   changed[settings.scan_id] = std::move(membership);
   const std::optional<std::vector<std::uint8_t>> drawn =
       drawn_there(project, settings.scan_id, taken);
   const auto figures = compute_figures(project, tree, changed);
-  store::Project::Edit edit =
-      project.begin_command("commit", settings_to_json(settings), revision);
+  store::Project::Edit edit = project.begin_command("commit", settings_to_json(settings), revision);
   project.put_node(edit, node);
   for (const auto& [scan_id, scan_membership] : changed)
     put_membership(project, edit, scan_id, scan_membership);
-  for (const auto& [scan_id, carried] : others.carried) put_carried(project, edit, scan_id, carried);
+  for (const auto& [scan_id, carried] : others.carried)
+    put_carried(project, edit, scan_id, carried);
   if (drawn) put_carried(project, edit, settings.scan_id, *drawn);
   project.remove_layer(edit, settings.scan_id, store::layer::kSelection);
   refresh_figures(project, edit, tree, figures);

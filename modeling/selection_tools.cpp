@@ -94,14 +94,15 @@ void SelectionTools::open_scan(const store::Project& project, std::int64_t scan_
 
 SelectResult SelectionTools::select(const store::Project& project, const SelectSettings& settings) {
   segmentation::PixelSet& selection = selection_of(project, settings.scan_id);
-  Step step{settings.scan_id, selection, {}};
+  const segmentation::PixelSet before = selection;
   const SelectResult result = select_region(project, settings, selection);
   if (!result.seed_open) return result;
   if (settings.mode != SelectMode::kSubtract) grown_with_[settings.scan_id] = settings.grow;
-  step.after = selection;
-  done_.push_back(std::move(step));
+  touched_.insert(settings.scan_id);
+  done_.push_back({settings.scan_id, segmentation::subtract(selection, before),
+                   segmentation::subtract(before, selection)});
+  if (done_.size() > kMaxSelectionSteps) done_.pop_front();
   undone_.clear();
-  grown_since_undo_ = true;
   return result;
 }
 
@@ -120,23 +121,28 @@ NodeCommandResult SelectionTools::commit(store::Project& project, const CommitSe
   segmentation::PixelSet& selection = selection_of(project, settings.scan_id);
   const NodeCommandResult result = commit_selection(project, settings, selection);
   command_ran();
-  committed_[result.command_id] = {settings.scan_id, selection, {}};
+  committed_[result.command_id] = {settings.scan_id, std::move(selection)};
+  if (committed_.size() > kMaxCommitsRemembered) committed_.erase(committed_.begin());
   selection.clear();
+  touched_.insert(settings.scan_id);
   return result;
 }
 
 bool SelectionTools::undo_selection() {
   if (done_.empty()) return false;
-  selections_[done_.back().scan_id] = done_.back().before;
+  const Step& step = done_.back();
+  segmentation::PixelSet& selection = selections_[step.scan_id];
+  selection = segmentation::unite(segmentation::subtract(selection, step.added), step.removed);
   undone_.push_back(std::move(done_.back()));
   done_.pop_back();
-  grown_since_undo_ = false;
   return true;
 }
 
 bool SelectionTools::redo_selection() {
   if (undone_.empty()) return false;
-  selections_[undone_.back().scan_id] = undone_.back().after;
+  const Step& step = undone_.back();
+  segmentation::PixelSet& selection = selections_[step.scan_id];
+  selection = segmentation::unite(segmentation::subtract(selection, step.removed), step.added);
   done_.push_back(std::move(undone_.back()));
   undone_.pop_back();
   return true;
@@ -145,19 +151,26 @@ bool SelectionTools::redo_selection() {
 void SelectionTools::command_ran() {
   done_.clear();
   undone_.clear();
-  grown_since_undo_ = false;
 }
 
-void SelectionTools::command_undone(std::int64_t command_id) {
-  command_ran();
-  const auto commit = committed_.find(command_id);
-  if (commit != committed_.end()) selections_[commit->second.scan_id] = commit->second.before;
+void SelectionTools::reread_untouched(const store::Project& project) {
+  for (auto& [scan_id, selection] : selections_) {
+    if (touched_.count(scan_id) == 0) selection = kept_selection(project, scan_id);
+  }
 }
 
-void SelectionTools::command_redone(std::int64_t command_id) {
+void SelectionTools::command_undone(const store::Project& project, std::int64_t command_id) {
   command_ran();
+  reread_untouched(project);
   const auto commit = committed_.find(command_id);
-  if (commit != committed_.end()) selections_[commit->second.scan_id].clear();
+  if (commit != committed_.end()) selections_[commit->second.first] = commit->second.second;
+}
+
+void SelectionTools::command_redone(const store::Project& project, std::int64_t command_id) {
+  command_ran();
+  reread_untouched(project);
+  const auto commit = committed_.find(command_id);
+  if (commit != committed_.end()) selections_[commit->second.first].clear();
 }
 
 std::map<std::int64_t, segmentation::PixelSet> SelectionTools::unkept(
@@ -165,19 +178,25 @@ std::map<std::int64_t, segmentation::PixelSet> SelectionTools::unkept(
   std::set<std::int64_t> scans;  // a scan whose import was undone keeps nothing
   for (const store::StoredScanSummary& stored : project.scans()) scans.insert(stored.id);
   std::map<std::int64_t, segmentation::PixelSet> changed;
-  for (const auto& [scan_id, selection] : selections_) {
-    if (scans.count(scan_id) != 0 && kept_selection(project, scan_id) != selection)
-      changed.emplace(scan_id, selection);
+  for (const std::int64_t scan_id : touched_) {
+    const segmentation::PixelSet& now = selection(scan_id);
+    if (scans.count(scan_id) != 0 && kept_selection(project, scan_id) != now)
+      changed.emplace(scan_id, now);
   }
   return changed;
 }
 
-std::int64_t SelectionTools::keep(store::Project& project) {
+SelectionTools::Kept SelectionTools::keep(store::Project& project, bool spare_redo_chain) {
   const std::map<std::int64_t, segmentation::PixelSet> changed = unkept(project);
-  if (changed.empty()) return 0;
+  if (changed.empty()) return {};
+  if (spare_redo_chain) {
+    for (const store::CommandRecord& c : project.history()) {
+      if (c.state == store::CommandState::kUndone) return {0, true};
+    }
+  }
   const std::int64_t command_id = keep_selections(project, changed);
   command_ran();
-  return command_id;
+  return {command_id, false};
 }
 
 }  // namespace scanbench::modeling

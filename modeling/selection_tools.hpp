@@ -10,13 +10,16 @@
 // nothing, so a click neither ends the project's redo chain nor collides
 // with another process's work. Undo takes the grows back one by one until
 // the last command; undoing a commit brings its selection back. keep()
-// stores them in the project, when the session ends or on request.
+// stores them in the project, when the session ends or on request, and the
+// next session starts from them.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -88,36 +91,50 @@ class SelectionTools {
 
   // ---- Undo and redo ------------------------------------------------------
   // Takes back the newest grow since the last command, or makes the newest
-  // one taken back again; false when there is none.
+  // one taken back again; false when there is none. The newest
+  // kMaxSelectionSteps grows are kept.
   bool undo_selection();
   bool redo_selection();
-  // A grow came after the last undo: redoing the project's commands would
-  // pass over it (the caller refuses, as a new command ends a redo chain).
-  bool grown_since_undo() const { return grown_since_undo_; }
+  // Grows since the last command (or undo): redoing the project's commands
+  // would pass over them (the caller refuses, as a new command ends a
+  // redo chain).
+  bool grown_since_command() const { return !done_.empty(); }
   // The caller ran another command: the grows before it are no longer
   // taken back one by one.
   void command_ran();
   // The caller undid or redid command `command_id` in the project: the
-  // selection a commit took comes back, or goes again.
-  void command_undone(std::int64_t command_id);
-  void command_redone(std::int64_t command_id);
+  // selection a commit took comes back, or goes again, and the scans this
+  // session has not changed show what the project now keeps.
+  void command_undone(const store::Project& project, std::int64_t command_id);
+  void command_redone(const store::Project& project, std::int64_t command_id);
 
   // ---- Keeping them -----------------------------------------------------
-  // The selections that differ from what the project keeps.
+  // The selections this session changed that differ from what the project
+  // keeps (a scan whose import was undone keeps nothing).
   std::map<std::int64_t, segmentation::PixelSet> unkept(const store::Project& project) const;
-  // Stores the selections that differ from what the project keeps as one
-  // command (keep_selections); its id, 0 when none differs.
-  std::int64_t keep(store::Project& project);
+  struct Kept {
+    std::int64_t command_id = 0;  // 0: nothing was kept
+    bool held_back = false;       // kept nothing, to spare the redo chain
+  };
+  // Stores unkept(project) as one command (keep_selections). Like every
+  // new command it ends the project's redo chain: with `spare_redo_chain`
+  // (when a session ends by itself) nothing is kept while there is one.
+  Kept keep(store::Project& project, bool spare_redo_chain);
+
+  static constexpr std::size_t kMaxSelectionSteps = 200;
+  static constexpr std::size_t kMaxCommitsRemembered = 32;
 
  private:
   void draw_on(std::int64_t scan_id);
   segmentation::PixelSet& selection_of(const store::Project& project, std::int64_t scan_id);
+  // Reads again the kept selections of the scans this session has not changed.
+  void reread_untouched(const store::Project& project);
 
-  // One change of a scan's selection, with the selection before and after.
+  // One change of a scan's selection: the pixels it added and removed.
   struct Step {
     std::int64_t scan_id = 0;
-    segmentation::PixelSet before;
-    segmentation::PixelSet after;
+    segmentation::PixelSet added;
+    segmentation::PixelSet removed;
   };
 
   std::optional<std::int64_t> scan_;
@@ -128,10 +145,12 @@ class SelectionTools {
   std::optional<Eigen::Vector2d> seed_;
   std::map<std::int64_t, segmentation::GrowSettings> grown_with_;  // per scan
   std::map<std::int64_t, segmentation::PixelSet> selections_;      // the scans' read so far
-  std::vector<Step> done_;                                         // grows since the last command
+  std::set<std::int64_t> touched_;  // scans whose selection this session changed
+  std::deque<Step> done_;           // grows since the last command, oldest first
   std::vector<Step> undone_;
-  bool grown_since_undo_ = false;
-  std::map<std::int64_t, Step> committed_;  // by commit command: the selection it took
+  // By commit command, the newest kMaxCommitsRemembered: the scan and the
+  // selection it took.
+  std::map<std::int64_t, std::pair<std::int64_t, segmentation::PixelSet>> committed_;
 };
 
 }  // namespace scanbench::modeling

@@ -44,34 +44,40 @@ NodeCommandResult group_nodes(store::Project& project, const GroupSettings& sett
 NodeCommandResult edit_node(store::Project& project, const NodeEdit& change) {
   const std::int64_t revision = project.revision();
   Tree tree = load_tree(project);
-  store::ObjectNode node = require_node(tree, change.node);
+  std::vector<std::int64_t> ids = {change.node};
+  ids.insert(ids.end(), change.others.begin(), change.others.end());
   nlohmann::json settings = {{"node", change.node}};
+  if (!change.others.empty()) settings["others"] = change.others;
   if (change.name) {
     require_name(*change.name);
-    node.name = *change.name;
     settings["name"] = *change.name;
   }
-  if (change.hidden) {
-    node.hidden = *change.hidden;
-    settings["hidden"] = *change.hidden;
-  }
+  if (change.hidden) settings["hidden"] = *change.hidden;
   if (change.parent) {
     require_group(tree, *change.parent);
-    if (*change.parent && is_at_or_above(tree, change.node, **change.parent)) {
-      refuse("node " + std::to_string(change.node), "cannot go into a group below itself");
-    }
-    node.parent = *change.parent;
     settings["parent"] = parent_json(*change.parent);
   }
-  tree[node.id] = node;
+  std::vector<store::ObjectNode> edited;
+  for (const std::int64_t id : ids) {
+    store::ObjectNode node = require_node(tree, id);
+    if (change.name && id == change.node) node.name = *change.name;
+    if (change.hidden) node.hidden = *change.hidden;
+    if (change.parent) {
+      if (*change.parent && is_at_or_above(tree, id, **change.parent))
+        refuse("node " + std::to_string(id), "cannot go into a group below itself");
+      node.parent = *change.parent;
+    }
+    tree[node.id] = node;
+    edited.push_back(node);
+  }
   const auto figures =
       change.parent ? compute_figures(project, tree, {}) : std::map<std::int64_t, Figures>{};
   store::Project::Edit edit = project.begin_command("edit", dump(settings), revision);
-  project.put_node(edit, node);
+  for (const store::ObjectNode& node : edited) project.put_node(edit, node);
   if (change.parent) refresh_figures(project, edit, tree, figures);
   const std::int64_t command_id = edit.command_id();
-  edit.commit(dump({{"node", node.id}}));
-  return {command_id, node.id};
+  edit.commit(dump({{"node", change.node}}));
+  return {command_id, change.node};
 }
 
 UngroupResult ungroup_node(store::Project& project, std::int64_t group) {
@@ -130,10 +136,14 @@ NodeCommandResult merge_objects(store::Project& project, const MergeSettings& se
 NodeCommandResult delete_node(store::Project& project, const DeleteSettings& settings) {
   const std::int64_t revision = project.revision();
   Tree tree = load_tree(project);
-  require_node(tree, settings.node);
+  std::vector<std::int64_t> roots = {settings.node};
+  roots.insert(roots.end(), settings.others.begin(), settings.others.end());
+  for (const std::int64_t root : roots) require_node(tree, root);
   std::vector<std::int64_t> gone;
   for (const auto& [id, node] : tree) {
-    if (is_at_or_above(tree, settings.node, id)) gone.push_back(id);
+    if (std::any_of(roots.begin(), roots.end(),
+                    [&](std::int64_t root) { return is_at_or_above(tree, root, id); }))
+      gone.push_back(id);
   }
   const std::uint32_t replacement =
       settings.points == DeletedPoints::kToPool ? 0 : store::kDeletedPoints;
@@ -142,11 +152,11 @@ NodeCommandResult delete_node(store::Project& project, const DeleteSettings& set
       reassign_pixels(project, gone_ids, replacement);
   for (const std::int64_t id : gone) tree.erase(id);
   const auto figures = compute_figures(project, tree, changed);
-  store::Project::Edit edit = project.begin_command(
-      "delete",
-      dump({{"node", settings.node},
-            {"points", settings.points == DeletedPoints::kToPool ? "pool" : "deleted"}}),
-      revision);
+  nlohmann::json journaled = {
+      {"node", settings.node},
+      {"points", settings.points == DeletedPoints::kToPool ? "pool" : "deleted"}};
+  if (!settings.others.empty()) journaled["others"] = settings.others;
+  store::Project::Edit edit = project.begin_command("delete", dump(journaled), revision);
   for (const std::int64_t id : gone) project.remove_node(edit, id);
   for (const auto& [scan_id, membership] : changed)
     put_membership(project, edit, scan_id, membership);
@@ -160,8 +170,8 @@ ScanCoverage scan_coverage(const store::Project& project) {
   const Tree tree = load_tree(project);
   ScanCoverage coverage;
   for (const store::StoredScanSummary& stored : project.scans()) {
-    const auto membership = project.load_layer<std::uint32_t>(
-        stored.id, store::layer::kMembership, store::ElementType::kU32);
+    const auto membership = project.load_layer<std::uint32_t>(stored.id, store::layer::kMembership,
+                                                              store::ElementType::kU32);
     if (!membership) continue;
     std::map<std::uint32_t, std::int64_t> owned;
     for (const std::uint32_t owner : *membership) {

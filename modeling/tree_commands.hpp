@@ -44,9 +44,13 @@ struct NodeEdit {
   std::optional<std::string> name;                    // rename
   std::optional<bool> hidden;                         // hide or show
   std::optional<std::optional<std::int64_t>> parent;  // reparent (inner none: to the roots)
+  // More nodes hidden, shown or reparented with it, in the same command
+  // (the proposals a review accepts); the name is the first node's only.
+  std::vector<std::int64_t> others;
 };
 
-// Renames, hides or shows, or reparents a node (what `edit` holds).
+// Renames, hides or shows, or reparents a node and `others` (what `edit`
+// holds), as one command.
 NodeCommandResult edit_node(store::Project& project, const NodeEdit& edit);
 
 struct UngroupResult {
@@ -66,10 +70,11 @@ enum class DeletedPoints {
 struct DeleteSettings {
   std::int64_t node = 0;
   DeletedPoints points = DeletedPoints::kToPool;
+  std::vector<std::int64_t> others;  // deleted with it (the proposals a review rejects)
 };
 
-// Deletes a node with everything below it; its objects' points go back to
-// the pool or are marked deleted.
+// Deletes a node (and `others`) with everything below it, as one command;
+// their objects' points go back to the pool or are marked deleted.
 NodeCommandResult delete_node(store::Project& project, const DeleteSettings& settings);
 
 struct MergeSettings {

@@ -35,8 +35,8 @@ class Runner {
 
   nlohmann::json apply(const ScriptOp& op, const std::string& at);
   // At the script's end: the selections it left, kept in the project
-  // (SelectionTools::keep); the command's id, 0 when none changed.
-  std::int64_t keep_selections() { return tools_.keep(project_); }
+  // unless that would end the redo chain (SelectionTools::keep).
+  modeling::SelectionTools::Kept keep_selections() { return tools_.keep(project_, true); }
 
  private:
   nlohmann::json apply_pixels(const ScriptOp& op, const std::string& at);
@@ -183,7 +183,7 @@ nlohmann::json Runner::apply_tree(const ScriptOp& op, const std::string& at) {
   }
   if (op.name == "delete") {
     const modeling::NodeCommandResult r =
-        modeling::delete_node(project_, {node_of(op.node, at), op.deleted_points});
+        modeling::delete_node(project_, {node_of(op.node, at), op.deleted_points, {}});
     return made(r.command_id, {{"node", r.node_id}});
   }
   modeling::NodeEdit edit;  // rename, hide, show, reparent
@@ -200,14 +200,14 @@ nlohmann::json Runner::apply_journal(const ScriptOp& op, const std::string& at) 
   // The grows since the last command first: they are the script's own state.
   if (undo ? tools_.undo_selection() : tools_.redo_selection())
     return {{"command", nullptr}, {"result", {{undo ? "undid" : "redid", "grow"}}}};
-  if (!undo && tools_.grown_since_undo())
+  if (!undo && tools_.grown_since_command())
     refuse(file_, at, "nothing to redo: the selection grew since the undo");
   const std::optional<store::CommandRecord> changed = undo ? project_.undo() : project_.redo();
   if (!changed) refuse(file_, at, undo ? "nothing to undo" : "nothing to redo");
   if (undo) {
-    tools_.command_undone(changed->id);
+    tools_.command_undone(project_, changed->id);
   } else {
-    tools_.command_redone(changed->id);
+    tools_.command_redone(project_, changed->id);
   }
   return {{"command", changed->id}, {"result", {{undo ? "undid" : "redid", changed->name}}}};
 }
@@ -259,7 +259,9 @@ SegmentScriptResult run_segment_script(store::Project& project, const SegmentScr
     }
   }
   // A selection left uncommitted stays for the next script or the workbench.
-  result.kept_selections = runner.keep_selections();
+  const modeling::SelectionTools::Kept kept = runner.keep_selections();
+  result.kept_selections = kept.command_id;
+  result.selections_held_back = kept.held_back;
   batch.commit();
   return result;
 }

@@ -23,8 +23,10 @@ struct SegmentScriptResult {
   nlohmann::json ops = nlohmann::json::array();
   // The command keeping the selections the script left uncommitted in the
   // project (they are the next script's and the workbench's to go on
-  // with); 0 when none changed.
+  // with); 0 when none changed, or when keeping them would have ended the
+  // redo chain (the script ended on an undo): then `selections_held_back`.
   std::int64_t kept_selections = 0;
+  bool selections_held_back = false;
 };
 
 // Plays `script` (read_segment_script) on `project`.

@@ -28,6 +28,11 @@
 // one live node. "channel" is range, color, intensity or normal (default
 // normal); "tolerance" defaults to the channel's (region_grow.hpp).
 //
+// Grows (grow, add, subtract) change the selection, session state: no
+// command. "undo" takes back the script's grows since its last command
+// first, then commands; a selection the script leaves uncommitted is kept
+// in the project at its end (SelectionTools::keep).
+//
 //
 // At most 16 MB and 10 000 ops; unknown ops and keys (at the top and in an
 // op) are refused, not ignored.

@@ -60,8 +60,7 @@ void clip_settings(WorkbenchState& s) {
     ImGui::SetNextItemWidth(60);
     if (ImGui::Combo("across", &s.slice_axis, "x\0y\0z\0"))
       s.slice_at = s.navigation.target()[s.slice_axis];  // a coordinate of the new axis
-    ImGui::DragScalar("at [m]", ImGuiDataType_Double, &s.slice_at, 0.05f, nullptr, nullptr,
-                      "%.2f");
+    ImGui::DragScalar("at [m]", ImGuiDataType_Double, &s.slice_at, 0.05f, nullptr, nullptr, "%.2f");
     ImGui::SliderFloat("thickness [m]", &s.slice_thickness, 0.05f, 20.0f, "%.2f",
                        ImGuiSliderFlags_Logarithmic);
   }
@@ -109,11 +108,10 @@ void measure_panel(WorkbenchState& s) {
     std::error_code error;
     if (std::filesystem::exists(file, error)) {
       // An earlier export is replaced only once confirmed.
-      s.question = Question{"Replace the file?",
-                            file.string() + " exists. Exporting replaces it with the " +
-                                std::to_string(s.session.measurements().size()) +
-                                " measurements listed.",
-                            "Replace", [&s, file] { s.session.export_measurements(file); }};
+      s.question =
+          Question{"Replace the file?",
+                   file.string() + " exists. Exporting replaces it with the measurements listed.",
+                   "Replace", [&s, file] { s.session.export_measurements(file); }};
     } else {
       s.session.export_measurements(file);
     }

@@ -32,7 +32,7 @@ void act_on(WorkbenchState& s, const std::vector<store::ObjectNode>& proposals,
   ImGui::BeginDisabled(ids.empty() || s.session.read_only());
   // Reject and Merge first: their places do not move with Accept's label.
   if (ImGui::Button("Reject") && !ids.empty()) {
-    for (const std::int64_t id : ids) s.session.remove(id);
+    s.session.reject(ids);  // one command, one undo
     s.selected.clear();
     s.after_command();
   }
@@ -51,8 +51,7 @@ void act_on(WorkbenchState& s, const std::vector<store::ObjectNode>& proposals,
   const std::string accept =
       ids.size() == 1 ? "Accept as \"" + s.name_text() + "\"###accept" : "Accept###accept";
   if (ImGui::Button(accept.c_str()) && !ids.empty()) {
-    for (const std::int64_t id : ids) s.session.reparent(id, group_parent);
-    if (ids.size() == 1) s.session.rename(ids.front(), s.name_text());
+    s.session.accept(ids, group_parent, s.name_text());  // one command, one undo
     s.after_command();
   }
   s.probe("accept proposal");
@@ -69,12 +68,13 @@ void proposals_panel(WorkbenchState& s) {
   const std::string title = "Proposals (" + std::to_string(proposals.size()) + " to review)";
   if (!ImGui::CollapsingHeader((title + "###proposals").c_str(), ImGuiTreeNodeFlags_DefaultOpen))
     return;
-  ImGui::TextWrapped("Click one to see it (cyan in the panorama, framed in 3D); Ctrl+click "
-                     "picks more, to merge.");
+  ImGui::TextWrapped(
+      "Click one to see it (cyan in the panorama, framed in 3D); Ctrl+click "
+      "picks more, to merge.");
   ImGui::BeginChild("proposal list", ImVec2(0, 110), true);
   for (const store::ObjectNode& n : proposals) {
-    const std::string label = n.name + " (" + std::to_string(n.points) + " points)##p" +
-                              std::to_string(n.id);
+    const std::string label =
+        n.name + " (" + std::to_string(n.points) + " points)##p" + std::to_string(n.id);
     ImGui::Selectable(label.c_str(), s.selected.count(n.id) != 0);
     // On the press, as the tree does: Ctrl is read while it is held.
     if (ImGui::IsItemClicked()) {

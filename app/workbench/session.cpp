@@ -1,9 +1,10 @@
 #include "app/workbench/session.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
@@ -40,8 +41,9 @@ Session::Session(const std::filesystem::path& project, bool read_only)
       read_only_(read_only) {
   show_first_scan();
   if (read_only_)
-    status_ = "read-only: you can look, grow selections, select nodes and frame them; nothing is "
-               "written";
+    status_ =
+        "read-only: you can look, grow selections, select nodes and frame them; nothing is "
+        "written";
 }
 
 void Session::show_first_scan() {
@@ -158,10 +160,9 @@ void Session::click(double x, double y) {
   try {
     const modeling::SelectResult result =
         tools_.select(project_, tools_.select_at(scan_id_, xy, mode, grow));
-    status_ = result.seed_open
-                  ? "grew " + std::to_string(result.region_pixels) + " pixels; selection " +
-                        std::to_string(result.selected_pixels)
-                  : "the seed cannot grow there: " + result.refused;
+    status_ = result.seed_open ? "grew " + std::to_string(result.region_pixels) +
+                                     " pixels; selection " + std::to_string(result.selected_pixels)
+                               : "the seed cannot grow there: " + result.refused;
   } catch (const core::InputError& e) {
     status_ = "refused: " + e.problem();
     if (!e.position().detail.empty()) status_ += " (" + e.position().detail + ")";
@@ -201,26 +202,47 @@ bool Session::group(const std::string& name, const std::vector<std::int64_t>& ch
 
 bool Session::rename(std::int64_t node, const std::string& name) {
   return act("renamed to \"" + name + "\"", [&] {
-    modeling::edit_node(project_, {node, name, std::nullopt, std::nullopt});
+    modeling::edit_node(project_, {node, name, std::nullopt, std::nullopt, {}});
   });
 }
 
 bool Session::set_hidden(std::int64_t node, bool hidden) {
   return act(hidden ? "hidden" : "shown", [&] {
-    modeling::edit_node(project_, {node, std::nullopt, hidden, std::nullopt});
+    modeling::edit_node(project_, {node, std::nullopt, hidden, std::nullopt, {}});
   });
 }
 
 bool Session::reparent(std::int64_t node, std::optional<std::int64_t> parent) {
   return act("moved", [&] {
-    modeling::edit_node(project_, {node, std::nullopt, std::nullopt, parent});
+    modeling::edit_node(project_, {node, std::nullopt, std::nullopt, parent, {}});
   });
 }
 
 bool Session::remove(std::int64_t node) {
   return act("deleted (its points are to be segmented again)", [&] {
-    modeling::delete_node(project_, {node, modeling::DeletedPoints::kToPool});
+    modeling::delete_node(project_, {node, modeling::DeletedPoints::kToPool, {}});
   });
+}
+
+bool Session::reject(const std::vector<std::int64_t>& proposals) {
+  if (proposals.empty()) return false;
+  modeling::DeleteSettings settings{proposals.front(), modeling::DeletedPoints::kToPool, {}};
+  settings.others.assign(proposals.begin() + 1, proposals.end());
+  return act("rejected " + std::to_string(proposals.size()) +
+                 " proposal(s): their points are to be segmented again",
+             [&] { modeling::delete_node(project_, settings); });
+}
+
+bool Session::accept(const std::vector<std::int64_t>& proposals, std::optional<std::int64_t> parent,
+                     const std::string& name) {
+  if (proposals.empty()) return false;
+  modeling::NodeEdit edit;
+  edit.node = proposals.front();
+  edit.parent = parent;
+  if (proposals.size() == 1) edit.name = name;
+  edit.others.assign(proposals.begin() + 1, proposals.end());
+  return act("accepted " + std::to_string(proposals.size()) + " proposal(s)",
+             [&] { modeling::edit_node(project_, edit); });
 }
 
 bool Session::separate(std::int64_t node) {
@@ -233,7 +255,8 @@ std::optional<std::int64_t> Session::propose() {
   modeling::ProposeSettings settings;
   settings.scan_id = scan_id_;
   modeling::SeparateResult result;
-  if (!act("", [&] { result = modeling::propose_objects(project_, settings); })) return std::nullopt;
+  if (!act("", [&] { result = modeling::propose_objects(project_, settings); }))
+    return std::nullopt;
   status_ = std::to_string(result.nodes.size()) +
             " proposals for the rest of the scan: review them in Proposals";
   // The group is the newest node that is not one of them.
@@ -244,11 +267,19 @@ std::optional<std::int64_t> Session::propose() {
   return group;
 }
 
-bool Session::keep_selections() {
-  if (read_only_ || tools_.unkept(project_).empty()) return true;
-  std::int64_t command = 0;
-  if (!act("", [&] { command = tools_.keep(project_); }, false)) return false;
-  status_ = "kept the selection in the project (command " + std::to_string(command) + ")";
+bool Session::keep_selections(bool at_close) {
+  if (read_only_) return true;
+  modeling::SelectionTools::Kept kept;
+  if (!act(
+          "", [&] { kept = tools_.keep(project_, at_close); }, false))
+    return false;
+  if (kept.held_back) {
+    status_ = "the selection is not kept: keeping it would end the redo chain";
+  } else if (kept.command_id != 0) {
+    status_ = "kept the selection in the project (command " + std::to_string(kept.command_id) + ")";
+  } else {
+    status_ = "the project keeps this selection already";
+  }
   return true;
 }
 
@@ -323,7 +354,7 @@ std::optional<store::CommandRecord> Session::undo(bool stages, std::optional<std
   }
   std::optional<store::CommandRecord> undone;
   act("", [&] { undone = project_.undo(newest->id); });
-  if (undone) tools_.command_undone(undone->id);
+  if (undone) tools_.command_undone(project_, undone->id);
   if (undone && is_batch_stage(undone->name)) show_first_scan_again();
   show_selection();
   if (status_.empty()) status_ = undone ? "undid " + undone->name : "nothing to undo";
@@ -336,13 +367,13 @@ bool Session::redo() {
     show_selection();
     return true;
   }
-  if (tools_.grown_since_undo()) {
-    status_ = "nothing to redo: the selection grew since the undo";
+  if (tools_.grown_since_command()) {
+    status_ = "nothing to redo: the selection grew since (Ctrl+Z takes the grows back first)";
     return false;
   }
   std::optional<store::CommandRecord> redone;
   act("", [&] { redone = project_.redo(); });
-  if (redone) tools_.command_redone(redone->id);
+  if (redone) tools_.command_redone(project_, redone->id);
   if (redone && is_batch_stage(redone->name)) show_first_scan_again();
   show_selection();
   if (status_.empty()) status_ = redone ? "redid " + redone->name : "nothing to redo";
@@ -352,9 +383,8 @@ bool Session::redo() {
 void Session::show_first_scan_again() {
   const std::string said = status_;
   scans_ = project_.scans();
-  const bool still_there = std::any_of(scans_.begin(), scans_.end(), [&](const auto& scan) {
-    return scan.id == scan_id_;
-  });
+  const bool still_there = std::any_of(scans_.begin(), scans_.end(),
+                                       [&](const auto& scan) { return scan.id == scan_id_; });
   if (still_there) {
     open_scan(scan_id_);  // its geometry may have come or gone
   } else {
@@ -365,7 +395,14 @@ void Session::show_first_scan_again() {
 }
 
 const modeling::ScanCoverage& Session::coverage() {
-  if (!coverage_) coverage_ = modeling::scan_coverage(project_);
+  if (!coverage_) {
+    try {
+      coverage_ = modeling::scan_coverage(project_);
+    } catch (const core::FileError& e) {  // a damaged layer: the panel shows none
+      coverage_ = modeling::ScanCoverage{};
+      status_ = "the objects' scans are unreadable: " + std::string(e.what());
+    }
+  }
   return *coverage_;
 }
 

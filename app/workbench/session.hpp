@@ -67,10 +67,11 @@ class Session {
   void finish_polyline();
   void clear_constraints();
   std::size_t selected_pixels() const { return selected_; }
-  // Keeps the selections that differ from the project's in it, as one
-  // command (when the session ends, or on request); true when there was
-  // nothing to keep or they were kept. Read-only, nothing is kept.
-  bool keep_selections();
+  // Keeps the selections this session changed in the project, as one
+  // command (modeling::SelectionTools::keep): on request, and `at_close`,
+  // when the session ends, unless that would end the redo chain. False
+  // (and status()) when it failed. Read-only, nothing is kept.
+  bool keep_selections(bool at_close = false);
 
   // ---- Commands: each one journal entry; false (and status()) when refused
   bool commit(const std::string& name, std::optional<std::int64_t> parent);
@@ -83,6 +84,12 @@ class Session {
   // Automatic proposals for the rest of the shown scan: the group that
   // holds them, none when refused.
   std::optional<std::int64_t> propose();
+  // A review of proposals, each one command: rejected ones are deleted
+  // (their points back to the pool); accepted ones move to `parent`, one
+  // alone renamed to `name`.
+  bool reject(const std::vector<std::int64_t>& proposals);
+  bool accept(const std::vector<std::int64_t>& proposals, std::optional<std::int64_t> parent,
+              const std::string& name);
   // Merges objects into the first (modeling::merge_objects).
   bool merge(const std::vector<std::int64_t>& objects);
   bool recolor(std::int64_t node, const store::ColorEdit& set, bool reset);

@@ -59,9 +59,9 @@ class Workbench {
   // The session ends: the selections are kept in the project
   // (Session::keep_selections). Throws core::RuntimeFailure when they cannot be.
   void end_session() {
-    if (!state_.session.keep_selections()) {
+    if (!state_.session.keep_selections(true)) {
       throw core::RuntimeFailure(state_.session.project().path().string(), {},
-                                 "the selection could not be kept: " + state_.session.status());
+                                 "the selection was not kept (" + state_.session.status() + ")");
     }
   }
 

@@ -1,6 +1,8 @@
 #include "modeling/store/command_footprint.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cassert>
 #include <utility>
 #include <vector>
 
@@ -13,30 +15,31 @@ using D = ProjectData;
 // where they are (an object's figures and its growth into other scans).
 constexpr ProjectDataSet kObjectInputs = D::kScans | D::kGeometry | D::kPoses | D::kObjects;
 
+constexpr ProjectDataSet only(ProjectData data) {
+  return static_cast<ProjectDataSet>(data);
+}
+
 constexpr std::array<std::pair<std::string_view, CommandFootprint>, 18> kFootprints = {{
     {"import", {0, D::kScans | D::kPoses | D::kMerge}},
-    {"geometry", {static_cast<ProjectDataSet>(D::kScans), D::kGeometry | D::kMerge}},
-    {"register",
-     {kObjectInputs, D::kPoses | D::kMerge | D::kObjects}},
-    {"merge", {D::kScans | D::kGeometry | D::kPoses, static_cast<ProjectDataSet>(D::kMerge)}},
+    {"geometry", {only(D::kScans), D::kGeometry | D::kMerge}},
+    {"register", {kObjectInputs, D::kPoses | D::kMerge | D::kObjects}},
+    {"merge", {D::kScans | D::kGeometry | D::kPoses, only(D::kMerge)}},
     {"harmonize",
-     {D::kScans | D::kGeometry | D::kPoses | D::kColorCorrections,
-      static_cast<ProjectDataSet>(D::kColorCorrections)}},
-    {"select", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},  // older journals
-    {"keep_selection", {0, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"commit", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"separate", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"propose", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"delete", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"group", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"edit", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"ungroup", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"merge_objects", {kObjectInputs, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"recolor", {static_cast<ProjectDataSet>(D::kObjects), static_cast<ProjectDataSet>(D::kObjects)}},
+     {D::kScans | D::kGeometry | D::kPoses | D::kColorCorrections, only(D::kColorCorrections)}},
+    {"select", {kObjectInputs, only(D::kSelections)}},  // in older journals
+    {"keep_selection", {0, only(D::kSelections)}},
+    {"commit", {kObjectInputs, D::kObjects | D::kSelections}},  // it removes a kept selection
+    {"separate", {kObjectInputs, only(D::kObjects)}},
+    {"propose", {kObjectInputs, only(D::kObjects)}},
+    {"delete", {kObjectInputs, only(D::kObjects)}},
+    {"group", {kObjectInputs, only(D::kObjects)}},
+    {"edit", {kObjectInputs, only(D::kObjects)}},
+    {"ungroup", {kObjectInputs, only(D::kObjects)}},
+    {"merge_objects", {kObjectInputs, only(D::kObjects)}},
+    {"recolor", {only(D::kObjects), only(D::kObjects)}},
     // A clone measures the source's colours as shown: corrections included.
-    {"clone", {kObjectInputs | D::kColorCorrections, static_cast<ProjectDataSet>(D::kObjects)}},
-    {"measure",
-     {static_cast<ProjectDataSet>(D::kMeasurements), static_cast<ProjectDataSet>(D::kMeasurements)}},
+    {"clone", {kObjectInputs | D::kColorCorrections, only(D::kObjects)}},
+    {"measure", {only(D::kMeasurements), only(D::kMeasurements)}},
 }};
 
 }  // namespace
@@ -56,7 +59,7 @@ struct DataNames {
   const char* name;  // in messages
 };
 
-constexpr std::array<DataNames, 7> kDataNames = {{
+constexpr std::array<DataNames, 8> kDataNames = {{
     {D::kScans, "scans", "scans"},
     {D::kGeometry, "geometry", "geometry"},
     {D::kPoses, "poses", "poses"},
@@ -64,13 +67,14 @@ constexpr std::array<DataNames, 7> kDataNames = {{
     {D::kColorCorrections, "color_corrections", "colour corrections"},
     {D::kObjects, "objects", "objects"},
     {D::kMeasurements, "measurements", "measurements"},
+    {D::kSelections, "selections", "kept selections"},
 }};
 
 const DataNames& names_of(ProjectData data) {
-  for (const DataNames& names : kDataNames) {
-    if (names.data == data) return names;
-  }
-  return kDataNames[0];  // unreachable: every enumerator is listed
+  const auto found = std::find_if(kDataNames.begin(), kDataNames.end(),
+                                  [&](const DataNames& names) { return names.data == data; });
+  assert(found != kDataNames.end() && "a kind of data missing from kDataNames");
+  return *found;
 }
 
 }  // namespace

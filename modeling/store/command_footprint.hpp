@@ -19,12 +19,13 @@ enum class ProjectData : std::uint32_t {
   kPoses = 1u << 2,             // the scans' poses in the world
   kMerge = 1u << 3,             // which points the merged model keeps
   kColorCorrections = 1u << 4,  // harmonize's per-scan colour corrections
-  kObjects = 1u << 5,           // the object tree, memberships, selections, object colours
+  kObjects = 1u << 5,           // the object tree, memberships, object colours
   kMeasurements = 1u << 6,      // the measurements list
+  kSelections = 1u << 7,        // selections kept for the next session (no command reads them)
 };
 
 using ProjectDataSet = std::uint32_t;
-inline constexpr ProjectDataSet kAllProjectData = (1u << 7) - 1;
+inline constexpr ProjectDataSet kAllProjectData = (1u << 8) - 1;
 
 constexpr ProjectDataSet operator|(ProjectData a, ProjectData b) {
   return static_cast<ProjectDataSet>(a) | static_cast<ProjectDataSet>(b);

@@ -202,7 +202,8 @@ class Project {
 
   // A number that changes with every committed edit, undo and redo, from
   // any process. A stage reads it before computing and passes it to
-  // begin_command, which refuses to write over a project that changed since.
+  // begin_command, which refuses to write when a command since changed data
+  // the stage read (command_footprint.hpp).
   std::int64_t revision() const;
 
   // ---- Scans -------------------------------------------------------------
@@ -339,9 +340,10 @@ class Project {
 
   // Starts command `name` (with its whole settings as JSON): takes the write
   // lock, discards undone commands (they can no longer be redone), and opens
-  // the journal entry. When `based_on_revision` is given and the project's
-  // revision has moved since (another process wrote to it while the caller
-  // computed), throws core::RuntimeFailure and changes nothing. Throws
+  // the journal entry. When `based_on_revision` is given and a command since
+  // (of another process, while the caller computed) changed data command
+  // `name` reads (command_footprint.hpp), throws core::RuntimeFailure and
+  // changes nothing. Throws
   // core::RuntimeFailure when another writer keeps the lock for longer than
   // kBusyTimeoutMs. Asserts no Edit is open on this project.
   Edit begin_command(std::string_view name, const std::string& settings_json,

@@ -85,7 +85,7 @@ class Project::LongCommand {
 
   // Opens the last transaction: checks the revision the command was begun
   // on (core::RuntimeFailure, and nothing becomes visible, when another
-  // process changed the project), ends the redo branch, and returns the
+  // process changed data the command reads), ends the redo branch, and returns the
   // Edit whose commit() makes the command done. The caller may write
   // through it first. Once the returned Edit commits, the command is no
   // longer abandoned on destruction.

@@ -198,17 +198,16 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
       run("reparent_out", {{{"drag", {grouped.widget("node wall south"), empty}}}, {{"wait", 2}}});
   tree = nodes(dir, project);
   EXPECT_TRUE(tree[1]["parent"].is_null());
-  const Layout in = run("reparent_in", {{{"drag", {out.widget("node wall south"),
-                                                    out.widget("node keller hall")}}},
-                                         {{"wait", 2}}});
+  const Layout in = run(
+      "reparent_in",
+      {{{"drag", {out.widget("node wall south"), out.widget("node keller hall")}}}, {{"wait", 2}}});
   tree = nodes(dir, project);
   EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
 
   // Deleting the group asks first: cancelled, nothing changes; confirmed,
   // the group goes with its walls.
-  const json ask = {{{"click", in.widget("node keller hall")}},
-                    {{"click", in.widget("delete")}},
-                    {{"wait", 2}}};
+  const json ask = {
+      {{"click", in.widget("node keller hall")}}, {{"click", in.widget("delete")}}, {{"wait", 2}}};
   const Layout asked = run("delete_group", ask);
   EXPECT_EQ(nodes(dir, project).size(), 3u);
   json cancel = ask;
@@ -320,9 +319,9 @@ TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
   const int x = v[0].get<int>(), y = v[1].get<int>(), w = v[2].get<int>(), h = v[3].get<int>();
   const std::filesystem::path before = dir / "workbench_carry_before.png";
   const std::filesystem::path after = dir / "workbench_carry_after.png";
-  EXPECT_GT(darkened_share(before, after, x + w * 43 / 100, y + h * 35 / 100, w * 14 / 100,
-                           h * 30 / 100),
-            0.8);
+  EXPECT_GT(
+      darkened_share(before, after, x + w * 43 / 100, y + h * 35 / 100, w * 14 / 100, h * 30 / 100),
+      0.8);
   EXPECT_LT(darkened_share(before, after, x, y + h / 4, w / 10, h / 2), 0.05);
 
   // The clipping box around the wall leaves the other building out.
@@ -360,13 +359,14 @@ TEST(Workbench, CtrlZStopsBeforeABatchStageAndAsks) {
   const Layout start = run("undo_open", json::array());
   const json undo = {{"key", "Z"}, {"mods", {"ctrl"}}};
   const Layout asked =
-      run("undo_question", {{{"click", start.pixel(654, 116)}}, {{"wait", 2}}, undo, undo,
-                            {{"wait", 2}}});
+      run("undo_question",
+          {{{"click", start.pixel(654, 116)}}, {{"wait", 2}}, undo, undo, {{"wait", 2}}});
   // The click grew a selection (session state: no command), the first
   // Ctrl+Z took it back, and the second asks.
   const std::vector<std::string> after_click = {"import done", "geometry done"};
   EXPECT_EQ(journal(dir, project), after_click);
-  run("undo_cancel", {undo, {{"wait", 2}}, {{"click", asked.widget("question no")}}, {{"wait", 1}}});
+  run("undo_cancel",
+      {undo, {{"wait", 2}}, {{"click", asked.widget("question no")}}, {{"wait", 1}}});
   EXPECT_EQ(journal(dir, project), after_click);
   run("undo_geometry",
       {undo, {{"wait", 2}}, {{"click", asked.widget("question yes")}}, {{"wait", 2}}});
@@ -392,27 +392,28 @@ TEST(Workbench, ProposalsAreReviewedOneByOne) {
   };
   const auto count = [&] { return nodes(dir, project).size(); };
   const Layout start = run("proposals_open", json::array());
-  const Layout proposed =
-      run("proposals", {{{"click", start.widget("propose")}}, {{"wait", 3}}});
+  const Layout proposed = run("proposals", {{{"click", start.widget("propose")}}, {{"wait", 3}}});
   const std::size_t made = count();
   ASSERT_GE(made, 5u);  // the group and its proposals
-  const Layout accepted = run("proposal_accept", {{{"click", proposed.widget("proposal proposal 1")}},
-                                                  {{"wait", 2}},
-                                                  {{"click", proposed.widget("name")}},
-                                                  {{"key", "A"}, {"mods", {"ctrl"}}},
-                                                  {{"text", "north hall"}},
-                                                  {{"click", proposed.widget("accept proposal")}},
-                                                  {{"wait", 2}}});
+  const Layout accepted =
+      run("proposal_accept", {{{"click", proposed.widget("proposal proposal 1")}},
+                              {{"wait", 2}},
+                              {{"click", proposed.widget("name")}},
+                              {{"key", "A"}, {"mods", {"ctrl"}}},
+                              {{"text", "north hall"}},
+                              {{"click", proposed.widget("accept proposal")}},
+                              {{"wait", 2}}});
   json tree = nodes(dir, project);
   const auto accepted_node = std::find_if(tree.begin(), tree.end(),
-                                 [](const json& n) { return n["name"] == "north hall"; });
+                                          [](const json& n) { return n["name"] == "north hall"; });
   ASSERT_NE(accepted_node, tree.end());
   EXPECT_TRUE((*accepted_node)["parent"].is_null());
   EXPECT_EQ(count(), made);
-  const Layout rejected = run("proposal_reject", {{{"click", accepted.widget("proposal proposal 2")}},
-                                                  {{"wait", 2}},
-                                                  {{"click", accepted.widget("reject proposal")}},
-                                                  {{"wait", 2}}});
+  const Layout rejected =
+      run("proposal_reject", {{{"click", accepted.widget("proposal proposal 2")}},
+                              {{"wait", 2}},
+                              {{"click", accepted.widget("reject proposal")}},
+                              {{"wait", 2}}});
   EXPECT_EQ(count(), made - 1);
   run("proposal_merge", {{{"click", rejected.widget("proposal proposal 3")}},
                          {{"wait", 1}},
@@ -433,12 +434,12 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
   const json centre = start.view3d_centre();
   const json aside = {centre[0].get<double>() + 80.0, centre[1].get<double>() + 40.0};
   run_stage(dir, project, "measure",
-                                    {{{"click", start.widget("measure")}},
-                                     {{"wait", 1}},
-                                     {{"click", centre}},
-                                     {{"wait", 2}},
-                                     {{"click", aside}},
-                                     {{"wait", 2}}});
+            {{{"click", start.widget("measure")}},
+             {{"wait", 1}},
+             {{"click", centre}},
+             {{"wait", 2}},
+             {{"click", aside}},
+             {{"wait", 2}}});
   const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
   const json& last = history["commands"].back();
   ASSERT_EQ(last["name"], "measure");
@@ -474,12 +475,12 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
       json::parse(run_cli(dir, {"measurements", project.string(), "--json"}).out);
   ASSERT_EQ(listed_json["measurements"].size(), 1u);
   EXPECT_NEAR(listed_json["measurements"][0]["value"].get<double>(), std::sqrt(squared), 1e-9);
-  EXPECT_EQ(run_cli(dir, {"measurements", project.string(), "--csv", (dir / "m.csv").string()})
-                .exit_code,
-            0);
+  EXPECT_EQ(
+      run_cli(dir, {"measurements", project.string(), "--csv", (dir / "m.csv").string()}).exit_code,
+      0);
   EXPECT_TRUE(std::filesystem::exists(dir / "m.csv"));
-  const CliResult over_project = run_cli(
-      dir, {"measurements", project.string(), "--csv", project.string(), "--force"});
+  const CliResult over_project =
+      run_cli(dir, {"measurements", project.string(), "--csv", project.string(), "--force"});
   EXPECT_NE(over_project.exit_code, 0);
 }
 
@@ -511,13 +512,12 @@ TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
                         {{"key", "Z"}, {"mods", {"ctrl"}}},
                         {{"wait", 2}}};
   const std::filesystem::path record = dir / "recorded.json";
-  const CliResult recorded =
-      run_on_display(dir, {project.string(), "--replay", events(dir, "session.json", session).string(),
-                           "--record", record.string()});
+  const CliResult recorded = run_on_display(
+      dir, {project.string(), "--replay", events(dir, "session.json", session).string(), "--record",
+            record.string()});
   ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
   ASSERT_TRUE(std::filesystem::exists(record));
-  const CliResult replayed =
-      run_on_display(dir, {copy.string(), "--replay", record.string()});
+  const CliResult replayed = run_on_display(dir, {copy.string(), "--replay", record.string()});
   ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
   const auto commands = [&](const std::filesystem::path& file) {
     json out = json::array();
@@ -527,10 +527,12 @@ TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
     return out;
   };
   const json original = commands(project);
-  // import, geometry, commit, keep_selection: the second commit, undone,
-  // gave its selection back, and closing kept it (ending the redo chain).
+  // import, geometry, commit, commit (undone): the undo gave the second
+  // commit's selection back, and closing did not keep it, which would have
+  // ended the redo chain.
   ASSERT_EQ(original.size(), 4u);
-  EXPECT_EQ(original[3][0], "keep_selection");
+  EXPECT_EQ(original[3][0], "commit");
+  EXPECT_EQ(original[3][1], "undone");
   EXPECT_EQ(commands(copy), original);
   // An existing file is never replaced by a recording.
   const CliResult again = run_on_display(dir, {project.string(), "--record", record.string()});
@@ -539,7 +541,8 @@ TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
 }
 
 // Read-only, by flag or because nobody may write the file (root included):
-// clicks and Ctrl+Z are refused and the journal stays as it was.
+// a click grows a selection (session state) and Ctrl+Z takes it back, a
+// commit is refused, and the journal stays as it was.
 TEST(Workbench, ReadOnlyWritesNothing) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
@@ -550,10 +553,9 @@ TEST(Workbench, ReadOnlyWritesNothing) {
                 .exit_code,
             0);
   const Layout start{read_json(layout)};
-  const json edits = {{{"click", start.pixel(654, 116)}},
-                      {{"wait", 2}},
-                      {{"key", "Z"}, {"mods", {"ctrl"}}},
-                      {{"wait", 1}}};
+  const json edits = {
+      {{"click", start.pixel(654, 116)}}, {{"wait", 2}}, {{"key", "C"}}, {{"wait", 1}},
+      {{"key", "Z"}, {"mods", {"ctrl"}}}, {{"wait", 1}}};
   const std::vector<std::string> before = journal(dir, project);
   const std::filesystem::path shot = dir / "workbench_read_only.png";
   const CliResult flagged = run_on_display(

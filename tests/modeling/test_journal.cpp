@@ -129,7 +129,8 @@ TEST(Journal, ARevisionThatMovedRefusesTheWriteAndChangesNothing) {
     project.begin_command("merge", "{}", revision);
     FAIL() << "expected core::RuntimeFailure";
   } catch (const core::RuntimeFailure& error) {
-    EXPECT_THAT(error.what(), HasSubstr("the project's geometry changed while merge was computing"));
+    EXPECT_THAT(error.what(),
+                HasSubstr("the project's geometry changed while merge was computing"));
   }
   EXPECT_EQ(project.history().size(), 2u);
 }

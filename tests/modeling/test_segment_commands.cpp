@@ -68,7 +68,8 @@ TEST(SegmentCommands, ACommitGrowsOnWithTheSettingsItsSelectionWasGrownWith) {
   const std::int64_t scan = store_room(project);
   SelectionTools tools;
   EXPECT_FALSE(tools.commit_of(scan, "wall", std::nullopt).grow.has_value());
-  SelectSettings range = select_at(scan, 20, 0, SelectMode::kReplace, segmentation::Channel::kRange);
+  SelectSettings range =
+      select_at(scan, 20, 0, SelectMode::kReplace, segmentation::Channel::kRange);
   range.grow.tolerance = 9.0;
   ASSERT_TRUE(tools.select(project, range).seed_open);
   ASSERT_TRUE(tools.select(project, select_at(scan, 0, -45, SelectMode::kSubtract)).seed_open);
@@ -146,22 +147,36 @@ TEST(SegmentCommands, SelectionsAreSessionStateKeptOnRequest) {
   const NodeCommandResult committed = tools.commit(project, tools.commit_of(scan, "both", {}));
   EXPECT_FALSE(tools.undo_selection());  // the grows before a command go with it
   ASSERT_TRUE(project.undo().has_value());
-  tools.command_undone(committed.command_id);
+  tools.command_undone(project, committed.command_id);
   EXPECT_EQ(tools.selection(scan).size(), both);
   ASSERT_TRUE(project.redo().has_value());
-  tools.command_redone(committed.command_id);
+  tools.command_redone(project, committed.command_id);
   EXPECT_TRUE(tools.selection(scan).empty());
   ASSERT_TRUE(project.undo().has_value());
-  tools.command_undone(committed.command_id);
+  tools.command_undone(project, committed.command_id);
+  // A grow after the undo, taken back and made again: redoing the commit
+  // would pass over it.
+  EXPECT_FALSE(tools.grown_since_command());
+  ASSERT_TRUE(tools.select(project, select_at(scan, 0, -45, SelectMode::kSubtract)).seed_open);
+  ASSERT_TRUE(tools.undo_selection());
+  EXPECT_FALSE(tools.grown_since_command());
+  ASSERT_TRUE(tools.redo_selection());
+  EXPECT_TRUE(tools.grown_since_command());
+  ASSERT_TRUE(tools.undo_selection());
 
   EXPECT_TRUE(kept_selection(project, scan).empty());
   const std::size_t journal = project.history().size();
-  const std::int64_t kept = tools.keep(project);
-  EXPECT_GT(kept, 0);
-  // It ended the redo chain: the undone commit gave its place to it.
+  // Kept when a session ends, it would end the redo chain: it is held back.
+  const SelectionTools::Kept spared = tools.keep(project, true);
+  EXPECT_TRUE(spared.held_back);
+  EXPECT_EQ(spared.command_id, 0);
+  EXPECT_EQ(project.history().size(), journal);
+  // Asked for, it is kept, and ends it: the undone commit gives its place.
+  const SelectionTools::Kept kept = tools.keep(project, false);
+  EXPECT_GT(kept.command_id, 0);
   EXPECT_EQ(project.history().size(), journal);
   EXPECT_EQ(kept_selection(project, scan), tools.selection(scan));
-  EXPECT_EQ(tools.keep(project), 0);  // nothing changed since
+  EXPECT_EQ(tools.keep(project, false).command_id, 0);  // nothing changed since
   // Another session starts from the kept selection, and a commit removes it.
   SelectionTools next;
   next.open_scan(project, scan);
@@ -189,8 +204,9 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
     edit.commit("{}");
   }
   // The poster, flush with the wall, is already an object of the second scan.
-  ASSERT_TRUE(tools.select(project, select_at(second, 31, 0, SelectMode::kReplace,
-                                               segmentation::Channel::kColor))
+  ASSERT_TRUE(tools
+                  .select(project, select_at(second, 31, 0, SelectMode::kReplace,
+                                             segmentation::Channel::kColor))
                   .seed_open);
   CommitSettings poster{second, "poster", std::nullopt};
   poster.other_scans = false;
@@ -278,7 +294,8 @@ TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
   ASSERT_EQ(count_owned(project, later, wall), 0u);
 
   // A registration swaps them: the second scan moves away, the later one comes.
-  const CarriedAgain again = carry_objects_again(project, {{second, away}, {later, here}});
+  core::Progress quiet;
+  const CarriedAgain again = carry_objects_again(project, {{second, away}, {later, here}}, quiet);
   EXPECT_EQ(again.released, in_second);
   EXPECT_EQ(again.carried_points, in_second);
   EXPECT_EQ(again.memberships.count(first), 0u);  // drawn there: unchanged
@@ -291,7 +308,41 @@ TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
   const std::vector<std::uint8_t>& carried = again.carried.at(later);
   EXPECT_EQ(static_cast<std::size_t>(std::count(carried.begin(), carried.end(), 1)), in_second);
   // Nothing moved: nothing changes.
-  EXPECT_TRUE(carry_objects_again(project, {}).memberships.empty());
+  EXPECT_TRUE(carry_objects_again(project, {}, quiet).memberships.empty());
+}
+
+// A review's rejected proposals go in one command, its accepted ones move
+// in one: one undo each.
+TEST(SegmentCommands, SeveralNodesAreDeletedOrMovedInOneCommand) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t scan = store_room(project);
+  const NodeCommandResult site = group_nodes(project, {"site", std::nullopt, {}});
+  ProposeSettings settings;
+  settings.scan_id = scan;
+  settings.parent = site.node_id;
+  const SeparateResult proposed = propose_objects(project, settings);
+  ASSERT_GE(proposed.nodes.size(), 4u);
+  const std::string before = state_of(project);
+  const std::size_t journal = project.history().size();
+  delete_node(project, {proposed.nodes[0], DeletedPoints::kToPool, {proposed.nodes[1]}});
+  EXPECT_EQ(project.history().size(), journal + 1);
+  EXPECT_EQ(project.object_nodes().size(), 2 + proposed.nodes.size() - 2);
+  EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(proposed.nodes[1])), 0u);
+  NodeEdit accept;
+  accept.node = proposed.nodes[2];
+  accept.parent = site.node_id;
+  accept.others = {proposed.nodes[3]};
+  edit_node(project, accept);
+  EXPECT_EQ(project.history().size(), journal + 2);
+  for (const store::ObjectNode& n : project.object_nodes()) {
+    if (n.id == proposed.nodes[2] || n.id == proposed.nodes[3]) {
+      EXPECT_EQ(n.parent, site.node_id);
+    }
+  }
+  ASSERT_TRUE(project.undo().has_value());
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(state_of(project), before);
 }
 
 TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
@@ -308,8 +359,7 @@ TEST(SegmentCommands, AddSubtractAndUndoRedoAcrossProcesses) {
     const SelectResult both = tools.select(project, select_at(scan, 0, -45, SelectMode::kAdd));
     EXPECT_GT(both.selected_pixels, wall_only);  // the floor joined
     // The floor's region also holds the pixels on its crease with the wall.
-    const SelectResult back =
-        tools.select(project, select_at(scan, 0, -45, SelectMode::kSubtract));
+    const SelectResult back = tools.select(project, select_at(scan, 0, -45, SelectMode::kSubtract));
     EXPECT_LE(back.selected_pixels, wall_only);
     EXPECT_GT(back.selected_pixels, wall_only * 98 / 100);
     committed = back.selected_pixels;
@@ -335,12 +385,12 @@ TEST(SegmentCommands, DeletedObjectsGiveTheirPointsBackOrMarkThemDeleted) {
   const NodeCommandResult room = group_nodes(project, {"room", std::nullopt, {}});
   const std::size_t floor = tools.select(project, select_at(scan, 0, -45)).selected_pixels;
   const NodeCommandResult object = tools.commit(project, {scan, "floor", room.node_id});
-  delete_node(project, {room.node_id, DeletedPoints::kDeleted});
+  delete_node(project, {room.node_id, DeletedPoints::kDeleted, {}});
   EXPECT_TRUE(project.object_nodes().empty());  // the group and the floor in it
   EXPECT_EQ(count_owned(project, scan, store::kDeletedPoints), floor);
   ASSERT_TRUE(project.undo().has_value());
   EXPECT_EQ(count_owned(project, scan, static_cast<std::uint32_t>(object.node_id)), floor);
-  delete_node(project, {object.node_id, DeletedPoints::kToPool});
+  delete_node(project, {object.node_id, DeletedPoints::kToPool, {}});
   EXPECT_EQ(project.object_nodes().size(), 1u);
   EXPECT_EQ(project.object_nodes()[0].points, 0);
   EXPECT_TRUE(tools.select(project, select_at(scan, 0, -45)).seed_open);
@@ -404,11 +454,10 @@ TEST(SegmentCommands, SeparateSplitsAnObjectIntoItsParts) {
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
   const std::size_t pane = tools.select(project, select_at(scan, 0, 8)).selected_pixels;
-  const std::size_t both = tools.select(project, select_at(scan, 36, 0, SelectMode::kAdd,
-                                                            segmentation::Channel::kColor))
-                               .selected_pixels;
-  const NodeCommandResult object =
-      tools.commit(project, {scan, "pane and poster", std::nullopt});
+  const std::size_t both =
+      tools.select(project, select_at(scan, 36, 0, SelectMode::kAdd, segmentation::Channel::kColor))
+          .selected_pixels;
+  const NodeCommandResult object = tools.commit(project, {scan, "pane and poster", std::nullopt});
   const SeparateResult parts = separate_object(project, {object.node_id, scan});
   ASSERT_EQ(parts.nodes.size(), 2u);
   const std::vector<store::ObjectNode> nodes = project.object_nodes();
@@ -475,10 +524,10 @@ TEST(SegmentCommands, RefusedCommandsNameTheProblemAndWriteNothing) {
   refused([&] { group_nodes(project, {"x", 99, {}}); }, "node 99");
   refused(
       [&] {
-        edit_node(project, {site.node_id, std::nullopt, std::nullopt, hall.node_id});
+        edit_node(project, {site.node_id, std::nullopt, std::nullopt, hall.node_id, {}});
       },
       "below itself");
-  refused([&] { delete_node(project, {42, DeletedPoints::kToPool}); }, "node 42");
+  refused([&] { delete_node(project, {42, DeletedPoints::kToPool, {}}); }, "node 42");
   refused([&] { merge_objects(project, {{site.node_id, hall.node_id}}); }, "is a group");
   refused([&] { merge_objects(project, {{site.node_id}}); }, "two objects or more");
 }
@@ -563,15 +612,19 @@ TEST(SegmentCommands, AThousandRandomOperationsUndoneRestoreTheStateExactly) {
           break;
         case 5:
           edit_node(project,
-                    {some_node(), "renamed " + std::to_string(k), pick(2) == 0, std::nullopt});
+                    {some_node(), "renamed " + std::to_string(k), pick(2) == 0, std::nullopt, {}});
           break;
         case 6:
-          edit_node(project, {some_node(), std::nullopt, std::nullopt,
-                              std::optional<std::int64_t>(some_node())});
+          edit_node(project, {some_node(),
+                              std::nullopt,
+                              std::nullopt,
+                              std::optional<std::int64_t>(some_node()),
+                              {}});
           break;
         case 7:
-          delete_node(project,
-                      {some_node(), pick(2) ? DeletedPoints::kToPool : DeletedPoints::kDeleted});
+          delete_node(
+              project,
+              {some_node(), pick(2) ? DeletedPoints::kToPool : DeletedPoints::kDeleted, {}});
           break;
         case 9:
           separate_object(project, {some_node(), scan});

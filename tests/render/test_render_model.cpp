@@ -82,8 +82,8 @@ TEST(RenderModel, ObjectsAreTiledOnTheirOwnAndCullingFollowsTheTree) {
   const NodeCommandResult wall = tools.commit(project, {scan, "wall", room.node_id});
   const std::size_t far_points = tools.select(project, select_at(scan, 90, 0)).selected_pixels;
   const NodeCommandResult far = tools.commit(project, {scan, "far wall", std::nullopt});
-  delete_node(project, {far.node_id, DeletedPoints::kDeleted});
-  edit_node(project, {room.node_id, std::nullopt, true, std::nullopt});  // hide the room
+  delete_node(project, {far.node_id, DeletedPoints::kDeleted, {}});
+  edit_node(project, {room.node_id, std::nullopt, true, std::nullopt, {}});  // hide the room
   RenderModelSettings settings;
   settings.tiles = {8000, 6.0f};
   const RenderModel model = build_render_model(project, settings);
