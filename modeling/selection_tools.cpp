@@ -154,8 +154,12 @@ void SelectionTools::command_ran() {
 }
 
 void SelectionTools::reread_untouched(const store::Project& project) {
+  std::set<std::int64_t> scans;  // a scan whose import was undone keeps nothing
+  for (const store::StoredScanSummary& stored : project.scans()) scans.insert(stored.id);
   for (auto& [scan_id, selection] : selections_) {
-    if (touched_.count(scan_id) == 0) selection = kept_selection(project, scan_id);
+    if (touched_.count(scan_id) != 0) continue;
+    selection = scans.count(scan_id) != 0 ? kept_selection(project, scan_id)
+                                           : segmentation::PixelSet{};
   }
 }
 
