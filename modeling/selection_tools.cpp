@@ -158,8 +158,8 @@ void SelectionTools::reread_untouched(const store::Project& project) {
   for (const store::StoredScanSummary& stored : project.scans()) scans.insert(stored.id);
   for (auto& [scan_id, selection] : selections_) {
     if (touched_.count(scan_id) != 0) continue;
-    selection = scans.count(scan_id) != 0 ? kept_selection(project, scan_id)
-                                           : segmentation::PixelSet{};
+    selection =
+        scans.count(scan_id) != 0 ? kept_selection(project, scan_id) : segmentation::PixelSet{};
   }
 }
 
