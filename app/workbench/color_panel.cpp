@@ -45,14 +45,18 @@ void color_panel(WorkbenchState& s) {
   // Apply sets what was moved (and keeps what the node set before).
   if (ImGui::Button("Apply") && n) {
     const store::ColorEdit set = moved_sliders(s);
-    if (!set.empty()) s.session.recolor(n->id, set, false);
-    s.load_color_editor();
+    s.run("Recolouring \"" + n->name + "\"", [&s, id = n->id, set] {
+      if (!set.empty()) s.session.recolor(id, set, false);
+      s.load_color_editor();
+    });
   }
   s.probe("apply colour");
   ImGui::SameLine();
   if (ImGui::Button("Inherit") && n) {
-    s.session.recolor(n->id, {}, true);
-    s.load_color_editor();
+    s.run("Recolouring \"" + n->name + "\"", [&s, id = n->id] {
+      s.session.recolor(id, {}, true);
+      s.load_color_editor();
+    });
   }
   s.probe("inherit colour");
   ImGui::SameLine();
@@ -62,8 +66,10 @@ void color_panel(WorkbenchState& s) {
   if (ImGui::Button("Clone from other") && two) {
     const std::int64_t source =
         *s.selected.begin() == n->id ? *s.selected.rbegin() : *s.selected.begin();
-    s.session.clone(source, n->id);
-    s.load_color_editor();
+    s.run("Cloning colours", [&s, source, id = n->id] {
+      s.session.clone(source, id);
+      s.load_color_editor();
+    });
   }
   s.probe("clone colour");
   ImGui::EndDisabled();

@@ -58,6 +58,7 @@ void WorkbenchInput::cursor_moved(double x, double y) {
 void WorkbenchInput::button(int button, bool pressed, int mods) {
   WorkbenchState& s = state_;
   ImGuiIO& io = ImGui::GetIO();
+  if (pressed && !takes_presses()) return;
   set_mods(pressed ? mods : 0);
   if (button >= 0 && button < 5) io.MouseDown[button] = pressed;
   if (!pressed) {
@@ -73,7 +74,8 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
   if (s.panorama.contains(x, y)) {
     if (button == 0) {
       const auto [image_x, image_y] = s.panorama_pixel(x, y);
-      s.session.click(image_x, image_y);
+      const char* what = s.session.tool == Tool::kSeed ? "Growing the selection" : "Drawing";
+      s.run(what, [&s, x = image_x, y = image_y] { s.session.click(x, y); });
     } else {
       s.drag = Drag::kPanPanorama;
     }
@@ -85,6 +87,7 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
 
 void WorkbenchInput::scrolled(double, double dy) {
   WorkbenchState& s = state_;
+  if (!takes_presses()) return;
   ImGuiIO& io = ImGui::GetIO();
   io.MouseWheel += static_cast<float>(dy);
   if (io.WantCaptureMouse) return;
@@ -103,6 +106,7 @@ void WorkbenchInput::scrolled(double, double dy) {
 }
 
 void WorkbenchInput::key(int key, bool pressed, int mods) {
+  if (pressed && !takes_presses()) return;
   ImGuiIO& io = ImGui::GetIO();
   if (key >= 0 && key < 512) io.KeysDown[key] = pressed;
   if (pressed) {
@@ -174,6 +178,7 @@ void WorkbenchInput::shortcut(int key, int mods) {
 }
 
 void WorkbenchInput::text(unsigned codepoint) {
+  if (!takes_presses()) return;
   ImGui::GetIO().AddInputCharacter(codepoint);
 }
 

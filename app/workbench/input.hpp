@@ -21,6 +21,12 @@ class WorkbenchInput final : public render::WindowInput {
   void key(int key, bool pressed, int mods) override;
   void text(unsigned codepoint) override;
 
+  // Whether presses, the wheel and text act now: not while a background
+  // command runs (only moves and releases are taken then, so that the
+  // cursor and the keys held stay true). A recorder leaves out what is
+  // not taken: replayed, it would act once the command has ended.
+  bool takes_presses() const { return !state_.command.running(); }
+
   // Walk/fly: moves the camera by the keys held for `seconds`.
   void fly_keys(double seconds);
 

@@ -31,7 +31,9 @@ void measurement_list(WorkbenchState& s) {
     if (ImGui::SmallButton(("remove##m" + std::to_string(k)).c_str())) {
       std::vector<modeling::Measurement> rest = list;
       rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
-      s.session.save_measurements(rest, "removed " + list[k].name);
+      s.run("Removing " + list[k].name, [&s, rest, what = "removed " + list[k].name] {
+        s.session.save_measurements(rest, what);
+      });
     }
     s.probe("remove " + list[k].name);
   }
@@ -57,7 +59,7 @@ void clip_settings(WorkbenchState& s) {
   s.probe("slice");
   if (s.slice_on) {
     ImGui::SameLine();
-    ImGui::SetNextItemWidth(60);
+    ImGui::SetNextItemWidth(s.px(60));
     if (ImGui::Combo("across", &s.slice_axis, "x\0y\0z\0"))
       s.slice_at = s.navigation.target()[s.slice_axis];  // a coordinate of the new axis
     ImGui::DragScalar("at [m]", ImGuiDataType_Double, &s.slice_at, 0.05f, nullptr, nullptr, "%.2f");
@@ -75,7 +77,7 @@ void measure_panel(WorkbenchState& s) {
   if (ImGui::Checkbox("pick in the 3D view (M)", &s.measuring)) s.picks.clear();
   s.probe("measure");
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(90);
+  ImGui::SetNextItemWidth(s.px(90));
   if (ImGui::Combo("##kind", &s.measure_kind, "point\0distance\0height\0angle\0area\0"))
     s.picks.clear();
   s.probe("measure kind");
@@ -99,7 +101,7 @@ void measure_panel(WorkbenchState& s) {
     const std::string text = csv.string() + "_measurements.csv";
     text.copy(s.csv_path.data(), s.csv_path.size() - 1);
   }
-  ImGui::SetNextItemWidth(220);
+  ImGui::SetNextItemWidth(s.px(220));
   ImGui::InputText("##csv", s.csv_path.data(), s.csv_path.size());
   ImGui::SameLine();
   ImGui::BeginDisabled(s.session.measurements().empty());
@@ -113,7 +115,7 @@ void measure_panel(WorkbenchState& s) {
                    file.string() + " exists. Exporting replaces it with the measurements listed.",
                    "Replace", [&s, file] { s.session.export_measurements(file); }};
     } else {
-      s.session.export_measurements(file);
+      s.run("Exporting the measurements", [&s, file] { s.session.export_measurements(file); });
     }
   }
   s.probe("export csv");
@@ -130,8 +132,8 @@ void measurement_overlay(WorkbenchState& s, ImDrawList* draw) {
     }
     if (screen.empty()) return std::optional<ImVec2>{};
     draw->AddPolyline(screen.data(), static_cast<int>(screen.size()), colour,
-                      closed ? ImDrawFlags_Closed : 0, 2.0f);
-    for (const ImVec2& p : screen) draw->AddCircleFilled(p, 4.0f, colour);
+                      closed ? ImDrawFlags_Closed : 0, s.px(2));
+    for (const ImVec2& p : screen) draw->AddCircleFilled(p, s.px(4), colour);
     return std::optional<ImVec2>(screen.back());
   };
   for (const modeling::Measurement& m : s.session.measurements()) {

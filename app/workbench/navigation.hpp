@@ -14,7 +14,8 @@ class Navigation {
   // enough to see all of it, speeds scaled to its diagonal. With `facing`
   // (a direction from the box towards the viewer, not zero) the eye moves
   // to that side, a little above; otherwise the view direction stays.
-  void frame(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& facing = Eigen::Vector3d::Zero());
+  void frame(const Eigen::AlignedBox3d& box,
+             const Eigen::Vector3d& facing = Eigen::Vector3d::Zero());
   // Orbit: pixels of mouse motion turn the eye about the target.
   void orbit(double dx_px, double dy_px);
   // Moves eye and target across the view by pixels of mouse motion.

@@ -78,7 +78,7 @@ void tree(WorkbenchState& s) {
       roots.push_back(&n);
     }
   }
-  ImGui::BeginChild("tree", ImVec2(0, 150), true);
+  ImGui::BeginChild("tree", ImVec2(0, s.px(150)), true);
   if (roots.empty()) ImGui::TextDisabled("no objects yet: click a seed, then Commit");
   for (const store::ObjectNode* root : roots) node_tree(s, *root, children);
   ImGui::EndChild();
@@ -87,7 +87,8 @@ void tree(WorkbenchState& s) {
     ImGui::EndDragDropTarget();
   }
   if (s.pending_reparent) {
-    s.session.reparent(s.pending_reparent->first, s.pending_reparent->second);
+    s.run("Moving",
+          [&s, move = *s.pending_reparent] { s.session.reparent(move.first, move.second); });
     s.pending_reparent.reset();
   }
 }
@@ -127,17 +128,22 @@ void objects_panel(WorkbenchState& s) {
   if (ImGui::Button("Group")) s.group();
   s.probe("group");
   ImGui::SameLine();
-  if (ImGui::Button("Rename") && p) s.session.rename(*p, s.name_text());
+  if (ImGui::Button("Rename") && p)
+    s.run("Renaming", [&s, id = *p, name = s.name_text()] { s.session.rename(id, name); });
   s.probe("rename");
   ImGui::SameLine();
   const std::optional<store::ObjectNode> n = p ? s.node(*p) : std::nullopt;
-  if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n) s.session.set_hidden(n->id, !n->hidden);
+  if (ImGui::Button(n && n->hidden ? "Show" : "Hide") && n) {
+    s.run(n->hidden ? "Showing" : "Hiding",
+          [&s, id = n->id, hide = !n->hidden] { s.session.set_hidden(id, hide); });
+  }
   s.probe("hide");
   ImGui::SameLine();
   if (ImGui::Button("Delete")) s.remove_selected();
   s.probe("delete");
   ImGui::SameLine();
-  if (ImGui::Button("Separate") && p) s.session.separate(*p);
+  if (ImGui::Button("Separate") && p)
+    s.run("Separating", [&s, id = *p] { s.session.separate(id); });
   s.probe("separate");
   ImGui::SameLine();
   if (ImGui::Button("Frame")) s.frame_selection();

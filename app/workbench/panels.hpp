@@ -19,8 +19,8 @@ void view_settings_panel(WorkbenchState& s);  // how the 3D view draws
 void measure_panel(WorkbenchState& s);        // clip box, slice; measurements: picks, list, CSV
 
 // Windows of their own:
-void toolbar_panel(WorkbenchState& s);  // tools, channel, tolerance, name, commit, undo
-void status_panel(WorkbenchState& s);   // what the last action did, the 3D frame's figures
+void toolbar_panel(WorkbenchState& s);    // tools, channel, tolerance, name, commit, undo
+void status_panel(WorkbenchState& s);     // what the last action did, the 3D frame's figures
 void questions_panel(WorkbenchState& s);  // the question being asked, modal
 
 // Views, drawn behind the panels; input reaches them when ImGui does not

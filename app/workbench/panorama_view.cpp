@@ -35,8 +35,8 @@ void polyline(const WorkbenchState& s, ImDrawList* draw, const segmentation::Pol
   for (const Eigen::Vector2d& v : line) points.push_back(s.panorama_screen(v));
   if (points.empty()) return;
   draw->AddPolyline(points.data(), static_cast<int>(points.size()), colour,
-                    closed ? ImDrawFlags_Closed : 0, 2.0f);
-  for (const ImVec2& p : points) draw->AddCircleFilled(p, 3.0f, colour);
+                    closed ? ImDrawFlags_Closed : 0, s.px(2));
+  for (const ImVec2& p : points) draw->AddCircleFilled(p, s.px(3), colour);
 }
 
 }  // namespace

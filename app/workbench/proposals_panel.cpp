@@ -32,16 +32,20 @@ void act_on(WorkbenchState& s, const std::vector<store::ObjectNode>& proposals,
   ImGui::BeginDisabled(ids.empty() || s.session.read_only());
   // Reject and Merge first: their places do not move with Accept's label.
   if (ImGui::Button("Reject") && !ids.empty()) {
-    s.session.reject(ids);  // one command, one undo
-    s.selected.clear();
-    s.after_command();
+    s.run("Rejecting", [&s, ids] {
+      s.session.reject(ids);  // one command, one undo
+      s.selected.clear();
+      s.after_command();
+    });
   }
   s.probe("reject proposal");
   ImGui::SameLine();
   ImGui::BeginDisabled(ids.size() < 2);
   if (ImGui::Button("Merge") && ids.size() >= 2) {
-    s.session.merge(ids);
-    s.select_only(ids.front());
+    s.run("Merging", [&s, ids] {
+      s.session.merge(ids);
+      s.select_only(ids.front());
+    });
   }
   s.probe("merge proposals");
   ImGui::EndDisabled();
@@ -51,8 +55,10 @@ void act_on(WorkbenchState& s, const std::vector<store::ObjectNode>& proposals,
   const std::string accept =
       ids.size() == 1 ? "Accept as \"" + s.name_text() + "\"###accept" : "Accept###accept";
   if (ImGui::Button(accept.c_str()) && !ids.empty()) {
-    s.session.accept(ids, group_parent, s.name_text());  // one command, one undo
-    s.after_command();
+    s.run("Accepting", [&s, ids, group_parent, name = s.name_text()] {
+      s.session.accept(ids, group_parent, name);  // one command, one undo
+      s.after_command();
+    });
   }
   s.probe("accept proposal");
   ImGui::EndDisabled();
@@ -71,7 +77,7 @@ void proposals_panel(WorkbenchState& s) {
   ImGui::TextWrapped(
       "Click one to see it (cyan in the panorama, framed in 3D); Ctrl+click "
       "picks more, to merge.");
-  ImGui::BeginChild("proposal list", ImVec2(0, 110), true);
+  ImGui::BeginChild("proposal list", ImVec2(0, s.px(110)), true);
   for (const store::ObjectNode& n : proposals) {
     const std::string label =
         n.name + " (" + std::to_string(n.points) + " points)##p" + std::to_string(n.id);
@@ -94,9 +100,11 @@ void proposals_panel(WorkbenchState& s) {
   ImGui::SameLine();
   if (ImGui::Button("Done")) {
     // What is left stays in the group, as objects of the tree.
-    if (proposals.empty()) s.session.remove(group);
-    s.review_group.reset();
-    s.after_command();
+    s.run("Closing the review", [&s, group, empty = proposals.empty()] {
+      if (empty) s.session.remove(group);
+      s.review_group.reset();
+      s.after_command();
+    });
   }
   s.probe("proposals done");
 }

@@ -1,3 +1,5 @@
+#include <utility>
+
 #include "app/workbench/panels.hpp"
 
 namespace scanbench::app::workbench {
@@ -9,15 +11,17 @@ void questions_panel(WorkbenchState& s) {
   const ImVec2 size = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(0.5f * size.x, 0.4f * size.y), ImGuiCond_Always,
                           ImVec2(0.5f, 0.5f));
-  ImGui::SetNextWindowSize(ImVec2(520, 0));
+  ImGui::SetNextWindowSize(ImVec2(s.px(520), 0));
   if (!ImGui::BeginPopupModal(title.c_str(), nullptr, ImGuiWindowFlags_NoResize)) return;
   ImGui::TextWrapped("%s", s.question->text.c_str());
   ImGui::Spacing();
   // The answer runs after the popup closes: it may ask another question.
   std::function<void()> answer;
+  std::string label;
   bool answered = false;
   if (ImGui::Button(s.question->yes.c_str())) {
     answer = s.question->on_yes;
+    label = s.question->yes;
     answered = true;
   }
   s.probe("question yes");
@@ -28,7 +32,7 @@ void questions_panel(WorkbenchState& s) {
   ImGui::EndPopup();
   if (!answered) return;
   s.question.reset();
-  if (answer) answer();
+  if (answer) s.run(label, std::move(answer));
 }
 
 }  // namespace scanbench::app::workbench

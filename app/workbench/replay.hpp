@@ -20,6 +20,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -59,12 +60,16 @@ std::optional<std::string> key_name(int code);
 // them as waits, so that the file replayed feeds the same input in the same
 // order (a replay feeds one event a frame; of a frame's cursor moves only
 // the last is kept). Modifier keys and keys the format does not name are
-// not written: every event carries its modifiers.
+// not written: every event carries its modifiers. While `takes_presses`
+// says no (a background command runs), presses, the wheel and text are
+// neither passed on nor written, and frames are not counted: a replay waits
+// for each command to end before it feeds the next event.
 class ReplayRecorder final : public render::WindowInput {
  public:
-  ReplayRecorder(render::WindowInput& inner, std::filesystem::path file);
+  ReplayRecorder(render::WindowInput& inner, std::filesystem::path file,
+                 std::function<bool()> takes_presses);
 
-  // A frame has ended.
+  // A frame has ended (the caller leaves out frames drawn while a command ran).
   void next_frame() { ++frames_since_event_; }
   // Writes the file, whole or not at all. Throws core::RuntimeFailure when
   // it cannot be written.
@@ -82,6 +87,7 @@ class ReplayRecorder final : public render::WindowInput {
 
   render::WindowInput& inner_;
   std::filesystem::path file_;
+  std::function<bool()> takes_presses_;
   nlohmann::json events_ = nlohmann::json::array();
   int frames_since_event_ = 0;
   bool moved_this_frame_ = false;

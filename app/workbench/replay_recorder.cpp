@@ -44,8 +44,9 @@ std::string utf8(unsigned c) {
 
 }  // namespace
 
-ReplayRecorder::ReplayRecorder(render::WindowInput& inner, std::filesystem::path file)
-    : inner_(inner), file_(std::move(file)) {}
+ReplayRecorder::ReplayRecorder(render::WindowInput& inner, std::filesystem::path file,
+                               std::function<bool()> takes_presses)
+    : inner_(inner), file_(std::move(file)), takes_presses_(std::move(takes_presses)) {}
 
 void ReplayRecorder::add(nlohmann::json event, int mods) {
   if (frames_since_event_ > 0) {
@@ -71,18 +72,21 @@ void ReplayRecorder::cursor_moved(double x, double y) {
 }
 
 void ReplayRecorder::button(int button, bool pressed, int mods) {
+  if (pressed && !takes_presses_()) return;
   inner_.button(button, pressed, mods);
   add({{pressed ? "press" : "release", button_name(button)}}, mods);
   moved_this_frame_ = false;
 }
 
 void ReplayRecorder::scrolled(double dx, double dy) {
+  if (!takes_presses_()) return;
   inner_.scrolled(dx, dy);
   if (dy != 0.0) add({{"scroll", dy}}, 0);
   moved_this_frame_ = false;
 }
 
 void ReplayRecorder::key(int key, bool pressed, int mods) {
+  if (pressed && !takes_presses_()) return;
   inner_.key(key, pressed, mods);
   const std::optional<std::string> name = key_name(key);
   if (!name) return;
@@ -91,6 +95,7 @@ void ReplayRecorder::key(int key, bool pressed, int mods) {
 }
 
 void ReplayRecorder::text(unsigned codepoint) {
+  if (!takes_presses_()) return;
   inner_.text(codepoint);
   add({{"text", utf8(codepoint)}}, 0);
   moved_this_frame_ = false;

@@ -44,7 +44,8 @@ void scans_panel(WorkbenchState& s) {
     }
   }
   if (chosen) {
-    s.session.open_scan(*chosen);
+    s.run("Opening scan " + std::to_string(*chosen),
+          [&s, id = *chosen] { s.session.open_scan(id); });
     s.zoom = 1.0f;
     s.pan = {0.0f, 0.0f};
   }

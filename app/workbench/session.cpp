@@ -394,6 +394,11 @@ void Session::show_first_scan_again() {
   status_ = said;
 }
 
+void Session::prepare_views() {
+  render_model();
+  if (!nodes_.empty()) coverage();
+}
+
 const modeling::ScanCoverage& Session::coverage() {
   if (!coverage_) {
     try {

@@ -137,6 +137,10 @@ class Session {
   Eigen::Vector3d render_model_origin() const {
     return model_ ? model_->origin : Eigen::Vector3d::Zero();
   }
+  // Builds what the views show after a change (the render model and the
+  // nodes' coverage), where it is stale; a background command calls it so
+  // that the window's thread does not.
+  void prepare_views();
   // Why the 3D view is empty (a scan without geometry); empty when it is not.
   const std::string& render_model_problem() const { return model_problem_; }
 
@@ -172,7 +176,7 @@ class Session {
   std::int64_t model_revision_ = -1;
   std::int64_t model_changes_ = 0;  // commands that changed what the 3D view shows
   std::string model_problem_;
-  std::int64_t model_generation_ = 0;  // models built so far
+  std::int64_t model_generation_ = 0;       // models built so far
   std::int64_t measurements_revision_ = 0;  // the project's revision they were read at
 };
 

@@ -7,7 +7,7 @@ namespace scanbench::app::workbench {
 
 void status_panel(WorkbenchState& s) {
   const ImVec2 size = ImGui::GetIO().DisplaySize;
-  place_window(0, size.y - kStatusHeight, size.x, kStatusHeight);
+  place_window(0, size.y - s.px(kStatusHeight), size.x, s.px(kStatusHeight));
   ImGui::Begin("Status", nullptr,
                kFixedWindow | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar);
   const render::FramePlan& plan = s.last_plan;
@@ -22,12 +22,16 @@ void status_panel(WorkbenchState& s) {
     ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "READ-ONLY");
     ImGui::SameLine();
   }
+  // How long the last command took, beside what it did.
+  char took[48] = "";
+  if (s.command.seconds() > 0.0) std::snprintf(took, sizeof took, " (%.1f s)", s.command.seconds());
   ImGui::Text(
-      "%s | selection %zu px | 3D %zu of %zu points (culled: clip %zu, frustum %zu, back %zu, "
+      "%s%s | selection %zu px | 3D %zu of %zu points (culled: clip %zu, frustum %zu, back %zu, "
       "detail %zu) | draw %s%.0f ms wall | %s frames/s",
-      s.session.status().empty() ? "ready" : s.session.status().c_str(),
-      s.session.selected_pixels(), plan.submitted, plan.points, plan.culled_clip, plan.culled_frustum,
-      plan.culled_backface, plan.culled_budget, gpu.c_str(), s.last_draw_ms, rate);
+      s.session.status().empty() ? "ready" : s.session.status().c_str(), took,
+      s.session.selected_pixels(), plan.submitted, plan.points, plan.culled_clip,
+      plan.culled_frustum, plan.culled_backface, plan.culled_budget, gpu.c_str(), s.last_draw_ms,
+      rate);
   ImGui::End();
 }
 

@@ -21,7 +21,7 @@ void tools_row(WorkbenchState& s) {
   s.probe("tool barrier");
   session.tool = static_cast<Tool>(tool);
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(100);
+  ImGui::SetNextItemWidth(s.px(100));
   int channel = static_cast<int>(session.channel);
   if (ImGui::Combo("##channel", &channel, "range\0colour\0intensity\0normal\0")) {
     session.channel = static_cast<segmentation::Channel>(channel);
@@ -29,7 +29,7 @@ void tools_row(WorkbenchState& s) {
   }
   s.probe("channel");
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(90);
+  ImGui::SetNextItemWidth(s.px(90));
   float tolerance = static_cast<float>(session.tolerance);
   // Units by channel (region_grow.hpp): range in footprints, colour in
   // ΔE, intensity in shares of the scan's spread, normal in degrees.
@@ -52,7 +52,7 @@ void tools_row(WorkbenchState& s) {
 // The second row: the name for commits, groups and renames, commit,
 // proposals, the panoramic view's channel, undo and redo.
 void commands_row(WorkbenchState& s) {
-  ImGui::SetNextItemWidth(220);
+  ImGui::SetNextItemWidth(s.px(220));
   if (ImGui::InputText("name", s.name.data(), s.name.size(),
                        ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll))
     s.commit();
@@ -65,7 +65,7 @@ void commands_row(WorkbenchState& s) {
   ImGui::SameLine();
   // The selection is session state, kept when the workbench closes: Keep
   // stores it now, for another process (a segment script) to go on with.
-  if (ImGui::Button("Keep")) s.session.keep_selections();
+  if (ImGui::Button("Keep")) s.run("Keeping the selection", [&s] { s.session.keep_selections(); });
   s.probe("keep selection");
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip("Keep the selection in the project now (it is kept when you close)");
@@ -73,13 +73,15 @@ void commands_row(WorkbenchState& s) {
   ImGui::SameLine();
   ImGui::BeginDisabled(read_only || !s.session.missing().empty());
   if (ImGui::Button("Automatic proposals")) {
-    s.review_group = s.session.propose();
-    s.after_command();
+    s.run("Proposing objects", [&s] {
+      s.review_group = s.session.propose();
+      s.after_command();
+    });
   }
   s.probe("propose");
   ImGui::EndDisabled();
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(110);
+  ImGui::SetNextItemWidth(s.px(110));
   ImGui::Combo("view", &s.panorama_channel, "colour\0range\0intensity\0normals\0");
   s.probe("panorama channel");
   ImGui::SameLine();
@@ -94,8 +96,8 @@ void commands_row(WorkbenchState& s) {
 }  // namespace
 
 void toolbar_panel(WorkbenchState& s) {
-  const float w = ImGui::GetIO().DisplaySize.x - kPanelWidth;
-  place_window(kPanelWidth, 0, w, kToolbarHeight);
+  const float w = ImGui::GetIO().DisplaySize.x - s.px(kPanelWidth);
+  place_window(s.px(kPanelWidth), 0, w, s.px(kToolbarHeight));
   ImGui::Begin("Tools", nullptr, kFixedWindow | ImGuiWindowFlags_NoTitleBar);
   tools_row(s);
   commands_row(s);

@@ -43,7 +43,7 @@ void view_3d(WorkbenchState& s) {
   draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(picture.texture)),
                  ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h),
                  ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
-  draw->AddText(ImVec2(r.x + 8, r.y + 6), IM_COL32(255, 255, 255, 200),
+  draw->AddText(ImVec2(r.x + s.px(8), r.y + s.px(6)), IM_COL32(255, 255, 255, 200),
                 s.fly ? "walk/fly: W A S D Q E, drag to look"
                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
   draw->PushClipRect(ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h), true);
@@ -52,7 +52,8 @@ void view_3d(WorkbenchState& s) {
   const std::string& problem = s.session.render_model_problem();
   if (!problem.empty()) {
     const std::string text = "nothing to draw: " + problem;
-    draw->AddText(ImVec2(r.x + 8, r.y + 26), IM_COL32(255, 200, 120, 255), text.c_str());
+    draw->AddText(ImVec2(r.x + s.px(8), r.y + s.px(26)), IM_COL32(255, 200, 120, 255),
+                  text.c_str());
   }
 }
 

@@ -10,9 +10,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "acquisition/formats/picture_file.hpp"
@@ -26,6 +29,11 @@ namespace scanbench::app::workbench {
 namespace {
 
 constexpr double kReplayFrameSeconds = 1.0 / 30.0;
+// While a command runs, the window repaints at most this often, leaving the
+// cores to the command.
+constexpr auto kWaitingFrame = std::chrono::milliseconds(50);
+// A command shorter than this shows no progress indicator (no flicker).
+constexpr double kIndicatorAfterSeconds = 0.25;
 
 // ImGui's context and OpenGL renderer for the life of the workbench.
 struct ImGuiScope {
@@ -48,17 +56,28 @@ class Workbench {
   Workbench(const WorkbenchOptions& options, render::WindowDevice& window)
       : state_(options, window), input_(state_) {
     glGenTextures(1, &state_.panorama_texture);
+    glGenTextures(1, &frozen_texture_);
     state_.frame_whole_model();
   }
-  ~Workbench() { glDeleteTextures(1, &state_.panorama_texture); }
+  ~Workbench() {
+    state_.command.wait();
+    glDeleteTextures(1, &state_.panorama_texture);
+    glDeleteTextures(1, &frozen_texture_);
+  }
   Workbench(const Workbench&) = delete;
   Workbench& operator=(const Workbench&) = delete;
 
-  render::WindowInput& input() { return input_; }
+  WorkbenchInput& input() { return input_; }
 
-  // The session ends: the selections are kept in the project
-  // (Session::keep_selections). Throws core::RuntimeFailure when they cannot be.
+  // Whether a background command runs: the frames show it, not the panels.
+  bool busy() const { return state_.command.running(); }
+
+  // The session ends, once the command running has: the selections are
+  // kept in the project (Session::keep_selections). Throws
+  // core::RuntimeFailure when they cannot be.
   void end_session() {
+    state_.command.wait();
+    state_.command.finished();  // rethrows what it threw
     if (!state_.session.keep_selections(true)) {
       throw core::RuntimeFailure(state_.session.project().path().string(), {},
                                  "the selection was not kept (" + state_.session.status() + ")");
@@ -68,7 +87,10 @@ class Workbench {
   // One frame that advances the input's clock by `seconds` (a replay's
   // fixed step, or the real interval live): the panels and views, then
   // ImGui's draw. The frame rate shown is measured from real intervals.
-  void frame(double seconds) {
+  // While a background command runs, the frame is the last one drawn
+  // before it, with a progress indicator; false then. A command asked for
+  // during the frame starts once it is drawn.
+  bool frame(double seconds) {
     WorkbenchState& s = state_;
     ImGuiIO& io = ImGui::GetIO();
     const auto [width, height] = s.window.framebuffer_size();
@@ -80,7 +102,12 @@ class Workbench {
       s.frame_seconds = s.frames == 1 ? real : 0.8 * s.frame_seconds + 0.2 * real;
     }
     s.last_frame = now;
+    if (s.command.running() && !s.command.finished()) {
+      waiting_frame(width, height);
+      return false;
+    }
     s.layout(width, height);
+    scale_fonts_and_style();
     input_.fly_keys(seconds);
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
@@ -97,6 +124,12 @@ class Workbench {
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     ++s.frames;
+    if (s.command.asked()) {
+      freeze(width, height);
+      s.drag = Drag::kNone;  // a drag does not go on under the command
+      s.command.start();
+    }
+    return true;
   }
 
   // The window as last drawn (before the buffers swap) into a PNG.
@@ -123,6 +156,7 @@ class Workbench {
     for (const auto& [name, at] : s.probes) widgets[name] = {at[0], at[1]};
     const nlohmann::json out = {{"widgets", widgets},
                                 {"scan", s.session.scan_id()},
+                                {"ui_scale", s.ui_scale},
                                 {"panorama",
                                  {{"x", s.panorama.x + s.pan[0]},
                                   {"y", s.panorama.y + s.pan[1]},
@@ -138,8 +172,8 @@ class Workbench {
  private:
   // The project panel on the left: scans, objects, colour, 3D view.
   void project_window() {
-    const float h = ImGui::GetIO().DisplaySize.y - kStatusHeight;
-    place_window(0, 0, kPanelWidth, h);
+    const float h = ImGui::GetIO().DisplaySize.y - state_.px(kStatusHeight);
+    place_window(0, 0, state_.px(kPanelWidth), h);
     ImGui::Begin("Project", nullptr, kFixedWindow);
     scans_panel(state_);
     objects_panel(state_);
@@ -150,8 +184,80 @@ class Workbench {
     ImGui::End();
   }
 
+  // ImGui's fonts and sizes at the layout's scale: the default font
+  // rasterised anew at its size (crisp, not stretched), the style's sizes
+  // scaled from the default's.
+  void scale_fonts_and_style() {
+    if (fonts_scale_ == state_.ui_scale) return;
+    fonts_scale_ = state_.ui_scale;
+    ImGuiIO& io = ImGui::GetIO();
+    io.Fonts->Clear();
+    ImFontConfig font;
+    font.SizePixels = std::round(13.0f * fonts_scale_);
+    io.Fonts->AddFontDefault(&font);
+    ImGui_ImplOpenGL3_DestroyFontsTexture();
+    ImGui_ImplOpenGL3_CreateFontsTexture();
+    ImGuiStyle style;
+    ImGui::StyleColorsDark(&style);
+    style.ScaleAllSizes(fonts_scale_);
+    ImGui::GetStyle() = style;
+  }
+
+  // The frame just drawn, kept in a texture to show while a command runs.
+  void freeze(int width, int height) {
+    glBindTexture(GL_TEXTURE_2D, frozen_texture_);
+    glReadBuffer(GL_BACK);
+    glCopyTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, 0, 0, width, height, 0);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glBindTexture(GL_TEXTURE_2D, 0);
+  }
+
+  // A frame while the command runs: the frozen frame (stretched if the
+  // window was resized meanwhile), dimmed, with what runs, for how long,
+  // and a bar sweeping to and fro. Nothing of the session is read.
+  void waiting_frame(int width, int height) {
+    std::this_thread::sleep_for(kWaitingFrame);
+    const BackgroundCommand& command = state_.command;
+    const auto w = static_cast<float>(width), h = static_cast<float>(height);
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui::NewFrame();
+    ImDrawList* draw = ImGui::GetBackgroundDrawList();
+    draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(frozen_texture_)),
+                   ImVec2(0, 0), ImVec2(w, h), ImVec2(0, 1), ImVec2(1, 0));
+    const double seconds = command.seconds();
+    if (seconds >= kIndicatorAfterSeconds) {
+      draw->AddRectFilled(ImVec2(0, 0), ImVec2(w, h), IM_COL32(0, 0, 0, 110));
+      const float box_w = state_.px(420), box_h = state_.px(78);
+      place_window(0.5f * (w - box_w), 0.45f * (h - box_h), box_w, box_h);
+      ImGui::Begin("##running", nullptr,
+                   kFixedWindow | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoInputs);
+      ImGui::Text("%s ...", command.label().c_str());
+      ImGui::TextDisabled("%.1f s; the window takes no input until it ends", seconds);
+      const ImVec2 at = ImGui::GetCursorScreenPos();
+      const float bar_w = ImGui::GetContentRegionAvail().x, bar_h = state_.px(8);
+      ImDrawList* box = ImGui::GetWindowDrawList();
+      box->AddRectFilled(at, ImVec2(at.x + bar_w, at.y + bar_h), IM_COL32(60, 64, 72, 255));
+      const double phase = std::fmod(seconds / 1.6, 2.0);  // 0 → 1 → 0 in 3.2 s
+      const float lit = 0.3f * bar_w;
+      const float from = static_cast<float>(phase < 1.0 ? phase : 2.0 - phase) * (bar_w - lit);
+      box->AddRectFilled(ImVec2(at.x + from, at.y), ImVec2(at.x + from + lit, at.y + bar_h),
+                         IM_COL32(90, 160, 240, 255));
+      ImGui::Dummy(ImVec2(bar_w, bar_h));
+      ImGui::End();
+    }
+    ImGui::Render();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, width, height);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    ++state_.command.frames_while_running;
+  }
+
   WorkbenchState state_;
   WorkbenchInput input_;
+  unsigned frozen_texture_ = 0;
+  float fonts_scale_ = 1.0f;  // what the font atlas and style were made for
 };
 
 // Feeds the events, a frame each, to `input` (the workbench's, or a
@@ -164,6 +270,12 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
   for (const ReplayEvent& e : events) {
     feed(input, e);
     bench.frame(kReplayFrameSeconds);
+    // The next event waits for the command this one started, as a user
+    // does: the window takes no presses meanwhile.
+    while (bench.busy()) {
+      window.swap_buffers();
+      bench.frame(kReplayFrameSeconds);
+    }
     if (recorder) recorder->next_frame();
     if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
     window.swap_buffers();
@@ -181,8 +293,8 @@ void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions
   while (!window.close_requested()) {
     window.poll_events();
     const auto now = std::chrono::steady_clock::now();
-    bench.frame(std::chrono::duration<double>(now - last).count());
-    if (recorder) recorder->next_frame();
+    const bool drew_panels = bench.frame(std::chrono::duration<double>(now - last).count());
+    if (recorder && drew_panels) recorder->next_frame();
     last = now;
     if (!layout_written && !options.layout.empty()) {
       bench.write_layout(options.layout);
@@ -206,8 +318,12 @@ void run_workbench(const WorkbenchOptions& options) {
   const ImGuiScope imgui;
   Workbench bench(options, window);
   std::optional<ReplayRecorder> recorder;
-  if (!options.record.empty()) recorder.emplace(bench.input(), options.record);
-  render::WindowInput& input = recorder ? *recorder : bench.input();
+  if (!options.record.empty()) {
+    recorder.emplace(bench.input(), options.record,
+                     [&bench] { return bench.input().takes_presses(); });
+  }
+  render::WindowInput& input =
+      recorder ? static_cast<render::WindowInput&>(*recorder) : bench.input();
   window.set_input(&input);
   struct Detach {
     render::WindowDevice& window;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <set>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "render/pick.hpp"
@@ -24,9 +26,12 @@ WorkbenchState::WorkbenchState(const WorkbenchOptions& options, render::WindowDe
 
 void WorkbenchState::layout(int width, int height) {
   const float w = static_cast<float>(width), h = static_cast<float>(height);
-  const float views_height = h - kToolbarHeight - kStatusHeight;
-  panorama = {kPanelWidth, kToolbarHeight, w - kPanelWidth, std::round(0.45f * views_height)};
-  view3d = {kPanelWidth, panorama.y + panorama.h, w - kPanelWidth, views_height - panorama.h};
+  const float ratio = std::min(w / 1280.0f, h / 800.0f);
+  ui_scale = std::clamp(std::floor(4.0f * ratio) / 4.0f, 1.0f, 3.0f);
+  const float left = px(kPanelWidth), top = px(kToolbarHeight);
+  const float views_height = h - top - px(kStatusHeight);
+  panorama = {left, top, w - left, std::round(0.45f * views_height)};
+  view3d = {left, panorama.y + panorama.h, w - left, views_height - panorama.h};
 }
 
 float WorkbenchState::panorama_scale() const {
@@ -102,29 +107,40 @@ void WorkbenchState::after_command() {
   load_color_editor();
 }
 
+void WorkbenchState::run(std::string label, std::function<void()> work) {
+  command.ask(std::move(label), [this, work = std::move(work)] {
+    work();
+    session.prepare_views();
+  });
+}
+
 void WorkbenchState::undo() {
-  const std::optional<store::CommandRecord> stage = session.undo();
-  after_command();
-  if (!stage) return;
-  const std::int64_t id = stage->id;
-  const std::string name = stage->name;
-  question = Question{
-      "Undo a batch stage?",
-      "The newest command is \"" + name + "\" (command " + std::to_string(id) + ", " +
-          stage->created_at +
-          "), a batch stage run over whole scans, not an edit made here.\nUndoing it takes back "
-          "its work on every scan; Ctrl+Y or `scanbench redo` brings it back.",
-      "Undo " + name, [this, id] {
-        session.undo(true, id);
-        after_command();
-        view_dirty = true;
-      }};
+  run("Undoing", [this] {
+    const std::optional<store::CommandRecord> stage = session.undo();
+    after_command();
+    if (!stage) return;
+    const std::int64_t id = stage->id;
+    const std::string name = stage->name;
+    question = Question{
+        "Undo a batch stage?",
+        "The newest command is \"" + name + "\" (command " + std::to_string(id) + ", " +
+            stage->created_at +
+            "), a batch stage run over whole scans, not an edit made here.\nUndoing it takes "
+            "back its work on every scan; Ctrl+Y or `scanbench redo` brings it back.",
+        "Undo " + name, [this, id] {
+          session.undo(true, id);
+          after_command();
+          view_dirty = true;
+        }};
+  });
 }
 
 void WorkbenchState::redo() {
-  session.redo();
-  after_command();
-  view_dirty = true;
+  run("Redoing", [this] {
+    session.redo();
+    after_command();
+    view_dirty = true;
+  });
 }
 
 void WorkbenchState::remove_selected() {
@@ -136,21 +152,16 @@ void WorkbenchState::remove_selected() {
     selected.clear();
     after_command();
   };
-  if (n->kind != store::NodeKind::kGroup) {
-    remove();
-    return;
-  }
   const std::size_t descendants = subtree(n->id).size() - 1;
-  if (descendants == 0) {
-    remove();
+  if (n->kind != store::NodeKind::kGroup || descendants == 0) {
+    run("Deleting \"" + n->name + "\"", remove);
     return;
   }
   question = Question{"Delete a group?",
                       "\"" + n->name + "\" holds " + std::to_string(descendants) +
                           " node(s). Deleting it deletes them too: their points return to the "
                           "pool to be segmented again. Ctrl+Z brings them back.",
-                      "Delete \"" + n->name + "\" and its " + std::to_string(descendants),
-                      remove};
+                      "Delete \"" + n->name + "\" and its " + std::to_string(descendants), remove};
 }
 
 void WorkbenchState::commit() {
@@ -159,15 +170,19 @@ void WorkbenchState::commit() {
     const store::ObjectNode n = *node(*p);
     parent = n.kind == store::NodeKind::kGroup ? std::optional(n.id) : n.parent;
   }
-  if (session.commit(name_text(), parent)) {
-    const std::int64_t made = session.nodes().empty() ? 0 : session.nodes().back().id;
-    select_only(made);
-  }
+  const std::string name = name_text();
+  run("Committing \"" + name + "\"", [this, name, parent] {
+    if (session.commit(name, parent))
+      select_only(session.nodes().empty() ? 0 : session.nodes().back().id);
+  });
 }
 
 void WorkbenchState::group() {
   const std::vector<std::int64_t> children(selected.begin(), selected.end());
-  if (session.group(name_text(), children)) select_only(session.nodes().back().id);
+  const std::string name = name_text();
+  run("Grouping as \"" + name + "\"", [this, name, children] {
+    if (session.group(name, children)) select_only(session.nodes().back().id);
+  });
 }
 
 void WorkbenchState::frame_whole_model() {
@@ -252,8 +267,7 @@ void WorkbenchState::apply_clipping() {
 void WorkbenchState::pick_at(double x, double y) {
   const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
   const render::RenderModel& model = session.render_model();
-  const render::RenderView view =
-      render::make_render_view(navigation.camera(w, h), model.origin);
+  const render::RenderView view = render::make_render_view(navigation.camera(w, h), model.origin);
   const std::optional<render::Pick> pick =
       render::pick_point(model, view.eye, render::pixel_ray(view, x - view3d.x, y - view3d.y),
                          settings.culling.clipping, settings.splat_scale);
@@ -278,7 +292,8 @@ void WorkbenchState::finish_measurement() {
   const std::string name = prefix + std::to_string(next);
   list.push_back({name, kind, picks});
   picks.clear();
-  session.save_measurements(list, "measured " + name);
+  run("Saving " + name,
+      [this, list, name] { session.save_measurements(list, "measured " + name); });
 }
 
 std::optional<ImVec2> WorkbenchState::screen_of(const Eigen::Vector3d& p) const {

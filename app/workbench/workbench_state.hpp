@@ -10,6 +10,7 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -21,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/workbench/background_command.hpp"
 #include "app/workbench/navigation.hpp"
 #include "app/workbench/session.hpp"
 #include "app/workbench/workbench.hpp"
@@ -29,9 +31,10 @@
 
 namespace scanbench::app::workbench {
 
-// The window's fixed layout [pixels]: the project panel on the left, the
-// tools across the top, the panoramic view above the 3D view, the status
-// bar at the bottom.
+// The window's layout [pixels at scale 1, a 1280 × 800 window]: the project
+// panel on the left, the tools across the top, the panoramic view above the
+// 3D view, the status bar at the bottom. Panels, fonts and widgets grow
+// with the window (WorkbenchState::ui_scale).
 inline constexpr float kPanelWidth = 340.0f;
 inline constexpr float kToolbarHeight = 64.0f;
 inline constexpr float kStatusHeight = 26.0f;
@@ -89,8 +92,8 @@ struct WorkbenchState {
 
   // ---- Measuring: left clicks in the 3D view pick points ----------------
   bool measuring = false;
-  int measure_kind = 1;  // modeling::MeasureKind
-  std::vector<Eigen::Vector3d> picks;  // world [m], of the measurement being taken
+  int measure_kind = 1;                         // modeling::MeasureKind
+  std::vector<Eigen::Vector3d> picks;           // world [m], of the measurement being taken
   std::array<double, 2> press_at = {0.0, 0.0};  // where the left button went down
   std::array<char, 4096> csv_path{};            // where Export CSV writes
 
@@ -128,8 +131,15 @@ struct WorkbenchState {
 
   std::string name_text() const { return std::string(name.data()); }
 
-  // Places the views for a window of `width` × `height` pixels.
+  // Places the views for a window of `width` × `height` pixels, and sets
+  // the scale of the panels for it.
   void layout(int width, int height);
+  // How much larger than at 1280 × 800 the panels, fonts and widgets are:
+  // the smaller of the window's two ratios to that size, in steps of ¼
+  // (a resize does not rebuild the fonts each pixel), 1 to 3.
+  float ui_scale = 1.0f;
+  // `pixels` at scale 1, scaled.
+  float px(float pixels) const { return std::round(pixels * ui_scale); }
 
   // The panoramic view's scale [window pixels per scan pixel], the image
   // point (x = column, y = row, pixel centres at integers) under window
@@ -158,7 +168,17 @@ struct WorkbenchState {
   std::optional<std::int64_t> review_group;
 
   // The question being asked, if any; the panels are inert until answered.
+  // Its answer runs as a background command labelled with its button.
   std::optional<Question> question;
+
+  // ---- Commands run on a worker thread (background_command.hpp) ---------
+  BackgroundCommand command;
+  // Runs `work` (a session command and what follows it, such as selecting
+  // what it made) as the background command `label`, starting once this
+  // frame is drawn, and then builds what the views show next
+  // (Session::prepare_views), so that the window's thread does not.
+  // Ignored while another is asked for or running.
+  void run(std::string label, std::function<void()> work);
 
   // Ctrl+Z: takes back the workbench's own edits; before a batch stage
   // (import, geometry, register, merge, harmonize) it asks.

@@ -29,13 +29,14 @@ using ::testing::HasSubstr;
 // its leak check is off: LeakSanitizer's tracer, stopping the world at exit
 // while Mesa's llvmpipe threads wind down, crashed once in about 40 runs
 // ("Tracer caught signal 11"); address and undefined-behaviour checks stay.
-CliResult run_on_display(const ScratchDir& dir, const std::vector<std::string>& args) {
+CliResult run_on_display(const ScratchDir& dir, const std::vector<std::string>& args,
+                         const std::string& screen = "1280x800") {
   std::vector<std::string> all = {"workbench"};
   all.insert(all.end(), args.begin(), args.end());
   const char* asan = std::getenv("ASAN_OPTIONS");
   const std::string no_leak_check =
       asan == nullptr ? "" : "env ASAN_OPTIONS='" + std::string(asan) + ":detect_leaks=0' ";
-  return run_cli(dir, all, no_leak_check + "xvfb-run -a -s '-screen 0 1280x800x24'");
+  return run_cli(dir, all, no_leak_check + "xvfb-run -a -s '-screen 0 " + screen + "x24'");
 }
 
 json read_json(const std::filesystem::path& file) {
@@ -603,6 +604,49 @@ TEST(Workbench, ClickingAnotherScanOpensIt) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_TRUE(std::filesystem::exists(dir / "b.png"));
   EXPECT_EQ(read_json(layout)["scan"], 2);
+}
+
+// On a screen twice as large each way, the panels, fonts and widgets are
+// twice as large (not a 1280 × 800 corner of it), and clicks at the larger
+// window's places act as at the smaller's.
+TEST(Workbench, PanelsScaleWithTheWindow) {
+  const ScratchDir dir;
+  const std::filesystem::path project = dir / "two.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  const auto layout_at = [&](int width, const json& list) {
+    const std::filesystem::path layout = dir / ("layout_" + std::to_string(width) + ".json");
+    const std::filesystem::path shot = dir / ("workbench_scaled_" + std::to_string(width) + ".png");
+    const std::string screen = std::to_string(width) + "x" + std::to_string(width * 5 / 8);
+    const CliResult run =
+        run_on_display(dir,
+                       {project.string(), "--size", std::to_string(width), "--replay",
+                        events(dir, "look.json", list).string(), "--layout", layout.string(),
+                        "--screenshot", shot.string()},
+                       screen);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    keep_screenshot(shot);
+    return Layout{read_json(layout)};
+  };
+  const Layout small = layout_at(1280, {{{"wait", 1}}});
+  const Layout large = layout_at(2560, {{{"wait", 1}}});
+  EXPECT_EQ(small.data["ui_scale"], 1.0);
+  EXPECT_EQ(large.data["ui_scale"], 2.0);
+  EXPECT_NEAR(large.data["panorama"]["x"].get<double>(),
+              2.0 * small.data["panorama"]["x"].get<double>(), 1.0);
+  EXPECT_NEAR(large.data["view3d"][3].get<double>(), 2.0 * small.data["view3d"][3].get<double>(),
+              2.0);
+  for (const std::string widget : {"scan 2", "commit", "undo", "apply colour"}) {
+    for (int axis = 0; axis < 2; ++axis) {
+      EXPECT_NEAR(large.widget(widget)[axis].get<double>(),
+                  2.0 * small.widget(widget)[axis].get<double>(), 6.0)
+          << widget << " axis " << axis;
+    }
+  }
+  // A click at the large window's place of "scan 2" opens it.
+  const Layout opened = layout_at(2560, {{{"click", large.widget("scan 2")}}, {{"wait", 2}}});
+  EXPECT_EQ(opened.data["scan"], 2);
 }
 
 TEST(Workbench, BadEventsAndProjectsAreRefusedByName) {
