@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
-#include <optional>
-#include <set>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -36,56 +34,41 @@ std::map<std::int64_t, CommitSettings> commit_settings_by_node(const store::Proj
   return out;
 }
 
-// One scan decoded and prepared for carrying, at its pose to be.
-struct Side {
-  acquisition::Scan scan;
-  acquisition::ScanGeometry geometry;
-  registration::PreparedScan prepared;
-  std::vector<std::uint32_t> membership;
-  std::vector<std::uint8_t> carried;
-};
+// Where each scan's objects were drawn (not carried there), for the objects
+// their commit carried: the pixels, ascending, by object. Only these act as
+// the sources of carrying.
+using DrawnPixels = std::map<std::uint32_t, std::vector<std::uint32_t>>;
 
-Side load_side(const store::Project& project, std::int64_t id,
-               const std::map<std::int64_t, Eigen::Isometry3d>& poses) {
-  Side side;
-  side.scan = project.load_scan(id);
-  if (const auto pose = poses.find(id); pose != poses.end()) side.scan.T_world_scan = pose->second;
-  std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, id);
-  if (!geometry) {
-    core::FilePosition position;
-    position.detail = "scan " + std::to_string(id);
-    throw core::InputError(project.path().string(), position,
-                           "has a normal layer but not the rest of its geometry (damaged?)");
+DrawnPixels drawn_pixels(const std::vector<std::uint32_t>& membership,
+                         const std::vector<std::uint8_t>& carried,
+                         const std::map<std::int64_t, CommitSettings>& commits) {
+  DrawnPixels out;
+  for (std::size_t p = 0; p < membership.size(); ++p) {
+    const std::uint32_t owner = membership[p];
+    if (owner == 0 || owner == store::kDeletedPoints || carried[p] != 0) continue;
+    if (commits.count(owner) != 0) out[owner].push_back(static_cast<std::uint32_t>(p));
   }
-  side.geometry = std::move(*geometry);
-  side.prepared = registration::prepare_scan(side.scan, side.geometry, 0);
-  side.membership = load_membership(project, id, side.scan.pixel_count());
-  side.carried = load_carried(project, id, side.scan.pixel_count());
-  return side;
-}
-
-bool drawn(const Side& side, std::size_t p) {
-  const std::uint32_t owner = side.membership[p];
-  return owner != 0 && owner != store::kDeletedPoints && side.carried[p] == 0;
+  return out;
 }
 
 // The grid a target grows on, one per noise model the commits used.
 class Grids {
  public:
-  explicit Grids(const Side& target) : target_(target) {}
+  Grids(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry)
+      : scan_(scan), geometry_(geometry) {}
   const segmentation::SegmentationGrid& with(const acquisition::RangeNoise& noise) {
     for (const auto& [n, grid] : grids_) {
       if (n.noise_m == noise.noise_m && n.noise_per_m == noise.noise_per_m) return grid;
     }
     segmentation::GridSettings settings;
     settings.range_noise = noise;
-    grids_.emplace_back(noise,
-                        segmentation::prepare_grid(target_.scan, target_.geometry, settings));
+    grids_.emplace_back(noise, segmentation::prepare_grid(scan_, geometry_, settings));
     return grids_.back().second;
   }
 
  private:
-  const Side& target_;
+  const acquisition::Scan& scan_;
+  const acquisition::ScanGeometry& geometry_;
   std::vector<std::pair<acquisition::RangeNoise, segmentation::SegmentationGrid>> grids_;
 };
 
@@ -98,53 +81,44 @@ std::vector<std::uint8_t> load_carried(const store::Project& project, std::int64
   return stored ? std::move(*stored) : std::vector<std::uint8_t>(pixels, 0);
 }
 
-CarriedAgain carry_objects_again(const store::Project& project,
-                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses,
+CarriedAgain carry_objects_again(const store::Project& project, const LoadedScans& loaded,
+                                 const std::vector<Eigen::Isometry3d>& poses,
                                  core::Progress& progress) {
   CarriedAgain out;
-  std::vector<std::int64_t> scans;  // with geometry
-  bool segmented = false;
-  for (const store::StoredScanSummary& stored : project.scans()) {
-    const std::vector<std::string> layers = project.layer_names(stored.id);
-    const auto has = [&](const char* name) {
-      return std::find(layers.begin(), layers.end(), name) != layers.end();
-    };
-    if (!has(store::layer::kNormal)) continue;
-    scans.push_back(stored.id);
-    segmented = segmented || has(store::layer::kMembership);
-  }
-  if (!segmented) return out;
   const std::map<std::int64_t, CommitSettings> commits = commit_settings_by_node(project);
   if (commits.empty()) return out;
-  for (std::size_t k = 0; k < scans.size(); ++k) {
-    const std::int64_t target_id = scans[k];
-    progress.update({"register", k, scans.size(), "carrying the objects again"});
+  const std::size_t n = loaded.ids.size();
+  // Each scan's layers are decoded once here, and the drawn pixels kept
+  // (a small share of a scan); a target's layers once more below.
+  std::vector<DrawnPixels> drawn(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t pixels = loaded.scans[k].pixel_count();
+    drawn[k] = drawn_pixels(load_membership(project, loaded.ids[k], pixels),
+                            load_carried(project, loaded.ids[k], pixels), commits);
+  }
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::int64_t target_id = loaded.ids[t];
+    progress.update({"register", t, n, "carrying the objects again"});
     progress.throw_if_cancelled("register");
-    Side target = load_side(project, target_id, poses);
-    const std::vector<std::uint32_t> before = target.membership;
-    std::vector<std::uint8_t> open(target.membership.size());
-    for (std::size_t p = 0; p < open.size(); ++p) {
-      if (target.carried[p] != 0 && target.membership[p] != 0 &&
-          target.membership[p] != store::kDeletedPoints) {
-        target.membership[p] = 0;
+    const std::size_t pixels = loaded.scans[t].pixel_count();
+    std::vector<std::uint32_t> membership = load_membership(project, target_id, pixels);
+    std::vector<std::uint8_t> carried = load_carried(project, target_id, pixels);
+    const std::vector<std::uint32_t> before = membership;
+    std::vector<std::uint8_t> open(pixels);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (carried[p] != 0 && membership[p] != 0 && membership[p] != store::kDeletedPoints) {
+        membership[p] = 0;
         ++out.released;
       }
-      target.carried[p] = 0;
-      open[p] = target.membership[p] == 0;
+      carried[p] = 0;
+      open[p] = membership[p] == 0;
     }
-    Grids grids(target);
-    for (const std::int64_t source_id : scans) {
-      if (source_id == target_id) continue;
-      const Side source = load_side(project, source_id, poses);
-      std::set<std::uint32_t> objects;  // drawn there, and carried by their commit
-      for (std::size_t p = 0; p < source.membership.size(); ++p) {
-        if (drawn(source, p) && commits.count(source.membership[p]) != 0)
-          objects.insert(source.membership[p]);
-      }
-      for (const std::uint32_t object : objects) {
-        std::vector<std::uint32_t> labels(source.membership.size(), 0);
-        for (std::size_t p = 0; p < labels.size(); ++p)
-          labels[p] = drawn(source, p) && source.membership[p] == object ? 1 : 0;
+    Grids grids(loaded.scans[t], loaded.geometry[t]);
+    for (std::size_t from = 0; from < n; ++from) {
+      if (from == t) continue;
+      for (const auto& [object, drawn_at] : drawn[from]) {
+        std::vector<std::uint32_t> labels(loaded.scans[from].pixel_count(), 0);
+        for (const std::uint32_t p : drawn_at) labels[p] = 1;
         const CommitSettings& commit = commits.at(object);
         CarrySettings settings;
         settings.transfer.noise = commit.range_noise;
@@ -152,19 +126,19 @@ CarriedAgain carry_objects_again(const store::Project& project,
         const segmentation::SegmentationGrid* grid =
             settings.grow ? &grids.with(settings.transfer.noise) : nullptr;
         const segmentation::PixelSet joins =
-            carry_object({&source.prepared, source.scan.T_world_scan, labels},
-                         {&target.prepared, target.scan.T_world_scan, grid, open}, settings);
+            carry_object({&loaded.prepared[from], poses[from], labels},
+                         {&loaded.prepared[t], poses[t], grid, open}, settings);
         for (const std::uint32_t q : joins) {
-          target.membership[q] = object;
-          target.carried[q] = 1;
+          membership[q] = object;
+          carried[q] = 1;
           open[q] = 0;
         }
         out.carried_points += joins.size();
       }
     }
-    if (target.membership != before) {
-      out.memberships.emplace(target_id, std::move(target.membership));
-      out.carried.emplace(target_id, std::move(target.carried));
+    if (membership != before) {
+      out.memberships.emplace(target_id, std::move(membership));
+      out.carried.emplace(target_id, std::move(carried));
     }
   }
   return out;

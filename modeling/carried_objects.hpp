@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
+#include "modeling/loaded_scans.hpp"
 #include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
@@ -29,13 +30,14 @@ struct CarriedAgain {
   std::size_t carried_points = 0;  // points carried at the new poses
 };
 
-// Carries every object its commit carried again, with the scans at `poses`
-// (the others where they are). Scans without geometry are left out. Holds
-// one target and one source scan decoded at a time, and the changed
-// layers. Reports progress per target scan as the "register" stage, and
-// throws core::Cancelled when cancelled.
-CarriedAgain carry_objects_again(const store::Project& project,
-                                 const std::map<std::int64_t, Eigen::Isometry3d>& poses,
+// Carries every object its commit carried again, with the scans `loaded`
+// (register's, with their geometry and prepared views) at `poses` (one per
+// scan, in their order). Decodes each scan's membership and carried layers
+// once, keeping only the pixels its objects were drawn on, and once more as
+// a target; holds the changed layers. Reports progress per target scan as
+// the "register" stage, and throws core::Cancelled when cancelled.
+CarriedAgain carry_objects_again(const store::Project& project, const LoadedScans& loaded,
+                                 const std::vector<Eigen::Isometry3d>& poses,
                                  core::Progress& progress);
 
 // Scan `scan_id`'s carried layer; all 0 (drawn, or still to be segmented)

@@ -73,7 +73,8 @@ RegisterCommandResult register_project(store::Project& project,
   std::map<std::int64_t, Eigen::Isometry3d> moved;
   for (std::size_t k = 0; k < loaded.ids.size(); ++k)
     moved.emplace(loaded.ids[k], out.result.T_world_scan[k]);
-  const CarriedAgain carried = carry_objects_again(project, moved, progress);
+  const CarriedAgain carried =
+      carry_objects_again(project, loaded, out.result.T_world_scan, progress);
   out.object_points_released = carried.released;
   out.object_points_carried = carried.carried_points;
   const std::vector<store::ObjectNode> refigured =
@@ -85,10 +86,10 @@ RegisterCommandResult register_project(store::Project& project,
   for (const store::ObjectNode& node : refigured) project.put_node(edit, node);
   for (const auto& [scan_id, membership] : carried.memberships) {
     put_membership(project, edit, scan_id, membership);
-    project.put_layer(edit, scan_id,
-                      store::encode_layer<std::uint8_t>(store::layer::kCarried,
-                                                        store::ElementType::kU8,
-                                                        carried.carried.at(scan_id)));
+    project.put_layer(
+        edit, scan_id,
+        store::encode_layer<std::uint8_t>(store::layer::kCarried, store::ElementType::kU8,
+                                          carried.carried.at(scan_id)));
   }
   for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
     loaded.scans[k].T_world_scan = out.result.T_world_scan[k];

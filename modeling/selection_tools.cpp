@@ -6,6 +6,17 @@
 
 namespace scanbench::modeling {
 
+namespace {
+
+// The project's scans now: a scan whose import was undone keeps nothing.
+std::set<std::int64_t> scan_ids(const store::Project& project) {
+  std::set<std::int64_t> out;
+  for (const store::StoredScanSummary& stored : project.scans()) out.insert(stored.id);
+  return out;
+}
+
+}  // namespace
+
 void SelectionTools::draw_on(std::int64_t scan_id) {
   assert((!scan_ || *scan_ == scan_id) && "lines of two scans at once: clear() between them");
   scan_ = scan_id;
@@ -154,8 +165,7 @@ void SelectionTools::command_ran() {
 }
 
 void SelectionTools::reread_untouched(const store::Project& project) {
-  std::set<std::int64_t> scans;  // a scan whose import was undone keeps nothing
-  for (const store::StoredScanSummary& stored : project.scans()) scans.insert(stored.id);
+  const std::set<std::int64_t> scans = scan_ids(project);
   for (auto& [scan_id, selection] : selections_) {
     if (touched_.count(scan_id) != 0) continue;
     selection =
@@ -179,8 +189,7 @@ void SelectionTools::command_redone(const store::Project& project, std::int64_t 
 
 std::map<std::int64_t, segmentation::PixelSet> SelectionTools::unkept(
     const store::Project& project) const {
-  std::set<std::int64_t> scans;  // a scan whose import was undone keeps nothing
-  for (const store::StoredScanSummary& stored : project.scans()) scans.insert(stored.id);
+  const std::set<std::int64_t> scans = scan_ids(project);
   std::map<std::int64_t, segmentation::PixelSet> changed;
   for (const std::int64_t scan_id : touched_) {
     const segmentation::PixelSet& now = selection(scan_id);

@@ -1,6 +1,7 @@
 #include "render/pick.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace scanbench::render {
@@ -42,7 +43,7 @@ Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y) {
 
 std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
                                const Eigen::Vector3f& direction, const Clipping& clipping,
-                               float splat_scale) {
+                               float splat_scale, bool oriented) {
   const RenderPoints& points = model.points;
   std::optional<Pick> best;
   for (const RenderNode& node : model.nodes) {
@@ -55,13 +56,38 @@ std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& 
         const Eigen::Vector3f& p = points.position[k];
         const Eigen::Vector3f to = p - origin;
         const float along = to.dot(direction);
-        if (along <= 0.0f || (best && along >= best->distance_m)) continue;
         const float radius = points.radii_m[k].maxCoeff() * splat_scale;
+        // Cheap rejections first: behind the eye, farther than the best
+        // hit by more than the splat's reach, or off the ray beyond it.
+        if (along + radius <= 0.0f || (best && along - radius >= best->distance_m)) continue;
         if ((to - along * direction).squaredNorm() > radius * radius) continue;
-        const Eigen::Vector3f& n = points.normal[k];
-        if (n.squaredNorm() > 0.25f && n.dot(-to) < 0.0f) continue;  // faces away
+        const Eigen::Vector3f& normal = points.normal[k];
+        const bool has_normal = normal.squaredNorm() > 0.25f;
+        if (has_normal && normal.dot(-to) < 0.0f) continue;  // faces away
         if (clipping.active() && !clipping.keeps(p)) continue;
-        best = Pick{k, along, p};
+        // Where the ray meets the splat as the view draws it: the ellipse
+        // in the plane of its normal, or a disk facing the eye (unoriented,
+        // no normal, or seen edge on).
+        bool in_plane = oriented && has_normal;
+        Eigen::Vector3f n = in_plane ? normal : Eigen::Vector3f(-to.normalized());
+        if (in_plane && std::abs(direction.dot(n)) < 0.05f) {
+          in_plane = false;
+          n = -to.normalized();
+        }
+        const float hit = to.dot(n) / direction.dot(n);
+        if (!(hit > 0.0f) || (best && hit >= best->distance_m)) continue;
+        const Eigen::Vector3f offset = origin + hit * direction - p;
+        const Eigen::Vector2f r = points.radii_m[k] * splat_scale;
+        const Eigen::Vector3f& major = points.major_axis[k];
+        float d2 = 0.0f;
+        if (in_plane && major.squaredNorm() > 0.25f) {
+          const Eigen::Vector2f e(offset.dot(n.cross(major)) / r.x(), offset.dot(major) / r.y());
+          d2 = e.squaredNorm();
+        } else {
+          d2 = offset.squaredNorm() / (in_plane ? r.x() * r.x() : r.x() * r.y());
+        }
+        if (d2 > 1.0f) continue;
+        best = Pick{k, hit, p};
       }
     }
   }

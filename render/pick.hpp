@@ -16,7 +16,7 @@ namespace scanbench::render {
 
 struct Pick {
   std::size_t point = 0;     // into RenderModel::points
-  float distance_m = 0.0f;   // from the ray's origin, along it
+  float distance_m = 0.0f;   // from the ray's origin, along it, to where it meets the splat
   Eigen::Vector3f position;  // the point's own position, model frame
 };
 
@@ -24,11 +24,14 @@ struct Pick {
 // the top left; pixel centres at +0.5) as a unit direction, model frame.
 Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y);
 
-// The nearest point whose splat (its larger radius × splat_scale) the ray
-// from `origin` along unit `direction` passes through; none when it meets
-// none. Walks only the tiles whose box the ray crosses.
+// The point whose splat the ray from `origin` along unit `direction` meets
+// first, the splat as the view draws it (splat_shaders.cpp): its ellipse
+// (radii × splat_scale) in the plane of its normal when `oriented`, else a
+// disk facing the eye. None when it meets none. Walks only the tiles whose
+// box the ray crosses. (A sphere of the larger radius would let the long
+// thin splats of distant ground catch rays that pass metres above them.)
 std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
                                const Eigen::Vector3f& direction, const Clipping& clipping,
-                               float splat_scale);
+                               float splat_scale, bool oriented = true);
 
 }  // namespace scanbench::render

@@ -5,7 +5,7 @@
 namespace scanbench::app::workbench {
 
 BackgroundCommand::~BackgroundCommand() {
-  if (future_.valid()) future_.wait();  // what it threw is lost with the window
+  if (future_.valid()) future_.wait();
 }
 
 bool BackgroundCommand::ask(std::string label, std::function<void()> work) {
@@ -18,16 +18,25 @@ bool BackgroundCommand::ask(std::string label, std::function<void()> work) {
 void BackgroundCommand::start() {
   if (!asked() || running()) return;
   started_ = std::chrono::steady_clock::now();
-  frames_while_running = 0;
-  future_ = std::async(std::launch::async, std::exchange(work_, {}));
+  future_ = std::async(std::launch::async, [this, work = std::exchange(work_, {})] {
+    // Timed here: the window's thread sees the end up to a frame later.
+    struct Timer {
+      BackgroundCommand& command;
+      ~Timer() {
+        command.took_ =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - command.started_)
+                .count();
+      }
+    } timer{*this};
+    work();
+  });
 }
 
-bool BackgroundCommand::finished() {
+bool BackgroundCommand::collect(std::chrono::milliseconds within) {
   if (!future_.valid()) return true;
-  if (future_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
-  took_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
-  std::future<void> done = std::move(future_);
-  done.get();  // rethrows
+  if (future_.wait_for(within) != std::future_status::ready) return false;
+  std::future<void> ended = std::move(future_);
+  ended.get();  // rethrows
   return true;
 }
 

@@ -58,24 +58,47 @@ void WorkbenchInput::cursor_moved(double x, double y) {
 void WorkbenchInput::button(int button, bool pressed, int mods) {
   WorkbenchState& s = state_;
   ImGuiIO& io = ImGui::GetIO();
-  if (pressed && !takes_presses()) return;
+  if (!takes_presses()) {
+    // A command runs: a release lets the button go, and does nothing else
+    // (no pick, no drag: the command's start ended any).
+    if (pressed) return;
+    set_mods(0);
+    if (button >= 0 && button < 5) io.MouseDown[button] = false;
+    s.drag = Drag::kNone;
+    return;
+  }
   set_mods(pressed ? mods : 0);
   if (button >= 0 && button < 5) io.MouseDown[button] = pressed;
   if (!pressed) {
     // Measuring, a left click that did not drag picks a point.
-    const bool clicked = s.drag == Drag::kOrbit && button == 0 &&
-                         std::hypot(s.cursor[0] - s.press_at[0], s.cursor[1] - s.press_at[1]) < 3.0;
+    const bool clicked =
+        s.drag == Drag::kOrbit && button == 0 &&
+        std::hypot(s.cursor[0] - s.press_at[0], s.cursor[1] - s.press_at[1]) < s.px(3);
     s.drag = Drag::kNone;
-    if (clicked && s.measuring && !s.fly) s.pick_at(s.cursor[0], s.cursor[1]);
+    if (clicked && !s.fly) {
+      if (s.measuring) {
+        s.pick_at(s.cursor[0], s.cursor[1]);
+      } else {
+        s.select_in_3d(s.cursor[0], s.cursor[1], (mods & keys::kModControl) != 0);
+      }
+    }
     return;
   }
   if (io.WantCaptureMouse) return;  // the panels have it
   const auto [x, y] = s.cursor;
   if (s.panorama.contains(x, y)) {
-    if (button == 0) {
+    if (button == 0 && s.measuring) {
       const auto [image_x, image_y] = s.panorama_pixel(x, y);
-      const char* what = s.session.tool == Tool::kSeed ? "Growing the selection" : "Drawing";
-      s.run(what, [&s, x = image_x, y = image_y] { s.session.click(x, y); });
+      s.pick_in_panorama(image_x, image_y);
+    } else if (button == 0) {
+      const auto [image_x, image_y] = s.panorama_pixel(x, y);
+      // A seed grows a region beside the window; a lasso or barrier vertex
+      // is added at once (clicks in quick succession each count).
+      if (s.session.tool == Tool::kSeed) {
+        s.run("Growing the selection", [&s, x = image_x, y = image_y] { s.session.click(x, y); });
+      } else {
+        s.session.click(image_x, image_y);
+      }
     } else {
       s.drag = Drag::kPanPanorama;
     }

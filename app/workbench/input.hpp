@@ -25,7 +25,7 @@ class WorkbenchInput final : public render::WindowInput {
   // command runs (only moves and releases are taken then, so that the
   // cursor and the keys held stay true). A recorder leaves out what is
   // not taken: replayed, it would act once the command has ended.
-  bool takes_presses() const { return !state_.command.running(); }
+  bool takes_presses() const { return !state_.command.running() && !state_.command.asked(); }
 
   // Walk/fly: moves the camera by the keys held for `seconds`.
   void fly_keys(double seconds);

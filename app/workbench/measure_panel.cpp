@@ -1,6 +1,10 @@
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -9,6 +13,8 @@
 namespace scanbench::app::workbench {
 
 namespace {
+
+constexpr int kMeasureKinds = 5;  // point, distance, height, angle, area (modeling::MeasureKind)
 
 std::string describe(const modeling::Measurement& m) {
   return fmt::format("{}: {:.3f} {}", m.name, modeling::measured_value(m),
@@ -74,13 +80,27 @@ void measure_panel(WorkbenchState& s) {
   if (!ImGui::CollapsingHeader("Clip and measure", ImGuiTreeNodeFlags_DefaultOpen)) return;
   clip_settings(s);
   ImGui::Separator();
-  if (ImGui::Checkbox("pick in the 3D view (M)", &s.measuring)) s.picks.clear();
+  if (ImGui::Checkbox("pick points (M)", &s.measuring)) s.picks.clear();
   s.probe("measure");
   ImGui::SameLine();
+  // The kinds, each probed while the list is open ("measure kind area").
+  const auto name_of = [](int kind) {
+    return std::string(modeling::measure_kind_name(static_cast<modeling::MeasureKind>(kind)));
+  };
   ImGui::SetNextItemWidth(s.px(90));
-  if (ImGui::Combo("##kind", &s.measure_kind, "point\0distance\0height\0angle\0area\0"))
-    s.picks.clear();
+  const bool open = ImGui::BeginCombo("##kind", name_of(s.measure_kind).c_str());
   s.probe("measure kind");
+  if (open) {
+    for (int kind = 0; kind < kMeasureKinds; ++kind) {
+      if (ImGui::Selectable(name_of(kind).c_str(), kind == s.measure_kind) &&
+          kind != s.measure_kind) {
+        s.measure_kind = kind;
+        s.picks.clear();
+      }
+      s.probe("measure kind " + name_of(kind));
+    }
+    ImGui::EndCombo();
+  }
   const auto kind = static_cast<modeling::MeasureKind>(s.measure_kind);
   if (s.measuring) {
     ImGui::Text("%zu of %s%zu points picked", s.picks.size(),
@@ -122,24 +142,35 @@ void measure_panel(WorkbenchState& s) {
   ImGui::EndDisabled();
 }
 
-void measurement_overlay(WorkbenchState& s, ImDrawList* draw) {
+void measurement_overlay(WorkbenchState& s, ImDrawList* draw,
+                         const std::function<std::optional<ImVec2>(const Eigen::Vector3d&)>& at,
+                         float longest_line) {
+  const float thick = s.px(2), dot = s.px(4);
+  // The points that project, and the lines between neighbours that both do
+  // and are no longer than `longest_line` (a panorama's seam).
   const auto path = [&](const std::vector<Eigen::Vector3d>& points, bool closed, ImU32 colour) {
-    std::vector<ImVec2> screen;
-    for (const Eigen::Vector3d& p : points) {
-      const std::optional<ImVec2> at = s.screen_of(p);
-      if (!at) return std::optional<ImVec2>{};
-      screen.push_back(*at);
+    std::vector<std::optional<ImVec2>> screen;
+    for (const Eigen::Vector3d& p : points) screen.push_back(at(p));
+    const std::size_t n = screen.size();
+    const std::size_t lines = closed && n > 2 ? n : std::max<std::size_t>(n, 1) - 1;
+    for (std::size_t k = 0; k < lines; ++k) {
+      const std::optional<ImVec2>& a = screen[k];
+      const std::optional<ImVec2>& b = screen[(k + 1) % n];
+      if (a && b && std::hypot(b->x - a->x, b->y - a->y) <= longest_line)
+        draw->AddLine(*a, *b, colour, thick);
     }
-    if (screen.empty()) return std::optional<ImVec2>{};
-    draw->AddPolyline(screen.data(), static_cast<int>(screen.size()), colour,
-                      closed ? ImDrawFlags_Closed : 0, s.px(2));
-    for (const ImVec2& p : screen) draw->AddCircleFilled(p, s.px(4), colour);
-    return std::optional<ImVec2>(screen.back());
+    std::optional<ImVec2> last;
+    for (const std::optional<ImVec2>& p : screen) {
+      if (!p) continue;
+      draw->AddCircleFilled(*p, dot, colour);
+      last = p;
+    }
+    return last;
   };
   for (const modeling::Measurement& m : s.session.measurements()) {
     const bool area = m.kind == modeling::MeasureKind::kArea;
     if (const std::optional<ImVec2> label = path(m.points, area, IM_COL32(255, 120, 255, 255))) {
-      draw->AddText(ImVec2(label->x + 6, label->y - 16), IM_COL32(255, 255, 255, 255),
+      draw->AddText(ImVec2(label->x + s.px(6), label->y - s.px(16)), IM_COL32(255, 255, 255, 255),
                     describe(m).c_str());
     }
   }

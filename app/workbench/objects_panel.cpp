@@ -87,9 +87,9 @@ void tree(WorkbenchState& s) {
     ImGui::EndDragDropTarget();
   }
   if (s.pending_reparent) {
-    s.run("Moving",
-          [&s, move = *s.pending_reparent] { s.session.reparent(move.first, move.second); });
-    s.pending_reparent.reset();
+    if (s.run("Moving",
+              [&s, move = *s.pending_reparent] { s.session.reparent(move.first, move.second); }))
+      s.pending_reparent.reset();
   }
 }
 

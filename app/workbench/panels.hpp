@@ -6,6 +6,9 @@
 
 #include <imgui.h>
 
+#include <functional>
+#include <optional>
+
 #include "app/workbench/workbench_state.hpp"
 
 namespace scanbench::app::workbench {
@@ -22,13 +25,19 @@ void measure_panel(WorkbenchState& s);        // clip box, slice; measurements: 
 void toolbar_panel(WorkbenchState& s);    // tools, channel, tolerance, name, commit, undo
 void status_panel(WorkbenchState& s);     // what the last action did, the 3D frame's figures
 void questions_panel(WorkbenchState& s);  // the question being asked, modal
+// While a command runs, over the frozen frame: what runs, for how long.
+void command_progress_panel(const WorkbenchState& s);
 
 // Views, drawn behind the panels; input reaches them when ImGui does not
 // want it (input.hpp).
 void panorama_view(WorkbenchState& s);
 void view_3d(WorkbenchState& s);
-// The measurements and the points being picked, over the 3D view.
-void measurement_overlay(WorkbenchState& s, ImDrawList* draw);
+// The measurements and the points being picked, over a view: `at` gives a
+// world point's place in the window (none where the view does not show
+// it); a line longer than `longest_line` is not drawn (a panorama's seam).
+void measurement_overlay(WorkbenchState& s, ImDrawList* draw,
+                         const std::function<std::optional<ImVec2>(const Eigen::Vector3d&)>& at,
+                         float longest_line);
 
 // A fixed window at (x, y) of w × h pixels.
 inline void place_window(float x, float y, float w, float h) {

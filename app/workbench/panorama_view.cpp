@@ -49,7 +49,8 @@ void panorama_view(WorkbenchState& s) {
   draw->AddRectFilled(low, high, IM_COL32(20, 20, 24, 255));
   const std::string missing = s.session.missing();
   if (!s.session.has_scan()) {
-    draw->AddText(ImVec2(low.x + 12, low.y + 10), IM_COL32(255, 200, 120, 255), missing.c_str());
+    draw->AddText(ImVec2(low.x + s.px(12), low.y + s.px(10)), IM_COL32(255, 200, 120, 255),
+                  missing.c_str());
     draw->PopClipRect();
     return;
   }
@@ -61,11 +62,22 @@ void panorama_view(WorkbenchState& s) {
   polyline(s, draw, s.session.lasso(), IM_COL32(80, 220, 255, 255), s.session.lasso_closed());
   for (const segmentation::Polyline& b : s.session.barriers())
     polyline(s, draw, b, IM_COL32(255, 70, 70, 255), false);
+  // Measurements where this scan sees them; a line across the seam of a
+  // full circle (longer than half the picture) is left out.
+  measurement_overlay(
+      s, draw,
+      [&s](const Eigen::Vector3d& p) -> std::optional<ImVec2> {
+        const std::optional<Eigen::Vector2d> image = s.session.image_point(p);
+        if (!image) return std::nullopt;
+        return s.panorama_screen(*image);
+      },
+      0.5f * s.panorama_scale() * static_cast<float>(scan.columns));
   if (!missing.empty()) {
-    const ImVec2 at(low.x + 12, high.y - 24);
+    const ImVec2 at(low.x + s.px(12), high.y - s.px(24));
     const ImVec2 size = ImGui::CalcTextSize(missing.c_str());
-    draw->AddRectFilled(ImVec2(at.x - 4, at.y - 2), ImVec2(at.x + size.x + 4, at.y + size.y + 2),
-                        IM_COL32(0, 0, 0, 200));
+    const float mx = s.px(4), my = s.px(2);
+    draw->AddRectFilled(ImVec2(at.x - mx, at.y - my),
+                        ImVec2(at.x + size.x + mx, at.y + size.y + my), IM_COL32(0, 0, 0, 200));
     draw->AddText(at, IM_COL32(255, 200, 120, 255), missing.c_str());
   }
   draw->PopClipRect();

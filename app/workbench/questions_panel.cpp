@@ -28,11 +28,12 @@ void questions_panel(WorkbenchState& s) {
   ImGui::SameLine();
   if (ImGui::Button("Cancel")) answered = true;
   s.probe("question no");
+  // An answer runs as a command; while another is asked for, the question
+  // stays.
+  if (answered && answer && !s.run(label, std::move(answer))) answered = false;
   if (answered) ImGui::CloseCurrentPopup();
   ImGui::EndPopup();
-  if (!answered) return;
-  s.question.reset();
-  if (answer) s.run(label, std::move(answer));
+  if (answered) s.question.reset();
 }
 
 }  // namespace scanbench::app::workbench

@@ -43,9 +43,8 @@ void scans_panel(WorkbenchState& s) {
                         scan.summary.columns, scan.summary.valid_points, t.x(), t.y(), t.z());
     }
   }
-  if (chosen) {
-    s.run("Opening scan " + std::to_string(*chosen),
-          [&s, id = *chosen] { s.session.open_scan(id); });
+  if (chosen && s.run("Opening scan " + std::to_string(*chosen),
+                      [&s, id = *chosen] { s.session.open_scan(id); })) {
     s.zoom = 1.0f;
     s.pan = {0.0f, 0.0f};
   }

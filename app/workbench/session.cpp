@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <variant>
 
 #include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
@@ -392,6 +394,32 @@ void Session::show_first_scan_again() {
   }
   ++model_changes_;
   status_ = said;
+}
+
+std::optional<Eigen::Vector3d> Session::world_point(int row, int col) const {
+  if (row < 0 || col < 0 || row >= scan_.rows || col >= scan_.columns) return std::nullopt;
+  const std::size_t p = scan_.index(row, col);
+  if (scan_.valid[p] == 0) return std::nullopt;
+  if (!normal_.empty() && normal_[p].squaredNorm() == 0.0f) return std::nullopt;
+  return acquisition::point_in_world(scan_, row, col);
+}
+
+std::optional<Eigen::Vector2d> Session::image_point(const Eigen::Vector3d& p) const {
+  if (!has_scan() || !scan_.is_spherical()) return std::nullopt;
+  const auto& angles = std::get<acquisition::SphericalAngles>(scan_.angles);
+  const Eigen::Vector3d q = scan_.T_world_scan.inverse() * p;
+  const double horizontal = std::hypot(q.x(), q.y());
+  if (horizontal == 0.0 && q.z() == 0.0) return std::nullopt;
+  double u = (std::atan2(q.y(), q.x()) - angles.azimuth_start_rad) / angles.azimuth_step_rad;
+  const double v =
+      (std::atan2(q.z(), horizontal) - angles.elevation_start_rad) / angles.elevation_step_rad;
+  if (acquisition::wraps_around(scan_)) {  // into [-½, columns - ½)
+    const double period = 2.0 * std::numbers::pi / std::abs(angles.azimuth_step_rad);
+    u -= period * std::floor((u + 0.5) / period);
+  }
+  if (!(u >= -0.5 && u <= scan_.columns - 0.5 && v >= -0.5 && v <= scan_.rows - 0.5))
+    return std::nullopt;
+  return Eigen::Vector2d(u, v);
 }
 
 void Session::prepare_views() {

@@ -73,6 +73,16 @@ class Session {
   // (and status()) when it failed. Read-only, nothing is kept.
   bool keep_selections(bool at_close = false);
 
+  // ---- Measuring in the panorama --------------------------------------
+  // The world point [m] of pixel (row, col) of the scan shown, for a
+  // measurement: none outside the scan, where it has no return, or where
+  // its geometry found no surface (a mixed pixel at an edge has no normal).
+  std::optional<Eigen::Vector3d> world_point(int row, int col) const;
+  // Where world point `p` lies in the scan shown, in image coordinates (x =
+  // column, y = row, pixel centres at integers; a full circle wraps): none
+  // outside its grid, or for a scan without a spherical grid.
+  std::optional<Eigen::Vector2d> image_point(const Eigen::Vector3d& p) const;
+
   // ---- Commands: each one journal entry; false (and status()) when refused
   bool commit(const std::string& name, std::optional<std::int64_t> parent);
   bool group(const std::string& name, const std::vector<std::int64_t>& children);

@@ -24,7 +24,8 @@ void status_panel(WorkbenchState& s) {
   }
   // How long the last command took, beside what it did.
   char took[48] = "";
-  if (s.command.seconds() > 0.0) std::snprintf(took, sizeof took, " (%.1f s)", s.command.seconds());
+  if (!s.command_status.empty() && s.command_status == s.session.status())
+    std::snprintf(took, sizeof took, " (%.1f s)", s.command.seconds());
   ImGui::Text(
       "%s%s | selection %zu px | 3D %zu of %zu points (culled: clip %zu, frustum %zu, back %zu, "
       "detail %zu) | draw %s%.0f ms wall | %s frames/s",

@@ -1,4 +1,5 @@
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -47,7 +48,9 @@ void view_3d(WorkbenchState& s) {
                 s.fly ? "walk/fly: W A S D Q E, drag to look"
                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
   draw->PushClipRect(ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h), true);
-  measurement_overlay(s, draw);
+  measurement_overlay(
+      s, draw, [&s](const Eigen::Vector3d& p) { return s.screen_of(p); },
+      std::numeric_limits<float>::infinity());
   draw->PopClipRect();
   const std::string& problem = s.session.render_model_problem();
   if (!problem.empty()) {

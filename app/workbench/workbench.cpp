@@ -32,8 +32,6 @@ constexpr double kReplayFrameSeconds = 1.0 / 30.0;
 // While a command runs, the window repaints at most this often, leaving the
 // cores to the command.
 constexpr auto kWaitingFrame = std::chrono::milliseconds(50);
-// A command shorter than this shows no progress indicator (no flicker).
-constexpr double kIndicatorAfterSeconds = 0.25;
 
 // ImGui's context and OpenGL renderer for the life of the workbench.
 struct ImGuiScope {
@@ -77,7 +75,7 @@ class Workbench {
   // core::RuntimeFailure when they cannot be.
   void end_session() {
     state_.command.wait();
-    state_.command.finished();  // rethrows what it threw
+    state_.command.collect();  // rethrows what it threw
     if (!state_.session.keep_selections(true)) {
       throw core::RuntimeFailure(state_.session.project().path().string(), {},
                                  "the selection was not kept (" + state_.session.status() + ")");
@@ -88,8 +86,9 @@ class Workbench {
   // fixed step, or the real interval live): the panels and views, then
   // ImGui's draw. The frame rate shown is measured from real intervals.
   // While a background command runs, the frame is the last one drawn
-  // before it, with a progress indicator; false then. A command asked for
-  // during the frame starts once it is drawn.
+  // before it, with a progress indicator. False for those frames and the
+  // one in which the command ended (a recorder counts the others). A
+  // command asked for during the frame starts once it is drawn.
   bool frame(double seconds) {
     WorkbenchState& s = state_;
     ImGuiIO& io = ImGui::GetIO();
@@ -102,14 +101,20 @@ class Workbench {
       s.frame_seconds = s.frames == 1 ? real : 0.8 * s.frame_seconds + 0.2 * real;
     }
     s.last_frame = now;
-    if (s.command.running() && !s.command.finished()) {
-      waiting_frame(width, height);
-      return false;
+    // A command running: its end is awaited for up to a frame's time (a
+    // short command shows nothing), else the frame shows it running.
+    const bool was_running = s.command.running();
+    if (was_running) {
+      if (!s.command.collect(kWaitingFrame)) {
+        waiting_frame(width, height);
+        return false;
+      }
+      s.command_status = s.session.status();
     }
     s.layout(width, height);
-    scale_fonts_and_style();
     input_.fly_keys(seconds);
     ImGui_ImplOpenGL3_NewFrame();
+    scale_fonts_and_style();  // after the backend made its font texture
     ImGui::NewFrame();
     project_window();
     toolbar_panel(s);
@@ -129,7 +134,7 @@ class Workbench {
       s.drag = Drag::kNone;  // a drag does not go on under the command
       s.command.start();
     }
-    return true;
+    return !was_running;
   }
 
   // The window as last drawn (before the buffers swap) into a PNG.
@@ -157,6 +162,7 @@ class Workbench {
     const nlohmann::json out = {{"widgets", widgets},
                                 {"scan", s.session.scan_id()},
                                 {"ui_scale", s.ui_scale},
+                                {"selected", s.selected},
                                 {"panorama",
                                  {{"x", s.panorama.x + s.pan[0]},
                                   {"y", s.panorama.y + s.pan[1]},
@@ -192,9 +198,12 @@ class Workbench {
     fonts_scale_ = state_.ui_scale;
     ImGuiIO& io = ImGui::GetIO();
     io.Fonts->Clear();
-    ImFontConfig font;
+    ImFontConfig font;  // as AddFontDefault sets it, at another size
     font.SizePixels = std::round(13.0f * fonts_scale_);
+    font.OversampleH = font.OversampleV = 1;
+    font.PixelSnapH = true;
     io.Fonts->AddFontDefault(&font);
+    io.MouseDragThreshold = 6.0f * fonts_scale_;
     ImGui_ImplOpenGL3_DestroyFontsTexture();
     ImGui_ImplOpenGL3_CreateFontsTexture();
     ImGuiStyle style;
@@ -214,44 +223,21 @@ class Workbench {
   }
 
   // A frame while the command runs: the frozen frame (stretched if the
-  // window was resized meanwhile), dimmed, with what runs, for how long,
-  // and a bar sweeping to and fro. Nothing of the session is read.
+  // window was resized meanwhile) and the progress indicator over it.
+  // Nothing of the session is read, and ImGui's clock stands still.
   void waiting_frame(int width, int height) {
-    std::this_thread::sleep_for(kWaitingFrame);
-    const BackgroundCommand& command = state_.command;
-    const auto w = static_cast<float>(width), h = static_cast<float>(height);
+    ImGui::GetIO().DeltaTime = 1e-6f;
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
-    ImDrawList* draw = ImGui::GetBackgroundDrawList();
-    draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(frozen_texture_)),
-                   ImVec2(0, 0), ImVec2(w, h), ImVec2(0, 1), ImVec2(1, 0));
-    const double seconds = command.seconds();
-    if (seconds >= kIndicatorAfterSeconds) {
-      draw->AddRectFilled(ImVec2(0, 0), ImVec2(w, h), IM_COL32(0, 0, 0, 110));
-      const float box_w = state_.px(420), box_h = state_.px(78);
-      place_window(0.5f * (w - box_w), 0.45f * (h - box_h), box_w, box_h);
-      ImGui::Begin("##running", nullptr,
-                   kFixedWindow | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoInputs);
-      ImGui::Text("%s ...", command.label().c_str());
-      ImGui::TextDisabled("%.1f s; the window takes no input until it ends", seconds);
-      const ImVec2 at = ImGui::GetCursorScreenPos();
-      const float bar_w = ImGui::GetContentRegionAvail().x, bar_h = state_.px(8);
-      ImDrawList* box = ImGui::GetWindowDrawList();
-      box->AddRectFilled(at, ImVec2(at.x + bar_w, at.y + bar_h), IM_COL32(60, 64, 72, 255));
-      const double phase = std::fmod(seconds / 1.6, 2.0);  // 0 → 1 → 0 in 3.2 s
-      const float lit = 0.3f * bar_w;
-      const float from = static_cast<float>(phase < 1.0 ? phase : 2.0 - phase) * (bar_w - lit);
-      box->AddRectFilled(ImVec2(at.x + from, at.y), ImVec2(at.x + from + lit, at.y + bar_h),
-                         IM_COL32(90, 160, 240, 255));
-      ImGui::Dummy(ImVec2(bar_w, bar_h));
-      ImGui::End();
-    }
+    ImGui::GetBackgroundDrawList()->AddImage(
+        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(frozen_texture_)), ImVec2(0, 0),
+        ImVec2(static_cast<float>(width), static_cast<float>(height)), ImVec2(0, 1), ImVec2(1, 0));
+    command_progress_panel(state_);
     ImGui::Render();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, width, height);
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    ++state_.command.frames_while_running;
   }
 
   WorkbenchState state_;
@@ -280,7 +266,9 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
     if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
     window.swap_buffers();
   }
-  bench.frame(kReplayFrameSeconds);
+  do {
+    bench.frame(kReplayFrameSeconds);
+  } while (bench.busy());
   if (!options.screenshot.empty()) bench.screenshot(options.screenshot);
   if (!options.layout.empty()) bench.write_layout(options.layout);
 }
@@ -296,7 +284,7 @@ void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions
     const bool drew_panels = bench.frame(std::chrono::duration<double>(now - last).count());
     if (recorder && drew_panels) recorder->next_frame();
     last = now;
-    if (!layout_written && !options.layout.empty()) {
+    if (!layout_written && !options.layout.empty() && !bench.busy()) {
       bench.write_layout(options.layout);
       layout_written = true;
     }
@@ -304,6 +292,12 @@ void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions
       bench.screenshot(options.screenshot);
       return;  // a screenshot of the opened project is all that was asked for
     }
+    window.swap_buffers();
+  }
+  // Closed while a command runs: the window shows it to its end.
+  while (bench.busy()) {
+    window.poll_events();
+    bench.frame(0.0);
     window.swap_buffers();
   }
 }
@@ -329,10 +323,15 @@ void run_workbench(const WorkbenchOptions& options) {
     render::WindowDevice& window;
     ~Detach() { window.set_input(nullptr); }
   } detach{window};
-  if (options.replay.empty()) {
-    live(bench, window, options, recorder ? &*recorder : nullptr);
-  } else {
-    replay(bench, window, options, events, input, recorder ? &*recorder : nullptr);
+  try {
+    if (options.replay.empty()) {
+      live(bench, window, options, recorder ? &*recorder : nullptr);
+    } else {
+      replay(bench, window, options, events, input, recorder ? &*recorder : nullptr);
+    }
+  } catch (...) {
+    if (recorder) recorder->save();  // a session that failed is the one to send
+    throw;
   }
   if (recorder) recorder->save();
   bench.end_session();

@@ -107,8 +107,8 @@ void WorkbenchState::after_command() {
   load_color_editor();
 }
 
-void WorkbenchState::run(std::string label, std::function<void()> work) {
-  command.ask(std::move(label), [this, work = std::move(work)] {
+bool WorkbenchState::run(std::string label, std::function<void()> work) {
+  return command.ask(std::move(label), [this, work = std::move(work)] {
     work();
     session.prepare_views();
   });
@@ -264,15 +264,43 @@ void WorkbenchState::apply_clipping() {
   view_dirty = true;
 }
 
-void WorkbenchState::pick_at(double x, double y) {
+std::optional<render::Pick> WorkbenchState::point_under(double x, double y) {
   const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
   const render::RenderModel& model = session.render_model();
   const render::RenderView view = render::make_render_view(navigation.camera(w, h), model.origin);
-  const std::optional<render::Pick> pick =
-      render::pick_point(model, view.eye, render::pixel_ray(view, x - view3d.x, y - view3d.y),
-                         settings.culling.clipping, settings.splat_scale);
-  if (!pick) return;
-  picks.push_back(model.origin + pick->position.cast<double>());
+  return render::pick_point(model, view.eye, render::pixel_ray(view, x - view3d.x, y - view3d.y),
+                            settings.culling.clipping, settings.splat_scale, settings.oriented);
+}
+
+void WorkbenchState::select_in_3d(double x, double y, bool toggle) {
+  const std::optional<render::Pick> pick = point_under(x, y);
+  const std::int64_t id = pick ? session.render_model().points.node[pick->point] : 0;
+  if (toggle) {
+    if (id == 0) return;
+    if (!selected.erase(id)) selected.insert(id);
+    primary_id = id;
+    load_color_editor();
+  } else if (id != 0) {
+    select_only(id);
+  } else {
+    selected.clear();
+    load_color_editor();
+  }
+}
+
+void WorkbenchState::pick_at(double x, double y) {
+  const std::optional<render::Pick> pick = point_under(x, y);
+  if (pick) add_pick(session.render_model().origin + pick->position.cast<double>());
+}
+
+void WorkbenchState::pick_in_panorama(double x, double y) {
+  const segmentation::GridPixel pixel = segmentation::nearest_pixel(Eigen::Vector2d(x, y));
+  if (const std::optional<Eigen::Vector3d> p = session.world_point(pixel.row, pixel.col))
+    add_pick(*p);
+}
+
+void WorkbenchState::add_pick(const Eigen::Vector3d& p) {
+  picks.push_back(p);
   const auto kind = static_cast<modeling::MeasureKind>(measure_kind);
   if (!modeling::takes_more_points(kind) && picks.size() >= modeling::points_needed(kind))
     finish_measurement();
@@ -291,9 +319,9 @@ void WorkbenchState::finish_measurement() {
   }
   const std::string name = prefix + std::to_string(next);
   list.push_back({name, kind, picks});
-  picks.clear();
-  run("Saving " + name,
-      [this, list, name] { session.save_measurements(list, "measured " + name); });
+  if (run("Saving " + name,
+          [this, list, name] { session.save_measurements(list, "measured " + name); }))
+    picks.clear();
 }
 
 std::optional<ImVec2> WorkbenchState::screen_of(const Eigen::Vector3d& p) const {

@@ -26,6 +26,7 @@
 #include "app/workbench/navigation.hpp"
 #include "app/workbench/session.hpp"
 #include "app/workbench/workbench.hpp"
+#include "render/pick.hpp"
 #include "render/splat_renderer.hpp"
 #include "render/window/window_device.hpp"
 
@@ -176,9 +177,13 @@ struct WorkbenchState {
   // Runs `work` (a session command and what follows it, such as selecting
   // what it made) as the background command `label`, starting once this
   // frame is drawn, and then builds what the views show next
-  // (Session::prepare_views), so that the window's thread does not.
-  // Ignored while another is asked for or running.
-  void run(std::string label, std::function<void()> work);
+  // (Session::prepare_views), so that the window's thread does not. False,
+  // and nothing runs, while another is asked for or running: the caller
+  // keeps what it would have cleared (the picks, the question).
+  bool run(std::string label, std::function<void()> work);
+  // The session's status when the last command ended: the status bar shows
+  // how long the command took beside it, until something else says more.
+  std::string command_status;
 
   // Ctrl+Z: takes back the workbench's own edits; before a batch stage
   // (import, geometry, register, merge, harmonize) it asks.
@@ -202,7 +207,19 @@ struct WorkbenchState {
   // the 3D view joins the measurement being taken, which is saved once it
   // has its points (an area: on finish_measurement).
   void pick_at(double x, double y);
+  // The same with a click at image point (x = column, y = row) of the
+  // panoramic view: the scan's own sample there (Session::world_point).
+  void pick_in_panorama(double x, double y);
+  // A picked point joins the measurement being taken.
+  void add_pick(const Eigen::Vector3d& p);
   void finish_measurement();
+  // Selecting: the object drawn under window point (x, y) of the 3D view
+  // becomes the selection, or with `toggle` (Ctrl) joins or leaves it; a
+  // click on no object's points clears the selection (not with `toggle`).
+  // What the view does not draw (hidden, clipped, sliced away) is not hit.
+  void select_in_3d(double x, double y, bool toggle);
+  // The point of the model drawn under window point (x, y) of the 3D view.
+  std::optional<render::Pick> point_under(double x, double y);
   // Window point of world point `p` in the 3D view; none behind the eye.
   std::optional<ImVec2> screen_of(const Eigen::Vector3d& p) const;
 

@@ -3,6 +3,7 @@
 // its end is seen once, and what it threw reaches the window's thread.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <future>
 #include <stdexcept>
 #include <thread>
@@ -30,18 +31,20 @@ TEST(BackgroundCommand, RunsOnAnotherThreadWhileTheCallerGoesOn) {
   command.start();
   EXPECT_FALSE(command.asked());
   EXPECT_TRUE(command.running());
-  // The caller's frames go on while the work waits; a second command is
-  // refused meanwhile.
-  for (int frame = 0; frame < 5; ++frame) EXPECT_FALSE(command.finished());
+  // The caller's frames go on while the work waits (a work run on the
+  // caller's thread would never have returned from start()); a second
+  // command is refused meanwhile.
+  for (int frame = 0; frame < 5; ++frame)
+    EXPECT_FALSE(command.collect(std::chrono::milliseconds(10)));
   EXPECT_FALSE(command.ask("Grouping", [] {}));
   EXPECT_EQ(command.label(), "Committing");
+  EXPECT_GE(command.seconds(), 0.04);  // the five frames' waits, at least
   release.set_value();
-  command.wait();
-  EXPECT_TRUE(command.finished());
+  EXPECT_TRUE(command.collect(std::chrono::seconds(60)));
   EXPECT_FALSE(command.running());
-  EXPECT_EQ(result, 42);  // seen once finished
+  EXPECT_EQ(result, 42);  // seen once collected
   EXPECT_NE(ran_on, std::this_thread::get_id());
-  EXPECT_GE(command.seconds(), 0.0);
+  EXPECT_GE(command.seconds(), 0.04);  // how long the work took
   // Idle again: the next command may be asked for.
   EXPECT_TRUE(command.ask("Grouping", [] {}));
 }
@@ -53,7 +56,7 @@ TEST(BackgroundCommand, OneIsAskedForAtATime) {
   EXPECT_FALSE(command.ask("second", [&] { ran += 10; }));
   command.start();
   command.wait();
-  EXPECT_TRUE(command.finished());
+  EXPECT_TRUE(command.collect());
   EXPECT_EQ(ran, 1);
   EXPECT_EQ(command.label(), "first");
 }
@@ -63,9 +66,24 @@ TEST(BackgroundCommand, WhatTheWorkThrewReachesTheCaller) {
   ASSERT_TRUE(command.ask("Failing", [] { throw std::runtime_error("disk full"); }));
   command.start();
   command.wait();
-  EXPECT_THROW(command.finished(), std::runtime_error);
+  EXPECT_THROW(command.collect(), std::runtime_error);
   EXPECT_FALSE(command.running());
-  EXPECT_TRUE(command.finished());  // thrown once; idle after
+  EXPECT_TRUE(command.collect());  // thrown once; idle after
+}
+
+TEST(BackgroundCommand, StartWithNothingAskedForDoesNothingAndTheEndIsAwaited) {
+  int ran = 0;
+  {
+    BackgroundCommand command;
+    command.start();
+    EXPECT_FALSE(command.running());
+    ASSERT_TRUE(command.ask("slow", [&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      ran = 1;
+    }));
+    command.start();
+  }  // destroyed while it runs: waits for it
+  EXPECT_EQ(ran, 1);
 }
 
 }  // namespace

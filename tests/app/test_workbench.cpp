@@ -10,7 +10,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -425,6 +428,29 @@ TEST(Workbench, ProposalsAreReviewedOneByOne) {
   EXPECT_EQ(count(), made - 2);
 }
 
+// Ticks "pick points" and clicks window points `a` then `b`, as stage
+// `stage`: the points of the distance the journal's newest command saved
+// (none, with a failure, when it saved no distance).
+json measured_distance(const ScratchDir& dir, const std::filesystem::path& project,
+                       const std::string& stage, const Layout& start, const json& a,
+                       const json& b) {
+  run_stage(dir, project, stage,
+            {{{"click", start.widget("measure")}},
+             {{"wait", 1}},
+             {{"click", a}},
+             {{"wait", 2}},
+             {{"click", b}},
+             {{"wait", 2}}});
+  const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
+  const json& last = history["commands"].back();
+  const json& list = last["result"]["measurements"];
+  if (last["name"] != "measure" || list.size() != 1 || list[0]["kind"] != "distance") {
+    ADD_FAILURE() << stage << ": no distance saved: " << last.dump();
+    return json::array();
+  }
+  return list[0]["points"];
+}
+
 // Measuring: with "measure" on, two clicks in the 3D view pick two points
 // of the model and save a distance; the project keeps it (a "measure"
 // command), and Export CSV writes it.
@@ -434,23 +460,11 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
   const Layout start = run_stage(dir, project, "measure_open", json::array());
   const json centre = start.view3d_centre();
   const json aside = {centre[0].get<double>() + 80.0, centre[1].get<double>() + 40.0};
-  run_stage(dir, project, "measure",
-            {{{"click", start.widget("measure")}},
-             {{"wait", 1}},
-             {{"click", centre}},
-             {{"wait", 2}},
-             {{"click", aside}},
-             {{"wait", 2}}});
-  const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
-  const json& last = history["commands"].back();
-  ASSERT_EQ(last["name"], "measure");
-  const json& list = last["result"]["measurements"];
-  ASSERT_EQ(list.size(), 1u);
-  EXPECT_EQ(list[0]["kind"], "distance");
-  ASSERT_EQ(list[0]["points"].size(), 2u);
+  const json points = measured_distance(dir, project, "measure", start, centre, aside);
+  ASSERT_EQ(points.size(), 2u);
   double squared = 0.0;
   for (int a = 0; a < 3; ++a) {
-    const double d = list[0]["points"][1][a].get<double>() - list[0]["points"][0][a].get<double>();
+    const double d = points[1][a].get<double>() - points[0][a].get<double>();
     squared += d * d;
   }
   EXPECT_GT(std::sqrt(squared), 0.5);  // two points of the campus, apart
@@ -483,6 +497,147 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
   const CliResult over_project =
       run_cli(dir, {"measurements", project.string(), "--csv", project.string(), "--force"});
   EXPECT_NE(over_project.exit_code, 0);
+}
+
+// Measuring in the panoramic view: two clicks on Keller Hall's west and
+// south walls make a distance between the scan's own samples at those
+// pixels. Each lies as far from the scanner as the simulator's true range
+// there, within 4 σ of the range noise.
+TEST(Workbench, ClicksInThePanoramaMeasureTheScansSamples) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const Layout start = run_stage(dir, project, "measure_panorama_open", json::array());
+  const std::vector<std::array<int, 2>> pixels = {{654, 116}, {617, 82}};  // column, row
+  const json points = measured_distance(dir, project, "measure_panorama", start,
+                                        start.pixel(pixels[0][0], pixels[0][1]),
+                                        start.pixel(pixels[1][0], pixels[1][1]));
+  ASSERT_EQ(points.size(), 2u);
+  const json truth = read_json(dir / "sim" / "truth.json");
+  const json& pose = truth["scans"][0]["T_world_scan"];  // row-major 4 × 4
+  const Eigen::Vector3d scanner(pose[3].get<double>(), pose[7].get<double>(),
+                                pose[11].get<double>());
+  const acquisition::DecodedImage range =
+      acquisition::decode_image(dir / "sim" / "truth" / "campus_scan_01_range.tiff", 225, 900);
+  ASSERT_TRUE(range.problem.empty()) << range.problem;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const json& p = points[k];
+    const Eigen::Vector3d point(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+    const double true_range = range.pixels.at<float>(pixels[k][1], pixels[k][0]);
+    const double sigma = 0.005 + 5e-5 * true_range;
+    EXPECT_NEAR((point - scanner).norm(), true_range, 4.0 * sigma) << "point " << k;
+  }
+}
+
+// Pixels of scan 1 around (col, row) on the same simulated surface, away
+// from its edges (the truth's object ids agree over 5 × 5 pixels, none
+// mixed), at least 4 pixels apart: picks that surely hit a sample.
+std::vector<json> surface_pixels(const ScratchDir& dir, const Layout& layout, int col, int row,
+                                 std::size_t count) {
+  const auto truth = [&](const char* name) {
+    return acquisition::decode_image(dir / "sim" / "truth" / name, 225, 900).pixels;
+  };
+  const cv::Mat ids = truth("campus_scan_01_object_id.png");
+  const cv::Mat mixed = truth("campus_scan_01_mixed.png");
+  const auto id_at = [&](int r, int c) {
+    return ids.depth() == CV_16U ? ids.at<std::uint16_t>(r, c) : ids.at<std::uint8_t>(r, c);
+  };
+  const auto mixed_at = [&](int r, int c) {
+    return mixed.depth() == CV_16U ? mixed.at<std::uint16_t>(r, c) != 0
+                                   : mixed.at<std::uint8_t>(r, c) != 0;
+  };
+  const int object = id_at(row, col);
+  std::vector<std::array<int, 2>> found;
+  for (int radius = 0; radius < 30 && found.size() < count; ++radius) {
+    for (int r = row - radius; r <= row + radius; ++r) {
+      for (int c = col - radius; c <= col + radius; ++c) {
+        if (std::max(std::abs(r - row), std::abs(c - col)) != radius || found.size() >= count)
+          continue;
+        if (r < 2 || c < 2 || r >= 223 || c >= 898) continue;
+        bool inside = true;
+        for (int dr = -2; dr <= 2 && inside; ++dr)
+          for (int dc = -2; dc <= 2 && inside; ++dc)
+            inside = id_at(r + dr, c + dc) == object && !mixed_at(r + dr, c + dc);
+        bool apart = true;
+        for (const auto& f : found)
+          apart = apart && std::max(std::abs(f[0] - c), std::abs(f[1] - r)) >= 4;
+        if (inside && apart) found.push_back({c, r});
+      }
+    }
+  }
+  EXPECT_EQ(found.size(), count) << "surface pixels near " << col << ", " << row;
+  std::vector<json> out;
+  for (const auto& [c, r] : found) out.push_back(layout.pixel(c, r));
+  return out;
+}
+
+// Every kind of measurement, taken in the panoramic view on Keller Hall's
+// west wall: the kind chosen from its list, its points clicked (an area
+// finished with Enter), each saved as it is complete.
+TEST(Workbench, EveryKindOfMeasurementIsTaken) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const Layout start = run_stage(dir, project, "measure_kinds_open", json::array());
+  const Layout listed = run_stage(dir, project, "measure_kinds_list",
+                                  {{{"click", start.widget("measure kind")}}, {{"wait", 1}}});
+  const std::vector<json> at = surface_pixels(dir, start, 654, 116, 3);
+  ASSERT_EQ(at.size(), 3u);
+  json list = {{{"click", start.widget("measure")}}, {{"wait", 1}}};
+  const auto choose = [&](const std::string& kind, std::size_t points) {
+    list.push_back({{"click", start.widget("measure kind")}});
+    list.push_back({{"wait", 1}});
+    list.push_back({{"click", listed.widget("measure kind " + kind)}});
+    list.push_back({{"wait", 1}});
+    for (std::size_t k = 0; k < points; ++k) {
+      list.push_back({{"click", at[k]}});
+      list.push_back({{"wait", 2}});
+    }
+  };
+  choose("point", 1);
+  choose("height", 2);
+  choose("angle", 3);
+  choose("area", 3);
+  list.push_back({{"key", "Enter"}});
+  list.push_back({{"wait", 2}});
+  run_stage(dir, project, "measure_kinds", list);
+  const json measured =
+      json::parse(run_cli(dir, {"measurements", project.string(), "--json"}).out)["measurements"];
+  ASSERT_EQ(measured.size(), 4u) << measured.dump();
+  const std::vector<std::string> kinds = {"point", "height", "angle", "area"};
+  for (std::size_t k = 0; k < kinds.size(); ++k) {
+    EXPECT_EQ(measured[k]["kind"], kinds[k]);
+    EXPECT_TRUE(std::isfinite(measured[k]["value"].get<double>()));
+  }
+  EXPECT_EQ(measured[3]["points"].size(), 3u);
+  const double angle = measured[2]["value"].get<double>();
+  EXPECT_GT(angle, 0.0);
+  EXPECT_LT(angle, 180.0);
+  EXPECT_GT(measured[3]["value"].get<double>(), 0.0);  // three points of a wall span an area
+}
+
+// A click in the 3D view selects the object drawn there: the west wall is
+// committed and framed, then the south wall committed (and selected); a
+// click at the view's centre, on the west wall, selects it instead.
+TEST(Workbench, AClickInThe3dViewSelectsTheObjectDrawnThere) {
+  const ScratchDir dir;
+  const std::filesystem::path project = campus_project(dir);
+  const Layout start = run_stage(dir, project, "select3d_open", json::array());
+  const Layout done = run_stage(dir, project, "select3d",
+                                {{{"click", start.pixel(654, 116)}},
+                                 {{"wait", 2}},
+                                 {{"key", "C"}},
+                                 {{"wait", 2}},
+                                 {{"key", "F"}},
+                                 {{"wait", 2}},
+                                 {{"click", start.pixel(617, 82)}},
+                                 {{"wait", 2}},
+                                 {{"key", "C"}},
+                                 {{"wait", 2}},
+                                 {{"click", start.view3d_centre()}},
+                                 {{"wait", 2}}});
+  const json list = nodes(dir, project);
+  ASSERT_EQ(list.size(), 2u);
+  const std::int64_t west = list[0]["id"].get<std::int64_t>();
+  EXPECT_EQ(done.data["selected"], json::array({west}));
 }
 
 // A session recorded with --record and replayed on a copy of the project

@@ -295,7 +295,9 @@ TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
 
   // A registration swaps them: the second scan moves away, the later one comes.
   core::Progress quiet;
-  const CarriedAgain again = carry_objects_again(project, {{second, away}, {later, here}}, quiet);
+  const LoadedScans loaded = load_scans(project, 1, "register", quiet);
+  ASSERT_EQ(loaded.ids, (std::vector<std::int64_t>{first, second, later}));
+  const CarriedAgain again = carry_objects_again(project, loaded, {here, away, here}, quiet);
   EXPECT_EQ(again.released, in_second);
   EXPECT_EQ(again.carried_points, in_second);
   EXPECT_EQ(again.memberships.count(first), 0u);  // drawn there: unchanged
@@ -308,7 +310,9 @@ TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
   const std::vector<std::uint8_t>& carried = again.carried.at(later);
   EXPECT_EQ(static_cast<std::size_t>(std::count(carried.begin(), carried.end(), 1)), in_second);
   // Nothing moved: nothing changes.
-  EXPECT_TRUE(carry_objects_again(project, {}, quiet).memberships.empty());
+  std::vector<Eigen::Isometry3d> where_they_are;
+  for (const acquisition::Scan& scan : loaded.scans) where_they_are.push_back(scan.T_world_scan);
+  EXPECT_TRUE(carry_objects_again(project, loaded, where_they_are, quiet).memberships.empty());
 }
 
 // A review's rejected proposals go in one command, its accepted ones move

@@ -35,6 +35,26 @@ TEST(Pick, TheRayThroughAPixelMeetsThePointDrawnThere) {
   EXPECT_FALSE(pick_point(model, view.eye, pixel_ray(view, 320.0, 20.0), {}, 1.5f).has_value());
 }
 
+// A ray meets a splat where the view draws it: the long thin splat of the
+// ground under the ray, whose 4 m major radius reaches the ray 1.5 m above
+// it, does not catch it; the wall behind does. Aimed at the strip, the ray
+// meets it.
+TEST(Pick, ALongGroundSplatCatchesOnlyTheRaysThatMeetIt) {
+  const RenderModel model = test::wall_model(false, true);
+  const RenderView view = front_view();
+  const std::optional<Pick> centre =
+      pick_point(model, view.eye, pixel_ray(view, 320.0, 240.0), {}, 1.5f);
+  ASSERT_TRUE(centre.has_value());
+  EXPECT_NE(model.points.node[centre->point], 0u);
+  EXPECT_NEAR(centre->distance_m, 10.0f, 0.05f);
+  const Eigen::Vector3f eye(0.0f, 0.0f, 1.5f);
+  const Eigen::Vector3f to_strip = (Eigen::Vector3f(7.0f, 0.01f, 0.0f) - eye).normalized();
+  const std::optional<Pick> strip = pick_point(model, eye, to_strip, {}, 1.5f);
+  ASSERT_TRUE(strip.has_value());
+  EXPECT_EQ(model.points.node[strip->point], 0u);
+  EXPECT_NEAR(strip->distance_m, (Eigen::Vector3f(7.0f, 0.01f, 0.0f) - eye).norm(), 1e-3f);
+}
+
 TEST(Pick, HiddenClippedAndBackFacingPointsAreNotPicked) {
   const RenderView view = front_view();
   const Eigen::Vector3f right_ray = pixel_ray(view, 440.0, 240.0);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -93,6 +94,12 @@ TEST(PickAccuracy, PickedPointsAndDistancesAreWithinTheScannersNoise) {
   // every distance within 4 σ of the two picks' combined noise.
   std::sort(point_sigmas.begin(), point_sigmas.end());
   std::sort(distance_sigmas.begin(), distance_sigmas.end());
+  std::printf(
+      "picks: %zu, worst %.2f σ, 99th percentile %.2f σ, median %.2f σ; distances: %zu, "
+      "worst %.2f σ, median %.2f σ\n",
+      point_sigmas.size(), point_sigmas.back(), point_sigmas[point_sigmas.size() * 99 / 100],
+      point_sigmas[point_sigmas.size() / 2], distance_sigmas.size(), distance_sigmas.back(),
+      distance_sigmas[distance_sigmas.size() / 2]);
   EXPECT_LT(point_sigmas.back(), 4.0) << "the worst pick";
   EXPECT_LT(distance_sigmas.back(), 4.0) << "the worst distance";
   EXPECT_LT(point_sigmas[point_sigmas.size() / 2], 1.0) << "the median pick";

@@ -3,6 +3,8 @@
 // red and owned by object 1, its right half blue and owned by object 2;
 // both objects in group 3. Splat radii 4 cm: just over half the diagonal of
 // a sample's cell, so the splats close the wall and raw points do not.
+// `ground_strip` adds, unowned, one long thin splat on the ground in front
+// of the wall, as distant ground gets: 8 cm across, 8 m along x.
 #pragma once
 
 #include <vector>
@@ -12,7 +14,7 @@
 
 namespace scanbench::render::test {
 
-inline RenderModel wall_model(bool hide_right = false) {
+inline RenderModel wall_model(bool hide_right = false, bool ground_strip = false) {
   RenderPoints p;
   for (int i = 0; i < 80; ++i) {
     for (int j = 0; j < 60; ++j) {
@@ -28,6 +30,15 @@ inline RenderModel wall_model(bool hide_right = false) {
       p.intensity.push_back(0.5f);
       p.node.push_back(left ? 1u : 2u);
     }
+  }
+  if (ground_strip) {
+    p.position.emplace_back(5.0f, 0.0f, 0.0f);
+    p.normal.emplace_back(0.0f, 0.0f, 1.0f);
+    p.radii_m.emplace_back(0.04f, 4.0f);
+    p.major_axis.emplace_back(1.0f, 0.0f, 0.0f);
+    p.rgba.push_back({90, 140, 60, 255});
+    p.intensity.push_back(0.5f);
+    p.node.push_back(0u);
   }
   std::vector<store::ObjectNode> tree(3);
   tree[0].id = 1;
