@@ -236,11 +236,9 @@ void add_harmonize_command(CLI::App& app) {
   command
       ->add_option("--model", options->settings.solve.model,
                    "gain-offset (per channel) or matrix (3 × 3 and offset)")
-      ->transform(CLI::CheckedTransformer(
-          std::map<std::string, registration::ColorModel>{
-              {"gain-offset", registration::ColorModel::kGainOffset},
-              {"matrix", registration::ColorModel::kMatrix}},
-          CLI::ignore_case))
+      ->transform(one_of(std::map<std::string, registration::ColorModel>{
+          {"gain-offset", registration::ColorModel::kGainOffset},
+          {"matrix", registration::ColorModel::kMatrix}}))
       ->default_str("gain-offset")
       ->excludes(settings);
   add_threads_option(command, options->threads);

@@ -48,7 +48,7 @@ void add_export_command(CLI::App& app) {
       {"las", modeling::ExportFormat::kLas}, {"e57", modeling::ExportFormat::kE57}};
   command->add_option("--format", options->settings.format, "ptx, ply, csv, las, e57 or triplet")
       ->required()
-      ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
+      ->transform(one_of(formats));
   command->add_option("--scan", options->scan_id, "Export only the scan with this id");
   command->add_flag("--merged", options->settings.merged,
                     "The merged model only: the points `scanbench merge` kept (PLY, CSV, LAS; in "

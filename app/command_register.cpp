@@ -105,7 +105,7 @@ void add_register_command(CLI::App& app) {
   CLI::Option* settings = add_settings_option(command, options->settings_file);
   command
       ->add_option("--coarse", options->coarse, "Coarse stage: features (default), pairs or none")
-      ->transform(CLI::CheckedTransformer(coarse_methods, CLI::ignore_case))
+      ->transform(one_of(coarse_methods))
       ->excludes(settings);
   command
       ->add_option("--pairs", options->pairs_file,

@@ -131,13 +131,13 @@ void add_render_command(CLI::App& app) {
   command->add_flag("--force", options->force,
                     "Replace the picture when it exists (never the project or its sources)");
   command->add_option("--mode", s.mode, "points, splats or blended")
-      ->transform(CLI::CheckedTransformer(names_of(&render::draw_mode_name, 3)))
+      ->transform(one_of(names_of(&render::draw_mode_name, 3)))
       ->default_str("blended");
   command->add_option("--kernel", s.kernel, "disk, gaussian or cosine")
-      ->transform(CLI::CheckedTransformer(names_of(&render::kernel_name, 3)))
+      ->transform(one_of(names_of(&render::kernel_name, 3)))
       ->default_str("gaussian");
   command->add_option("--color", s.color, "color, intensity, height, normal or object")
-      ->transform(CLI::CheckedTransformer(names_of(&render::color_mode_name, 5)))
+      ->transform(one_of(names_of(&render::color_mode_name, 5)))
       ->default_str("color");
   command->add_option("--budget", s.culling.budget, "Points per frame (0: no budget)")
       ->capture_default_str();

@@ -40,8 +40,9 @@ void run_segment(const SegmentOptions& options) {
                result.kept_selections);
   }
   if (result.selections_held_back) {
-    fmt::print("the selection left uncommitted is not kept: keeping it would end the redo "
-               "chain (redo, or commit it, first)\n");
+    fmt::print(
+        "the selection left uncommitted is not kept: keeping it would end the redo "
+        "chain (redo, or commit it, first)\n");
   }
   fmt::print("{} op(s) applied to {}; `scanbench objects` shows the tree\n", result.ops.size(),
              options.project);

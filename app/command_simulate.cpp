@@ -83,7 +83,7 @@ void add_simulate_command(CLI::App& app) {
       {"triplet", sim::CampaignFormat::kTriplet},
       {"both", sim::CampaignFormat::kBoth}};
   command->add_option("--format", campaign.format, "ptx, triplet or both (default triplet)")
-      ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
+      ->transform(one_of(formats));
   add_threads_option(command, campaign.simulation.threads);
   command
       ->add_option("--pose-error-deg", campaign.pose_error_deg,

@@ -45,8 +45,8 @@ void add_workbench_command(CLI::App& app) {
     if (!options->record.empty() && options->record.extension() != ".json")
       throw CLI::ValidationError("--record", "must name a .json file");
     if (!options->record.empty() && std::filesystem::exists(options->record))
-      throw CLI::ValidationError("--record", options->record.string() +
-                                                 " exists: name a new file, or remove it first");
+      throw CLI::ValidationError(
+          "--record", options->record.string() + " exists: name a new file, or remove it first");
     for (const auto& [option, file] :
          {std::pair{"--screenshot", options->screenshot}, std::pair{"--layout", options->layout},
           std::pair{"--record", options->record}}) {

@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <map>
+#include <string>
 
 #include "acquisition/formats/json_input.hpp"
 #include "core/errors.hpp"
@@ -48,6 +50,27 @@ inline void add_threads_option(CLI::App* command, int& threads) {
                    "Worker threads: 0 = all cores (the default), at most " +
                        std::to_string(core::kMaxThreads) + "; more than the cores run as many")
       ->check(CLI::Range(0, core::kMaxThreads));
+}
+
+// A choice among named values of `Enum`, any case: the option's text
+// becomes the value's number for CLI11 to read, and a text that names none
+// is a usage error that lists the names ("--format: xyz is not one of csv,
+// e57, ..."; CLI11's own CheckedTransformer shows the numbers too).
+template <typename Enum>
+CLI::Validator one_of(const std::map<std::string, Enum>& names) {
+  std::string list;
+  for (const auto& entry : names) list += (list.empty() ? "" : ", ") + entry.first;
+  return CLI::Validator(
+      [names, list](std::string& text) -> std::string {
+        for (const auto& [name, value] : names) {
+          if (CLI::detail::to_lower(text) == CLI::detail::to_lower(name)) {
+            text = std::to_string(static_cast<long long>(value));
+            return {};
+          }
+        }
+        return text + " is not one of " + list;
+      },
+      "", "one_of");
 }
 
 // The --settings option of the batch commands (geometry, register, merge,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 
 #include "core/errors.hpp"
 #include "modeling/carried_objects.hpp"
@@ -49,6 +50,24 @@ std::vector<registration::PickedPairs> picks_by_index(const RegisterCommandSetti
   return picks;
 }
 
+// No pair registered: nothing is stored (the poses would be the ones the
+// scans had), and the failure names each pair and why.
+void refuse_when_nothing_registered(const store::Project& project,
+                                    const RegisterCommandResult& out) {
+  const std::vector<registration::PairReport>& pairs = out.result.pairs;
+  if (pairs.empty() ||
+      std::any_of(pairs.begin(), pairs.end(), [](const auto& pair) { return pair.registered; }))
+    return;
+  std::string why;
+  for (const registration::PairReport& pair : pairs) {
+    why += (why.empty() ? "" : "; ") + std::string("scan ") +
+           std::to_string(out.ids[static_cast<std::size_t>(pair.source)]) + " to scan " +
+           std::to_string(out.ids[static_cast<std::size_t>(pair.target)]) + ": " + pair.failure;
+  }
+  throw core::RuntimeFailure(project.path().string(), {},
+                             "no pair of scans registered, nothing stored (" + why + ")");
+}
+
 }  // namespace
 
 RegisterCommandResult register_project(store::Project& project,
@@ -70,6 +89,7 @@ RegisterCommandResult register_project(store::Project& project,
   out.result =
       registration::register_scans(loaded.prepared, out.initial_T_world_scan, run, &progress);
   progress.throw_if_cancelled(kStage);
+  refuse_when_nothing_registered(project, out);
   std::map<std::int64_t, Eigen::Isometry3d> moved;
   for (std::size_t k = 0; k < loaded.ids.size(); ++k)
     moved.emplace(loaded.ids[k], out.result.T_world_scan[k]);

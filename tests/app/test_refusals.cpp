@@ -239,5 +239,40 @@ TEST(Refusals, EveryRefusalNamesTheFileAndKeepsItsMessageShort) {
                         "unknown key \"scann\"");
 }
 
+// A choice that names no value lists the names, not CLI11's numbers.
+TEST(Refusals, AChoiceThatNamesNoValueListsTheNames) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  make_project(dir, project);
+  const CliResult format =
+      run_cli(dir, {"export", project.string(), "--format", "xyz", "-o", (dir / "o").string()});
+  expect_one_line_error(format, 2, "xyz is not one of csv, e57, las, ply, ptx, triplet");
+  EXPECT_THAT(format.err, Not(HasSubstr("->")));
+  expect_one_line_error(run_cli(dir, {"register", project.string(), "--coarse", "icp"}), 2,
+                        "icp is not one of features, none, pairs, point_pairs");
+  // Any case names a value.
+  EXPECT_EQ(
+      run_cli(dir, {"export", project.string(), "--format", "CSV", "-o", (dir / "o.csv").string()})
+          .exit_code,
+      0);
+}
+
+// A registration in which no pair of scans registers is a failure that
+// names each pair and why, and stores nothing.
+TEST(Refusals, ARegistrationWithNoPairRegisteredFailsAndStoresNothing) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
+  const std::string before = test::read_file_bytes(project);
+  const CliResult registered = run_cli(dir, {"register", project.string()});
+  EXPECT_EQ(registered.exit_code, 1) << registered.out;
+  EXPECT_THAT(registered.err, HasSubstr("no pair of scans registered, nothing stored"));
+  EXPECT_THAT(registered.err, HasSubstr("scan 2 to scan 1: "));
+  EXPECT_THAT(run_cli(dir, {"history", project.string()}).out, Not(HasSubstr("register")));
+}
+
 }  // namespace
 }  // namespace scanbench
