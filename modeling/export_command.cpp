@@ -93,8 +93,24 @@ std::string common_coordinate_metadata(
   return common;
 }
 
+// A guid for a scan that came without one (PTX, a triplet, PCD): derived
+// from the project's first command and the scan's id and source, so that
+// every export of the project names the scan alike.
+std::string derived_guid(const store::Project& project, std::int64_t id,
+                         const acquisition::ScanSource* source) {
+  const std::vector<store::CommandRecord> history = project.history();
+  std::string identity = "scanbench scan " + std::to_string(id);
+  if (!history.empty()) identity += " of a project begun " + history.front().created_at;
+  if (source != nullptr) {
+    identity +=
+        " from " + source->format + " (" + std::to_string(source->points_in_file) + " records)";
+    if (!source->files.empty()) identity += " at " + source->files.front().path;
+  }
+  return acquisition::e57_guid_from(identity);
+}
+
 // The scans as E57 data3D entries with their guids (kept from an E57
-// import) and images; the images tied to no scan go with a whole-project
+// import, else derived_guid) and images; the images tied to no scan go with a whole-project
 // export only.
 void write_e57(const store::Project& project, const std::vector<std::int64_t>& ids,
                const std::vector<acquisition::Scan>& scans,
@@ -105,9 +121,10 @@ void write_e57(const store::Project& project, const std::vector<std::int64_t>& i
   std::vector<acquisition::E57ScanOutput> outputs(scans.size());
   for (std::size_t s = 0; s < scans.size(); ++s) {
     outputs[s].scan = &scans[s];
-    if (const auto source = sources.find(ids[s]); source != sources.end()) {
-      outputs[s].guid = source->second.guid;
-    }
+    const auto source = sources.find(ids[s]);
+    const acquisition::ScanSource* from = source != sources.end() ? &source->second : nullptr;
+    outputs[s].guid =
+        from && !from->guid.empty() ? from->guid : derived_guid(project, ids[s], from);
     if (!keep.empty()) outputs[s].keep = keep[s];
     for (store::StoredImage& stored : images) {
       if (stored.scan_id == ids[s]) outputs[s].images.push_back(std::move(stored.image));

@@ -274,5 +274,32 @@ TEST(Refusals, ARegistrationWithNoPairRegisteredFailsAndStoresNothing) {
   EXPECT_THAT(run_cli(dir, {"history", project.string()}).out, Not(HasSubstr("register")));
 }
 
+// A scan that came without an E57 guid (PTX) gets the same one in every
+// E57 export of the project, and each scan its own.
+TEST(Refusals, AnE57ExportNamesAScanAlikeEveryTime) {
+  ScratchDir dir;
+  const std::filesystem::path project = dir / "p.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/two_scans.ptx").string()})
+                .exit_code,
+            0);
+  const auto guids_of_export = [&](const std::string& name) {
+    const std::filesystem::path e57 = dir / (name + ".e57"), back = dir / (name + ".sbproj");
+    EXPECT_EQ(
+        run_cli(dir, {"export", project.string(), "--format", "e57", "-o", e57.string()}).exit_code,
+        0);
+    EXPECT_EQ(run_cli(dir, {"import", back.string(), e57.string()}).exit_code, 0);
+    const nlohmann::json info =
+        nlohmann::json::parse(run_cli(dir, {"info", back.string(), "--json"}).out);
+    std::vector<std::string> guids;
+    for (const auto& scan : info["scans"]) guids.push_back(scan["source"]["guid"]);
+    return guids;
+  };
+  const std::vector<std::string> first = guids_of_export("a");
+  ASSERT_EQ(first.size(), 2u);
+  EXPECT_NE(first[0], first[1]);
+  EXPECT_EQ(first[0].size(), 38u);  // {8-4-4-4-12}
+  EXPECT_EQ(guids_of_export("b"), first);
+}
+
 }  // namespace
 }  // namespace scanbench

@@ -179,6 +179,20 @@ std::string new_e57_guid() {
                      a & 0xFFF, 0x8000 | ((b >> 48) & 0x3FFF), b & 0xFFFFFFFFFFFF);
 }
 
+std::string e57_guid_from(std::string_view identity) {
+  const auto fnv1a = [&](std::uint64_t hash) {
+    for (const char c : identity) {
+      hash ^= static_cast<unsigned char>(c);
+      hash *= 0x100000001b3ULL;
+    }
+    return hash;
+  };
+  const std::uint64_t a = fnv1a(0xcbf29ce484222325ULL);  // FNV-1a's offset basis
+  const std::uint64_t b = fnv1a(0x84222325cbf29ce4ULL ^ identity.size());
+  return fmt::format("{{{:08x}-{:04x}-5{:03x}-{:04x}-{:012x}}}", a >> 32, (a >> 16) & 0xFFFF,
+                     a & 0xFFF, 0x8000 | ((b >> 48) & 0x3FFF), b & 0xFFFFFFFFFFFF);
+}
+
 void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
                std::span<const ScanImage> loose_images, const std::string& coordinate_metadata) {
   OutputFile out(path);

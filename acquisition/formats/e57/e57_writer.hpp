@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "acquisition/scan_source.hpp"
@@ -38,5 +39,10 @@ void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput>
 
 // A new random GUID in the braced form E57 files use.
 std::string new_e57_guid();
+
+// A GUID in the same form named by `identity`: the same text always gives
+// the same GUID (a name-based one, version 5's layout, from two 64-bit
+// FNV-1a hashes rather than SHA-1), different texts different ones.
+std::string e57_guid_from(std::string_view identity);
 
 }  // namespace scanbench::acquisition
