@@ -79,13 +79,18 @@ TEST(Robustness, NamesThatAreNotUtf8KeepEveryJsonReportValid) {
             0);
   for (const std::vector<std::string>& command :
        {std::vector<std::string>{"info", project, "--json"},
-        std::vector<std::string>{"register", project, "--coarse", "none", "--json"},
         std::vector<std::string>{"merge", project, "--json"},
         std::vector<std::string>{"history", project, "--json"}}) {
     const CliResult result = run_cli(dir, command);
     ASSERT_EQ(result.exit_code, 0) << command[0] << ": " << result.err;
     EXPECT_TRUE(nlohmann::json::accept(result.out)) << command[0] << ": " << result.out;
   }
+  // Two scans of 2 × 2 points: no pair registers, a failure in one line
+  // (naming the scans by id), with nothing printed on stdout.
+  const CliResult registered = run_cli(dir, {"register", project, "--coarse", "none", "--json"});
+  EXPECT_EQ(registered.exit_code, 1) << registered.err;
+  EXPECT_EQ(std::count(registered.err.begin(), registered.err.end(), '\n'), 1) << registered.err;
+  EXPECT_EQ(registered.out, "");
 }
 
 // The decoder's reason is part of our one line; nothing else is printed.
