@@ -69,7 +69,7 @@ double set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points,
     scan.range_m[i] = static_cast<float>(range);
     if (directions) unit[i] = (p / range).cast<float>();
   }
-  if (directions) scan.angles = PerPixelDirections{std::move(unit)};
+  if (directions) scan.angles = PerPixelDirections{std::move(unit), scan.is_scattered()};
   return farthest;
 }
 
@@ -84,7 +84,7 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
   if (centre_hint_file && centre_hint_file->allFinite() && !centre_hint_file->isZero(0.0)) {
     candidates.push_back(*centre_hint_file);
   }
-  if (!settings.try_spherical) candidates.clear();
+  if (!settings.try_spherical || scan.is_scattered()) candidates.clear();
   LocalOriginResult result;
   for (const Eigen::Vector3d& centre : candidates) {
     const SphericalFitResult fit =
@@ -106,6 +106,14 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
   result.farthest_m = set_ranges(scan, points_file, result.origin_file, !result.spherical);
   scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result.origin_file);
   return result;
+}
+
+LocalOriginResult set_scattered_points(Scan& scan, std::span<const Eigen::Vector3d> points_file) {
+  assert(scan.is_scattered() && points_file.size() == count_valid(scan) &&
+         "one point per valid pixel of a scattered scan");
+  std::vector<Eigen::Vector3d> padded(points_file.begin(), points_file.end());
+  padded.resize(scan.pixel_count(), Eigen::Vector3d::Zero());
+  return set_grid_from_points(scan, padded, std::nullopt);
 }
 
 }  // namespace scanbench::acquisition

@@ -58,4 +58,10 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
                                        const std::optional<Eigen::Vector3d>& centre_hint_file,
                                        const LocalOriginSettings& settings = {});
 
+// The same for a scattered scan (make_scattered_scan), whose k-th valid
+// pixel takes points_file[k]: per-pixel directions from the file frame's
+// origin, or from the points' centroid when they lie far from it. Asserts
+// one point per valid pixel.
+LocalOriginResult set_scattered_points(Scan& scan, std::span<const Eigen::Vector3d> points_file);
+
 }  // namespace scanbench::acquisition

@@ -20,6 +20,18 @@ Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color
   return scan;
 }
 
+Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_color) {
+  const auto columns = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(points))));
+  const std::size_t rows = columns == 0 ? 0 : (points + columns - 1) / columns;
+  assert(rows < (1u << 31) && columns < (1u << 31) && "a scattered scan of at most 2^62 points");
+  Scan scan = make_empty_scan(static_cast<int>(rows), static_cast<int>(columns), with_intensity,
+                              with_color);
+  std::fill_n(scan.valid.begin(), points, std::uint8_t{1});
+  scan.angles = PerPixelDirections{
+      std::vector<Eigen::Vector3f>(scan.pixel_count(), Eigen::Vector3f::Zero()), true};
+  return scan;
+}
+
 Eigen::Vector3d direction_precise(const Scan& scan, int row, int col) {
   assert(row >= 0 && row < scan.rows && col >= 0 && col < scan.columns);
   if (const auto* spherical = std::get_if<SphericalAngles>(&scan.angles)) {
@@ -102,6 +114,12 @@ std::string check_consistency(const Scan& scan) {
   }
   if (const auto* per_pixel = std::get_if<PerPixelDirections>(&scan.angles)) {
     if (per_pixel->directions.size() != n) return "direction count differs from rows x columns";
+    if (per_pixel->scattered) {
+      const auto first_empty = std::find(scan.valid.begin(), scan.valid.end(), 0);
+      if (std::find(first_empty, scan.valid.end(), 1) != scan.valid.end()) {
+        return "a scattered scan's points do not fill its first pixels";
+      }
+    }
   }
   return {};
 }

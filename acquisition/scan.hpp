@@ -38,8 +38,20 @@ struct SphericalAngles {
 // Irregular grids (structured light, resampled clouds): one unit direction per
 // pixel, row-major, in the scan frame. A pixel whose direction is unknown (no
 // return and no model to predict it) holds the zero vector.
+//
+// A scattered scan is an unstructured cloud (E57 without row and column
+// indices, LAS, PLY, unorganized PCD) kept whole: its points fill the
+// pixels 0 … n − 1 in the file's order, the rest of the last row is
+// invalid, and neighbouring pixels are not neighbouring points. Projecting
+// such a cloud into a panorama would drop every point that falls on a
+// pixel a nearer one holds (a quarter of a scanned object, or of a cloud
+// unified from several stations); storing it as a list loses nothing, and
+// every stage that works on points (geometry from the k nearest
+// neighbours, registration, merge, rendering, export) works on it. The
+// tools that need a range image (seed, lasso, barrier) refuse it.
 struct PerPixelDirections {
   std::vector<Eigen::Vector3f> directions;
+  bool scattered = false;
 
   friend bool operator==(const PerPixelDirections&, const PerPixelDirections&) = default;
 };
@@ -75,11 +87,22 @@ struct Scan {
   bool has_intensity() const { return !intensity.empty(); }
   bool has_color() const { return !rgb.empty(); }
   bool is_spherical() const { return std::holds_alternative<SphericalAngles>(angles); }
+  bool is_scattered() const {
+    const auto* per_pixel = std::get_if<PerPixelDirections>(&angles);
+    return per_pixel != nullptr && per_pixel->scattered;
+  }
 };
 
 // Allocates every channel of a rows × columns scan: range 0, all pixels
 // invalid, intensity / rgb only when requested. Asserts rows, columns ≥ 0.
 Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color);
+
+// A scattered scan of `points` points (PerPixelDirections::scattered): a
+// grid about as wide as tall whose first `points` pixels are valid, range
+// 0, directions zero, intensity / rgb only when requested. The caller
+// fills the channels of pixel k with the cloud's k-th point, then the
+// geometry (set_grid_from_points). Asserts points < 2^31 · 2^31.
+Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_color);
 
 // Unit viewing direction of pixel (row, col) in the scan frame. For per-pixel
 // grids this is the stored direction (zero when unknown). Every per-pixel

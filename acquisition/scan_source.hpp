@@ -65,8 +65,8 @@ struct ScanSource {
   std::string coordinate_metadata;
   // Records the file held for the scan (returns or not; for the grid
   // formats, rows × columns), and how many of them the grid could
-  // not place: an unstructured scan's points that fell on a pixel already
-  // taken, or a structured scan's later returns and repeated indices.
+  // not place: a structured scan's later returns and repeated indices (an
+  // unstructured scan places every point: scan.hpp's scattered scans).
   std::uint64_t points_in_file = 0;
   std::uint64_t unplaced_points = 0;
   // The files the reader read besides the one it was given (a triplet's

@@ -11,6 +11,7 @@ ScanSummary summarize(const Scan& scan) {
   summary.has_color = scan.has_color();
   summary.has_intensity = scan.has_intensity();
   summary.spherical = scan.is_spherical();
+  summary.scattered = scan.is_scattered();
   summary.T_world_scan = scan.T_world_scan;
   summary.bbox_world = world_bounds(scan);
   summary.scanner = scan.scanner;

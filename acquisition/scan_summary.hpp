@@ -19,6 +19,7 @@ struct ScanSummary {
   bool has_color = false;
   bool has_intensity = false;
   bool spherical = true;  // angle model: spherical, else per-pixel directions
+  bool scattered = false;  // an unstructured cloud (PerPixelDirections::scattered)
   Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();
   std::optional<Eigen::AlignedBox3d> bbox_world;  // empty when no valid point
   ScannerMetadata scanner;

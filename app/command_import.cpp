@@ -30,8 +30,8 @@ void run_import(const ImportOptions& options) {
   if (result.images > 0) fmt::print("  {} image(s) stored with the scans\n", result.images);
   if (result.unplaced_points > 0) {
     fmt::print(
-        "  {} point(s) not placed in the scan grids: they fell on a pixel a nearer point of an "
-        "unstructured scan holds, or were later returns (see `scanbench info PROJECT`)\n",
+        "  {} record(s) not placed in the scan grids: later returns, or records repeating a "
+        "pixel of a structured scan (see `scanbench info PROJECT`)\n",
         result.unplaced_points);
   }
 }

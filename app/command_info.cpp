@@ -118,6 +118,7 @@ nlohmann::json to_json(const Entry& entry) {
           {"has_color", s.has_color},
           {"has_intensity", s.has_intensity},
           {"angle_model", acquisition::angle_model_name(s.spherical)},
+          {"layout", s.scattered ? "scattered" : "grid"},
           {"T_world_scan", acquisition::row_major(s.T_world_scan)},
           {"bbox_world", bbox},
           {"scanner", s.scanner.name},
@@ -142,11 +143,12 @@ void print_table(const std::string& path, const Contents& contents) {
                core::one_line(s.name, core::kMaxMessagePart),
                fmt::format("{} x {}", s.rows, s.columns), s.valid_points,
                s.has_color ? "yes" : "no", s.has_intensity ? "yes" : "no",
-               acquisition::angle_model_name(s.spherical), t.x(), t.y(), t.z());
+               s.scattered ? "scattered" : acquisition::angle_model_name(s.spherical), t.x(), t.y(),
+               t.z());
     if (e.source && e.source->unplaced_points > 0) {
       fmt::print(
-          "      {} of the file's {} records not placed in the grid (collisions of an "
-          "unstructured scan, or later returns)\n",
+          "      {} of the file's {} records not placed in the grid (later returns, or "
+          "records repeating a pixel)\n",
           e.source->unplaced_points, e.source->points_in_file);
     }
   }

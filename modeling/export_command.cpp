@@ -68,6 +68,20 @@ void write_triplet(const store::Project& project, const std::vector<acquisition:
   acquisition::write_triplet(scans.front(), settings.output);
 }
 
+// A PTX holds grids: its readers take neighbouring cells for neighbouring
+// points, which a scattered scan's are not.
+void write_ptx(const store::Project& project, const std::vector<acquisition::Scan>& scans,
+               const ExportSettings& settings) {
+  for (const acquisition::Scan& scan : scans) {
+    if (scan.is_scattered()) {
+      throw core::InputError(project.path().string(), {{}, {}, "scan \"" + scan.name + "\""},
+                             "is an unstructured cloud, and a PTX holds scan grids (export it as "
+                             "e57, ply, las or csv)");
+    }
+  }
+  acquisition::write_ptx(settings.output, scans);
+}
+
 // The coordinate reference system the exported scans' files named: the
 // one they share (none when no file named one). Throws core::InputError
 // when two scans come from files that name different ones: one E57 file
@@ -253,7 +267,7 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
   for (const auto& mask : keep) keep_of.push_back(&mask);
   switch (settings.format) {
     case ExportFormat::kPtx:
-      acquisition::write_ptx(settings.output, scans);
+      write_ptx(project, scans, settings);
       break;
     case ExportFormat::kPly:
       acquisition::write_ply(settings.output, scans, geometry_of, keep_of);

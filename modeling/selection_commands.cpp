@@ -77,6 +77,16 @@ std::vector<std::uint8_t> taken_mask(const std::vector<std::uint32_t>& membershi
   return taken;
 }
 
+// Growing, lassos, barriers and parts work on a range image, which an
+// unstructured cloud does not have.
+void require_grid(bool scattered, std::int64_t scan_id) {
+  if (scattered) {
+    refuse("scan " + std::to_string(scan_id),
+           "is an unstructured cloud (imported without a scan grid): growing a region, lassos, "
+           "barriers and parts need a range image");
+  }
+}
+
 // The scan, its geometry (refused when missing) and the grid a region grows on.
 struct Prepared {
   acquisition::Scan scan;
@@ -88,6 +98,7 @@ Prepared prepare(const store::Project& project, std::int64_t scan_id,
                  const acquisition::RangeNoise& noise) {
   Prepared p;
   p.scan = project.load_scan(scan_id);
+  require_grid(p.scan.is_scattered(), scan_id);
   std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, scan_id);
   if (!geometry) {
     refuse("scan " + std::to_string(scan_id), "has no geometry: run `scanbench geometry` first");
@@ -109,6 +120,7 @@ SeparateResult separate_object(store::Project& project, const SeparateSettings& 
     refuse("node " + std::to_string(settings.node), "is a group: only objects own pixels");
   }
   const acquisition::Scan scan = project.load_scan(settings.scan_id);
+  require_grid(scan.is_scattered(), settings.scan_id);
   std::vector<std::uint32_t> membership =
       load_membership(project, settings.scan_id, scan.pixel_count());
   segmentation::PixelSet owned;
@@ -231,6 +243,7 @@ SelectResult select_region(const store::Project& project, const SelectSettings& 
                            segmentation::PixelSet& selection) {
   const std::string where = "scan " + std::to_string(settings.scan_id);
   const store::StoredScanSummary summary = require_scan(project, settings.scan_id);
+  require_grid(summary.summary.scattered, settings.scan_id);
   const int rows = summary.summary.rows, columns = summary.summary.columns;
   if (settings.seed_row < 0 || settings.seed_row >= rows || settings.seed_col < 0 ||
       settings.seed_col >= columns) {

@@ -9,7 +9,9 @@
 // Edit.
 //
 // Errors: a scan or node that does not exist, a seed outside the grid, a
-// scan without geometry, an empty selection, a bad name (tree_commands.hpp):
+// scan without geometry, growing, proposals or parts in an unstructured
+// cloud (a scattered scan has no range image), an empty selection, a bad
+// name (tree_commands.hpp):
 // core::InputError naming it, and nothing written.
 #pragma once
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "acquisition/geometry/sampling.hpp"
+#include "acquisition/geometry/scattered_geometry.hpp"
 #include "core/parallel.hpp"
 
 namespace scanbench::registration {
@@ -24,6 +25,10 @@ void prepare_row(const acquisition::Scan& scan, const acquisition::ScanGeometry&
     out.in_model[i] = 1;
     out.usable[i] = geometry.has_normal(i) ? 1 : 0;
     const float cos_incidence = out.usable[i] ? geometry.normal[i].dot(d) : 1.0f;
+    if (scan.is_scattered()) {
+      out.sample_area_m2[i] = acquisition::scattered_sample_area_m2(geometry.footprint_m[i]);
+      continue;
+    }
     const float omega =
         scan.is_spherical() ? row_solid_angle : acquisition::pixel_solid_angle(scan, row, col);
     out.sample_area_m2[i] = acquisition::sample_area_m2(range, omega, cos_incidence);

@@ -9,7 +9,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config ccache git
   libeigen3-dev libopencv-dev libpng-dev libtiff-dev zlib1g-dev libceres-dev libpcl-dev libtbb-dev
-  libsqlite3-dev libzstd-dev nlohmann-json3-dev libcli11-dev libpugixml-dev
+  libsqlite3-dev libzstd-dev nlohmann-json3-dev libcli11-dev libpugixml-dev libnanoflann-dev
   libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev libglfw3-dev libepoxy-dev libegl-dev libegl1-mesa-dev
   libgl1-mesa-dri xvfb xauth clang libclang-rt-14-dev

@@ -39,6 +39,7 @@
 #include "acquisition/geometry/branch_free.hpp"
 #include "acquisition/geometry/grid_covariance.hpp"
 #include "acquisition/geometry/mixed_pixels.hpp"
+#include "acquisition/geometry/scattered_geometry.hpp"
 #include "acquisition/geometry/window_moments.hpp"
 #include "core/parallel.hpp"
 #include "core/timing.hpp"
@@ -479,6 +480,7 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
          settings.window_radius >= settings.edge_window_radius &&
          settings.window_radius <= kMaxWindowRadius);
+  if (scan.is_scattered()) return compute_scattered_geometry(scan, settings);
   const auto start = std::chrono::steady_clock::now();
   GeometryResult result;
   ScanGeometry& g = result.geometry;

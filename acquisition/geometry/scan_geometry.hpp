@@ -98,7 +98,8 @@ struct GeometryResult {
 
 // Computes footprints, normals, confidences and flags for every pixel. Works
 // on spherical and per-pixel-direction scans (for the latter the fit runs on
-// the points themselves). Asserts the scan is consistent.
+// the points themselves), and on scattered scans from each point's nearest
+// neighbours (scattered_geometry.hpp). Asserts the scan is consistent.
 GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings = {});
 
 }  // namespace scanbench::acquisition

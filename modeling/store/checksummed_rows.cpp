@@ -25,6 +25,9 @@ std::int64_t checksum(const ScanRecord& r) {
   for (const std::optional<double>& angle : r.angles) sum.add(angle);
   sum.add(r.scanner_name).add(r.source_file).add(r.valid_points).add(r.has_color);
   sum.add(r.has_intensity).add(r.content_digest);
+  // Rows of schema 8 are grids: the default layout adds nothing, so their
+  // checksums still hold.
+  if (r.layout != "grid") sum.add(r.layout);
   return sum.value();
 }
 
@@ -132,7 +135,8 @@ std::pair<ScanRecord, std::int64_t> read_scan_record(const sqlite::Statement& ro
   r.has_color = row.column_int(c + 12);
   r.has_intensity = row.column_int(c + 13);
   r.content_digest = row.column_int(c + 14);
-  return {std::move(r), row.column_int(c + 15)};
+  r.layout = row.column_text(c + 15);
+  return {std::move(r), row.column_int(c + 16)};
 }
 
 std::pair<PoseRecord, std::int64_t> read_pose_record(const sqlite::Statement& row, int c) {
@@ -192,7 +196,9 @@ FROM scans s JOIN scan_layers r ON r.scan_id = s.id AND r.name = 'range_m'
 // statement that is still reading it.
 void fill_scan_and_pose_checksums(sqlite3* db, const std::string& file) {
   std::vector<std::pair<std::int64_t, std::int64_t>> sums;  // (key, checksum)
-  const std::string scans_sql = sql_of({"SELECT s.id, ", kScanRecordColumns, " FROM scans s"});
+  // Schema 4 has no layout column: every scan is a grid.
+  const std::string scans_sql =
+      sql_of({"SELECT s.id, ", kScanRecordColumnsBeforeLayout, "'grid', s.checksum FROM scans s"});
   for (sqlite::Statement scans(db, scans_sql.c_str(), file); scans.step();) {
     sums.emplace_back(scans.column_int(0), checksum(read_scan_record(scans, 1).first));
   }

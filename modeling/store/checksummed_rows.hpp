@@ -36,6 +36,7 @@ struct ScanRecord {
   std::int64_t has_color = 0;
   std::int64_t has_intensity = 0;
   std::int64_t content_digest = 0;
+  std::string layout = "grid";  // or "scattered" (acquisition::PerPixelDirections)
 };
 
 struct PoseRecord {
@@ -122,11 +123,14 @@ std::int64_t content_digest(std::int64_t rows, std::int64_t columns, std::string
 
 // The columns of each record, in the order the readers below expect, for
 // SELECT lists ("s." / "p." prefixed for the scans-poses join).
-inline constexpr const char* kScanRecordColumns =
+// A scan record's columns up to the layout, which schema 9 added.
+inline constexpr const char* kScanRecordColumnsBeforeLayout =
     "s.created_by, s.name, s.rows, s.columns, s.angle_model, s.azimuth_start_rad, "
     "s.azimuth_step_rad, s.elevation_start_rad, s.elevation_step_rad, s.scanner_name, "
-    "s.source_file, s.valid_points, s.has_color, s.has_intensity, s.content_digest, s.checksum";
-inline constexpr int kScanRecordColumnCount = 16;
+    "s.source_file, s.valid_points, s.has_color, s.has_intensity, s.content_digest, ";
+inline const std::string kScanRecordColumns =
+    std::string(kScanRecordColumnsBeforeLayout) + "s.layout, s.checksum";
+inline constexpr int kScanRecordColumnCount = 17;
 inline constexpr const char* kPoseRecordColumns =
     "p.scan_id, p.command_id, p.T_world_scan, p.scanner_x, p.scanner_y, p.scanner_z, "
     "p.bbox_min_x, p.bbox_min_y, p.bbox_min_z, p.bbox_max_x, p.bbox_max_y, p.bbox_max_z, "

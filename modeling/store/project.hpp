@@ -64,7 +64,7 @@ inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplication
 // versioned poses and the per-scan layer store; 5: the object tree; 6: colour
 // edits of objects and colour corrections of scans; 7: scan sources and images;
 // 8: indexes of the journal's undone and pending commands.
-inline constexpr int kProjectSchemaVersion = 8;
+inline constexpr int kProjectSchemaVersion = 9;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;

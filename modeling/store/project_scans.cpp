@@ -39,8 +39,9 @@ WHERE (SELECT state FROM commands WHERE id = s.created_by) = 'done'
 constexpr const char* kInsertScan = R"sql(
 INSERT INTO scans (created_by, name, rows, columns, angle_model, azimuth_start_rad,
                    azimuth_step_rad, elevation_start_rad, elevation_step_rad, scanner_name,
-                   source_file, valid_points, has_color, has_intensity, content_digest, checksum)
-VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16))sql";
+                   source_file, valid_points, has_color, has_intensity, content_digest, checksum,
+                   layout)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17))sql";
 
 constexpr const char* kInsertPose = R"sql(
 INSERT OR REPLACE INTO scan_poses (scan_id, command_id, T_world_scan, scanner_x, scanner_y,
@@ -92,6 +93,7 @@ ScanRecord scan_record(std::int64_t command_id, const EncodedScan& encoded) {
   r.has_color = encoded.summary.has_color;
   r.has_intensity = encoded.summary.has_intensity;
   r.content_digest = encoded.content_digest;
+  r.layout = scan.is_scattered() ? "scattered" : "grid";
   return r;
 }
 
@@ -102,7 +104,7 @@ void bind_scan_record(sqlite::Statement& insert, const ScanRecord& r) {
     insert.bind_optional_double(6 + k, r.angles[static_cast<std::size_t>(k)]);
   insert.bind_text(10, r.scanner_name).bind_text(11, r.source_file);
   insert.bind_int(12, r.valid_points).bind_int(13, r.has_color).bind_int(14, r.has_intensity);
-  insert.bind_int(15, r.content_digest).bind_int(16, checksum(r));
+  insert.bind_int(15, r.content_digest).bind_int(16, checksum(r)).bind_text(17, r.layout);
 }
 
 void insert_pose(sqlite3* db, const std::string& file, std::int64_t id, std::int64_t command_id,
@@ -157,6 +159,10 @@ StoredScanSummary read_summary(const sqlite::Statement& row, const std::string& 
     damaged(file, stored.id, "unknown angle model");
   }
   summary.spherical = scan.angle_model == "spherical";
+  if (scan.layout != "grid" && (scan.layout != "scattered" || summary.spherical)) {
+    damaged(file, stored.id, "unknown layout");
+  }
+  summary.scattered = scan.layout == "scattered";
   summary.T_world_scan = decode_pose(pose.pose, file, stored.id);
   summary.scanner.name = scan.scanner_name;
   summary.scanner.source_file = scan.source_file;
@@ -172,8 +178,9 @@ StoredScanSummary read_summary(const sqlite::Statement& row, const std::string& 
   return stored;
 }
 
-acquisition::AngleModel read_angles(const sqlite::Statement& row, bool spherical) {
-  if (!spherical) return acquisition::PerPixelDirections{};
+acquisition::AngleModel read_angles(const sqlite::Statement& row,
+                                    const acquisition::ScanSummary& summary) {
+  if (!summary.spherical) return acquisition::PerPixelDirections{{}, summary.scattered};
   const ScanRecord scan = read_scan_record(row, kFirstScanColumn).first;
   return acquisition::SphericalAngles{*scan.angles[0], *scan.angles[1], *scan.angles[2],
                                       *scan.angles[3]};
@@ -219,7 +226,7 @@ EncodedScan encode_scan(const acquisition::Scan& scan) {
   if (const auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&scan.angles)) {
     layers.push_back(encode_layer<Eigen::Vector3f>(layer::kDirections, ElementType::kF32x3,
                                                    per_pixel->directions));
-    encoded.metadata.angles = acquisition::PerPixelDirections{};
+    encoded.metadata.angles = acquisition::PerPixelDirections{{}, per_pixel->scattered};
   } else {
     encoded.metadata.angles = scan.angles;
   }
@@ -305,7 +312,7 @@ acquisition::Scan Project::load_scan(std::int64_t id) const {
   scan.name = summary.name;
   scan.rows = summary.rows;
   scan.columns = summary.columns;
-  scan.angles = read_angles(select, summary.spherical);
+  scan.angles = read_angles(select, summary);
   scan.T_world_scan = summary.T_world_scan;
   scan.scanner = summary.scanner;
   scan.range_m = required_layer<float>(*this, id, layer::kRange, ElementType::kF32);

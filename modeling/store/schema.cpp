@@ -385,6 +385,14 @@ CREATE INDEX commands_undone ON commands (seq) WHERE state = 'undone';
 CREATE INDEX commands_pending ON commands (id) WHERE state = 'pending';
 )sql";
 
+// Version 9: a scan's layout: a grid, or an unstructured cloud kept as a
+// list of points (acquisition::PerPixelDirections::scattered). Grid rows
+// keep their checksums: the default layout adds nothing to them.
+constexpr const char* kMigrate8To9 = R"sql(
+ALTER TABLE scans ADD COLUMN layout TEXT NOT NULL DEFAULT 'grid'
+  CHECK (layout IN ('grid', 'scattered'));
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction; `original_version` is the version the file had when opened.
 void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
@@ -410,6 +418,9 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
       return;
     case 7:
       sqlite::execute(db, kMigrate7To8, file);
+      return;
+    case 8:
+      sqlite::execute(db, kMigrate8To9, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

@@ -6,9 +6,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <random>
 
 #include "acquisition/formats/e57/crc32c.hpp"
@@ -217,47 +219,86 @@ TEST(E57Fixture, StructuredSphericalScanKeepsItsGridValuesPoseAndImages) {
   EXPECT_EQ(loose[0].data[1], 0xD8);
 }
 
-// The points fixtures/generate_e57_fixtures.py puts in the unstructured scan.
-std::vector<Eigen::Vector3d> unstructured_points() {
+// The points fixtures/generate_e57_fixtures.py puts in the unstructured
+// scan, as the file holds them (mm steps), each `scale` times as far.
+std::vector<Eigen::Vector3d> unstructured_points(double scale = 1.0) {
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < 20; ++i) {
     for (int j = 0; j < 30; ++j) {
       const double az = -0.5 + 0.01 * j, el = -0.1 + 0.01 * i, range = 8.0 + 0.01 * j;
       const Eigen::Vector3d p(range * std::cos(el) * std::cos(az),
                               range * std::cos(el) * std::sin(az), range * std::sin(el));
-      points.push_back((p / 0.001).array().round().matrix() * 0.001);  // as the file holds them
+      points.push_back((scale * p / 0.001).array().round().matrix() * 0.001);
     }
   }
   return points;
 }
 
-TEST(E57Fixture, UnstructuredScanIsProjectedKeepingEveryPointAndCountingCollisions) {
+TEST(E57Fixture, AnUnstructuredScanKeepsEveryPointWithAReturn) {
   const std::vector<ImportedScan> scans =
       read_all(test::fixture("good/e57/unstructured_cartesian.e57"));
   ASSERT_EQ(scans.size(), 1u);
   const Scan& scan = scans[0].scan;
-  EXPECT_FALSE(scan.is_spherical());
+  EXPECT_TRUE(scan.is_scattered());
+  EXPECT_EQ(check_consistency(scan), "");
   EXPECT_EQ(scans[0].source.points_in_file, 605u);
-  EXPECT_EQ(scans[0].source.unplaced_points, 2u) << "the two points behind others";
-  EXPECT_EQ(count_valid(scan), 600u);
-  // Every valid pixel is one of the 600 near points, within 0.1 mm of the
-  // file's value, each exactly once.
-  const std::vector<Eigen::Vector3d> expected = unstructured_points();
+  EXPECT_EQ(scans[0].source.unplaced_points, 0u);
+  EXPECT_EQ(count_valid(scan), 602u) << "all but the three records without a return";
+  // The 600 points and the two behind two of them, each within 0.1 mm of
+  // the file's value, each exactly once.
+  std::vector<Eigen::Vector3d> expected = unstructured_points();
+  std::vector<float> intensity;
+  for (int k = 0; k < 600; ++k) intensity.push_back(static_cast<float>(k / 600.0));
+  for (const int behind : {45, 301}) {
+    expected.push_back(unstructured_points(2.0)[behind]);
+    intensity.push_back(intensity[behind]);
+  }
   std::vector<int> seen(expected.size(), 0);
-  for (int r = 0; r < scan.rows; ++r) {
-    for (int c = 0; c < scan.columns; ++c) {
-      if (!scan.valid[scan.index(r, c)]) continue;
-      const Eigen::Vector3d p = point_in_world(scan, r, c);
-      std::size_t best = 0;
-      for (std::size_t k = 1; k < expected.size(); ++k) {
-        if ((expected[k] - p).norm() < (expected[best] - p).norm()) best = k;
-      }
-      EXPECT_LT((expected[best] - p).norm(), 1e-4);
-      EXPECT_NEAR(scan.intensity[scan.index(r, c)], static_cast<float>(best / 600.0), 1e-6);
-      ++seen[best];
+  for (std::size_t p = 0; p < count_valid(scan); ++p) {
+    const int r = static_cast<int>(p) / scan.columns, c = static_cast<int>(p) % scan.columns;
+    const Eigen::Vector3d point = point_in_world(scan, r, c);
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < expected.size(); ++k) {
+      if ((expected[k] - point).norm() < (expected[best] - point).norm()) best = k;
     }
+    EXPECT_LT((expected[best] - point).norm(), 1e-4);
+    EXPECT_NEAR(scan.intensity[p], intensity[best], 1e-6);
+    ++seen[best];
   }
   EXPECT_THAT(seen, ::testing::Each(1));
+}
+
+// fixtures/generate_e57_fixtures.py's sphere: 4 000 points of a closed
+// surface seen from outside, in file order.
+Eigen::Vector3d sphere_point(int k) {
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  const double z = 1.0 - 2.0 * (k + 0.5) / 4000.0, r = std::sqrt(1.0 - z * z);
+  return Eigen::Vector3d(4.0 + r * std::cos(golden * k), 1.0 + r * std::sin(golden * k), 0.5 + z);
+}
+
+TEST(E57Fixture, AClosedObjectKeepsThePointsAPanoramaWouldHide) {
+  const std::vector<ImportedScan> scans =
+      read_all(test::fixture("good/e57/unstructured_sphere.e57"));
+  ASSERT_EQ(scans.size(), 1u);
+  const Scan& scan = scans[0].scan;
+  ASSERT_TRUE(scan.is_scattered());
+  ASSERT_EQ(count_valid(scan), 4000u);
+  // The file's order, each point as the file gives it (0.1 mm steps).
+  double worst = 0.0;
+  for (int k = 0; k < 4000; ++k) {
+    const Eigen::Vector3d p = point_in_world(scan, k / scan.columns, k % scan.columns);
+    worst = std::max(worst, (p - sphere_point(k)).norm());
+  }
+  EXPECT_LT(worst, 1e-4);
+  // Its far side lies behind its near side: seen from the origin, about
+  // half the sphere is hidden, the cloud's points that a panorama drops.
+  int hidden = 0;
+  const Eigen::Vector3d centre(4.0, 1.0, 0.5);
+  for (int k = 0; k < 4000; ++k) {
+    const Eigen::Vector3d p = sphere_point(k);
+    hidden += (p - centre).dot(p) > 0.0;
+  }
+  EXPECT_GT(hidden, 1000) << "at least a quarter of the points would collide";
 }
 
 TEST(E57Fixture, GeoreferencedCoordinatesKeepATenthOfAMillimetre) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -10,6 +11,7 @@
 
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/geometry/window_moments.hpp"
+#include "acquisition/local_origin.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -314,6 +316,75 @@ TEST(WindowSlopes, MatchBruteForceOnAMaskedGrid) {
       }
     }
   }
+}
+
+}  // namespace
+}  // namespace scanbench::acquisition
+
+namespace scanbench::acquisition {
+namespace {
+
+// A scattered scan of a sphere (radius 1 m, centre (4, 1, 0.5)) sampled
+// evenly, its far side behind its near side as seen from the origin, with
+// the points in a shuffled order: neighbours in the list are not neighbours
+// in space.
+Scan scattered_sphere(int count) {
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  std::vector<Eigen::Vector3d> points;
+  for (int k = 0; k < count; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / count, r = std::sqrt(1.0 - z * z);
+    points.emplace_back(4.0 + r * std::cos(golden * k), 1.0 + r * std::sin(golden * k), 0.5 + z);
+  }
+  std::shuffle(points.begin(), points.end(), std::mt19937(5));
+  Scan scan = make_scattered_scan(points.size(), false, false);
+  set_scattered_points(scan, points);
+  return scan;
+}
+
+TEST(ScatteredGeometry, ASphereSeenFromOutsideGetsItsNormalsFromItsNearestNeighbours) {
+  const Scan scan = scattered_sphere(5000);
+  ASSERT_EQ(check_consistency(scan), "");
+  const GeometryResult result = compute_geometry(scan);
+  EXPECT_EQ(result.valid_points, 5000u);
+  EXPECT_EQ(result.normals, 5000u);
+  EXPECT_EQ(result.mixed_pixels, 0u);
+  // Mean spacing of 5 000 points on 4π m²: √(4π / 5000) ≈ 5.0 cm.
+  const double spacing = std::sqrt(4.0 * std::numbers::pi / 5000.0);
+  const Eigen::Vector3f centre(4.0f, 1.0f, 0.5f);
+  int aligned = 0;
+  for (std::size_t i = 0; i < 5000; ++i) {
+    const Eigen::Vector3f p =
+        point_in_scan(scan, static_cast<int>(i) / scan.columns, static_cast<int>(i) % scan.columns);
+    const Eigen::Vector3f n = result.geometry.normal[i];
+    EXPECT_GE(n.dot(-p), 0.0f) << "towards the viewpoint, the scan frame's origin";
+    aligned += std::abs(n.dot((p - centre).normalized())) > 0.99f;
+    EXPECT_GT(result.geometry.footprint_m[i], 0.5 * spacing);
+    EXPECT_LT(result.geometry.footprint_m[i], 1.5 * spacing);
+    EXPECT_GT(result.geometry.confidence[i], 0.0f);
+  }
+  EXPECT_GE(aligned, 4950) << "the radial direction, within 8°";
+  // The same on one thread as on all.
+  GeometrySettings one;
+  one.threads = 1;
+  const GeometryResult single = compute_geometry(scan, one);
+  EXPECT_EQ(single.geometry.normal, result.geometry.normal);
+  EXPECT_EQ(single.geometry.footprint_m, result.geometry.footprint_m);
+}
+
+TEST(ScatteredGeometry, APointFarFromTheOthersGetsNoNormal) {
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 20; ++i) {
+    for (int j = 0; j < 20; ++j) points.emplace_back(5.0, 0.01 * i, 0.01 * j);
+  }
+  points.emplace_back(7.0, 3.0, 3.0);
+  Scan scan = make_scattered_scan(points.size(), false, false);
+  set_scattered_points(scan, points);
+  const GeometryResult result = compute_geometry(scan);
+  EXPECT_EQ(result.normals, 400u);
+  EXPECT_TRUE(result.geometry.flags[400] & kFlagNoNormal);
+  EXPECT_NEAR(std::abs(result.geometry.normal[0].x()), 1.0f, 1e-4f);
+  const double spacing = 0.01;
+  EXPECT_LT(result.geometry.footprint_m[400], 5.0 * spacing) << "no splat across the 3 m gap";
 }
 
 }  // namespace

@@ -304,7 +304,7 @@ TEST(Cli, RefusedImportLeavesTheProjectUnchanged) {
   EXPECT_EQ(info_json(dir, project), before);
 }
 
-TEST(Cli, E57ImportReportsUnplacedPointsAndImagesAndExportsBack) {
+TEST(Cli, E57ImportReportsUnplacedRecordsAndImagesAndExportsBack) {
   ScratchDir dir;
   const std::string project = (dir / "p.sbproj").string();
   const CliResult imported =
@@ -312,12 +312,15 @@ TEST(Cli, E57ImportReportsUnplacedPointsAndImagesAndExportsBack) {
                     fixture("good/e57/unstructured_cartesian.e57").string()});
   ASSERT_EQ(imported.exit_code, 0) << imported.err;
   EXPECT_THAT(imported.out, ::testing::HasSubstr("2 image(s) stored with the scans"));
-  EXPECT_THAT(imported.out, ::testing::HasSubstr("3 point(s) not placed in the scan grids"));
+  EXPECT_THAT(imported.out, ::testing::HasSubstr("1 record(s) not placed in the scan grids"));
   const nlohmann::json info = info_json(dir, project);
   ASSERT_EQ(info["scans"].size(), 2u);
   EXPECT_EQ(info["scans"][0]["source"]["unplaced_points"], 1);
-  EXPECT_EQ(info["scans"][1]["source"]["unplaced_points"], 2);
+  EXPECT_EQ(info["scans"][1]["source"]["unplaced_points"], 0) << "an unstructured scan keeps all";
   EXPECT_EQ(info["scans"][1]["source"]["points_in_file"], 605);
+  EXPECT_EQ(info["scans"][1]["valid_points"], 602) << "all but the 3 records without a return";
+  EXPECT_EQ(info["scans"][1]["layout"], "scattered");
+  EXPECT_EQ(info["scans"][0]["layout"], "grid");
   EXPECT_EQ(info["scans"][0]["source"]["guid"], "{scan-structured}");
   ASSERT_EQ(info["images"].size(), 2u);
   EXPECT_EQ(info["images"][0]["scan"], 1);

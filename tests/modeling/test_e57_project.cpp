@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "modeling/export_command.hpp"
 #include "modeling/import_command.hpp"
+#include "modeling/selection_commands.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::modeling {
@@ -145,6 +146,36 @@ TEST(E57Project, TheCoordinateSystemGoesBackOutAndIsNeverMixed) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("another coordinate system"));
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "two_systems.e57"));
+}
+
+TEST(E57Project, AnUnstructuredCloudComesBackWholeInItsOrder) {
+  const ScratchDir dir;
+  import_files(dir / "a.sbproj", {fixture("good/e57/unstructured_sphere.e57")});
+  const auto file = export_e57(dir / "a.sbproj", dir / "a.e57");
+  const ImportResult again = import_files(dir / "b.sbproj", {file});
+  EXPECT_EQ(again.unplaced_points, 0u);
+  expect_same_scans(dir / "a.sbproj", dir / "b.sbproj");
+  const store::Project b = store::Project::open_for_reading(dir / "b.sbproj");
+  EXPECT_TRUE(b.load_scan(1).is_scattered());
+  EXPECT_EQ(b.scan_sources().at(1).points_in_file, 4000u) << "one record per point, no padding";
+}
+
+TEST(E57Project, GridOnlyToolsSayAnUnstructuredCloudHasNoGrid) {
+  const ScratchDir dir;
+  import_files(dir / "a.sbproj", {fixture("good/e57/unstructured_sphere.e57")});
+  ExportSettings ptx;
+  ptx.format = ExportFormat::kPtx;
+  ptx.output = dir / "a.ptx";
+  EXPECT_THAT([&] { export_project(store::Project::open_for_reading(dir / "a.sbproj"), ptx); },
+              ::testing::ThrowsMessage<core::InputError>(
+                  ::testing::HasSubstr("is an unstructured cloud, and a PTX holds scan grids")));
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.ptx"));
+  segmentation::PixelSet selection;
+  SelectSettings seed;
+  seed.scan_id = 1;
+  EXPECT_THAT([&] { select_region(store::Project::open(dir / "a.sbproj"), seed, selection); },
+              ::testing::ThrowsMessage<core::InputError>(
+                  ::testing::HasSubstr("is an unstructured cloud (imported without a scan grid)")));
 }
 
 TEST(E57Project, ABadFileChangesNothing) {

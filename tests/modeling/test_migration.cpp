@@ -37,15 +37,36 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
+// fixtures/projects/version9.sbproj: version8.sbproj (below) opened by the
+// build that introduced version 9, then fixtures/good/e57/unstructured_sphere.e57
+// imported: an unstructured cloud of 4 000 points kept as a scattered scan.
+TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsScatteredScan) {
+  static_assert(store::kProjectSchemaVersion == 9, "add fixtures/projects/version10.sbproj");
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 9);
+  const std::string before = test::read_file_bytes(file);
+  {
+    const store::Project project = store::Project::open(file);
+    const std::vector<store::StoredScanSummary> scans = project.scans();
+    ASSERT_EQ(scans.size(), 6u);
+    EXPECT_FALSE(scans[4].summary.scattered);
+    EXPECT_TRUE(scans[5].summary.scattered);
+    EXPECT_EQ(scans[5].summary.valid_points, 4000u);
+    const acquisition::Scan sphere = project.load_scan(scans[5].id);
+    EXPECT_TRUE(sphere.is_scattered());
+    EXPECT_EQ(acquisition::check_consistency(sphere), "");
+    EXPECT_TRUE(project.check().damage.empty());
+  }
+  EXPECT_EQ(test::read_file_bytes(file), before);
+}
+
 // fixtures/projects/version8.sbproj: version7.sbproj (below) opened by the
 // build that introduced version 8, then fixtures/good/ptx/georef_world_1e5.ptx
 // imported as station.ptx (its source file recorded), the groups "site" and
 // "annex" made by one script, and the second undone.
-TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournalIndexed) {
-  static_assert(store::kProjectSchemaVersion == 8, "add fixtures/projects/version9.sbproj");
+TEST(Migration, VersionEightKeepsItsJournalIndexedAndItsScansAreGrids) {
   const ScratchDir dir;
   const auto file = migrated_copy(dir, 8);
-  const std::string before = test::read_file_bytes(file);
   {
     const store::Project project = store::Project::open(file);
     const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
@@ -58,7 +79,9 @@ TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsJournalIndexed
     EXPECT_EQ(history.back().state, store::CommandState::kUndone);
     ASSERT_EQ(project.object_nodes().size(), 3u);
   }
-  EXPECT_EQ(test::read_file_bytes(file), before);
+  for (const store::StoredScanSummary& s : store::Project::open(file).scans()) {
+    EXPECT_FALSE(s.summary.scattered) << s.summary.name;
+  }
   test::RawDatabase raw(file);
   for (const char* index : {"commands_undone", "commands_pending"}) {
     EXPECT_EQ(raw.text(std::string("SELECT name FROM sqlite_schema WHERE name = '") + index + "'"),

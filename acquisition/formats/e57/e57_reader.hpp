@@ -1,11 +1,10 @@
 // Reading ASTM E2807 (E57) files: every data3D entry becomes one scan, with
 // the images2D the file ties to it.
 //
-// Structured scans (rowIndex and columnIndex fields) keep their grid; a
-// scan without them is projected into a panoramic grid around its origin at
-// an angular step estimated from its points, each point keeping its exact
-// position (per-pixel directions), and the points that land on a pixel
-// already taken (the farther ones) are counted in ScanSource::unplaced_points.
+// Structured scans (rowIndex and columnIndex fields) keep their grid, and a
+// later return or a second record of a pixel already taken is counted in
+// ScanSource::unplaced_points. A scan without them becomes a scattered scan
+// (scan.hpp) that keeps every point with a return, in the file's order.
 // Coordinates may be spherical or cartesian, fields Float, ScaledInteger or
 // Integer of any width; the invalid-state fields mark pixels without a
 // return. Intensity becomes [0, 1] and colour 8 bits through the scan's

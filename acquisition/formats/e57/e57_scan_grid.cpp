@@ -7,7 +7,6 @@
 #include <optional>
 #include <string_view>
 
-#include "acquisition/formats/panorama_projection.hpp"
 #include "acquisition/local_origin.hpp"
 #include "acquisition/spherical_fit.hpp"
 #include "core/errors.hpp"
@@ -359,10 +358,11 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
 
 ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanEntry& entry,
                                const PointFields& fields) {
-  // Each point with its angles and channels, and up to 4 pixels of grid
-  // for it: about 200 bytes per record.
-  core::check_memory(entry.points.record_count * 200, path.string());
-  // The returns, compactly, with their channels.
+  // Each point in double, its channels, and the scattered scan's own
+  // channels and directions: about 64 bytes per record.
+  core::check_memory(entry.points.record_count * 64, path.string());
+  // The returns in the file's order, compactly, with their channels: a
+  // scattered scan keeps every one (scan.hpp).
   std::vector<Eigen::Vector3d> points;
   Scan channels = make_empty_scan(0, 0, static_cast<bool>(fields.intensity),
                                   static_cast<bool>(fields.color[0]));
@@ -381,22 +381,12 @@ ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanE
     if (fields.color[0]) channels.rgb.resize(3 * points.size());
     fill_pixels(block, slot, scales, channels);
   });
-  const PanoramaProjection projection = project_to_panorama(points);
   ImportedScan out;
-  out.source.unplaced_points = projection.collisions;
   Scan& scan = out.scan;
-  scan = make_empty_scan(projection.rows, projection.columns, static_cast<bool>(fields.intensity),
-                         static_cast<bool>(fields.color[0]));
-  std::vector<Eigen::Vector3d> points_file(scan.pixel_count(), Eigen::Vector3d::Zero());
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const std::int64_t p = projection.pixel[k];
-    if (p < 0) continue;
-    scan.valid[p] = 1;
-    points_file[p] = points[k];
-    if (scan.has_intensity()) scan.intensity[p] = channels.intensity[k];
-    if (scan.has_color()) std::copy_n(&channels.rgb[3 * k], 3, &scan.rgb[3 * p]);
-  }
-  set_grid_from_points(scan, points_file, std::nullopt);
+  scan = make_scattered_scan(points.size(), channels.has_intensity(), channels.has_color());
+  std::copy(channels.intensity.begin(), channels.intensity.end(), scan.intensity.begin());
+  std::copy(channels.rgb.begin(), channels.rgb.end(), scan.rgb.begin());
+  set_scattered_points(scan, points);
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <set>
@@ -50,12 +51,13 @@ std::vector<E57Field> scan_fields(const Scan& scan, double max_range_m) {
   range.minimum = 0;
   range.maximum = static_cast<std::int64_t>(std::ceil(max_range_m / kRangeScaleM)) + 1;
   std::vector<E57Field> fields = {
-      range,
-      float_field("sphericalAzimuth", false, -std::numbers::pi, std::numbers::pi),
-      float_field("sphericalElevation", false, -std::numbers::pi / 2, std::numbers::pi / 2),
-      integer_field("rowIndex", 0, std::max(scan.rows - 1, 0)),
-      integer_field("columnIndex", 0, std::max(scan.columns - 1, 0)),
-      integer_field("sphericalInvalidState", 0, 2)};
+      range, float_field("sphericalAzimuth", false, -std::numbers::pi, std::numbers::pi),
+      float_field("sphericalElevation", false, -std::numbers::pi / 2, std::numbers::pi / 2)};
+  if (!scan.is_scattered()) {
+    fields.push_back(integer_field("rowIndex", 0, std::max(scan.rows - 1, 0)));
+    fields.push_back(integer_field("columnIndex", 0, std::max(scan.columns - 1, 0)));
+  }
+  fields.push_back(integer_field("sphericalInvalidState", 0, 2));
   if (scan.has_intensity()) fields.push_back(float_field("intensity", true, 0.0, 1.0));
   if (scan.has_color()) {
     for (const char* name : {"colorRed", "colorGreen", "colorBlue"}) {
@@ -81,24 +83,41 @@ bool pixel_angles(const Scan& scan, int row, int col, double& azimuth, double& e
   return true;
 }
 
-E57RecordSource record_values(const E57ScanOutput& output) {
-  return [&output](std::uint64_t first, std::uint64_t count,
-                   std::vector<std::vector<double>>& columns) {
+bool written_as_valid(const E57ScanOutput& output, std::size_t p) {
+  return output.scan->valid[p] && (output.keep == nullptr || (*output.keep)[p]);
+}
+
+// The pixels a scan's records hold, in order: every pixel of a grid (the
+// reader gets the grid back whole), the written points of a scattered scan.
+std::vector<std::size_t> record_pixels(const E57ScanOutput& output) {
+  std::vector<std::size_t> pixels;
+  for (std::size_t p = 0; p < output.scan->pixel_count(); ++p) {
+    if (!output.scan->is_scattered() || written_as_valid(output, p)) pixels.push_back(p);
+  }
+  return pixels;
+}
+
+E57RecordSource record_values(const E57ScanOutput& output,
+                              std::shared_ptr<const std::vector<std::size_t>> pixels) {
+  return [&output, pixels](std::uint64_t first, std::uint64_t count,
+                           std::vector<std::vector<double>>& columns) {
     const Scan& scan = *output.scan;
     for (std::uint64_t k = 0; k < count; ++k) {
-      const std::size_t p = first + k;
+      const std::size_t p = (*pixels)[first + k];
       const int row = static_cast<int>(p / scan.columns);
       const int col = static_cast<int>(p % scan.columns);
       double azimuth = 0.0, elevation = 0.0;
       const bool known = pixel_angles(scan, row, col, azimuth, elevation);
-      const bool valid = scan.valid[p] && (output.keep == nullptr || (*output.keep)[p]);
-      columns[0][k] = valid ? scan.range_m[p] : 0.0;
-      columns[1][k] = azimuth;
-      columns[2][k] = elevation;
-      columns[3][k] = row;
-      columns[4][k] = col;
-      columns[5][k] = valid ? 0.0 : known ? 1.0 : 2.0;
-      std::size_t f = 6;
+      const bool valid = written_as_valid(output, p);
+      std::size_t f = 0;
+      columns[f++][k] = valid ? scan.range_m[p] : 0.0;
+      columns[f++][k] = azimuth;
+      columns[f++][k] = elevation;
+      if (!scan.is_scattered()) {
+        columns[f++][k] = row;
+        columns[f++][k] = col;
+      }
+      columns[f++][k] = valid ? 0.0 : known ? 1.0 : 2.0;
       if (scan.has_intensity()) columns[f++][k] = scan.intensity[p];
       if (scan.has_color()) {
         for (int c = 0; c < 3; ++c) columns[f++][k] = scan.rgb[3 * p + c];
@@ -152,14 +171,17 @@ E57ScanEntry scan_entry(E57PageWriter& file, const E57ScanOutput& output, const 
   entry.name = scan.name;
   entry.sensor_model = scan.scanner.name;
   entry.pose = scan.T_world_scan;
-  entry.index_bounds =
-      E57IndexBounds{0, std::max(scan.rows - 1, 0), 0, std::max(scan.columns - 1, 0), 0, 0};
+  if (!scan.is_scattered()) {
+    entry.index_bounds =
+        E57IndexBounds{0, std::max(scan.rows - 1, 0), 0, std::max(scan.columns - 1, 0), 0, 0};
+  }
   if (scan.has_intensity()) entry.intensity_limits = std::pair{0.0, 1.0};
   if (scan.has_color()) entry.color_limits = {{{0.0, 255.0}, {0.0, 255.0}, {0.0, 255.0}}};
   entry.points.fields = scan_fields(scan, max_range(scan, name));
-  entry.points.record_count = scan.pixel_count();
-  entry.points.file_offset =
-      write_e57_points(file, entry.points.fields, entry.points.record_count, record_values(output));
+  auto pixels = std::make_shared<const std::vector<std::size_t>>(record_pixels(output));
+  entry.points.record_count = pixels->size();
+  entry.points.file_offset = write_e57_points(file, entry.points.fields, entry.points.record_count,
+                                              record_values(output, pixels));
   return entry;
 }
 

@@ -2,8 +2,9 @@
 // columnIndex) in spherical coordinates, the range as a ScaledInteger of
 // 0.1 mm and the angles as doubles, with intensity, colour, the invalid
 // state of every pixel, the pose, index bounds, limits, GUIDs and the
-// scan's images. Every pixel of the grid is one record, so that a reader
-// gets the grid back whole.
+// scan's images. Every pixel of a grid is one record, so that a reader
+// gets the grid back whole; a scattered scan (scan.hpp) is written as an
+// unstructured one, without indices, one record per point.
 #pragma once
 
 #include <cstdint>

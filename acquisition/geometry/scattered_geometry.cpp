@@ -1,0 +1,151 @@
+#include "acquisition/geometry/scattered_geometry.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <nanoflann.hpp>
+
+#include "core/parallel.hpp"
+#include "core/timing.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+constexpr std::size_t kNear = 16;  // neighbours of the first fit (the point itself included)
+constexpr std::size_t kWide = 64;  // of the second, where the first spans no plane
+constexpr std::size_t kFootprintNeighbour = 4;
+constexpr float kGapFactor = 3.0f;
+constexpr float kFootprintFactor = 0.75f;
+constexpr int kBlock = 4096;  // points per parallel task
+
+// nanoflann's view of the points.
+struct Cloud {
+  const std::vector<Eigen::Vector3f>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][dim]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using Tree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3>;
+
+struct Fit {
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+  std::size_t used = 0;
+  bool planar = false;
+};
+
+// Plane through the found neighbours nearer than the gap limit.
+Fit fit_plane(const std::vector<Eigen::Vector3f>& points, const std::uint32_t* found,
+              const float* squared_distance, std::size_t count, float limit_squared) {
+  Fit fit;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < count && squared_distance[k] <= limit_squared; ++k) {
+    mean += points[found[k]].cast<double>();
+    ++fit.used;
+  }
+  if (fit.used < 3) return fit;
+  mean /= static_cast<double>(fit.used);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < fit.used; ++k) {
+    const Eigen::Vector3d d = points[found[k]].cast<double>() - mean;
+    covariance += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  const Eigen::Vector3d lambda = solver.eigenvalues();  // ascending
+  // A plane: the second spread well above the thickness, and the points
+  // not on a line.
+  fit.planar = lambda[1] > 4.0 * lambda[0] && lambda[1] > 1e-4 * lambda[2];
+  fit.normal = solver.eigenvectors().col(0).cast<float>();
+  return fit;
+}
+
+}  // namespace
+
+GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings) {
+  assert(scan.is_scattered() && "a scattered scan");
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n = count_valid(scan);  // the points fill pixels 0 … n − 1
+  std::vector<Eigen::Vector3f> points(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    points[i] = scan.range_m[i] * std::get<PerPixelDirections>(scan.angles).directions[i];
+  }
+  GeometryResult result;
+  ScanGeometry& g = result.geometry;
+  const std::size_t pixels = scan.pixel_count();
+  g.footprint_m.assign(pixels, 0.0f);
+  g.normal.assign(pixels, Eigen::Vector3f::Zero());
+  g.confidence.assign(pixels, 0.0f);
+  g.flags.assign(pixels, 0);
+  const Cloud cloud{points};
+  const Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  const std::size_t near = std::min(kNear, n), wide = std::min(kWide, n);
+  const int blocks = static_cast<int>((n + kBlock - 1) / kBlock);
+  const auto for_each_point = [&](auto&& body) {
+    core::parallel_for_index(blocks, settings.threads, [&](int block) {
+      const std::size_t end = std::min(n, static_cast<std::size_t>(block + 1) * kBlock);
+      for (std::size_t i = static_cast<std::size_t>(block) * kBlock; i < end; ++i) body(i);
+    });
+  };
+  // Each point's sampling scale: the distance to its 4th nearest neighbour.
+  std::vector<float> scale(n, 0.0f);
+  for_each_point([&](std::size_t i) {
+    std::array<std::uint32_t, kFootprintNeighbour + 1> found{};
+    std::array<float, kFootprintNeighbour + 1> squared{};
+    const std::size_t count = tree.knnSearch(points[i].data(), std::min(kFootprintNeighbour + 1, n),
+                                             found.data(), squared.data());
+    scale[i] = std::sqrt(squared[count - 1]);
+  });
+  std::atomic<std::size_t> normals{0};
+  for_each_point([&](std::size_t i) {
+    std::array<std::uint32_t, kWide> found{};
+    std::array<float, kWide> squared{};
+    const float* query = points[i].data();
+    std::size_t count = tree.knnSearch(query, near, found.data(), squared.data());
+    // A point much farther from its neighbours than they are from theirs
+    // stands alone (an outlier, a stray return): no surface, and a
+    // footprint at its neighbours' scale, not one that bridges the gap.
+    std::array<float, kNear> around{};
+    for (std::size_t k = 1; k < count; ++k) around[k - 1] = scale[found[k]];
+    const auto middle = around.begin() + static_cast<std::ptrdiff_t>((count - 1) / 2);
+    std::nth_element(around.begin(), middle,
+                     around.begin() + static_cast<std::ptrdiff_t>(count - 1));
+    const float local = count > 1 ? *middle : scale[i];
+    const bool alone = scale[i] > kGapFactor * local;
+    g.footprint_m[i] = kFootprintFactor * std::min(scale[i], kGapFactor * local);
+    const float limit = kGapFactor * kGapFactor * scale[i] * scale[i];
+    Fit fit = fit_plane(points, found.data(), squared.data(), count, limit);
+    if (!fit.planar && wide > near) {
+      count = tree.knnSearch(query, wide, found.data(), squared.data());
+      fit = fit_plane(points, found.data(), squared.data(), count, limit);
+    }
+    const Eigen::Vector3f towards_viewpoint = -points[i].normalized();
+    if (alone || !fit.planar || fit.used < static_cast<std::size_t>(settings.min_neighbours) ||
+        !fit.normal.allFinite() || !towards_viewpoint.allFinite()) {
+      g.flags[i] |= kFlagNoNormal;
+      return;
+    }
+    if (fit.normal.dot(towards_viewpoint) < 0.0f) fit.normal = -fit.normal;
+    g.normal[i] = fit.normal;
+    const float share = static_cast<float>(fit.used) / static_cast<float>(count);
+    g.confidence[i] = std::max(1e-6f, share * fit.normal.dot(towards_viewpoint));
+    ++normals;
+  });
+  result.valid_points = n;
+  result.normals = normals;
+  result.seconds = core::seconds_since(start);
+  return result;
+}
+
+float scattered_sample_area_m2(float footprint_m) {
+  const float step = footprint_m / kFootprintFactor;
+  return step * step;
+}
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,34 @@
+// Per-point geometry of a scattered scan (scan.hpp), which has no grid to
+// take neighbours from: each point's neighbours are its k nearest in space.
+// The outputs mean what they mean for a grid (scan_geometry.hpp), so every
+// later stage reads them alike.
+#pragma once
+
+#include "acquisition/geometry/scan_geometry.hpp"
+#include "acquisition/scan.hpp"
+
+namespace scanbench::acquisition {
+
+// For every point: a plane fitted to its 16 nearest neighbours (to its 64
+// where 16 do not span a plane above the noise), leaving out those farther
+// than 3 × the distance to its 4th nearest (across a gap, they sample
+// another surface); the normal is oriented towards the scan frame's origin,
+// the viewpoint as far as the file tells (a scanner's position, or the
+// origin a unified cloud was exported in). The footprint is 3/4 of the
+// distance to the 4th nearest neighbour (on a regular sampling of step s,
+// 0.75 s closes the gap as the grid's half cell diagonal, 0.71 s, does;
+// distances between points already include a slanted surface's stretch,
+// so there is no incidence factor). A point whose distance to its 4th
+// nearest exceeds 3 × the median of its neighbours' stands alone (a stray
+// return): no normal, and a footprint of at most 3 × that median, not one
+// that bridges the gap. Confidence is the share of neighbours the fit kept
+// times the cosine of the incidence angle.
+// Mixed pixels and depth edges are properties of a beam's neighbours in a
+// grid: none is flagged. Asserts scan.is_scattered().
+GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings);
+
+// The surface [m²] a point of a scattered scan stands for: the square of
+// the sampling step its footprint was made from.
+float scattered_sample_area_m2(float footprint_m);
+
+}  // namespace scanbench::acquisition
