@@ -1,5 +1,6 @@
 #include "acquisition/local_origin.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <vector>
@@ -48,7 +49,8 @@ Eigen::Vector3d centroid_origin(std::span<const Eigen::Vector3d> points,
     for (std::size_t i = 0; i < points.size() && clear; ++i) {
       if (valid[i] && (points[i] - origin).norm() < kMinRangeM) clear = false;
     }
-    if (!clear) origin.z() += 1.0;
+    // A metre, or the next double where a metre is below its precision.
+    if (!clear) origin.z() = std::max(origin.z() + 1.0, std::nextafter(origin.z(), HUGE_VAL));
   }
   return origin;
 }
@@ -108,12 +110,11 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
   return result;
 }
 
-LocalOriginResult set_scattered_points(Scan& scan, std::span<const Eigen::Vector3d> points_file) {
+LocalOriginResult set_scattered_points(Scan& scan, std::vector<Eigen::Vector3d> points_file) {
   assert(scan.is_scattered() && points_file.size() == count_valid(scan) &&
          "one point per valid pixel of a scattered scan");
-  std::vector<Eigen::Vector3d> padded(points_file.begin(), points_file.end());
-  padded.resize(scan.pixel_count(), Eigen::Vector3d::Zero());
-  return set_grid_from_points(scan, padded, std::nullopt);
+  points_file.resize(scan.pixel_count(), Eigen::Vector3d::Zero());  // the last row's padding
+  return set_grid_from_points(scan, points_file, std::nullopt);
 }
 
 }  // namespace scanbench::acquisition

@@ -61,7 +61,9 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
 // The same for a scattered scan (make_scattered_scan), whose k-th valid
 // pixel takes points_file[k]: per-pixel directions from the file frame's
 // origin, or from the points' centroid when they lie far from it. Asserts
-// one point per valid pixel.
-LocalOriginResult set_scattered_points(Scan& scan, std::span<const Eigen::Vector3d> points_file);
+// one point per valid pixel. The points are taken (moved in, they are not
+// copied) and padded to the grid: a reader that reserves
+// scattered_pixel_count(n) spares a reallocation.
+LocalOriginResult set_scattered_points(Scan& scan, std::vector<Eigen::Vector3d> points_file);
 
 }  // namespace scanbench::acquisition

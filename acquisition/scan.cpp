@@ -20,9 +20,23 @@ Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color
   return scan;
 }
 
-Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_color) {
+namespace {
+
+// A grid about as wide as tall.
+std::pair<std::size_t, std::size_t> scattered_grid(std::size_t points) {
   const auto columns = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(points))));
-  const std::size_t rows = columns == 0 ? 0 : (points + columns - 1) / columns;
+  return {columns == 0 ? 0 : (points + columns - 1) / columns, columns};
+}
+
+}  // namespace
+
+std::size_t scattered_pixel_count(std::size_t points) {
+  const auto [rows, columns] = scattered_grid(points);
+  return rows * columns;
+}
+
+Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_color) {
+  const auto [rows, columns] = scattered_grid(points);
   assert(rows < (1u << 31) && columns < (1u << 31) && "a scattered scan of at most 2^62 points");
   Scan scan = make_empty_scan(static_cast<int>(rows), static_cast<int>(columns), with_intensity,
                               with_color);

@@ -104,6 +104,14 @@ Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color
 // geometry (set_grid_from_points). Asserts points < 2^31 · 2^31.
 Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_color);
 
+// The pixels of such a scan: its points and the padding of its last row.
+std::size_t scattered_pixel_count(std::size_t points);
+
+// Readers refuse coordinates farther than this from their file's origin
+// [m]: no survey reaches them (UTM northings stay below 10^7 m), and a
+// corrupt value or scale would otherwise pass as a point.
+inline constexpr double kMaxCoordinateM = 1e8;
+
 // Unit viewing direction of pixel (row, col) in the scan frame. For per-pixel
 // grids this is the stored direction (zero when unknown). Every per-pixel
 // accessor below asserts 0 ≤ row < rows and 0 ≤ col < columns.

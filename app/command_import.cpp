@@ -42,9 +42,9 @@ void add_import_command(CLI::App& app) {
   auto options = std::make_shared<ImportOptions>();
   CLI::App* command = app.add_subcommand(
       "import",
-      "Import raw scans (Leica .ptx, ASTM E57 .e57, image-triplet .json sidecars, organized "
-      ".pcd) into a "
-      "project, creating it when missing. All files of one call go in one transaction: "
+      "Import raw scans (Leica .ptx, ASTM E57 .e57, image-triplet .json sidecars, .pcd, and the "
+      "unstructured clouds of .las and .ply, kept whole) into a project, creating it when "
+      "missing. All files of one call go in one transaction: "
       "on any error the project is left unchanged.");
   command->add_option("project", options->project, "Project file (.sbproj)")->required();
   command->add_option("files", options->files, "Scan files")->required()->check(CLI::ExistingFile);

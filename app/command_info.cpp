@@ -192,7 +192,7 @@ void add_info_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "info",
       "Describe the scans and images of a project or of a raw scan file (.ptx, .e57, .json, "
-      ".pcd).");
+      ".pcd, .ply, .las).");
   command->add_option("path", options->path, "Project (.sbproj) or scan file")
       ->required()
       ->check(CLI::ExistingPath);

@@ -14,7 +14,10 @@
 
 #include "acquisition/formats/e57/e57_reader.hpp"
 #include "acquisition/formats/e57/e57_writer.hpp"
+#include "acquisition/formats/las_reader.hpp"
 #include "acquisition/formats/pcd_reader.hpp"
+#include "acquisition/formats/ply_reader.hpp"
+#include "acquisition/formats/point_export.hpp"
 #include "acquisition/formats/ptx_reader.hpp"
 #include "acquisition/formats/ptx_writer.hpp"
 #include "bench/pcl_io.hpp"
@@ -105,7 +108,7 @@ void write_ascii_pcd(const std::filesystem::path& path, const Scan& scan,
 // Our PCD reader against PCL's two on one file (single-threaded, all three):
 // points per second, best of `repeats`.
 nlohmann::json compare_pcd_readers(const std::filesystem::path& pcd, double points, int repeats) {
-  const double ours = best_seconds(repeats, [&] { acquisition::read_organized_pcd(pcd); });
+  const double ours = best_seconds(repeats, [&] { acquisition::read_pcd(pcd); });
   const double pcl_xyzi = best_seconds(repeats, [&] { read_pcd_xyzi_with_pcl(pcd); });
   const double pcl_blob = best_seconds(repeats, [&] { read_pcd_blob_with_pcl(pcd); });
   return {
@@ -145,6 +148,15 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
   const double e57_read_s = best_seconds(
       repeats, [&] { acquisition::read_e57(e57, [](acquisition::ImportedScan&&) {}, {}); });
   const double e57_bytes = static_cast<double>(std::filesystem::file_size(e57));
+  // The unstructured exchange formats: the scan's valid points written by
+  // our exporters, read back into a scattered scan (one thread).
+  const std::filesystem::path las = dir / "room.las", ply = dir / "room.ply";
+  const std::uint16_t source_id = 1;
+  acquisition::write_las(las, {&scan, 1}, {&source_id, 1});
+  acquisition::write_ply(ply, {&scan, 1});
+  const double valid_points = static_cast<double>(acquisition::count_valid(scan));
+  const double las_read_s = best_seconds(repeats, [&] { acquisition::read_las(las); });
+  const double ply_read_s = best_seconds(repeats, [&] { acquisition::read_ply(ply); });
   const nlohmann::json pcd_ascii = compare_pcd_readers(ascii_pcd, points, repeats);
   const nlohmann::json pcd_binary = compare_pcd_readers(binary_pcd, points, repeats);
 
@@ -176,6 +188,11 @@ nlohmann::json run_io_bench(const BenchOptions& options) {
           {"e57_read_mb_per_s", e57_bytes / 1e6 / e57_read_s},
           {"e57_write_points_per_s", points / e57_write_s},
           {"e57_read_speedup_vs_ptx", read_s / e57_read_s},
+          {"las_points", valid_points},
+          {"las_bytes", std::filesystem::file_size(las)},
+          {"las_read_points_per_s", valid_points / las_read_s},
+          {"ply_bytes", std::filesystem::file_size(ply)},
+          {"ply_read_points_per_s", valid_points / ply_read_s},
           {"pcd_ascii", pcd_ascii},
           {"pcd_binary", pcd_binary},
           {"project_store_seconds", store_s},

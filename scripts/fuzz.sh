@@ -13,8 +13,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(fuzz_ptx fuzz_pcd fuzz_triplet fuzz_e57 fuzz_project fuzz_view
-  fuzz_script fuzz_replay)
+[ ${#targets[@]} -eq 0 ] && targets=(fuzz_ptx fuzz_pcd fuzz_triplet fuzz_e57 fuzz_ply fuzz_las
+  fuzz_project fuzz_view fuzz_script fuzz_replay)
 build=${FUZZ_BUILD_DIR:-$root/build-fuzz}
 
 "$root/scripts/install-deps.sh"
@@ -29,6 +29,8 @@ seed() {  # target -> the fixtures its corpus starts from
     fuzz_pcd) ls "$root"/fixtures/good/pcd/*.pcd "$root"/fixtures/bad/pcd_*.pcd ;;
     fuzz_triplet) ls "$root"/fixtures/good/triplet/*.json "$root"/fixtures/bad/triplet_*.json ;;
     fuzz_e57) ls "$root"/fixtures/good/e57/*.e57 "$root"/fixtures/bad/e57_*.e57 ;;
+    fuzz_ply) ls "$root"/fixtures/good/ply/*.ply ;;
+    fuzz_las) ls "$root"/fixtures/good/las/*.las ;;
     fuzz_project) ls "$root"/fixtures/projects/*.sbproj "$root"/fixtures/bad/project_*.sbproj ;;
     fuzz_view) ls "$root"/scripts/views/*.json "$root"/fixtures/bad/view_*.json ;;
     fuzz_script) ls "$root"/scripts/*.json "$root"/fixtures/bad/script_*.json ;;
@@ -41,6 +43,7 @@ max_len() {  # projects hold compressed layers; the text readers' inputs are sma
 dictionary() {
   case $1 in
     fuzz_ptx) echo ptx ;; fuzz_pcd) echo pcd ;; fuzz_triplet) echo triplet ;; fuzz_e57) echo e57 ;;
+    fuzz_ply) echo ply ;; fuzz_las) echo las ;;
     fuzz_project) echo project ;; fuzz_view) echo view ;; fuzz_script) echo script ;;
     fuzz_replay) echo replay ;;
   esac

@@ -169,11 +169,12 @@ void check_dimensions(TextLineReader& reader, const Lines& h, PcdHeader& out) {
   out.points = *h.points;
   out.height = h.height.value_or(1);
   out.width = h.width.value_or(out.points);
-  if (out.height <= 1) {
-    reader.fail("not an organized point cloud (height " + std::to_string(out.height) + ")");
+  if (out.width == 0 || out.height == 0 || out.points == 0) {
+    reader.fail("empty point cloud (no points)");
   }
-  if (out.width == 0 || out.points == 0) reader.fail("empty point cloud (no points)");
-  if (out.width > kMaxSide || out.height > kMaxSide || out.points > kMaxPoints) {
+  // An unorganized cloud (HEIGHT 1) is one row of any length.
+  const bool organized = out.height > 1;
+  if ((organized && out.width > kMaxSide) || out.height > kMaxSide || out.points > kMaxPoints) {
     reader.fail("absurd dimensions (more than 1000000 a side or 2^31 points)");
   }
   if (out.width * out.height != out.points) {

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "acquisition/formats/lzf.hpp"
@@ -207,7 +208,6 @@ std::vector<std::uint8_t> read_compressed_body(const Body& source, const PcdHead
 
 // Coordinates beyond this [m] are no place on or near the Earth: a corrupt
 // value, refused before it makes a range that no float holds.
-constexpr double kMaxCoordinateM = 1e8;
 
 // Refuses a point whose values do not fit what the scan stores.
 void check_fits(TextLineReader& reader, const Eigen::Vector3d& p, double intensity, std::size_t i,
@@ -237,6 +237,26 @@ Eigen::Vector3d coordinates(const std::uint8_t* point, const Fields& f, bool flo
           value_at(point + f.z->offset, *f.z)};
 }
 
+// An unorganized cloud (HEIGHT 1) read as one row: its points with a
+// return, in the file's order, as a scattered scan (scan.hpp).
+Scan scattered(const Scan& row, const std::vector<Eigen::Vector3d>& points) {
+  std::vector<Eigen::Vector3d> returns;
+  returns.reserve(scattered_pixel_count(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (row.valid[i]) returns.push_back(points[i]);
+  }
+  Scan scan = make_scattered_scan(returns.size(), row.has_intensity(), row.has_color());
+  for (std::size_t i = 0, k = 0; i < points.size(); ++i) {
+    if (!row.valid[i]) continue;
+    if (row.has_intensity()) scan.intensity[k] = row.intensity[i];
+    if (row.has_color()) std::copy_n(&row.rgb[3 * i], 3, &scan.rgb[3 * k]);
+    ++k;
+  }
+  scan.T_world_scan = row.T_world_scan;
+  set_scattered_points(scan, std::move(returns));
+  return scan;
+}
+
 Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, const PcdHeader& h,
              const Fields& f) {
   Scan scan = make_empty_scan(static_cast<int>(h.height), static_cast<int>(h.width),
@@ -264,6 +284,7 @@ Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, cons
     }
   }
   scan.T_world_scan = h.viewpoint;
+  if (h.height == 1) return scattered(scan, points);
   LocalOriginSettings grid;
   grid.try_spherical = false;  // depth-camera grids are pinhole images, not panoramas
   set_grid_from_points(scan, points, std::nullopt, grid);
@@ -272,7 +293,7 @@ Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, cons
 
 }  // namespace
 
-Scan read_organized_pcd(const std::filesystem::path& path) {
+Scan read_pcd(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
     const std::u8string utf8 = path.u8string();

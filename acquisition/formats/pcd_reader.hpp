@@ -1,5 +1,6 @@
-// Reading organized point clouds (structured-light and depth-camera captures)
-// from PCD files into a Scan with per-pixel directions. Our own reader of
+// Reading PCD files: organized point clouds (structured-light and
+// depth-camera captures) into a Scan with per-pixel directions, unorganized
+// ones (HEIGHT 1) into a scattered scan (scan.hpp). Our own reader of
 // PCL's format (pcd_header.hpp); `scanbench bench io` compares it with PCL's.
 #pragma once
 
@@ -9,10 +10,11 @@
 
 namespace scanbench::acquisition {
 
-// Reads an organized PCD file (DATA ascii, binary or binary_compressed).
+// Reads a PCD file (DATA ascii, binary or binary_compressed).
 //
 // Grid: rows = HEIGHT, columns = WIDTH; point i of the file is pixel
-// (i / WIDTH, i % WIDTH). Fields x, y, z (float, count 1) are required; an
+// (i / WIDTH, i % WIDTH). With HEIGHT 1 the cloud is unorganized: its
+// points with a return become a scattered scan, in the file's order. Fields x, y, z (float, count 1) are required; an
 // "rgb" or "rgba" field (4 bytes, packed 0x00RRGGBB as float or uint32) fills
 // Scan::rgb and an "intensity" field (any numeric type) fills Scan::intensity,
 // as the file gives it. Every other field is ignored.
@@ -30,13 +32,13 @@ namespace scanbench::acquisition {
 //
 // Throws InputError naming the file, the header line where it applies, and the
 // problem, before loading any body, for: a missing or empty file, a header that
-// is not a PCD header, HEIGHT ≤ 1 ("not an organized point cloud"), absurd
-// dimensions (over 1,000,000 a side or 2^31 points), WIDTH × HEIGHT ≠ POINTS,
+// is not a PCD header, no points, absurd dimensions (an organized cloud over
+// 1,000,000 a side, HEIGHT over 1,000,000, or 2^31 points), WIDTH × HEIGHT ≠ POINTS,
 // missing or non-float x/y/z, a badly sized rgb field, a body shorter than the
 // header promises (truncated), a non-numeric or missing ASCII value, extra
 // ASCII points, a value that does not fit its field's type, a damaged
 // compressed body, and a VIEWPOINT that is non-finite, not numeric or whose
 // quaternion is not unit (within kRigidTolerance).
-Scan read_organized_pcd(const std::filesystem::path& path);
+Scan read_pcd(const std::filesystem::path& path);
 
 }  // namespace scanbench::acquisition

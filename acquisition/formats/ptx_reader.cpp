@@ -18,7 +18,6 @@ constexpr std::int64_t kMaxDimension = 1'000'000;
 // Coordinates beyond this [m] are no place on or near the Earth (geocentric
 // coordinates stay within 10^7 m): a corrupt value, refused before it makes a
 // range that no float holds.
-constexpr double kMaxCoordinateM = 1e8;
 constexpr std::int64_t kMaxPixels = std::int64_t{1} << 31;
 constexpr std::uint64_t kMinPointLineBytes = 8;  // "0 0 0 0\n"
 

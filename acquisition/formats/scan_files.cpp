@@ -4,7 +4,9 @@
 #include <cctype>
 
 #include "acquisition/formats/e57/e57_reader.hpp"
+#include "acquisition/formats/las_reader.hpp"
 #include "acquisition/formats/pcd_reader.hpp"
+#include "acquisition/formats/ply_reader.hpp"
 #include "acquisition/formats/triplet_reader.hpp"
 #include "core/errors.hpp"
 
@@ -16,12 +18,20 @@ ScanFileFormat scan_file_format(const std::filesystem::path& path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (extension == ".ptx") return ScanFileFormat::kPtx;
   if (extension == ".json") return ScanFileFormat::kTriplet;
-  if (extension == ".pcd") return ScanFileFormat::kOrganizedPcd;
+  if (extension == ".pcd") return ScanFileFormat::kPcd;
   if (extension == ".e57") return ScanFileFormat::kE57;
+  if (extension == ".ply") return ScanFileFormat::kPly;
+  if (extension == ".las") return ScanFileFormat::kLas;
+  if (extension == ".laz") {
+    throw core::InputError(path.string(), {},
+                           "a LAZ (LASzip-compressed) file, which scanbench cannot read: Debian "
+                           "does not package LASzip; decompress it to LAS first (laszip -i "
+                           "FILE.laz -o FILE.las, or pdal translate)");
+  }
   throw core::InputError(
       path.string(), {},
       "unknown scan file type \"" + extension +
-          "\" (expected .ptx, .pcd, .e57, or the .json sidecar of an image triplet)");
+          "\" (expected .ptx, .pcd, .e57, .ply, .las, or the .json sidecar of an image triplet)");
 }
 
 namespace {
@@ -52,11 +62,17 @@ void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& s
       on_scan(std::move(scan));
       return;
     }
-    case ScanFileFormat::kOrganizedPcd:
-      on_scan(plain(read_organized_pcd(path), "pcd"));
+    case ScanFileFormat::kPcd:
+      on_scan(plain(read_pcd(path), "pcd"));
       return;
     case ScanFileFormat::kE57:
       read_e57(path, on_scan, on_loose_image);
+      return;
+    case ScanFileFormat::kPly:
+      on_scan(read_ply(path));
+      return;
+    case ScanFileFormat::kLas:
+      on_scan(read_las(path));
       return;
   }
 }

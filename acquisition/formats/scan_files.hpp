@@ -12,10 +12,10 @@
 
 namespace scanbench::acquisition {
 
-enum class ScanFileFormat { kPtx, kTriplet, kOrganizedPcd, kE57 };
+enum class ScanFileFormat { kPtx, kTriplet, kPcd, kE57, kPly, kLas };
 
 // By extension, case-insensitive: .ptx, .json (an image triplet's sidecar),
-// .pcd, .e57. Throws InputError naming the file for any other extension.
+// .pcd, .e57, .ply, .las (.laz is refused by name: no LASzip on Debian). Throws InputError naming the file for any other extension.
 ScanFileFormat scan_file_format(const std::filesystem::path& path);
 
 struct ScanFileSettings {

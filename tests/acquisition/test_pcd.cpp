@@ -32,7 +32,7 @@ std::vector<std::uint8_t> rgb_of(const Scan& scan, std::size_t i) {
 }
 
 TEST(PcdReader, ReadsHandWrittenOrganizedAsciiWithExactValues) {
-  const Scan scan = read_organized_pcd(fixture("good/pcd/organized_ascii.pcd"));
+  const Scan scan = read_pcd(fixture("good/pcd/organized_ascii.pcd"));
   ASSERT_EQ(scan.rows, 3);
   ASSERT_EQ(scan.columns, 4);
   ASSERT_FALSE(scan.is_spherical());
@@ -56,8 +56,24 @@ TEST(PcdReader, ReadsHandWrittenOrganizedAsciiWithExactValues) {
                                                 0.375f, 0.875f, 0.5f}));
 }
 
+TEST(PcdReader, AnUnorganizedCloudKeepsEveryReturnInItsOrder) {
+  const Scan scan = read_pcd(fixture("good/pcd/unorganized_ascii.pcd"));
+  ASSERT_TRUE(scan.is_scattered());
+  ASSERT_TRUE(check_consistency(scan).empty()) << check_consistency(scan);
+  ASSERT_EQ(count_valid(scan), 10u) << "12 records, one NaN and one (0, 0, 0)";
+  const auto point = [&](std::size_t k) {
+    return point_in_world(scan, static_cast<int>(k) / scan.columns,
+                          static_cast<int>(k) % scan.columns);
+  };
+  EXPECT_LT((point(0) - Eigen::Vector3d(1, 0, 0)).norm(), 1e-6);
+  EXPECT_LT((point(3) - Eigen::Vector3d(3, 4, 0)).norm(), 1e-6);
+  EXPECT_LT((point(4) - Eigen::Vector3d(1, 2, 2)).norm(), 1e-6) << "the 7th record, 5th return";
+  EXPECT_EQ(rgb_of(scan, 3), (std::vector<std::uint8_t>{10, 20, 30}));
+  EXPECT_EQ(scan.intensity[4], 0.125f);
+}
+
 TEST(PcdReader, TakesPoseFromViewpointAndNameFromStem) {
-  const Scan scan = read_organized_pcd(fixture("good/pcd/organized_ascii.pcd"));
+  const Scan scan = read_pcd(fixture("good/pcd/organized_ascii.pcd"));
   // VIEWPOINT 1 2 3 0.70710678 0 0 0.70710678: 90 degrees about z.
   EXPECT_EQ(scan.T_world_scan.translation(), Eigen::Vector3d(1, 2, 3));
   EXPECT_TRUE((scan.T_world_scan.linear() * Eigen::Vector3d::UnitX())
@@ -91,30 +107,30 @@ void expect_pcl_written_cloud(const Scan& scan) {
 }
 
 TEST(PcdReader, ReadsBinaryWrittenByPcl) {
-  expect_pcl_written_cloud(read_organized_pcd(fixture("good/pcd/organized_binary.pcd")));
+  expect_pcl_written_cloud(read_pcd(fixture("good/pcd/organized_binary.pcd")));
 }
 
 TEST(PcdReader, ReadsBinaryCompressedWrittenByPcl) {
-  expect_pcl_written_cloud(read_organized_pcd(fixture("good/pcd/organized_compressed.pcd")));
+  expect_pcl_written_cloud(read_pcd(fixture("good/pcd/organized_compressed.pcd")));
 }
 
 TEST(PcdReader, ReadsPathWithSpacesAndNonAscii) {
   const ScratchDir dir;  // its name already holds a space and an é
   const auto copy = dir / "capture ü 1.pcd";
   std::filesystem::copy_file(fixture("good/pcd/organized_binary.pcd"), copy);
-  const Scan scan = read_organized_pcd(copy);
+  const Scan scan = read_pcd(copy);
   EXPECT_EQ(scan.name, "capture ü 1");
   expect_pcl_written_cloud(scan);
 }
 
 TEST(PcdReader, MissingFileIsAnInputError) {
   const ScratchDir dir;
-  EXPECT_THROW(read_organized_pcd(dir / "absent.pcd"), core::InputError);
+  EXPECT_THROW(read_pcd(dir / "absent.pcd"), core::InputError);
 }
 
 TEST(PcdReader, NonNumericValueReportsItsLine) {
   try {
-    read_organized_pcd(fixture("bad/pcd_non_numeric.pcd"));
+    read_pcd(fixture("bad/pcd_non_numeric.pcd"));
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& e) {
     ASSERT_TRUE(e.position().line.has_value()) << e.what();
@@ -134,7 +150,7 @@ TEST(PcdReader, RefusesCompressedBodyWhoseSizeWordLies) {
   const auto path = dir / "lying.pcd";
   std::ofstream(path, std::ios::binary) << bytes;
   try {
-    read_organized_pcd(path);
+    read_pcd(path);
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& e) {
     EXPECT_NE(e.problem().find("disagrees"), std::string::npos) << e.what();
@@ -154,7 +170,7 @@ TEST(PcdReader, RefusesADamagedCompressedBody) {
   const auto path = dir / "damaged.pcd";
   std::ofstream(path, std::ios::binary) << bytes;
   try {
-    read_organized_pcd(path);
+    read_pcd(path);
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& e) {
     EXPECT_NE(e.problem().find("damaged compressed body"), std::string::npos) << e.what();
@@ -165,7 +181,7 @@ TEST(PcdReader, RefusesADamagedCompressedBody) {
 // moves near the points.
 TEST(PcdReader, WorldCoordinatesKeepATenthOfAMillimetre) {
   const std::filesystem::path path = fixture("good/pcd/world_utm_double.pcd");
-  const Scan scan = read_organized_pcd(path);
+  const Scan scan = read_pcd(path);
   std::ifstream in(path);
   std::string line;
   for (int k = 0; k < 11; ++k) std::getline(in, line);
@@ -200,7 +216,7 @@ TEST(PcdReader, AHeaderAskingForMoreMemoryThanThereIsIsRefused) {
     GTEST_SKIP() << "needs a sparse file and less than 129 GB of free memory";
   }
   try {
-    read_organized_pcd(path);
+    read_pcd(path);
     FAIL() << "expected core::RuntimeFailure";
   } catch (const core::RuntimeFailure& e) {
     EXPECT_NE(std::string(e.what()).find("GB of memory"), std::string::npos) << e.what();
@@ -218,7 +234,7 @@ TEST_P(PcdBadInput, ThrowsInputErrorNamingFileAndProblem) {
   const BadPcd& c = GetParam();
   const std::string name = std::string(c.fixture) + ".pcd";
   try {
-    read_organized_pcd(fixture("bad/" + name));
+    read_pcd(fixture("bad/" + name));
     FAIL() << "expected core::InputError";
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
@@ -229,7 +245,6 @@ TEST_P(PcdBadInput, ThrowsInputErrorNamingFileAndProblem) {
 INSTANTIATE_TEST_SUITE_P(
     Cases, PcdBadInput,
     testing::Values(BadPcd{"pcd_empty", "empty file"}, BadPcd{"pcd_not_pcd", "not a PCD file"},
-                    BadPcd{"pcd_unorganized", "not an organized point cloud (height 1)"},
                     BadPcd{"pcd_empty_cloud", "empty point cloud"},
                     BadPcd{"pcd_missing_xyz", "missing field z"},
                     BadPcd{"pcd_truncated_ascii", "truncated ASCII body"},

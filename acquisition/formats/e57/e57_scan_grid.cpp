@@ -364,6 +364,7 @@ ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanE
   // The returns in the file's order, compactly, with their channels: a
   // scattered scan keeps every one (scan.hpp).
   std::vector<Eigen::Vector3d> points;
+  points.reserve(scattered_pixel_count(entry.points.record_count));
   Scan channels = make_empty_scan(0, 0, static_cast<bool>(fields.intensity),
                                   static_cast<bool>(fields.color[0]));
   const ChannelScales scales = channel_scales(entry, fields);
@@ -386,7 +387,7 @@ ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanE
   scan = make_scattered_scan(points.size(), channels.has_intensity(), channels.has_color());
   std::copy(channels.intensity.begin(), channels.intensity.end(), scan.intensity.begin());
   std::copy(channels.rgb.begin(), channels.rgb.end(), scan.rgb.begin());
-  set_scattered_points(scan, points);
+  set_scattered_points(scan, std::move(points));
   return out;
 }
 

@@ -1,0 +1,234 @@
+#include "acquisition/formats/las_reader.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "acquisition/formats/point_cloud.hpp"
+#include "core/errors.hpp"
+#include "core/memory.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+constexpr std::size_t kVlrHeaderSize = 54;
+constexpr std::uint64_t kBlock = 1 << 16;  // records read at a time
+// Record sizes of point data formats 0–10, and where their colour starts
+// (0: none).
+constexpr std::array<std::uint16_t, 11> kRecordSize = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+constexpr std::array<std::uint16_t, 11> kColourAt = {0, 0, 20, 28, 0, 28, 0, 30, 30, 0, 30};
+
+class LasFile {
+ public:
+  explicit LasFile(const std::filesystem::path& path) : name_(path.string()) {
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error)) fail(0, "missing or not a regular file");
+    size_ = std::filesystem::file_size(path, error);
+    file_ = std::fopen(path.c_str(), "rb");
+    if (file_ == nullptr) throw core::RuntimeFailure(name_, {}, "cannot open the file");
+  }
+  ~LasFile() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  LasFile(const LasFile&) = delete;
+  LasFile& operator=(const LasFile&) = delete;
+
+  std::uint64_t size() const { return size_; }
+
+  // `bytes` bytes at `offset` into `out`, or an error naming `what` as cut short.
+  void read_into(std::uint64_t offset, std::size_t bytes, const std::string& what,
+                 std::vector<unsigned char>& out) {
+    if (offset > size_ || size_ - offset < bytes) fail(offset, what + " is cut short");
+    out.resize(bytes);
+    if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0 ||
+        std::fread(out.data(), 1, bytes, file_) != bytes) {
+      throw core::RuntimeFailure(name_, {std::nullopt, offset, ""}, "cannot read " + what);
+    }
+  }
+  std::vector<unsigned char> read(std::uint64_t offset, std::size_t bytes,
+                                  const std::string& what) {
+    std::vector<unsigned char> out;
+    read_into(offset, bytes, what, out);
+    return out;
+  }
+
+  [[noreturn]] void fail(std::uint64_t offset, const std::string& problem) const {
+    throw core::InputError(name_, {std::nullopt, offset, ""}, problem);
+  }
+
+ private:
+  std::string name_;
+  std::uint64_t size_ = 0;
+  std::FILE* file_ = nullptr;
+};
+
+template <typename T>
+T at(const std::vector<unsigned char>& bytes, std::size_t offset) {
+  T value;
+  std::memcpy(&value, bytes.data() + offset, sizeof(T));
+  return value;  // LAS is little-endian, as every machine we build for
+}
+
+std::string text(const std::vector<unsigned char>& bytes, std::size_t offset, std::size_t size) {
+  std::string out(reinterpret_cast<const char*>(bytes.data() + offset), size);
+  return out.substr(0, out.find('\0'));
+}
+
+struct Header {
+  int version_minor = 0;
+  std::uint16_t header_size = 0;
+  std::uint32_t point_offset = 0;
+  std::uint32_t vlr_count = 0;
+  int format = 0;
+  std::uint16_t record_length = 0;
+  std::uint64_t points = 0;
+  Eigen::Vector3d scale, offset;
+};
+
+Header read_header(LasFile& file) {
+  const std::vector<unsigned char> h = file.read(0, 227, "the header");
+  if (text(h, 0, 4) != "LASF") file.fail(0, "not a LAS file (no \"LASF\" signature)");
+  Header out;
+  const int major = h[24];
+  out.version_minor = h[25];
+  if (major != 1 || out.version_minor > 4) {
+    file.fail(24, "LAS version " + std::to_string(major) + "." + std::to_string(out.version_minor) +
+                      " (1.0 to 1.4 are read)");
+  }
+  out.header_size = at<std::uint16_t>(h, 94);
+  out.point_offset = at<std::uint32_t>(h, 96);
+  out.vlr_count = at<std::uint32_t>(h, 100);
+  const int format_byte = h[104];
+  if (format_byte & 0xC0) {
+    file.fail(104,
+              "a LAZ (LASzip-compressed) file, which scanbench cannot read: Debian does not "
+              "package LASzip; decompress it to LAS first (laszip -i FILE.laz -o FILE.las, "
+              "or pdal translate)");
+  }
+  out.format = format_byte;
+  if (out.format > 10) file.fail(104, "unknown point data format " + std::to_string(out.format));
+  out.record_length = at<std::uint16_t>(h, 105);
+  if (out.record_length < kRecordSize[static_cast<std::size_t>(out.format)]) {
+    file.fail(105, "records of " + std::to_string(out.record_length) +
+                       " bytes, shorter than point data format " + std::to_string(out.format) +
+                       "'s " + std::to_string(kRecordSize[static_cast<std::size_t>(out.format)]));
+  }
+  out.points = at<std::uint32_t>(h, 107);
+  if (out.version_minor >= 4) {
+    const std::vector<unsigned char> wide = file.read(247, 8, "the LAS 1.4 header");
+    if (at<std::uint64_t>(wide, 0) != 0) out.points = at<std::uint64_t>(wide, 0);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    out.scale[axis] = at<double>(h, 131 + 8 * static_cast<std::size_t>(axis));
+    out.offset[axis] = at<double>(h, 155 + 8 * static_cast<std::size_t>(axis));
+  }
+  if (!(out.scale.allFinite() && out.scale.minCoeff() > 0.0 && out.offset.allFinite())) {
+    file.fail(131, "scale factors or offsets that are not positive, finite numbers");
+  }
+  return out;
+}
+
+// "EPSG:N" from a GeoTIFF key directory: its projected, else its
+// geographic coordinate system key; empty when it names none.
+std::string epsg_from_geokeys(const std::vector<unsigned char>& keys) {
+  if (keys.size() < 8) return {};
+  const std::size_t count = at<std::uint16_t>(keys, 6);
+  std::string geographic;
+  for (std::size_t k = 0; k < count && 8 + 8 * k + 8 <= keys.size(); ++k) {
+    const std::size_t e = 8 + 8 * k;
+    const auto id = at<std::uint16_t>(keys, e), location = at<std::uint16_t>(keys, e + 2);
+    const auto value = at<std::uint16_t>(keys, e + 6);
+    if (location != 0 || value == 0 || value == 32767) continue;   // not a code, or user-defined
+    if (id == 3072) return "EPSG:" + std::to_string(value);        // ProjectedCSTypeGeoKey
+    if (id == 2048) geographic = "EPSG:" + std::to_string(value);  // GeographicTypeGeoKey
+  }
+  return geographic;
+}
+
+// The coordinate system the variable length records name: OGC WKT first,
+// then GeoTIFF keys.
+std::string coordinate_system(LasFile& file, const Header& h) {
+  std::string wkt, geotiff;
+  std::uint64_t offset = h.header_size;
+  for (std::uint32_t k = 0; k < h.vlr_count; ++k) {
+    const std::vector<unsigned char> vlr =
+        file.read(offset, kVlrHeaderSize, "variable length record " + std::to_string(k));
+    const std::string user = text(vlr, 2, 16);
+    const auto record = at<std::uint16_t>(vlr, 18);
+    const auto length = at<std::uint16_t>(vlr, 20);
+    if (user == "LASF_Projection" && (record == 2112 || record == 34735)) {
+      const std::vector<unsigned char> data =
+          file.read(offset + kVlrHeaderSize, length, "variable length record " + std::to_string(k));
+      if (record == 2112) wkt = text(data, 0, data.size());
+      if (record == 34735) geotiff = epsg_from_geokeys(data);
+    }
+    offset += kVlrHeaderSize + length;
+  }
+  return wkt.empty() ? geotiff : wkt;
+}
+
+}  // namespace
+
+ImportedScan read_las(const std::filesystem::path& path) {
+  LasFile file(path);
+  const Header h = read_header(file);
+  const std::uint64_t bytes = h.points * h.record_length;
+  if (h.points > 0 && (bytes / h.points != h.record_length || h.point_offset > file.size() ||
+                       file.size() - h.point_offset < bytes)) {
+    file.fail(h.point_offset, "the header's " + std::to_string(h.points) +
+                                  " records are cut short (the file holds " +
+                                  std::to_string(file.size()) + " bytes)");
+  }
+  // Each point in double, 16-bit colour, and the scan's layers.
+  core::check_memory(h.points * 64, path.string());
+  ImportedScan out;
+  out.source.format = "las";
+  out.source.points_in_file = h.points;
+  out.source.coordinate_metadata = coordinate_system(file, h);
+  const std::size_t colour_at = kColourAt[static_cast<std::size_t>(h.format)];
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(scattered_pixel_count(h.points));  // set_scattered_points pads it
+  points.resize(h.points);
+  std::vector<float> intensity(h.points);
+  std::vector<std::uint16_t> colour(colour_at > 0 ? 3 * h.points : 0);
+  std::vector<unsigned char> block;
+  for (std::uint64_t first = 0; first < h.points; first += kBlock) {
+    const std::uint64_t count = std::min(kBlock, h.points - first);
+    file.read_into(h.point_offset + first * h.record_length, count * h.record_length,
+                   "record " + std::to_string(first), block);
+    for (std::uint64_t k = 0; k < count; ++k) {
+      const std::size_t r = k * h.record_length;
+      const std::size_t i = first + k;
+      for (int axis = 0; axis < 3; ++axis) {
+        points[i][axis] =
+            at<std::int32_t>(block, r + 4 * static_cast<std::size_t>(axis)) * h.scale[axis] +
+            h.offset[axis];
+      }
+      if (!(points[i].cwiseAbs().maxCoeff() <= kMaxCoordinateM)) {
+        file.fail(h.point_offset + i * h.record_length,
+                  "record " + std::to_string(i) +
+                      ": coordinate beyond 10^8 m (a corrupt value, scale or offset?)");
+      }
+      intensity[i] = static_cast<float>(at<std::uint16_t>(block, r + 12) / 65535.0);
+      for (std::size_t c = 0; c < (colour_at > 0 ? 3u : 0u); ++c) {
+        colour[3 * i + c] = at<std::uint16_t>(block, r + colour_at + 2 * c);
+      }
+    }
+  }
+  const bool wide_colour =
+      std::any_of(colour.begin(), colour.end(), [](std::uint16_t v) { return v > 255; });
+  PointCloud cloud{std::move(points), std::move(intensity), {}};
+  cloud.rgb.resize(colour.size());
+  for (std::size_t k = 0; k < colour.size(); ++k) {
+    cloud.rgb[k] = static_cast<std::uint8_t>(wide_colour ? (colour[k] + 128) / 257 : colour[k]);
+  }
+  out.scan = scattered_scan(std::move(cloud), path);
+  return out;
+}
+
+}  // namespace scanbench::acquisition

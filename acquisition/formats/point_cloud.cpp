@@ -1,0 +1,27 @@
+#include "acquisition/formats/point_cloud.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <string>
+#include <utility>
+
+#include "acquisition/local_origin.hpp"
+
+namespace scanbench::acquisition {
+
+Scan scattered_scan(PointCloud&& cloud, const std::filesystem::path& path) {
+  const std::size_t n = cloud.points.size();
+  assert((cloud.intensity.empty() || cloud.intensity.size() == n) &&
+         (cloud.rgb.empty() || cloud.rgb.size() == 3 * n) && "channels of one value per point");
+  Scan scan = make_scattered_scan(n, !cloud.intensity.empty(), !cloud.rgb.empty());
+  std::copy(cloud.intensity.begin(), cloud.intensity.end(), scan.intensity.begin());
+  std::copy(cloud.rgb.begin(), cloud.rgb.end(), scan.rgb.begin());
+  set_scattered_points(scan, std::move(cloud.points));
+  const std::u8string stem = path.stem().u8string();
+  const std::u8string utf8 = path.u8string();
+  scan.name = std::string(stem.begin(), stem.end());
+  scan.scanner.source_file = std::string(utf8.begin(), utf8.end());
+  return scan;
+}
+
+}  // namespace scanbench::acquisition
