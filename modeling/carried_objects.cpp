@@ -123,8 +123,10 @@ CarriedAgain carry_objects_again(const store::Project& project, const LoadedScan
         CarrySettings settings;
         settings.transfer.noise = commit.range_noise;
         settings.grow = commit.grow;
+        // A scattered target has no grid to grow on: it takes the carried points.
         const segmentation::SegmentationGrid* grid =
-            settings.grow ? &grids.with(settings.transfer.noise) : nullptr;
+            settings.grow && !loaded.scans[t].is_scattered() ? &grids.with(settings.transfer.noise)
+                                                             : nullptr;
         const segmentation::PixelSet joins =
             carry_object({&loaded.prepared[from], poses[from], labels},
                          {&loaded.prepared[t], poses[t], grid, open}, settings);

@@ -119,6 +119,11 @@ LabStats region_colors(const store::Project& project, const ColorPipeline& pipel
                        const PixelRect& region) {
   const std::string where = "scan " + std::to_string(region.scan_id);
   const acquisition::Scan scan = project.load_scan(region.scan_id);  // throws when missing
+  if (scan.is_scattered()) {
+    refuse(where,
+           "is an unstructured cloud (imported without a scan grid): a region of its "
+           "range image is not a region of the scene; match an object instead");
+  }
   if (region.row_begin < 0 || region.col_begin < 0 || region.row_end > scan.rows ||
       region.col_end > scan.columns || region.row_begin >= region.row_end ||
       region.col_begin >= region.col_end) {

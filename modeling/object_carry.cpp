@@ -40,11 +40,10 @@ segmentation::PixelSet carry_object(const DrawnObject& drawn, const CarryTarget&
     if (target.open[q] && seen.sighting[q] == registration::Sighting::kSurface && labelled(q))
       carried.push_back(static_cast<std::uint32_t>(q));
   }
-  if (!settings.grow || carried.empty()) return carried;
+  if (!settings.grow || target.grid == nullptr || carried.empty()) return carried;
 
   // Where growth may go: open, in the box, and not a place the drawn scan
   // sampled and left out of the object.
-  assert(target.grid != nullptr && "growth needs the target's grid");
   const segmentation::SegmentationGrid& grid = *target.grid;
   const Eigen::AlignedBox3f box = growth_box(drawn, settings.box_margin);
   const Eigen::Isometry3f T_box_target = T_drawn_target.cast<float>();  // composed in double

@@ -41,8 +41,10 @@ struct DrawnObject {
 };
 
 // The scan the object is carried into. `grid` is needed only with
-// CarrySettings::grow. `open` has one byte per pixel: 0 where the pixel may
-// not join (another object's, or deleted).
+// CarrySettings::grow; without one (a scattered scan, which has no grid)
+// the object takes the carried points and does not grow. `open` has one
+// byte per pixel: 0 where the pixel may not join (another object's, or
+// deleted).
 struct CarryTarget {
   const registration::PreparedScan* scan = nullptr;
   Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();

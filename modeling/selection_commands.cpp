@@ -341,7 +341,7 @@ CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_
     const acquisition::Scan scan = project.load_scan(stored.id);
     const registration::PreparedScan target = registration::prepare_scan(scan, *geometry, 0);
     std::optional<segmentation::SegmentationGrid> grid;
-    if (grow) {
+    if (grow && !scan.is_scattered()) {  // a scattered scan has no grid to grow on
       segmentation::GridSettings grid_settings;
       grid_settings.range_noise = noise;
       grid = segmentation::prepare_grid(scan, *geometry, grid_settings);

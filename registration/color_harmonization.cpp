@@ -27,7 +27,10 @@ bool usable_color(const acquisition::Scan& scan, std::size_t i, const ColorPairS
 }
 
 // Whether pixel i's colour is within `limit` of its valid 4-neighbours'.
+// A scattered scan's pixels are not neighbours: its points count as
+// uniform (the pair's colours are still checked against each other).
 bool locally_uniform(const acquisition::Scan& scan, std::size_t i, int limit) {
+  if (scan.is_scattered()) return true;
   const int row = static_cast<int>(i / static_cast<std::size_t>(scan.columns));
   const int col = static_cast<int>(i % static_cast<std::size_t>(scan.columns));
   const std::array<std::array<int, 2>, 4> steps = {{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};

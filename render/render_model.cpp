@@ -95,6 +95,12 @@ void append_splat(const acquisition::Scan& scan, const acquisition::ScanGeometry
     return;
   }
   const Eigen::Vector3f n = geometry.normal[i];
+  if (scan.is_scattered()) {  // its footprint is a spacing on the surface: a round splat
+    p.normal.push_back(rotation * n);
+    p.radii_m.emplace_back(footprint, footprint);
+    p.major_axis.push_back(Eigen::Vector3f::Zero());
+    return;
+  }
   const Eigen::Vector3f beam = acquisition::direction(scan, row, col);  // scanner → point
   constexpr float kEdgeOnStretch = 4.0f;  // the geometry stage's footprint limit
   float cos_incidence = std::clamp(std::abs(n.dot(beam)), 1.0f / max_stretch, 1.0f);

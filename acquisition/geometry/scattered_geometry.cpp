@@ -20,6 +20,7 @@ constexpr std::size_t kWide = 64;  // of the second, where the first spans no pl
 constexpr std::size_t kFootprintNeighbour = 4;
 constexpr float kGapFactor = 3.0f;
 constexpr float kFootprintFactor = 0.75f;
+constexpr float kMinSpacingM = 1e-4f;  // 0.1 mm: points nearer are the same point
 constexpr int kBlock = 4096;  // points per parallel task
 
 // nanoflann's view of the points.
@@ -93,14 +94,22 @@ GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettin
       for (std::size_t i = static_cast<std::size_t>(block) * kBlock; i < end; ++i) body(i);
     });
   };
-  // Each point's sampling scale: the distance to its 4th nearest neighbour.
+  // Each point's sampling scale: the distance to its 4th nearest neighbour
+  // apart from it (files repeat points: quantised coordinates, overlapping
+  // tiles), at least the coordinates' resolution.
   std::vector<float> scale(n, 0.0f);
   for_each_point([&](std::size_t i) {
-    std::array<std::uint32_t, kFootprintNeighbour + 1> found{};
-    std::array<float, kFootprintNeighbour + 1> squared{};
-    const std::size_t count = tree.knnSearch(points[i].data(), std::min(kFootprintNeighbour + 1, n),
-                                             found.data(), squared.data());
-    scale[i] = std::sqrt(squared[count - 1]);
+    std::array<std::uint32_t, kNear> found{};
+    std::array<float, kNear> squared{};
+    const std::size_t count = tree.knnSearch(points[i].data(), near, found.data(), squared.data());
+    std::size_t apart = 0;
+    float reach = 0.0f;
+    for (std::size_t k = 0; k < count && apart < kFootprintNeighbour; ++k) {
+      if (squared[k] <= kMinSpacingM * kMinSpacingM) continue;
+      reach = squared[k];
+      ++apart;
+    }
+    scale[i] = std::max(std::sqrt(reach), kMinSpacingM);
   });
   std::atomic<std::size_t> normals{0};
   for_each_point([&](std::size_t i) {
@@ -122,8 +131,11 @@ GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettin
     const float limit = kGapFactor * kGapFactor * scale[i] * scale[i];
     Fit fit = fit_plane(points, found.data(), squared.data(), count, limit);
     if (!fit.planar && wide > near) {
+      // Wider: up to 3 × the 16th neighbour's distance, which reaches the
+      // next line of a sampling denser along its lines than across them.
+      const float wide_limit = std::max(limit, kGapFactor * kGapFactor * squared[count - 1]);
       count = tree.knnSearch(query, wide, found.data(), squared.data());
-      fit = fit_plane(points, found.data(), squared.data(), count, limit);
+      fit = fit_plane(points, found.data(), squared.data(), count, wide_limit);
     }
     const Eigen::Vector3f towards_viewpoint = -points[i].normalized();
     if (alone || !fit.planar || fit.used < static_cast<std::size_t>(settings.min_neighbours) ||

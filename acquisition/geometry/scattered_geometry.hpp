@@ -9,13 +9,15 @@
 
 namespace scanbench::acquisition {
 
-// For every point: a plane fitted to its 16 nearest neighbours (to its 64
-// where 16 do not span a plane above the noise), leaving out those farther
-// than 3 × the distance to its 4th nearest (across a gap, they sample
-// another surface); the normal is oriented towards the scan frame's origin,
-// the viewpoint as far as the file tells (a scanner's position, or the
-// origin a unified cloud was exported in). The footprint is 3/4 of the
-// distance to the 4th nearest neighbour (on a regular sampling of step s,
+// For every point: a plane fitted to its 16 nearest neighbours, leaving
+// out those farther than 3 × the distance to its 4th nearest (across a gap,
+// they sample another surface), or, where they do not span a plane above
+// the noise, to its 64 nearest within 3 × the 16th's distance. Distances
+// count neighbours apart from the point (more than 0.1 mm: files repeat
+// points), and are at least 0.1 mm. The normal is oriented towards the scan
+// frame's origin, the viewpoint as far as the file tells (a scanner's
+// position, or the origin a unified cloud was exported in). The footprint
+// is 3/4 of the distance to the 4th nearest neighbour (on a regular sampling of step s,
 // 0.75 s closes the gap as the grid's half cell diagonal, 0.71 s, does;
 // distances between points already include a slanted surface's stretch,
 // so there is no incidence factor). A point whose distance to its 4th

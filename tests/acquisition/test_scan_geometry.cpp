@@ -387,5 +387,41 @@ TEST(ScatteredGeometry, APointFarFromTheOthersGetsNoNormal) {
   EXPECT_LT(result.geometry.footprint_m[400], 5.0 * spacing) << "no splat across the 3 m gap";
 }
 
+TEST(ScatteredGeometry, RepeatedPointsTakeTheirSpacingFromTheDistinctNeighbours) {
+  // A plane sampled every centimetre, each point written three times (as
+  // overlapping tiles or quantised coordinates repeat points).
+  std::vector<Eigen::Vector3d> points;
+  for (int copy = 0; copy < 3; ++copy) {
+    for (int i = 0; i < 30; ++i) {
+      for (int j = 0; j < 30; ++j) points.emplace_back(5.0, 0.01 * i, 0.01 * j);
+    }
+  }
+  Scan scan = make_scattered_scan(points.size(), false, false);
+  set_scattered_points(scan, points);
+  const GeometryResult result = compute_geometry(scan);
+  EXPECT_EQ(result.normals, points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    ASSERT_NEAR(result.geometry.footprint_m[i], 0.75 * 0.01, 1e-4) << "point " << i;
+  }
+}
+
+TEST(ScatteredGeometry, LinesDenserAlongThanAcrossStillSpanAPlane) {
+  // A profiler's sampling: lines 2 cm apart, a point every millimetre along
+  // them. The 16 nearest neighbours lie on the point's own line; the plane
+  // comes from the wider neighbourhood reaching the next lines.
+  std::vector<Eigen::Vector3d> points;
+  for (int line = 0; line < 10; ++line) {
+    for (int k = 0; k < 200; ++k) points.emplace_back(0.001 * k, 0.02 * line, 6.0);
+  }
+  Scan scan = make_scattered_scan(points.size(), false, false);
+  set_scattered_points(scan, points);
+  const GeometryResult result = compute_geometry(scan);
+  EXPECT_GE(result.normals, points.size() * 95 / 100);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (result.geometry.flags[i] & kFlagNoNormal) continue;
+    ASSERT_NEAR(result.geometry.normal[i].z(), -1.0f, 1e-3f) << "point " << i;
+  }
+}
+
 }  // namespace
 }  // namespace scanbench::acquisition

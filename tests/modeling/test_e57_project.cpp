@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
+#include "modeling/color_commands.hpp"
 #include "modeling/export_command.hpp"
 #include "modeling/import_command.hpp"
 #include "modeling/selection_commands.hpp"
@@ -176,6 +177,20 @@ TEST(E57Project, GridOnlyToolsSayAnUnstructuredCloudHasNoGrid) {
   EXPECT_THAT([&] { select_region(store::Project::open(dir / "a.sbproj"), seed, selection); },
               ::testing::ThrowsMessage<core::InputError>(
                   ::testing::HasSubstr("is an unstructured cloud (imported without a scan grid)")));
+  // An object picked in 3D is kept; a region of the range image is refused.
+  store::Project project = store::Project::open(dir / "a.sbproj");
+  segmentation::PixelSet picked;
+  for (std::uint32_t i = 0; i < 100; ++i) picked.push_back(i);
+  CommitSettings commit;
+  commit.scan_id = 1;
+  commit.name = "cap";
+  const NodeCommandResult cap = commit_selection(project, commit, picked);
+  CloneSettings region;
+  region.target = cap.node_id;
+  region.source_region = PixelRect{1, 0, 1, 0, 10};
+  EXPECT_THAT([&] { clone_color(project, region); },
+              ::testing::ThrowsMessage<core::InputError>(
+                  ::testing::HasSubstr("a region of its range image is not a region")));
 }
 
 TEST(E57Project, ABadFileChangesNothing) {

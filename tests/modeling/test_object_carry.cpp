@@ -99,5 +99,23 @@ TEST(CarryObject, NeverTakesAPlaceTheDrawnScanLeftOut) {
   EXPECT_FALSE(carried.empty());
 }
 
+// A target without a grid (a scattered scan) takes the carried points:
+// growth is asked for but has nothing to grow on.
+TEST(CarryObject, WithoutATargetGridTheObjectTakesTheCarriedPoints) {
+  const SimulatedCampus& site = campus(2);
+  const sim::ObjectId crown = object_named("tree_01/crown");
+  std::vector<std::uint32_t> labels(site.prepared[0].in_model.size(), 0);
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    labels[i] = site.prepared[0].in_model[i] && site.truth[0].object_id[i] == crown;
+  const std::vector<std::uint8_t> open(site.prepared[1].in_model.size(), 1);
+  const DrawnObject drawn{&site.prepared[0], site.true_poses[0], labels};
+  const CarryTarget no_grid{&site.prepared[1], site.true_poses[1], nullptr, open};
+  CarrySettings plain, grown;
+  grown.grow = segmentation::default_grow_settings(segmentation::Channel::kColor);
+  const segmentation::PixelSet without = carry_object(drawn, no_grid, plain);
+  EXPECT_FALSE(without.empty());
+  EXPECT_EQ(carry_object(drawn, no_grid, grown), without);
+}
+
 }  // namespace
 }  // namespace scanbench::modeling

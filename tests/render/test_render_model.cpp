@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
+#include "modeling/geometry_command.hpp"
+#include "modeling/import_command.hpp"
 #include "modeling/room_project.hpp"
 #include "modeling/selection_commands.hpp"
 #include "modeling/selection_tools.hpp"
@@ -129,6 +131,27 @@ TEST(RenderModel, OnlyWhatTheMergeKeptUnlessAskedForAll) {
   RenderModelSettings all;
   all.merged_only = false;
   EXPECT_EQ(build_render_model(project, all).points.size(), usable_points());
+}
+
+// An unstructured cloud's footprint is its point spacing on the surface:
+// its splats are round, with no beam to stretch them.
+TEST(RenderModel, AnUnstructuredCloudIsDrawnWithRoundSplatsOfItsSpacing) {
+  const ScratchDir dir;
+  core::Progress quiet;
+  const std::vector<std::filesystem::path> files = {
+      test::fixture("good/e57/unstructured_sphere.e57")};
+  modeling::import_scan_files(dir / "p.sbproj", files, {}, quiet);
+  store::Project project = store::Project::open(dir / "p.sbproj");
+  modeling::geometry_project(project, {}, quiet);
+  const RenderModel model = build_render_model(project, {});
+  ASSERT_EQ(model.points.size(), 4000u);
+  // 4 000 points on a sphere of radius 1 m: about 5.6 cm apart.
+  for (std::size_t k = 0; k < model.points.size(); ++k) {
+    EXPECT_EQ(model.points.radii_m[k].x(), model.points.radii_m[k].y());
+    EXPECT_GT(model.points.radii_m[k].x(), 0.02f);
+    EXPECT_LT(model.points.radii_m[k].x(), 0.08f);
+    EXPECT_EQ(model.points.major_axis[k], Eigen::Vector3f::Zero());
+  }
 }
 
 TEST(RenderModel, AScanWithoutGeometryIsRefusedByName) {
