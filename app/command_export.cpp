@@ -1,4 +1,5 @@
-// scanbench export PROJECT --format ptx|ply|csv|las|e57|triplet [--scan ID] [--merged] -o OUT
+// scanbench export PROJECT --format ptx|ply|csv|las|e57|triplet [--scan ID] [--merged]
+//   [--colors shown|recorded] [--all] [--force] -o OUT
 #include <fmt/core.h>
 
 #include <map>
@@ -25,6 +26,11 @@ void run_export(ExportOptions& options) {
   const modeling::ExportResult result = modeling::export_project(project, options.settings);
   fmt::print("exported {} scan(s), {} {} points, to {}\n", result.scans, result.points,
              options.settings.merged ? "merged-model" : "valid", options.output);
+  if (result.hidden + result.deleted > 0) {
+    fmt::print("left out {} points of hidden objects and {} deleted points (--all writes them)\n",
+               result.hidden, result.deleted);
+  }
+  for (const std::string& note : result.notes) fmt::print("note: {}\n", note);
 }
 
 }  // namespace
@@ -53,6 +59,17 @@ void add_export_command(CLI::App& app) {
   command->add_flag("--merged", options->settings.merged,
                     "The merged model only: the points `scanbench merge` kept (PLY, CSV, LAS; in "
                     "E57 the other pixels are marked invalid)");
+  const std::map<std::string, modeling::ExportColors> colors{
+      {"shown", modeling::ExportColors::kShown}, {"recorded", modeling::ExportColors::kRecorded}};
+  command
+      ->add_option("--colors", options->settings.colors,
+                   "shown (default: as the model shows them, with the harmonisation and the "
+                   "objects' colour edits) or recorded (as the scanner recorded them)")
+      ->transform(one_of(colors));
+  command->add_flag("--all", options->settings.all_points,
+                    "Every point: also those of hidden objects and the deleted ones (by default "
+                    "the export holds what the model shows; grid formats mark the others "
+                    "invalid)");
   command->add_option("-o,--output", options->output, "Output file (triplet: the .json sidecar)")
       ->required();
   command->add_flag("--force", options->settings.replace_existing,

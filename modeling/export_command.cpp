@@ -11,6 +11,8 @@
 #include "acquisition/formats/triplet_writer.hpp"
 #include "core/errors.hpp"
 #include "core/project_file.hpp"
+#include "modeling/color_pipeline.hpp"
+#include "modeling/shown_nodes.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
@@ -154,6 +156,82 @@ void write_e57(const store::Project& project, const std::vector<std::int64_t>& i
                          common_coordinate_metadata(project, ids, sources));
 }
 
+// The scans as the model shows them, unless the settings ask otherwise:
+// colours through the scan's correction and the owner's edit, and the
+// points of hidden objects and deleted ones left out. A grid format (PTX,
+// a triplet) marks them invalid; the others take them out of `keep`, made
+// from the valid points where there was none.
+void show_as_the_model_does(const store::Project& project, const std::vector<std::int64_t>& ids,
+                            const ExportSettings& settings, std::vector<acquisition::Scan>& scans,
+                            std::vector<std::vector<std::uint8_t>>& keep, ExportResult& result) {
+  const bool recolour = settings.colors == ExportColors::kShown;
+  if (!recolour && settings.all_points) return;
+  const std::vector<store::ObjectNode> tree = project.object_nodes();
+  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
+  const ColorPipeline colors(project.scan_color_corrections(), resolve_color_edits(tree));
+  const bool grid_format =
+      settings.format == ExportFormat::kPtx || settings.format == ExportFormat::kTriplet;
+  const auto leave_out = [&](std::size_t s, std::size_t i) {
+    if (grid_format) {
+      scans[s].valid[i] = 0;
+      return;
+    }
+    if (keep.empty()) {
+      for (const acquisition::Scan& scan : scans) keep.push_back(scan.valid);
+    }
+    keep[s][i] = 0;
+  };
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    acquisition::Scan& scan = scans[s];
+    const auto membership = project.load_layer<std::uint32_t>(ids[s], store::layer::kMembership,
+                                                              store::ElementType::kU32);
+    for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+      if (!scan.valid[i] || (!keep.empty() && keep[s][i] == 0)) continue;
+      std::uint32_t owner = membership ? (*membership)[i] : 0;
+      if (owner == store::kDeletedPoints) {
+        owner = 0;
+        if (!settings.all_points) {
+          ++result.deleted;
+          leave_out(s, i);
+          continue;
+        }
+      } else if (owner != 0) {
+        const auto found = shown.find(owner);
+        if (found == shown.end()) {
+          owner = 0;  // a node no longer in the tree owns nothing
+        } else if (!found->second && !settings.all_points) {
+          ++result.hidden;
+          leave_out(s, i);
+          continue;
+        }
+      }
+      if (!recolour || !scan.has_color()) continue;
+      std::uint8_t* rgb = &scan.rgb[3 * i];
+      const std::array<std::uint8_t, 3> out = colors.shown(ids[s], owner, {rgb[0], rgb[1], rgb[2]});
+      std::copy(out.begin(), out.end(), rgb);
+    }
+  }
+}
+
+// The coordinate system for a LAS file, which names it in OGC WKT only;
+// anything else the scans' files named becomes a note.
+std::string las_wkt(const std::string& coordinate_system, ExportResult& result) {
+  if (coordinate_system.empty()) return {};
+  if (!acquisition::looks_like_wkt(coordinate_system)) {
+    result.notes.push_back("the scans' coordinate system \"" + coordinate_system +
+                           "\" is not OGC WKT, which LAS needs: not written (E57 keeps it)");
+    return {};
+  }
+  if (coordinate_system.size() > acquisition::kMaxLasWktBytes) {
+    result.notes.push_back("the scans' coordinate system is " +
+                           std::to_string(coordinate_system.size()) +
+                           " bytes of WKT, more than a LAS record holds: not written (E57 keeps "
+                           "it)");
+    return {};
+  }
+  return coordinate_system;
+}
+
 // The scans' ids as LAS point source ids (16 bits).
 std::vector<std::uint16_t> point_source_ids(const store::Project& project,
                                             const std::vector<std::int64_t>& ids) {
@@ -249,7 +327,7 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
   // Masks, poses and channels from one state, whatever commits meanwhile.
   const store::Project::ReadSnapshot snapshot = project.read_snapshot();
   const std::vector<std::int64_t> ids = exported_ids(project, settings);
-  const std::vector<std::vector<std::uint8_t>> keep = keep_masks(project, settings, ids);
+  std::vector<std::vector<std::uint8_t>> keep = keep_masks(project, settings, ids);
   std::vector<acquisition::Scan> scans;
   std::vector<std::optional<acquisition::ScanGeometry>> geometry;
   for (const std::int64_t id : ids) {
@@ -261,6 +339,9 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
           ? acquisition::triplet_files(scans.front(), settings.output)
           : std::vector<std::filesystem::path>{settings.output};
   refuse_to_replace_inputs(project, outputs, settings.replace_existing);
+  ExportResult result;
+  result.scans = scans.size();
+  show_as_the_model_does(project, ids, settings, scans, keep, result);
   std::vector<const acquisition::ScanGeometry*> geometry_of;
   for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
   std::vector<const std::vector<std::uint8_t>*> keep_of;
@@ -279,8 +360,9 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
       write_triplet(project, scans, settings);
       break;
     case ExportFormat::kLas:
-      acquisition::write_las(settings.output, scans, point_source_ids(project, ids), geometry_of,
-                             keep_of);
+      acquisition::write_las(
+          settings.output, scans, point_source_ids(project, ids), geometry_of, keep_of,
+          las_wkt(common_coordinate_metadata(project, ids, project.scan_sources()), result));
       break;
     case ExportFormat::kE57:
       write_e57(project, ids, scans, keep_of, settings);
@@ -291,8 +373,9 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
   const bool point_list = settings.format == ExportFormat::kPly ||
                           settings.format == ExportFormat::kCsv ||
                           settings.format == ExportFormat::kLas;
-  return {scans.size(), point_list ? acquisition::count_exported_points(scans, geometry_of, keep_of)
-                                   : count_points(scans, keep)};
+  result.points = point_list ? acquisition::count_exported_points(scans, geometry_of, keep_of)
+                             : count_points(scans, keep);
+  return result;
 }
 
 }  // namespace scanbench::modeling

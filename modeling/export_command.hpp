@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <optional>
 #include <span>
+#include <string>
+#include <vector>
 
 #include "modeling/store/project.hpp"
 
@@ -21,6 +23,12 @@ enum class ExportFormat {
   kE57,      // ASTM E57: structured scans in spherical coordinates + pose, with their images
 };
 
+// The colours an export writes.
+enum class ExportColors {
+  kShown,     // as the model shows them: the scans' harmonisation and the objects' edits
+  kRecorded,  // as the scanner recorded them
+};
+
 struct ExportSettings {
   ExportFormat format = ExportFormat::kPly;
   std::optional<std::int64_t> scan_id;  // only this scan; all scans when empty
@@ -28,6 +36,10 @@ struct ExportSettings {
   // and E57 (whose grids keep every pixel, the others marked invalid).
   bool merged = false;
   std::filesystem::path output;  // the file (triplet: the .json sidecar)
+  ExportColors colors = ExportColors::kShown;
+  // Every point (--all): those of hidden objects and deleted ones too. By
+  // default the export holds what the model shows.
+  bool all_points = false;
   // Replace an existing output file (--force). A project, or a file a scan
   // was imported from, is never replaced.
   bool replace_existing = false;
@@ -38,10 +50,18 @@ struct ExportResult {
   // The points written: valid (point formats: not mixed) or, with `merged`,
   // kept ones.
   std::size_t points = 0;
+  std::size_t hidden = 0;   // left out: owned by a hidden object
+  std::size_t deleted = 0;  // left out: deleted in the segmentation
+  // What the file could not hold (a LAS names its coordinate system in WKT
+  // only), for the user to read.
+  std::vector<std::string> notes;
 };
 
 // Writes the project's scans as the settings say, all read from one state of
-// the project (Project::read_snapshot). Outputs are checked first
+// the project (Project::read_snapshot): what the model shows unless the
+// settings ask for recorded colours or all points. Points left out are
+// marked invalid in the grid formats (PTX, triplet, E57's structured scans)
+// and not written in the others. Outputs are checked first
 // (refuse_to_replace_inputs): core::InputError, nothing written. Where a scan has geometry,
 // the point formats leave its mixed pixels out and PLY carries its normals
 // and footprints. Throws core::InputError (naming the project and, where it

@@ -9,28 +9,12 @@
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "core/errors.hpp"
 #include "modeling/color_pipeline.hpp"
+#include "modeling/shown_nodes.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::render {
 
 namespace {
-
-// For every node, whether it is shown: not hidden, nor any group above it.
-std::map<std::int64_t, bool> shown_nodes(const std::vector<store::ObjectNode>& nodes) {
-  std::map<std::int64_t, const store::ObjectNode*> by_id;
-  for (const store::ObjectNode& n : nodes) by_id[n.id] = &n;
-  std::map<std::int64_t, bool> shown;
-  for (const store::ObjectNode& n : nodes) {
-    bool visible = true;
-    for (const store::ObjectNode* at = &n; at;) {
-      visible = visible && !at->hidden;
-      const auto parent = at->parent ? by_id.find(*at->parent) : by_id.end();
-      at = parent == by_id.end() ? nullptr : parent->second;
-    }
-    shown[n.id] = visible;
-  }
-  return shown;
-}
 
 // Half the diagonal of pixel (row, col)'s cell [rad]: a sample's footprint
 // per metre of range seen head on. Per-pixel grids have no cell: none.
@@ -213,7 +197,7 @@ void append_points(const RenderPoints& from, const std::vector<std::uint32_t>& o
 // the points no object owns; returns each node id's index (0: that root).
 std::map<std::int64_t, std::size_t> link_tree(const std::vector<store::ObjectNode>& tree,
                                               RenderModel& model) {
-  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
+  const std::map<std::int64_t, bool> shown = modeling::shown_nodes(tree);
   std::map<std::int64_t, std::size_t> index_of;
   for (const store::ObjectNode& n : tree) {
     index_of[n.id] = model.nodes.size();
@@ -287,7 +271,7 @@ RenderModel build_render_model(const store::Project& project, const RenderModelS
     origin = scanner.array().round();
   }
   const std::vector<store::ObjectNode> tree = project.object_nodes();
-  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
+  const std::map<std::int64_t, bool> shown = modeling::shown_nodes(tree);
   RenderModelCounts counts;
   RenderPoints points;
   const modeling::ColorPipeline colors(project.scan_color_corrections(),

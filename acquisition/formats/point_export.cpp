@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cassert>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <ctime>
@@ -133,7 +134,21 @@ std::string extra_bytes_vlr() {
   return out;
 }
 
-std::string las_header(const LasExtent& extent, bool extra_bytes, const Eigen::Vector3d& offset) {
+// The coordinate system as OGC WKT, null-terminated.
+std::string wkt_vlr(std::string_view wkt) {
+  std::string out;
+  append_binary(out, std::uint16_t{0});  // reserved
+  append_text(out, "LASF_Projection", 16);
+  append_binary(out, std::uint16_t{2112});  // OGC coordinate system WKT
+  append_binary(out, static_cast<std::uint16_t>(wkt.size() + 1));
+  append_text(out, "coordinate system", 32);
+  out += wkt;
+  out += '\0';
+  return out;
+}
+
+std::string las_header(const LasExtent& extent, const std::string& vlrs, std::uint32_t vlr_count,
+                       bool extra_bytes, const Eigen::Vector3d& offset) {
   std::string h;
   h += "LASF";
   append_binary(h, std::uint16_t{0});       // file source id
@@ -149,10 +164,8 @@ std::string las_header(const LasExtent& extent, bool extra_bytes, const Eigen::V
   append_binary(h, static_cast<std::uint16_t>(utc.tm_yday + 1));
   append_binary(h, static_cast<std::uint16_t>(utc.tm_year + 1900));
   append_binary(h, kLasHeaderSize);
-  const std::uint32_t vlr_bytes =
-      extra_bytes ? kVlrHeaderSize + 4u * kExtraBytesDescriptorSize : 0u;
-  append_binary(h, static_cast<std::uint32_t>(kLasHeaderSize + vlr_bytes));  // offset to points
-  append_binary(h, static_cast<std::uint32_t>(extra_bytes ? 1 : 0));         // VLRs
+  append_binary(h, static_cast<std::uint32_t>(kLasHeaderSize + vlrs.size()));  // offset to points
+  append_binary(h, vlr_count);
   h += '\x07';  // point data record format 7
   append_binary(h, static_cast<std::uint16_t>(kPointFormat7Size + (extra_bytes ? 16 : 0)));
   for (int k = 0; k < 6; ++k) append_binary(h, std::uint32_t{0});  // legacy counts: 0 for 6–10
@@ -239,7 +252,7 @@ void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
 void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const std::uint16_t> source_ids,
                std::span<const ScanGeometry* const> geometry,
-               std::span<const std::vector<std::uint8_t>* const> keep) {
+               std::span<const std::vector<std::uint8_t>* const> keep, std::string_view wkt) {
   assert(source_ids.size() == scans.size() && "a point source id per scan");
   const Channels channels = common_channels(scans, geometry);
   LasExtent extent;
@@ -263,9 +276,13 @@ void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
   // The header's bounds are those of the quantised coordinates.
   for (int axis = 0; axis < 3; ++axis)
     extent.max[axis] = offset[axis] + std::round(span[axis]) * kLasScale;
+  assert(wkt.size() <= kMaxLasWktBytes && "a VLR holds 65535 bytes");
+  std::string vlrs = channels.geometry ? extra_bytes_vlr() : std::string();
+  if (!wkt.empty()) vlrs += wkt_vlr(wkt);
+  const std::uint32_t vlr_count = (channels.geometry ? 1u : 0u) + (wkt.empty() ? 0u : 1u);
   OutputFile file(path);
-  file.write(las_header(extent, channels.geometry, offset));
-  if (channels.geometry) file.write(extra_bytes_vlr());
+  file.write(las_header(extent, vlrs, vlr_count, channels.geometry, offset));
+  file.write(vlrs);
   for_each_point(
       scans, geometry, keep, channels, [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
         const Scan& scan = scans[s];
@@ -291,6 +308,16 @@ void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
         file.flush_if_full();
       });
   file.commit();
+}
+
+bool looks_like_wkt(std::string_view text) {
+  std::size_t k = std::min(text.find_first_not_of(" \t\r\n"), text.size());
+  const std::size_t keyword = k;
+  while (k < text.size() && (std::isupper(static_cast<unsigned char>(text[k])) ||
+                             std::isdigit(static_cast<unsigned char>(text[k])) || text[k] == '_'))
+    ++k;
+  const std::size_t last = text.find_last_not_of(" \t\r\n");
+  return k >= keyword + 4 && k < text.size() && text[k] == '[' && text[last] == ']';
 }
 
 }  // namespace scanbench::acquisition

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "acquisition/geometry/scan_geometry.hpp"
@@ -52,12 +53,22 @@ void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
 // When every scan has geometry, four extra bytes fields (float NormalX,
 // NormalY, NormalZ in the world frame, and Footprint [m]) described by the
 // LASF_Spec extra bytes VLR. The legacy point counts are 0, as the
-// specification requires for formats 6–10. Throws core::InputError naming
-// `path` when the points span more than 0.1 mm × 2³¹ on an axis; All-or-
-// nothing output as write_ply.
+// specification requires for formats 6–10. A non-empty `wkt` (OGC WKT of
+// the coordinate system, at most kMaxLasWktBytes) goes into the
+// LASF_Projection 2112 VLR. Throws core::InputError naming `path` when the
+// points span more than 0.1 mm × 2³¹ on an axis; All-or-nothing output as
+// write_ply.
 void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const std::uint16_t> source_ids,
                std::span<const ScanGeometry* const> geometry = {},
-               std::span<const std::vector<std::uint8_t>* const> keep = {});
+               std::span<const std::vector<std::uint8_t>* const> keep = {},
+               std::string_view wkt = {});
+
+// A VLR's length is 16 bits; the WKT is written with its terminating null.
+inline constexpr std::size_t kMaxLasWktBytes = 65534;
+
+// Whether `text` reads as OGC WKT (a keyword and a bracket: PROJCS[...,
+// GEOGCS[..., PROJCRS[..., COMPOUNDCRS[...), not an "EPSG:N" code or a name.
+bool looks_like_wkt(std::string_view text);
 
 }  // namespace scanbench::acquisition

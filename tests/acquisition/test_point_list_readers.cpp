@@ -226,6 +226,26 @@ TEST(LasReader, OurVersionOneFourExportComesBackWholeInItsOrder) {
   expect_same_cloud(read.scan, sphere, true);
 }
 
+TEST(LasReader, OurExportNamesItsCoordinateSystemInWkt) {
+  const ScratchDir dir;
+  const Scan sphere = sphere_scan();
+  const std::uint16_t source = 1;
+  const std::string wkt =
+      "PROJCS[\"ETRS89 / UTM zone 32N\",GEOGCS[\"ETRS89\",DATUM[\"European_Terrestrial_"
+      "Reference_System_1989\",SPHEROID[\"GRS 1980\",6378137,298.257222101]],PRIMEM["
+      "\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_"
+      "Mercator\"],PARAMETER[\"central_meridian\",9],PARAMETER[\"scale_factor\",0.9996],"
+      "PARAMETER[\"false_easting\",500000],UNIT[\"metre\",1],AUTHORITY[\"EPSG\",\"25832\"]]";
+  EXPECT_TRUE(looks_like_wkt(wkt));
+  EXPECT_TRUE(looks_like_wkt("  COMPOUNDCRS[\"a\",x]\n"));
+  EXPECT_FALSE(looks_like_wkt("EPSG:25832"));
+  EXPECT_FALSE(looks_like_wkt("[]"));
+  write_las(dir / "sphere.las", std::span(&sphere, 1), std::span(&source, 1), {}, {}, wkt);
+  const ImportedScan read = read_las(dir / "sphere.las");
+  EXPECT_EQ(read.source.coordinate_metadata, wkt);
+  expect_same_cloud(read.scan, sphere, true);
+}
+
 TEST(LasReader, BadFilesAreRefusedWithTheirPlace) {
   const ScratchDir dir;
   std::string laz = las_1_2(2);

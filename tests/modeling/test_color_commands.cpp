@@ -4,14 +4,21 @@
 // harmonize recovers gains applied to a copy of a scan.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
+#include <string>
+
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
 #include "core/progress.hpp"
+#include "acquisition/formats/ptx_reader.hpp"
 #include "modeling/color_commands.hpp"
+#include "modeling/export_command.hpp"
 #include "modeling/harmonize_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
 #include "modeling/selection_tools.hpp"
+#include "modeling/tree_commands.hpp"
 #include "render/render_model.hpp"
 #include "room_project.hpp"
 #include "support/test_support.hpp"
@@ -176,6 +183,93 @@ TEST(Recolor, BadRequestsAreRefusedAndChangeNothing) {
   into_itself.source_node = room.wall;
   EXPECT_THROW(clone_color(project, into_itself), core::InputError);
   EXPECT_EQ(project.revision(), revision);
+}
+
+// The colours of a CSV export, sorted.
+std::vector<std::array<int, 3>> csv_colours(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_TRUE(line.ends_with(",r,g,b")) << line;
+  std::vector<std::array<int, 3>> out;
+  while (std::getline(in, line)) {
+    std::array<int, 3> c{};
+    std::size_t end = line.size();
+    for (int k = 2; k >= 0; --k) {
+      const std::size_t comma = line.rfind(',', end - 1);
+      c[static_cast<std::size_t>(k)] = std::stoi(line.substr(comma + 1, end - comma - 1));
+      end = comma;
+    }
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// An export holds what the model shows: the edited colours, without the
+// hidden objects' points; asked for, the recorded colours of every point.
+TEST(Export, WritesWhatTheModelShowsUnlessAskedForTheRecording) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const RoomObjects room = segment_room(project);
+  RecolorSettings warm;
+  warm.node = room.wall;
+  warm.set.hue_deg = 90.0;
+  warm.set.brightness = 15.0;
+  recolor_object(project, warm);
+  edit_node(project, {room.floor, std::nullopt, true, std::nullopt, {}});  // hide the floor
+  SelectionTools tools;
+  const std::size_t deleted = tools.select(project, select_at(room.scan, 90, 0)).selected_pixels;
+  const NodeCommandResult far = tools.commit(project, {room.scan, "far wall", std::nullopt});
+  delete_node(project, {far.node_id, DeletedPoints::kDeleted, {}});
+  const render::RenderModel model = model_of(project);  // without the deleted points
+  std::vector<std::array<int, 3>> shown;
+  std::size_t floor = 0;
+  for (std::size_t k = 0; k < model.points.size(); ++k) {
+    const auto& c = model.points.rgba[k];
+    if (model.points.node[k] == static_cast<std::uint32_t>(room.floor)) {
+      ++floor;
+    } else {
+      shown.push_back({c[0], c[1], c[2]});
+    }
+  }
+  std::sort(shown.begin(), shown.end());
+  ASSERT_GT(floor, 1000u);
+
+  ExportSettings settings;
+  settings.format = ExportFormat::kCsv;
+  settings.output = dir / "shown.csv";
+  const ExportResult result = export_project(project, settings);
+  EXPECT_EQ(result.hidden, floor);
+  EXPECT_EQ(result.deleted, deleted);
+  EXPECT_EQ(result.points, shown.size());
+  EXPECT_EQ(csv_colours(settings.output), shown);
+
+  settings.colors = ExportColors::kRecorded;
+  settings.all_points = true;
+  settings.output = dir / "recorded.csv";
+  const ExportResult all = export_project(project, settings);
+  EXPECT_EQ(all.hidden + all.deleted, 0u);
+  EXPECT_EQ(all.points, model.points.size() + deleted);
+  const acquisition::Scan scan = project.load_scan(room.scan);
+  const acquisition::ScanGeometry geometry = *store::load_geometry(project, room.scan);
+  std::vector<std::array<int, 3>> recorded;
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+    if (acquisition::in_model(scan, geometry, i))
+      recorded.push_back({scan.rgb[3 * i], scan.rgb[3 * i + 1], scan.rgb[3 * i + 2]});
+  }
+  std::sort(recorded.begin(), recorded.end());
+  EXPECT_EQ(csv_colours(settings.output), recorded);
+
+  // A grid format keeps the grid: the hidden floor's pixels have no return.
+  ExportSettings ptx;
+  ptx.format = ExportFormat::kPtx;
+  ptx.output = dir / "room.ptx";
+  EXPECT_EQ(export_project(project, ptx).hidden, floor);
+  const std::vector<acquisition::Scan> back = acquisition::read_ptx(ptx.output);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(acquisition::count_valid(back.front()),
+            acquisition::count_valid(scan) - floor - deleted);
 }
 
 TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {

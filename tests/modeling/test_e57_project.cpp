@@ -125,6 +125,15 @@ TEST(E57Project, TheCoordinateSystemGoesBackOutAndIsNeverMixed) {
   const auto sources = store::Project::open_for_reading(dir / "again.sbproj").scan_sources();
   ASSERT_EQ(sources.size(), 2u);
   EXPECT_EQ(sources.at(1).coordinate_metadata, "EPSG:25832");
+  // LAS names a coordinate system in WKT only: a code is not written, and
+  // the export says so.
+  ExportSettings las;
+  las.format = ExportFormat::kLas;
+  las.output = dir / "geo.las";
+  las.scan_id = 1;
+  const ExportResult written = export_project(store::Project::open_for_reading(dir / "geo.sbproj"), las);
+  ASSERT_EQ(written.notes.size(), 1u);
+  EXPECT_THAT(written.notes.front(), ::testing::HasSubstr("\"EPSG:25832\" is not OGC WKT"));
   // A scan of a file that names no system joins any; one that names another
   // is refused.
   import_files(dir / "geo.sbproj", {fixture("good/e57/structured_spherical.e57")});
