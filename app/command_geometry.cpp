@@ -1,4 +1,4 @@
-// scanbench geometry PROJECT [--window R] [--edge-window R] [--no-mixed-pixels]
+// scanbench geometry PROJECT [--window R] [--edge-window R] [--no-mixed-pixels] [--fixed-noise]
 //                            [--settings FILE] [--threads N]
 #include <fmt/core.h>
 
@@ -16,6 +16,7 @@ struct GeometryOptions {
   std::string project;
   acquisition::GeometrySettings geometry;
   bool no_mixed_pixels = false;
+  bool fixed_noise = false;
   std::string settings_file;
 };
 
@@ -29,16 +30,21 @@ void run_geometry(GeometryOptions& options) {
     throw CLI::ValidationError("--edge-window", "must not exceed --window");
   } else {
     g.flag_mixed_pixels = !options.no_mixed_pixels;
+    g.estimate_range_noise = !options.fixed_noise;
   }
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
   const modeling::GeometryCommandResult result =
       modeling::geometry_project(project, options.geometry, progress);
-  fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8}\n", "id", "name", "valid", "normals",
-             "mixed", "edges", "seconds");
+  fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8}  {:<30} {:>8}\n", "id", "name", "valid",
+             "normals", "mixed", "edges", "range noise σ at 1/10/50 m [mm]", "seconds");
   for (const modeling::GeometryCommandScan& s : result.scans) {
-    fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8} {:>8.3f}\n", s.id, s.name, s.valid_points,
-               s.normals, s.mixed_pixels, s.edge_pixels, s.seconds);
+    const std::string noise =
+        fmt::format("{:.2f} / {:.2f} / {:.2f}{}", 1e3 * s.range_noise.sigma(1.0),
+                    1e3 * s.range_noise.sigma(10.0), 1e3 * s.range_noise.sigma(50.0),
+                    s.noise_estimated ? " (estimated)" : "");
+    fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8}  {:<30} {:>8.3f}\n", s.id, s.name,
+               s.valid_points, s.normals, s.mixed_pixels, s.edge_pixels, noise, s.seconds);
   }
   fmt::print("geometry of {} scan(s) stored in {} ({:.2f} s)\n", result.scans.size(),
              options.project, result.seconds);
@@ -69,6 +75,11 @@ void add_geometry_command(CLI::App& app) {
       ->capture_default_str()
       ->excludes(settings);
   command->add_flag("--no-mixed-pixels", options->no_mixed_pixels, "Do not flag mixed pixels")
+      ->excludes(settings);
+  command
+      ->add_flag("--fixed-noise", options->fixed_noise,
+                 "Do not estimate each scan's range noise from its data; take the pulsed "
+                 "scanner's (σ = 5 mm + 5e-5 · range) for every scan")
       ->excludes(settings);
   add_threads_option(command, g.threads);
   command->callback([options] { run_geometry(*options); });

@@ -21,6 +21,7 @@ namespace sim = acquisition::sim;
 
 struct SimulateOptions {
   sim::CampaignSettings campaign;
+  sim::NoiseProfile noise = sim::NoiseProfile::kPulsed;
   std::string out_dir;
   std::string render_view;
   std::string output_png;
@@ -29,6 +30,7 @@ struct SimulateOptions {
 void run_campaign(SimulateOptions& options) {
   if (options.out_dir.empty())
     throw CLI::ValidationError("--out", "is required (the output folder)");
+  options.campaign.scanner = sim::with_noise_profile(options.campaign.scanner, options.noise);
   ProgressBar progress;
   const sim::CampaignResult result =
       sim::simulate_campaign(options.campaign, options.out_dir, progress);
@@ -84,6 +86,15 @@ void add_simulate_command(CLI::App& app) {
       {"both", sim::CampaignFormat::kBoth}};
   command->add_option("--format", campaign.format, "ptx, triplet or both (default triplet)")
       ->transform(one_of(formats));
+  std::map<std::string, sim::NoiseProfile> profiles;
+  for (const sim::NoiseProfile profile : sim::kNoiseProfiles)
+    profiles[sim::noise_profile_name(profile)] = profile;
+  command
+      ->add_option("--noise", options->noise,
+                   "Range noise of: pulsed (default; σ = 5 mm + 5e-5 r, 1–200 m), phase-shift "
+                   "(σ = 0.6 mm + 2e-5 r + 2e-6 r², 0.6–120 m) or structured-light (σ = 1.5e-3 "
+                   "r², 0.5–8 m)")
+      ->transform(one_of(profiles));
   add_threads_option(command, campaign.simulation.threads);
   command
       ->add_option("--pose-error-deg", campaign.pose_error_deg,

@@ -58,7 +58,7 @@ class Grids {
       : scan_(scan), geometry_(geometry) {}
   const segmentation::SegmentationGrid& with(const acquisition::RangeNoise& noise) {
     for (const auto& [n, grid] : grids_) {
-      if (n.noise_m == noise.noise_m && n.noise_per_m == noise.noise_per_m) return grid;
+      if (n == noise) return grid;
     }
     segmentation::GridSettings settings;
     settings.range_noise = noise;

@@ -20,11 +20,12 @@
 // The field lists below are the whole structs minus `threads`.
 
 namespace scanbench::acquisition {
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RangeNoise, noise_m, noise_per_m)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RangeNoise, noise_m, noise_per_m, noise_per_m2)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GeometrySettings, window_radius, edge_window_radius,
                                                 depth_jump_sigmas, depth_jump_relative,
                                                 min_neighbours, max_footprint_stretch,
-                                                flag_mixed_pixels, range_noise, mixed_pixel_sigmas)
+                                                flag_mixed_pixels, range_noise, mixed_pixel_sigmas,
+                                                estimate_range_noise)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SphericalFitSettings, max_deviation_m)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(LocalOriginSettings, angle_fit,
                                                 max_per_pixel_range_m, try_spherical)
@@ -271,6 +272,7 @@ constexpr double kMaxIterations = 1e6;
 void check(const acquisition::RangeNoise& n, const Bounds& b, const std::string& at) {
   b.in(n.noise_m, 0, 10, at + "noise_m");
   b.in(n.noise_per_m, 0, 1, at + "noise_per_m");
+  b.in(n.noise_per_m2, 0, 1, at + "noise_per_m2");
 }
 
 void check(const ImportSettings& s, const Bounds& b) {

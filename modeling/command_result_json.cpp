@@ -55,7 +55,12 @@ nlohmann::json to_report(const GeometryCommandResult& result) {
                      {"valid_points", s.valid_points},
                      {"normals", s.normals},
                      {"mixed_pixels", s.mixed_pixels},
-                     {"edge_pixels", s.edge_pixels}});
+                     {"edge_pixels", s.edge_pixels},
+                     {"range_noise",
+                      {{"noise_m", s.range_noise.noise_m},
+                       {"noise_per_m", s.range_noise.noise_per_m},
+                       {"noise_per_m2", s.range_noise.noise_per_m2}}},
+                     {"noise_estimated", s.noise_estimated}});
   }
   return {{"scans", scans}, {"seconds", result.seconds}};
 }

@@ -37,7 +37,8 @@ GeometryCommandResult geometry_project(store::Project& project,
     for (const store::EncodedLayer& layer : layers) project.put_layer(part, stored.id, layer);
     part.commit_part();
     result.scans.push_back({stored.id, scan.name, geometry.valid_points, geometry.normals,
-                            geometry.mixed_pixels, geometry.edge_pixels, geometry.seconds});
+                            geometry.mixed_pixels, geometry.edge_pixels, geometry.noise.noise,
+                            geometry.noise.estimated, geometry.seconds});
     progress.update({kStage, result.scans.size(), scans.size(), scan.name});
   }
   progress.throw_if_cancelled(kStage);

@@ -20,6 +20,10 @@ struct GeometryCommandScan {
   std::size_t normals = 0;
   std::size_t mixed_pixels = 0;
   std::size_t edge_pixels = 0;
+  // The σ(range) the depth-jump and mixed-pixel tests used: estimated from
+  // the scan (GeometrySettings::estimate_range_noise) or the settings'.
+  acquisition::RangeNoise range_noise;
+  bool noise_estimated = false;
   double seconds = 0.0;
 };
 

@@ -51,15 +51,17 @@ inline bool mixed_along(float centre, float a2, float a1, float b1, float b2, fl
          (miss_a * miss_b < 0.0f);
 }
 
-// One row's flags into out; the threshold at range r [m] is sigma0_m + sigma1 · r.
+// One row's flags into out; the threshold at range r [m] is sigma0_m +
+// (sigma1 + sigma2 · r) · r.
 SCANBENCH_VECTOR_CLONES void detect_row(const PaddedBlock& block, int row, int columns,
-                                        float sigma0_m, float sigma1, std::uint8_t* out) {
+                                        float sigma0_m, float sigma1, float sigma2,
+                                        std::uint8_t* out) {
   const std::ptrdiff_t s = block.stride;
   const float* p = block.values.data() + block.at(row, 0);
   for (int col = 0; col < columns; ++col) {
     const float* c = p + col;
     const float centre = *c;
-    const float threshold_m = sigma0_m + sigma1 * centre;
+    const float threshold_m = sigma0_m + (sigma1 + sigma2 * centre) * centre;
     const bool mixed =
         mixed_along(centre, c[-2], c[-1], c[1], c[2], threshold_m) |
         mixed_along(centre, c[-2 * s], c[-s], c[s], c[2 * s], threshold_m) |
@@ -79,12 +81,15 @@ void detect_mixed_pixels(const Scan& scan, const GeometrySettings& settings,
       static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise.noise_m);
   const auto sigma1 =
       static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise.noise_per_m);
+  const auto sigma2 =
+      static_cast<float>(settings.mixed_pixel_sigmas * settings.range_noise.noise_per_m2);
   const int blocks = (scan.rows + kBlockRows - 1) / kBlockRows;
   core::parallel_for_index(blocks, settings.threads, [&](int b) {
     const int begin = b * kBlockRows, end = std::min(scan.rows, begin + kBlockRows);
     const PaddedBlock block(scan, begin, end);
     for (int row = begin; row < end; ++row)
-      detect_row(block, row, scan.columns, sigma0_m, sigma1, mixed.data() + scan.index(row, 0));
+      detect_row(block, row, scan.columns, sigma0_m, sigma1, sigma2,
+                 mixed.data() + scan.index(row, 0));
   });
 }
 

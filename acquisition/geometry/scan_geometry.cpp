@@ -106,22 +106,32 @@ void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, Fit
 }
 
 // The depth-jump test of GeometrySettings: a second difference `d` of
-// log-range above depth_jump_relative, or above depth_jump_sigmas · √6 ·
-// σ(range) / range — compared as d · range > √6 · depth_jump_sigmas · σ,
-// without a division.
+// log-range above depth_jump_sigmas · √6 · σ(range) / range, or above
+// depth_jump_relative where that is also above 5/6 of the former (5 σ at
+// the default 6): the relative test catches small edges near the scanner,
+// but never inside the noise, which a noisy sensor (a structured-light
+// camera at 5 m: σ / range = 0.75 %) would otherwise turn into jumps all
+// over its surfaces. Compared as d · range > √6 · sigmas · σ, without a
+// division.
 struct JumpTest {
-  float relative;          // threshold on d (ln range: no unit)
-  float noise0_m, noise1;  // threshold · range [m] = noise0_m + noise1 · range [m]
+  float relative;  // threshold on d (ln range: no unit)
+  // threshold · range [m] = noise0_m + (noise1 + noise2 · range) · range [m]
+  float noise0_m, noise1, noise2;
 
   explicit JumpTest(const GeometrySettings& s)
       : relative(static_cast<float>(s.depth_jump_relative)),
         noise0_m(static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_m)),
         noise1(
-            static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_per_m)) {}
+            static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_per_m)),
+        noise2(
+            static_cast<float>(s.depth_jump_sigmas * std::sqrt(6.0) * s.range_noise.noise_per_m2)) {
+  }
 
   bool operator()(float before, float centre, float after, float range_m) const {
     const float d = std::abs(before - 2.0f * centre + after);
-    return (d > relative) | (d * range_m > noise0_m + noise1 * range_m);
+    const float noise = noise0_m + (noise1 + noise2 * range_m) * range_m;
+    constexpr float kFloor = 5.0f / 6.0f;
+    return (d * range_m > noise) | ((d > relative) & (d * range_m > kFloor * noise));
   }
 };
 
@@ -476,11 +486,9 @@ void allocate(ScanGeometry& g, std::size_t n) {
 
 }  // namespace
 
-GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
-  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
-         settings.window_radius >= settings.edge_window_radius &&
-         settings.window_radius <= kMaxWindowRadius);
-  if (scan.is_scattered()) return compute_scattered_geometry(scan, settings);
+namespace {
+
+GeometryResult compute_grid_geometry(const Scan& scan, const GeometrySettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   GeometryResult result;
   ScanGeometry& g = result.geometry;
@@ -512,6 +520,27 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   }
   result.valid_points = counts.valid, result.normals = counts.normals;
   result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;
+  result.seconds = core::seconds_since(start);
+  return result;
+}
+
+}  // namespace
+
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
+  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
+         settings.window_radius >= settings.edge_window_radius &&
+         settings.window_radius <= kMaxWindowRadius);
+  const auto start = std::chrono::steady_clock::now();
+  GeometrySettings used = settings;
+  NoiseEstimate noise;
+  noise.noise = settings.range_noise;
+  if (settings.estimate_range_noise) {
+    noise = estimate_range_noise(scan, settings.range_noise, settings.threads);
+    used.range_noise = noise.noise;
+  }
+  GeometryResult result = scan.is_scattered() ? compute_scattered_geometry(scan, used)
+                                              : compute_grid_geometry(scan, used);
+  result.noise = std::move(noise);
   result.seconds = core::seconds_since(start);
   return result;
 }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "acquisition/geometry/noise_estimate.hpp"
 #include "acquisition/range_noise.hpp"
 #include "acquisition/scan.hpp"
 
@@ -63,8 +64,9 @@ struct GeometrySettings {
   int edge_window_radius = 2;
   // A depth discontinuity: the second difference of log-range along a row or
   // column exceeds depth_jump_sigmas times its noise (√6 · σ(range) / range),
-  // or depth_jump_relative, whichever is smaller. A grazing but smooth
-  // surface has a steady range gradient and no second difference.
+  // or depth_jump_relative, whichever is smaller, but never less than 5/6 of
+  // the former (5 σ at the default: no jumps inside the noise). A grazing
+  // but smooth surface has a steady range gradient and no second difference.
   double depth_jump_sigmas = 6.0;
   // Neighbours whose range differs from the centre's by more than
   // depth_jump_relative · range · (pixel distance) are across a depth
@@ -82,6 +84,10 @@ struct GeometrySettings {
   // grid line, it lies between its neighbours and off the linear continuation
   // of both sides by more than mixed_pixel_sigmas · σ.
   RangeNoise range_noise;
+  // Estimate σ(range) from the scan (noise_estimate.hpp) and use that;
+  // range_noise is then only the fallback for a scan that gives no
+  // estimate. `scanbench geometry` does so unless told the noise.
+  bool estimate_range_noise = false;
   double mixed_pixel_sigmas = 8.0;
   // Worker threads; 0 = all cores. Results do not depend on it.
   int threads = 0;
@@ -89,6 +95,7 @@ struct GeometrySettings {
 
 struct GeometryResult {
   ScanGeometry geometry;
+  NoiseEstimate noise;  // the σ(range) used: estimated, or the settings'.
   std::size_t valid_points = 0;
   std::size_t normals = 0;  // valid points given a normal
   std::size_t mixed_pixels = 0;

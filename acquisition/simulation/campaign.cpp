@@ -52,6 +52,7 @@ json scanner_json(const ScannerModel& m) {
 json noise_json(const ScannerModel& m) {
   return {{"range_noise_m", m.range_noise.noise_m},
           {"range_noise_per_m", m.range_noise.noise_per_m},
+          {"range_noise_per_m2", m.range_noise.noise_per_m2},
           {"mixed_pixel_probability", m.mixed_pixel_probability},
           {"discontinuity_min_gap_m", m.discontinuity_min_gap_m},
           {"discontinuity_relative_gap", m.discontinuity_relative_gap},

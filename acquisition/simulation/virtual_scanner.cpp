@@ -137,6 +137,39 @@ void parallel_rows(int rows, const SimulationSettings& settings, Body&& body) {
 
 }  // namespace
 
+const char* noise_profile_name(NoiseProfile profile) {
+  switch (profile) {
+    case NoiseProfile::kPulsed:
+      return "pulsed";
+    case NoiseProfile::kPhaseShift:
+      return "phase-shift";
+    case NoiseProfile::kStructuredLight:
+      return "structured-light";
+  }
+  return "pulsed";
+}
+
+ScannerModel with_noise_profile(ScannerModel model, NoiseProfile profile) {
+  switch (profile) {
+    case NoiseProfile::kPulsed:
+      model.range_noise = RangeNoise{0.005, 5e-5, 0.0};
+      model.min_range_m = 1.0;
+      model.max_range_m = 200.0;
+      break;
+    case NoiseProfile::kPhaseShift:
+      model.range_noise = RangeNoise{0.0006, 2e-5, 2e-6};
+      model.min_range_m = 0.6;
+      model.max_range_m = 120.0;
+      break;
+    case NoiseProfile::kStructuredLight:
+      model.range_noise = RangeNoise{0.0, 0.0, 1.5e-3};
+      model.min_range_m = 0.5;
+      model.max_range_m = 8.0;
+      break;
+  }
+  return model;
+}
+
 ScanLighting reference_lighting() {
   return ScanLighting{};
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,6 +42,25 @@ struct ScannerModel {
   double intensity_reference_range_m = 10.0;
   bool shadows = true;  // sun shadows in the colour image
 };
+
+// The range noise of three kinds of instrument, for `scanbench simulate
+// --noise` and the geometry bench:
+//   pulsed            time of flight (RIEGL LMS-Z360, the default):
+//                     σ = 5 mm + 5·10⁻⁵ r, 1–200 m;
+//   phase-shift       low noise near, growing with the weaker return far
+//                     away: σ = 0.6 mm + 2·10⁻⁵ r + 2·10⁻⁶ r², 0.6–120 m;
+//   structured-light  triangulation, whose depth error grows with r²:
+//                     σ = 1.5·10⁻³ r², 0.5–8 m.
+enum class NoiseProfile { kPulsed, kPhaseShift, kStructuredLight };
+
+inline constexpr std::array<NoiseProfile, 3> kNoiseProfiles = {
+    NoiseProfile::kPulsed, NoiseProfile::kPhaseShift, NoiseProfile::kStructuredLight};
+
+// "pulsed", "phase-shift", "structured-light".
+const char* noise_profile_name(NoiseProfile profile);
+
+// `model` with the profile's range noise and range limits.
+ScannerModel with_noise_profile(ScannerModel model, NoiseProfile profile);
 
 // Lighting of one scan's colour image. Each scan of a campaign gets its own,
 // so scans of the same wall disagree in colour (seed 004 §4.5).

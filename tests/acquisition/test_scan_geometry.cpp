@@ -318,6 +318,85 @@ TEST(WindowSlopes, MatchBruteForceOnAMaskedGrid) {
   }
 }
 
+// Ground (z = −1.6 m) and a wall 30 m ahead, seen from 2° above to 60°
+// below the horizon at 0.25° steps (ranges 1.8 to 30 m), with Gaussian range
+// noise of σ(range) = `truth`; in `rough` of its 8 × 8 pixel tiles the
+// points instead lie off the surface by up to ±5 cm, as on bushes or rubble.
+Scan noisy_ground(const RangeNoise& truth, double rough, std::uint32_t seed) {
+  const double step = 0.25 * kDeg;
+  Scan scan = make_empty_scan(248, 400, false, false);
+  scan.angles = SphericalAngles{0.5 * scan.columns * step, -step, 2.0 * kDeg, -step};
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> uniform;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const Eigen::Vector3d d = direction_precise(scan, row, col);
+      const double ground = plane(d, Eigen::Vector3d(0.0, 0.0, -1.0), 1.6);
+      const double wall = plane(d, Eigen::Vector3d::UnitX(), 30.0);
+      const double range = ground < 0 ? wall : (wall < 0 ? ground : std::min(ground, wall));
+      const std::size_t i = scan.index(row, col);
+      scan.valid[i] = range > 0;
+      if (range <= 0) continue;
+      const std::uint32_t tile = static_cast<std::uint32_t>(row / 8 * 1000 + col / 8) * 2654435761u;
+      const bool bush = static_cast<double>(tile >> 8) / static_cast<double>(1u << 24) < rough;
+      const double off = bush ? 0.1 * (uniform(rng) - 0.5) : 0.0;
+      scan.range_m[i] = static_cast<float>(range + truth.sigma(range) * normal(rng) + off);
+    }
+  }
+  return scan;
+}
+
+// The estimate's σ against the truth's at the ranges the scan covers well.
+void expect_sigma_near(const NoiseEstimate& estimate, const RangeNoise& truth, double tolerance) {
+  ASSERT_TRUE(estimate.estimated);
+  EXPECT_GE(estimate.bands.size(), 8u);
+  for (const double range : {3.0, 6.0, 12.0, 25.0}) {
+    EXPECT_NEAR(estimate.noise.sigma(range) / truth.sigma(range), 1.0, tolerance)
+        << "at " << range << " m: " << 1e3 * estimate.noise.sigma(range) << " mm, truth "
+        << 1e3 * truth.sigma(range) << " mm";
+  }
+}
+
+TEST(NoiseEstimate, FindsEachInstrumentsNoiseWithoutBeingTold) {
+  const RangeNoise pulsed{0.005, 5e-5, 0.0};
+  const RangeNoise phase_shift{0.0006, 2e-5, 2e-6};
+  const RangeNoise triangulating{0.0, 0.0, 1.5e-4};
+  for (const RangeNoise& truth : {pulsed, phase_shift, triangulating}) {
+    const Scan scan = noisy_ground(truth, 0.0, 3);
+    expect_sigma_near(estimate_range_noise(scan), truth, 0.1);
+  }
+}
+
+TEST(NoiseEstimate, RoughSurfacesDoNotInflateIt) {
+  const RangeNoise truth{0.002, 1e-5, 0.0};
+  const NoiseEstimate estimate = estimate_range_noise(noisy_ground(truth, 0.2, 4));
+  expect_sigma_near(estimate, truth, 0.2);
+  // The same on one thread as on all.
+  const NoiseEstimate single = estimate_range_noise(noisy_ground(truth, 0.2, 4), {}, 1);
+  EXPECT_EQ(single.noise, estimate.noise);
+}
+
+TEST(NoiseEstimate, AScanWithoutGridLinesKeepsTheFallback) {
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 100; ++i) points.emplace_back(5.0, 0.01 * i, 0.0);
+  Scan scattered = make_scattered_scan(points.size(), false, false);
+  set_scattered_points(scattered, points);
+  const RangeNoise fallback{0.003, 0.0, 0.0};
+  const NoiseEstimate estimate = estimate_range_noise(scattered, fallback);
+  EXPECT_FALSE(estimate.estimated);
+  EXPECT_EQ(estimate.noise, fallback);
+  // Told to estimate, the geometry stage reports what it used.
+  GeometrySettings settings;
+  settings.estimate_range_noise = true;
+  settings.range_noise = fallback;
+  EXPECT_EQ(compute_geometry(scattered, settings).noise.noise, fallback);
+  const RangeNoise truth{0.004, 0.0, 0.0};
+  const GeometryResult estimated = compute_geometry(noisy_ground(truth, 0.0, 5), settings);
+  EXPECT_TRUE(estimated.noise.estimated);
+  EXPECT_NEAR(estimated.noise.noise.sigma(10.0), 0.004, 0.0005);
+}
+
 }  // namespace
 }  // namespace scanbench::acquisition
 

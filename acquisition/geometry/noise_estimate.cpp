@@ -1,0 +1,162 @@
+#include "acquisition/geometry/noise_estimate.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+
+#include "core/parallel.hpp"
+
+namespace scanbench::acquisition {
+namespace {
+
+// Bands of range: band k holds [0.1 m · 2^(k/4), 0.1 m · 2^((k+1)/4)), up to 6.5 km.
+constexpr int kBands = 64;
+constexpr double kNearestM = 0.1;
+constexpr double kBandsPerOctave = 4.0;
+constexpr int kTile = 16;                 // tiles of 16 × 16 pixels
+constexpr std::size_t kTileMinimum = 64;  // residuals for a tile's σ
+constexpr std::size_t kBandMinimumTiles = 8;
+// The median of |N(0, 1)| is Φ⁻¹(0.75); the fourth difference of
+// independent readings has variance (1 + 16 + 36 + 16 + 1) σ² = 70 σ².
+constexpr double kMedianOfUnitNormal = 0.674489750196082;
+const double kResidualPerSigma = kMedianOfUnitNormal * std::sqrt(70.0);
+constexpr double kTileQuantile = 0.3;
+constexpr double kMinSigmaM = 1e-4;
+
+// One tile's σ, at its mean range.
+struct TileSigma {
+  double range_m = 0.0;
+  double sigma_m = 0.0;
+  std::size_t samples = 0;
+};
+
+// The fourth difference of five inverse ranges, times the centre's range
+// squared (a range error ε moves 1/r by −ε / r²), or NaN where one has no
+// return.
+inline double residual(const Scan& scan, std::size_t i, std::ptrdiff_t step) {
+  const auto inverse = [&](std::ptrdiff_t k) {
+    const auto j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(i) + k * step);
+    return scan.valid[j] ? 1.0 / static_cast<double>(scan.range_m[j])
+                         : std::numeric_limits<double>::quiet_NaN();
+  };
+  const double r = scan.range_m[i];
+  return r * r *
+         (inverse(-2) - 4.0 * inverse(-1) + 6.0 * inverse(0) - 4.0 * inverse(1) + inverse(2));
+}
+
+// The σ of the tile whose top left pixel is (row0, col0): the median of its
+// |residuals| along rows and columns.
+std::optional<TileSigma> tile_sigma(const Scan& scan, int row0, int col0,
+                                    std::vector<double>& residuals) {
+  residuals.clear();
+  double range_sum = 0.0;
+  const auto stride = static_cast<std::ptrdiff_t>(scan.columns);
+  for (int row = row0; row < std::min(scan.rows, row0 + kTile); ++row) {
+    for (int col = col0; col < std::min(scan.columns, col0 + kTile); ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (!scan.valid[i]) continue;
+      for (const bool along_row : {true, false}) {
+        const bool inside =
+            along_row ? col >= 2 && col + 2 < scan.columns : row >= 2 && row + 2 < scan.rows;
+        if (!inside) continue;
+        const double r = residual(scan, i, along_row ? 1 : stride);
+        if (!std::isfinite(r)) continue;
+        residuals.push_back(std::abs(r));
+        range_sum += scan.range_m[i];
+      }
+    }
+  }
+  if (residuals.size() < kTileMinimum) return std::nullopt;
+  const auto middle = residuals.begin() + static_cast<std::ptrdiff_t>(residuals.size() / 2);
+  std::nth_element(residuals.begin(), middle, residuals.end());
+  return TileSigma{range_sum / static_cast<double>(residuals.size()), *middle / kResidualPerSigma,
+                   residuals.size()};
+}
+
+// σ(r) = a + b r + c r² with a, b, c ≥ 0: the least-squares fit relative to
+// each band's σ, weighted by its samples, over every subset of free terms
+// (the others 0), keeping the best whose terms are all ≥ 0.
+RangeNoise fit(const std::vector<NoiseBand>& bands) {
+  double best_cost = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best = Eigen::Vector3d::Zero();
+  for (int subset = 1; subset < 8; ++subset) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (const NoiseBand& b : bands) {
+      const double w = static_cast<double>(b.samples) / (b.sigma_m * b.sigma_m);
+      Eigen::Vector3d x(1.0, b.range_m, b.range_m * b.range_m);
+      for (int t = 0; t < 3; ++t) x[t] = (subset >> t) & 1 ? x[t] : 0.0;
+      normal += w * x * x.transpose();
+      rhs += w * x * b.sigma_m;
+    }
+    for (int t = 0; t < 3; ++t) {
+      if (!((subset >> t) & 1)) normal(t, t) = 1.0;  // the term stays 0
+    }
+    const Eigen::Vector3d c = normal.ldlt().solve(rhs);
+    if (!c.allFinite() || c.minCoeff() < 0.0) continue;
+    double cost = 0.0;
+    for (const NoiseBand& b : bands) {
+      const double e =
+          (c[0] + c[1] * b.range_m + c[2] * b.range_m * b.range_m - b.sigma_m) / b.sigma_m;
+      cost += static_cast<double>(b.samples) * e * e;
+    }
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = c;
+    }
+  }
+  RangeNoise noise;
+  noise.noise_m = std::max(best[0], kMinSigmaM);
+  noise.noise_per_m = best[1];
+  noise.noise_per_m2 = best[2];
+  return noise;
+}
+
+}  // namespace
+
+NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback, int threads) {
+  NoiseEstimate out;
+  out.noise = fallback;
+  if (scan.is_scattered() || scan.rows < 5 || scan.columns < 5) return out;
+  const int tile_rows = (scan.rows + kTile - 1) / kTile;
+  const int tile_columns = (scan.columns + kTile - 1) / kTile;
+  std::vector<std::optional<TileSigma>> tiles(static_cast<std::size_t>(tile_rows) * tile_columns);
+  core::parallel_for_index(tile_rows, threads, [&](int tr) {
+    std::vector<double> residuals;
+    for (int tc = 0; tc < tile_columns; ++tc) {
+      tiles[static_cast<std::size_t>(tr) * tile_columns + tc] =
+          tile_sigma(scan, tr * kTile, tc * kTile, residuals);
+    }
+  });
+  std::array<std::vector<TileSigma>, kBands> by_band;
+  for (const std::optional<TileSigma>& tile : tiles) {
+    if (!tile) continue;
+    const int band =
+        static_cast<int>(std::floor(kBandsPerOctave * std::log2(tile->range_m / kNearestM)));
+    if (band >= 0 && band < kBands) by_band[static_cast<std::size_t>(band)].push_back(*tile);
+  }
+  for (std::vector<TileSigma>& band : by_band) {
+    if (band.size() < kBandMinimumTiles) continue;
+    std::sort(band.begin(), band.end(),
+              [](const TileSigma& a, const TileSigma& b) { return a.sigma_m < b.sigma_m; });
+    const TileSigma& low = band[static_cast<std::size_t>(kTileQuantile * (band.size() - 1))];
+    double range_sum = 0.0;
+    std::size_t samples = 0;
+    for (const TileSigma& t : band) {
+      range_sum += t.range_m;
+      samples += t.samples;
+    }
+    out.bands.push_back({range_sum / static_cast<double>(band.size()), low.sigma_m, samples});
+    out.samples += samples;
+  }
+  if (out.bands.empty()) return out;
+  out.noise = fit(out.bands);
+  out.estimated = true;
+  return out;
+}
+
+}  // namespace scanbench::acquisition

@@ -1,0 +1,50 @@
+// The range noise of a scan, estimated from the scan itself: what the
+// geometry stage's depth-jump and mixed-pixel tests compare against, for any
+// instrument, without being told which one recorded it.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "acquisition/range_noise.hpp"
+#include "acquisition/scan.hpp"
+
+namespace scanbench::acquisition {
+
+// σ measured in one band of ranges.
+struct NoiseBand {
+  double range_m = 0.0;  // the band's mean range
+  double sigma_m = 0.0;
+  std::size_t samples = 0;
+};
+
+struct NoiseEstimate {
+  RangeNoise noise;  // the fit, or the fallback when !estimated
+  bool estimated = false;
+  std::vector<NoiseBand> bands;  // the bands the fit used, nearest first
+  std::size_t samples = 0;       // residuals measured, in all bands
+};
+
+// Estimates σ(range) of a grid scan. Along every row and every column, five
+// consecutive valid returns give the residual of a local fit: the fourth
+// difference of their inverse ranges u = 1/r, u₋₂ − 4u₋₁ + 6u₀ − 4u₊₁ + u₊₂,
+// times r₀². A plane's 1/r is a sum of sines and cosines of the beam angles,
+// which the fourth difference all but removes at any incidence, grazing
+// ground included (a range's own fourth difference does not: at 3.7° over
+// ground and 0.25° steps it is 12 mm), as it removes any cubic of a gently
+// curved surface. What remains is noise, of standard deviation √70 · σ,
+// except across depth jumps, on mixed pixels and on rough surfaces (foliage,
+// rubble), which only make it larger.
+//   Each tile of 16 × 16 pixels gets σ from the median of its |residuals|
+// (0.674 √70 σ for Gaussian noise), at its mean range. Tiles fall into bands
+// of range 19 % wide; a band of at least 8 tiles takes the 30th percentile
+// of its tiles' σ, so rough or broken ground in up to about two thirds of a
+// band's tiles does not drag it up. The bands are fitted with σ(r) = a + b r
+// + c r², a, b, c ≥ 0 (a ≥ 0.1 mm), least squares relative to each band's σ
+// and weighted by its residuals. A scan with no such band (a scattered
+// scan, which has no grid lines; a tiny or empty one) keeps `fallback`. The
+// result does not depend on `threads` (0: all cores).
+NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback = {},
+                                   int threads = 0);
+
+}  // namespace scanbench::acquisition
