@@ -101,7 +101,18 @@ Header read_header(LasFile& file) {
                       " (1.0 to 1.4 are read)");
   }
   out.header_size = at<std::uint16_t>(h, 94);
+  // The header's fixed part: 227 bytes up to 1.2, 235 in 1.3, 375 in 1.4.
+  const std::uint16_t fixed = out.version_minor >= 4 ? 375 : out.version_minor == 3 ? 235 : 227;
+  if (out.header_size < fixed) {
+    file.fail(94, "a header size of " + std::to_string(out.header_size) +
+                      " bytes, less than LAS 1." + std::to_string(out.version_minor) + "'s " +
+                      std::to_string(fixed));
+  }
   out.point_offset = at<std::uint32_t>(h, 96);
+  if (out.point_offset < out.header_size) {
+    file.fail(96, "points at byte " + std::to_string(out.point_offset) + ", inside the " +
+                      std::to_string(out.header_size) + "-byte header");
+  }
   out.vlr_count = at<std::uint32_t>(h, 100);
   const int format_byte = h[104];
   if (format_byte & 0xC0) {

@@ -284,7 +284,10 @@ Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, cons
     }
   }
   scan.T_world_scan = h.viewpoint;
-  if (h.height == 1) return scattered(scan, points);
+  if (h.height == 1) {
+    if (count_valid(scan) == 0) reader.fail("no point with a return: there is nothing to import");
+    return scattered(scan, points);
+  }
   LocalOriginSettings grid;
   grid.try_spherical = false;  // depth-camera grids are pinhole images, not panoramas
   set_grid_from_points(scan, points, std::nullopt, grid);

@@ -6,11 +6,14 @@
 #include <utility>
 
 #include "acquisition/local_origin.hpp"
+#include "core/errors.hpp"
 
 namespace scanbench::acquisition {
 
 Scan scattered_scan(PointCloud&& cloud, const std::filesystem::path& path) {
   const std::size_t n = cloud.points.size();
+  if (n == 0)
+    throw core::InputError(path.string(), {}, "holds no points: there is nothing to import");
   assert((cloud.intensity.empty() || cloud.intensity.size() == n) &&
          (cloud.rgb.empty() || cloud.rgb.size() == 3 * n) && "channels of one value per point");
   Scan scan = make_scattered_scan(n, !cloud.intensity.empty(), !cloud.rgb.empty());

@@ -18,8 +18,9 @@ struct PointCloud {
 };
 
 // The scattered scan of `cloud` (its points taken), named after the stem
-// of `path`, with `path` as its source file. Asserts the channels are
-// empty or one per point.
+// of `path`, with `path` as its source file. Throws core::InputError naming
+// `path` when the cloud has no point (a 0 × 0 scan is no scan). Asserts the
+// channels are empty or one per point.
 Scan scattered_scan(PointCloud&& cloud, const std::filesystem::path& path);
 
 }  // namespace scanbench::acquisition

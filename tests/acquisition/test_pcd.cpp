@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -70,6 +71,16 @@ TEST(PcdReader, AnUnorganizedCloudKeepsEveryReturnInItsOrder) {
   EXPECT_LT((point(4) - Eigen::Vector3d(1, 2, 2)).norm(), 1e-6) << "the 7th record, 5th return";
   EXPECT_EQ(rgb_of(scan, 3), (std::vector<std::uint8_t>{10, 20, 30}));
   EXPECT_EQ(scan.intensity[4], 0.125f);
+}
+
+TEST(PcdReader, AnUnorganizedCloudWithoutAReturnIsRefused) {
+  const ScratchDir dir;
+  const std::filesystem::path path = dir / "nothing.pcd";
+  std::ofstream(path) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                         "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\nnan nan nan\n0 0 0\n";
+  EXPECT_THAT([&] { read_pcd(path); },
+              ::testing::ThrowsMessage<core::InputError>(
+                  ::testing::HasSubstr("no point with a return: there is nothing to import")));
 }
 
 TEST(PcdReader, TakesPoseFromViewpointAndNameFromStem) {

@@ -137,6 +137,10 @@ TEST(PlyReader, BadFilesAreRefusedWithTheirPlace) {
         << bytes;
   };
   refused("plx\n", "not a PLY file");
+  refused(
+      "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n",
+      "holds no points");
   refused("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
           "no x, y and z");
   refused(
@@ -270,6 +274,20 @@ TEST(LasReader, BadFilesAreRefusedWithTheirPlace) {
   write_bytes(dir / "f.las", far);
   EXPECT_THAT([&] { read_las(dir / "f.las"); },
               ThrowsMessage<core::InputError>(HasSubstr("record 0: coordinate beyond 10^8 m")));
+  std::string small_header = las_1_2(2);
+  small_header[94] = static_cast<char>(200);  // header size 200 < 227
+  write_bytes(dir / "g.las", small_header);
+  EXPECT_THAT([&] { read_las(dir / "g.las"); },
+              ThrowsMessage<core::InputError>(HasSubstr("a header size of 200 bytes, less than")));
+  std::string inside = las_1_2(2);
+  inside[96] = static_cast<char>(100);  // points at byte 100, inside the header
+  inside[97] = 0;
+  write_bytes(dir / "h.las", inside);
+  EXPECT_THAT([&] { read_las(dir / "h.las"); },
+              ThrowsMessage<core::InputError>(HasSubstr("inside the 227-byte header")));
+  write_bytes(dir / "i.las", las_1_2(0).substr(0, las_1_2(0).size() - 2 * 34));
+  EXPECT_THAT([&] { read_las(dir / "i.las"); },
+              ThrowsMessage<core::InputError>(HasSubstr("holds no points")));
   write_bytes(dir / "e.laz", "");
   EXPECT_THAT([&] { scan_file_format(dir / "e.laz"); },
               ThrowsMessage<core::InputError>(HasSubstr("Debian does not package LASzip")));

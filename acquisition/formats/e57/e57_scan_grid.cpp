@@ -382,6 +382,10 @@ ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanE
     if (fields.color[0]) channels.rgb.resize(3 * points.size());
     fill_pixels(block, slot, scales, channels);
   });
+  if (points.empty()) {
+    throw core::InputError(path.string(), {{}, {}, "scan \"" + entry.name + "\""},
+                           "an unstructured scan with no valid point: there is nothing to import");
+  }
   ImportedScan out;
   Scan& scan = out.scan;
   scan = make_scattered_scan(points.size(), channels.has_intensity(), channels.has_color());
