@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -78,12 +79,19 @@ std::optional<TileSigma> tile_sigma(const Scan& scan, int row0, int col0,
 }
 
 // σ(r) = a + b r + c r² with a, b, c ≥ 0: the least-squares fit relative to
-// each band's σ, weighted by its samples, over every subset of free terms
-// (the others 0), keeping the best whose terms are all ≥ 0.
-RangeNoise fit(const std::vector<NoiseBand>& bands) {
+// each band's σ, weighted by its samples, over the subsets of free terms
+// (the others 0) that have at least as many bands as terms, simplest first;
+// a subset replaces the one before only when its terms are all ≥ 0 and it
+// lowers the cost by more than 10 %. One band gives a constant σ, not
+// whichever one-term model rounding favours. None when no subset fits.
+std::optional<RangeNoise> fit(const std::vector<NoiseBand>& bands) {
+  constexpr double kClearlyBetter = 0.9;
+  constexpr std::array<int, 7> kSubsets = {0b001, 0b010, 0b100, 0b011, 0b101, 0b110, 0b111};
   double best_cost = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d best = Eigen::Vector3d::Zero();
-  for (int subset = 1; subset < 8; ++subset) {
+  std::optional<Eigen::Vector3d> best;
+  for (const int subset : kSubsets) {
+    if (static_cast<std::size_t>(std::popcount(static_cast<unsigned>(subset))) > bands.size())
+      continue;
     Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
     Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
     for (const NoiseBand& b : bands) {
@@ -104,15 +112,16 @@ RangeNoise fit(const std::vector<NoiseBand>& bands) {
           (c[0] + c[1] * b.range_m + c[2] * b.range_m * b.range_m - b.sigma_m) / b.sigma_m;
       cost += static_cast<double>(b.samples) * e * e;
     }
-    if (cost < best_cost) {
+    if (!best || cost < kClearlyBetter * best_cost) {
       best_cost = cost;
       best = c;
     }
   }
+  if (!best) return std::nullopt;
   RangeNoise noise;
-  noise.noise_m = std::max(best[0], kMinSigmaM);
-  noise.noise_per_m = best[1];
-  noise.noise_per_m2 = best[2];
+  noise.noise_m = std::max((*best)[0], kMinSigmaM);
+  noise.noise_per_m = (*best)[1];
+  noise.noise_per_m2 = (*best)[2];
   return noise;
 }
 
@@ -144,6 +153,9 @@ NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback,
     std::sort(band.begin(), band.end(),
               [](const TileSigma& a, const TileSigma& b) { return a.sigma_m < b.sigma_m; });
     const TileSigma& low = band[static_cast<std::size_t>(kTileQuantile * (band.size() - 1))];
+    // Ranges quantised coarser than their noise (equal readings along a
+    // head-on wall) leave medians of 0: no estimate in that band.
+    if (low.sigma_m < kMinSigmaM) continue;
     double range_sum = 0.0;
     std::size_t samples = 0;
     for (const TileSigma& t : band) {
@@ -153,8 +165,9 @@ NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback,
     out.bands.push_back({range_sum / static_cast<double>(band.size()), low.sigma_m, samples});
     out.samples += samples;
   }
-  if (out.bands.empty()) return out;
-  out.noise = fit(out.bands);
+  const std::optional<RangeNoise> fitted = out.bands.empty() ? std::nullopt : fit(out.bands);
+  if (!fitted) return out;
+  out.noise = *fitted;
   out.estimated = true;
   return out;
 }

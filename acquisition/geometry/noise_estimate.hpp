@@ -39,11 +39,15 @@ struct NoiseEstimate {
 // (0.674 √70 σ for Gaussian noise), at its mean range. Tiles fall into bands
 // of range 19 % wide; a band of at least 8 tiles takes the 30th percentile
 // of its tiles' σ, so rough or broken ground in up to about two thirds of a
-// band's tiles does not drag it up. The bands are fitted with σ(r) = a + b r
-// + c r², a, b, c ≥ 0 (a ≥ 0.1 mm), least squares relative to each band's σ
-// and weighted by its residuals. A scan with no such band (a scattered
-// scan, which has no grid lines; a tiny or empty one) keeps `fallback`. The
-// result does not depend on `threads` (0: all cores).
+// band's tiles does not drag it up; a band whose σ comes out below 0.1 mm
+// (ranges quantised coarser than their noise) is left out. The bands are
+// fitted with σ(r) = a + b r + c r², a, b, c ≥ 0 (a ≥ 0.1 mm), least squares
+// relative to each band's σ and weighted by its residuals, a term added only
+// where the bands support it (one band: a constant). The percentile of
+// tiles' medians runs a few per cent low (measured: 0.94–0.98 of the truth).
+// A scan with no usable band (a scattered scan, which has no grid lines; a
+// tiny, empty or coarsely quantised one) keeps `fallback`. The result does
+// not depend on `threads` (0: all cores).
 NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback = {},
                                    int threads = 0);
 

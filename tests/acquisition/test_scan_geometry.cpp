@@ -377,6 +377,32 @@ TEST(NoiseEstimate, RoughSurfacesDoNotInflateIt) {
   EXPECT_EQ(single.noise, estimate.noise);
 }
 
+// A wall 10 m ahead, head on: every range in one band.
+Scan noisy_wall(double sigma_m, double quantum_m) {
+  std::mt19937 rng(6);
+  std::normal_distribution<double> normal;
+  return cast_scan(64, 64, 0.1, [&](const Eigen::Vector3d& d) {
+    const double range = plane(d, Eigen::Vector3d::UnitX(), 10.0) + sigma_m * normal(rng);
+    return quantum_m > 0 ? quantum_m * std::round(range / quantum_m) : range;
+  });
+}
+
+TEST(NoiseEstimate, OneBandOfRangeGivesAConstantSigma) {
+  const NoiseEstimate estimate = estimate_range_noise(noisy_wall(0.003, 0.0));
+  ASSERT_TRUE(estimate.estimated);
+  EXPECT_EQ(estimate.bands.size(), 1u);
+  EXPECT_NEAR(estimate.noise.noise_m, 0.003, 0.0003);
+  EXPECT_EQ(estimate.noise.noise_per_m, 0.0);
+  EXPECT_EQ(estimate.noise.noise_per_m2, 0.0);
+}
+
+TEST(NoiseEstimate, RangesQuantisedCoarserThanTheirNoiseKeepTheFallback) {
+  const RangeNoise fallback{0.002, 0.0, 0.0};
+  const NoiseEstimate estimate = estimate_range_noise(noisy_wall(0.001, 0.01), fallback);
+  EXPECT_FALSE(estimate.estimated);
+  EXPECT_EQ(estimate.noise, fallback);
+}
+
 TEST(NoiseEstimate, AScanWithoutGridLinesKeepsTheFallback) {
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < 100; ++i) points.emplace_back(5.0, 0.01 * i, 0.0);
