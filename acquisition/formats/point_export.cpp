@@ -94,7 +94,6 @@ std::string ply_header(std::size_t vertices, Channels channels) {
 
 constexpr double kLasScale = 1e-4;  // 0.1 mm
 constexpr std::uint16_t kLasHeaderSize = 375;
-constexpr std::uint16_t kVlrHeaderSize = 54;
 constexpr std::uint16_t kExtraBytesDescriptorSize = 192;
 constexpr std::uint16_t kPointFormat7Size = 36;
 
