@@ -23,9 +23,11 @@ inline constexpr int kExitBadInput = 2;  // bad file, bad argument, usage error
 void add_import_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_export_command(CLI::App& app);
-// The bench suites' own command (bench/command_bench.cpp; builds with the
-// benches only).
+// The bench suites' own command (bench/command_bench.cpp), in the
+// scanbench-bench executable only: scanbench hands `bench` calls to it.
 void add_bench_command(CLI::App& app);
+inline constexpr const char* kBenchDescription =
+    "Measure a stage: accuracy against ground truth and speed against PCL, one run.";
 void add_simulate_command(CLI::App& app);
 void add_geometry_command(CLI::App& app);
 void add_register_command(CLI::App& app);

@@ -3,9 +3,13 @@
 // recolor → render → export, the workbench, and info / objects / history /
 // undo / redo / check over all of them).
 #include <fmt/core.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <opencv2/core/utils/logger.hpp>
 #include <string>
 #include <string_view>
@@ -57,6 +61,28 @@ std::string unknown_word(const CLI::App& app, int argc, char** argv) {
   return "";
 }
 
+#ifndef SCANBENCH_WITH_BENCH
+// `scanbench bench …` runs as `scanbench-bench bench …`, the same command
+// line with the benches, beside this executable: the benches link PCL, whose
+// libraries would cost every other command 0.1 s of dynamic linking before
+// main(). Returns only when that executable cannot start.
+int run_benches(char** argv) {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path benches = self.parent_path() / "scanbench-bench";
+  if (error || !std::filesystem::exists(benches)) {
+    return report_error("usage",
+                        "this scanbench was built without the benchmark suites "
+                        "(scanbench-bench is not beside it; configure with -DSCANBENCH_BENCH=ON)",
+                        scanbench::app::kExitBadInput, 1);
+  }
+  ::execv(benches.c_str(), argv);
+  return report_error("error",
+                      "could not start " + benches.string() + " (" + std::strerror(errno) + ")",
+                      scanbench::app::kExitFailure, 1);
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -86,13 +112,9 @@ int main(int argc, char** argv) {
 #ifdef SCANBENCH_WITH_BENCH
   sb::add_bench_command(app);
 #else
-  app.add_subcommand("bench", "Not in this build (configured with -DSCANBENCH_BENCH=OFF)")
-      ->allow_extras()
-      ->callback([] {
-        throw CLI::ValidationError("bench",
-                                   "this scanbench was built without the benchmark "
-                                   "suites (-DSCANBENCH_BENCH=OFF)");
-      });
+  // Listed in --help; the call itself goes to scanbench-bench before parsing.
+  app.add_subcommand("bench", sb::kBenchDescription);
+  if (argc >= 2 && std::string_view(argv[1]) == "bench") return run_benches(argv);
 #endif
   try {
     app.parse(argc, argv);

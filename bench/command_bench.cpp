@@ -41,8 +41,7 @@ void run_bench(const BenchCommandOptions& options) {
 
 void add_bench_command(CLI::App& app) {
   auto options = std::make_shared<BenchCommandOptions>();
-  CLI::App* command = app.add_subcommand(
-      "bench", "Measure a stage: accuracy against ground truth and speed against PCL, one run.");
+  CLI::App* command = app.add_subcommand("bench", kBenchDescription);
   command->add_option("suite", options->suite, "Suite to run")
       ->required()
       ->check(CLI::IsMember(bench::suite_names()));

@@ -21,8 +21,8 @@
 #include <numbers>
 #include <vector>
 
+#include "bench/pcl_sample_cloud.hpp"
 #include "core/timing.hpp"
-#include "registration/pcl_sample_cloud.hpp"
 #include "registration/pose_parameters.hpp"
 
 namespace scanbench::bench {

@@ -1,16 +1,16 @@
-// Automatic coarse registration: FPFH features (Rusu et al. 2009) through
-// PCL, matched between two scans, and pose hypotheses drawn from the matches
+// Automatic coarse registration: FPFH features (Rusu et al. 2009, fpfh.hpp)
+// matched between two scans, and pose hypotheses drawn from the matches
 // by RANSAC. No pose guess is needed. A hypothesis is only a candidate: the
 // pipeline (register_scans.cpp) keeps one only after ICP from it lands most
 // of the scan on the target's surfaces and none in its free space.
 #pragma once
 
 #include <cstddef>
-#include <memory>
 #include <string>
 #include <vector>
 
 #include "registration/coarse_hypotheses.hpp"
+#include "registration/fpfh.hpp"
 #include "registration/sample_cloud.hpp"
 
 namespace scanbench::registration {
@@ -59,16 +59,13 @@ struct FeatureAlignmentResult {
 class FeatureCloud {
  public:
   FeatureCloud(const SampleCloud& sample, const FeatureSettings& settings);
-  ~FeatureCloud();
-  FeatureCloud(FeatureCloud&&) noexcept;
-  FeatureCloud& operator=(FeatureCloud&&) noexcept;
-  std::size_t size() const;
+  std::size_t size() const { return sample_.size(); }
+  const SampleCloud& sample() const { return sample_; }
+  const FpfhResult& fpfh() const { return fpfh_; }
 
  private:
-  friend FeatureAlignmentResult align_features(const FeatureCloud&, const FeatureCloud&,
-                                               const FeatureSettings&);
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  SampleCloud sample_;
+  FpfhResult fpfh_;
 };
 
 // Pose hypotheses taking the source scan's frame to the target's.

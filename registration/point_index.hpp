@@ -1,6 +1,6 @@
 // Nearest-neighbour index over a scan's points: the association fallback for
 // grids without a regular angle model (per-pixel directions), where the pixel
-// a point projects to cannot be computed. A small adapter over PCL's kd-tree.
+// a point projects to cannot be computed. A k-d tree (nearest_points.hpp).
 #pragma once
 
 #include <Eigen/Core>

@@ -43,16 +43,6 @@ Format format_of(const std::filesystem::path& path) {
   return Format::kOther;
 }
 
-// B, G, R(, A) from R, G, B(, A), in place.
-void rgb_to_bgr(cv::Mat& pixels) {
-  if (pixels.channels() < 3) return;
-  cv::Mat swapped(pixels.size(), pixels.type());
-  const int channels = pixels.channels();
-  const std::array<int, 8> pairs = {0, 2, 1, 1, 2, 0, 3, 3};
-  cv::mixChannels(&pixels, 1, &swapped, 1, pairs.data(), static_cast<std::size_t>(channels));
-  pixels = swapped;
-}
-
 // ---- TIFF ------------------------------------------------------------
 
 // The first error libtiff reports while a file is open, as text.
@@ -184,7 +174,7 @@ DecodedImage decode_tiff(const std::filesystem::path& path, int rows, int column
                                                  : read_tiff_strips(tiff.get(), result.pixels);
   if (!read)
     return {{}, unreadable(problem.empty() ? "the TIFF's pixel data cannot be read" : problem)};
-  rgb_to_bgr(result.pixels);
+  result.pixels = swap_red_blue(result.pixels);
   return result;
 }
 
@@ -266,7 +256,7 @@ DecodedImage decode_pfm(PnmReader& in, const std::filesystem::path& path, int ch
   for (int row = rows - 1; row >= 0; --row) in.bytes(result.pixels.ptr(row), row_bytes);
   const bool little = scale < 0.0;
   if (little != (std::endian::native == std::endian::little)) swap_bytes(result.pixels, 4);
-  rgb_to_bgr(result.pixels);
+  result.pixels = swap_red_blue(result.pixels);
   return result;
 }
 
@@ -304,7 +294,7 @@ DecodedImage decode_pnm_samples(PnmReader& in, const std::filesystem::path& path
         reinterpret_cast<std::uint16_t*>(result.pixels.data)[i] = static_cast<std::uint16_t>(value);
     }
   }
-  rgb_to_bgr(result.pixels);
+  result.pixels = swap_red_blue(result.pixels);
   return result;
 }
 
@@ -350,6 +340,15 @@ DecodedImage decode_image(const std::filesystem::path& path, int rows, int colum
       {},
       unreadable(std::filesystem::file_size(path, error) == 0 ? "the file is empty"
                                                               : "not a PNG, TIFF or PNM image")};
+}
+
+cv::Mat swap_red_blue(const cv::Mat& pixels) {
+  if (pixels.channels() < 3) return pixels;
+  cv::Mat swapped(pixels.size(), pixels.type());
+  const std::array<int, 8> pairs = {0, 2, 1, 1, 2, 0, 3, 3};
+  cv::mixChannels(&pixels, 1, &swapped, 1, pairs.data(),
+                  static_cast<std::size_t>(pixels.channels()));
+  return swapped;
 }
 
 }  // namespace scanbench::acquisition

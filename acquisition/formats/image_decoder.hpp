@@ -3,8 +3,9 @@
 // imread prints "can't read header" lines), every reason becomes part of
 // one error, and the size a header declares is checked against the
 // sidecar's before any pixel memory is allocated (a 200-byte TIFF that
-// declares 30000 × 30000 floats gets no 3.6 GB). Internal to the triplet
-// reader.
+// declares 30000 × 30000 floats gets no 3.6 GB). Internal to
+// acquisition: the triplet reader and the simulator's truth images read
+// through it.
 #pragma once
 
 #include <filesystem>
@@ -32,6 +33,11 @@ DecodedImage decode_image(const std::filesystem::path& path, int rows, int colum
 // The parts that need no file, for decode_image and the PNG decoder.
 std::string size_differs(long long rows, long long columns, int expected_rows,
                          int expected_columns);
+// The image with its first and third channels exchanged (R, G, B(, A) ⇄
+// B, G, R(, A)); one or two channels come back as they are. Files hold RGB,
+// OpenCV's images BGR: the decoder and the encoder (image_file.cpp) both
+// cross here.
+cv::Mat swap_red_blue(const cv::Mat& pixels);
 inline std::string unreadable(const std::string& reason) {
   return "image is unreadable or corrupt (" + reason + ")";
 }

@@ -2,8 +2,8 @@
 
 #include <cassert>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
+#include "acquisition/formats/image_decoder.hpp"
 #include "acquisition/formats/image_file.hpp"
 #include "core/errors.hpp"
 
@@ -11,15 +11,13 @@ namespace scanbench::acquisition::sim {
 namespace {
 
 cv::Mat read_image(const std::filesystem::path& path, int type, int rows, int columns) {
-  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw core::InputError(path.string(), {}, "missing or unreadable truth image");
-  if (image.type() != type)
+  if (!std::filesystem::exists(path))
+    throw core::InputError(path.string(), {}, "missing truth image");
+  DecodedImage image = decode_image(path, rows, columns);
+  if (image.pixels.empty()) throw core::InputError(path.string(), {}, "truth " + image.problem);
+  if (image.pixels.type() != type)
     throw core::InputError(path.string(), {}, "truth image has the wrong type");
-  if (image.rows != rows || image.cols != columns) {
-    throw core::InputError(path.string(), {},
-                           "truth image size differs from the scan's rows x columns");
-  }
-  return image;
+  return image.pixels;
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// A SampleCloud as a PCL cloud of points with normals. Include only from the
-// few translation units that use PCL (feature_alignment.cpp, bench/pcl_icp.cpp).
+// A SampleCloud as a PCL cloud of points with normals, for the PCL peers.
+// Include only from the bench files that use PCL (pcl_icp.cpp).
 #pragma once
 
 #include <pcl/point_cloud.h>
