@@ -75,6 +75,40 @@ double set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points,
   return farthest;
 }
 
+// The largest distance [m] between a valid point of `points` and where the
+// scan puts it: origin + its double direction × its float range.
+double largest_round_trip_error(const Scan& scan, std::span<const Eigen::Vector3d> points,
+                                const Eigen::Vector3d& origin) {
+  double largest = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!scan.valid[i]) continue;
+    const int row = static_cast<int>(i / static_cast<std::size_t>(scan.columns));
+    const int col = static_cast<int>(i % static_cast<std::size_t>(scan.columns));
+    const Eigen::Vector3d back =
+        origin + direction_precise(scan, row, col) * static_cast<double>(scan.range_m[i]);
+    largest = std::max(largest, (back - points[i]).squaredNorm());
+  }
+  return std::sqrt(largest);
+}
+
+// Ranges from `origin` and, unless the scan's angles are a panorama whose
+// fit moved points by `panorama_deviation_m`, per-pixel directions; then
+// the round trip of every point bounded, or checked where the bound does
+// not settle it. A float range errs by 6e-8 of itself, a float unit
+// direction by 1e-7 of the range.
+LocalOriginResult place(Scan& scan, std::span<const Eigen::Vector3d> points,
+                        const Eigen::Vector3d& origin, std::optional<double> panorama_deviation_m,
+                        const LocalOriginSettings& settings) {
+  const bool spherical = panorama_deviation_m.has_value();
+  LocalOriginResult result{origin, spherical};
+  result.farthest_m = set_ranges(scan, points, origin, !spherical);
+  const double bound =
+      spherical ? *panorama_deviation_m + 6e-8 * result.farthest_m : 1.6e-7 * result.farthest_m;
+  result.max_error_m =
+      bound <= settings.max_error_m ? bound : largest_round_trip_error(scan, points, origin);
+  return result;
+}
+
 }  // namespace
 
 LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector3d> points_file,
@@ -87,7 +121,12 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
     candidates.push_back(*centre_hint_file);
   }
   if (!settings.try_spherical || scan.is_scattered()) candidates.clear();
-  LocalOriginResult result;
+  // The first representation whose every point comes back within
+  // max_error_m: a panorama around a candidate centre, then per-pixel
+  // directions from the file's origin (points near it), then from the
+  // points' centroid. Float ranges of points far from a centre the fit
+  // accepted (a scanner position kilometres away) fail the first.
+  std::optional<LocalOriginResult> result;
   for (const Eigen::Vector3d& centre : candidates) {
     const SphericalFitResult fit =
         centre.isZero(0.0) ? fit_spherical_angles(scan.rows, scan.columns, points_file, scan.valid,
@@ -95,19 +134,22 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
                            : fit_spherical_angles(scan.rows, scan.columns,
                                                   relative_to(points_file, scan.valid, centre),
                                                   scan.valid, settings.angle_fit);
-    if (fit.regular) {
-      scan.angles = fit.angles;
-      result = {centre, true};
-      break;
-    }
+    if (!fit.regular) continue;
+    scan.angles = fit.angles;
+    result = place(scan, points_file, centre, fit.max_deviation_m, settings);
+    if (result->max_error_m <= settings.max_error_m) break;
+    result.reset();
   }
-  if (!result.spherical) {
-    const bool near = farthest(points_file, scan.valid) <= settings.max_per_pixel_range_m;
-    result.origin_file = near ? Eigen::Vector3d::Zero() : centroid_origin(points_file, scan.valid);
+  if (!result && farthest(points_file, scan.valid) <= settings.max_per_pixel_range_m) {
+    result = place(scan, points_file, Eigen::Vector3d::Zero(), std::nullopt, settings);
+    if (result->max_error_m > settings.max_error_m) result.reset();
   }
-  result.farthest_m = set_ranges(scan, points_file, result.origin_file, !result.spherical);
-  scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result.origin_file);
-  return result;
+  if (!result) {
+    result =
+        place(scan, points_file, centroid_origin(points_file, scan.valid), std::nullopt, settings);
+  }
+  scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result->origin_file);
+  return *result;
 }
 
 LocalOriginResult set_scattered_points(Scan& scan, std::vector<Eigen::Vector3d> points_file) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -184,6 +185,46 @@ INSTANTIATE_TEST_SUITE_P(Magnitudes, PtxWorldCoordinates,
                                            std::pair{"georef_world_utm", true},
                                            std::pair{"georef_world_1e7", true},
                                            std::pair{"georef_world_unknown_centre", false}));
+
+// Issue 27's case: a regular panorama around the header's scanner position,
+// 3 km from the points. The grid fits, but float ranges of 3 km round by up
+// to 0.12 mm: the reader must notice and fall back to directions from the
+// points' centroid.
+TEST(PtxWorldCoordinates, PointsFarFromTheHeadersScannerStillKeepATenthOfAMillimetre) {
+  const int rows = 20, columns = 60;
+  const Eigen::Vector3d scanner(637000.0, 8490000.0, 400.0);
+  ScratchDir dir;
+  const std::filesystem::path path = dir / "far_scanner.ptx";
+  {
+    std::ofstream out(path);
+    out << columns << '\n'
+        << rows << '\n'
+        << std::fixed << std::setprecision(6) << scanner.x() << ' ' << scanner.y() << ' '
+        << scanner.z() << '\n'
+        << "1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
+    for (int col = 0; col < columns; ++col) {
+      for (int row = 0; row < rows; ++row) {
+        const double azimuth = 0.3 + 5e-4 * col, elevation = 0.01 - 5e-4 * row;
+        const double range = 3000.0 + 7.0 * std::sin(0.1 * col) + 0.37 * row;
+        const Eigen::Vector3d p =
+            scanner + range * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                              std::cos(elevation) * std::sin(azimuth),
+                                              std::sin(elevation));
+        out << p.x() << ' ' << p.y() << ' ' << p.z() << " 0.5\n";
+      }
+    }
+  }
+  const std::vector<Scan> scans = read_ptx(path);
+  ASSERT_EQ(scans.size(), 1u);
+  const std::vector<Eigen::Vector3d> expected = file_points(path);
+  ASSERT_EQ(expected.size(), scans[0].pixel_count());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    const int row = static_cast<int>(k % rows), col = static_cast<int>(k / rows);
+    worst = std::max(worst, (point_in_world(scans[0], row, col) - expected[k]).norm());
+  }
+  EXPECT_LT(worst, 1e-4);
+}
 
 TEST(PtxRoundTrip, WorldCoordinateScansExportAndReimportLosslessly) {
   const ScratchDir dir;
