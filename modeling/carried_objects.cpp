@@ -51,12 +51,14 @@ DrawnPixels drawn_pixels(const std::vector<std::uint32_t>& membership,
   return out;
 }
 
-// The grid a target grows on, one per noise model the commits used.
+// The grid a target grows on, one per noise model the commits used (none:
+// the target's own).
 class Grids {
  public:
   Grids(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry)
       : scan_(scan), geometry_(geometry) {}
-  const segmentation::SegmentationGrid& with(const acquisition::RangeNoise& noise) {
+  const segmentation::SegmentationGrid& with(const std::optional<acquisition::RangeNoise>& given) {
+    const acquisition::RangeNoise noise = given.value_or(geometry_.range_noise);
     for (const auto& [n, grid] : grids_) {
       if (n == noise) return grid;
     }

@@ -28,10 +28,25 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GeometrySettings, window_radius,
                                                 estimate_range_noise)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SphericalFitSettings, max_deviation_m)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(LocalOriginSettings, angle_fit,
-                                                max_per_pixel_range_m, try_spherical)
+                                                max_per_pixel_range_m, max_error_m, try_spherical)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PtxReadSettings, grid)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ScanFileSettings, ptx)
 }  // namespace scanbench::acquisition
+
+// A noise model the user may leave to each scan: null when none.
+template <>
+struct nlohmann::adl_serializer<std::optional<scanbench::acquisition::RangeNoise>> {
+  static void to_json(json& j, const std::optional<scanbench::acquisition::RangeNoise>& noise) {
+    j = noise ? json(*noise) : json(nullptr);
+  }
+  static void from_json(const json& j, std::optional<scanbench::acquisition::RangeNoise>& noise) {
+    if (j.is_null()) {
+      noise.reset();
+    } else {
+      noise = j.get<scanbench::acquisition::RangeNoise>();
+    }
+  }
+};
 
 namespace scanbench::registration {
 // Enums as the reports spell them (coarse_method_name, color_model_name).
@@ -353,7 +368,7 @@ void check(const RegisterCommandSettings& s, const Bounds& b) {
 }
 
 void check(const registration::MergeSettings& s, const Bounds& b) {
-  check(s.noise, b, "noise.");
+  if (s.noise) check(*s.noise, b, "noise.");
   b.positive(s.range_sigmas, kMaxRatio, "range_sigmas");
   b.in(s.max_normal_angle_deg, 0, 180, "max_normal_angle_deg");
   b.in(s.tie_tolerance, 0, 10, "tie_tolerance");
@@ -385,12 +400,12 @@ void check(const segmentation::GrowSettings& g, const Bounds& b, const std::stri
 
 void check(const SelectSettings& s, const Bounds& b) {
   check(s.grow, b, "");
-  check(s.range_noise, b, "range_noise.");
+  if (s.range_noise) check(*s.range_noise, b, "range_noise.");
 }
 
 void check(const CommitSettings& s, const Bounds& b) {
   if (s.grow) check(*s.grow, b, "grow.");
-  check(s.range_noise, b, "range_noise.");
+  if (s.range_noise) check(*s.range_noise, b, "range_noise.");
 }
 
 // Refuses the first place where `given` differs from `read_back`, the

@@ -95,7 +95,7 @@ struct Prepared {
 };
 
 Prepared prepare(const store::Project& project, std::int64_t scan_id,
-                 const acquisition::RangeNoise& noise) {
+                 const std::optional<acquisition::RangeNoise>& noise) {
   Prepared p;
   p.scan = project.load_scan(scan_id);
   require_grid(p.scan.is_scattered(), scan_id);
@@ -105,7 +105,7 @@ Prepared prepare(const store::Project& project, std::int64_t scan_id,
   }
   p.geometry = std::move(*geometry);
   segmentation::GridSettings settings;
-  settings.range_noise = noise;
+  settings.range_noise = noise.value_or(p.geometry.range_noise);
   p.grid = segmentation::prepare_grid(p.scan, p.geometry, settings);
   return p;
 }
@@ -319,7 +319,7 @@ CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_
                                       const std::vector<std::uint32_t>& membership,
                                       std::uint32_t node,
                                       const std::optional<segmentation::GrowSettings>& grow,
-                                      const acquisition::RangeNoise& noise) {
+                                      const std::optional<acquisition::RangeNoise>& noise) {
   CarriedAgain out;
   const std::optional<acquisition::ScanGeometry> drawn_geometry =
       store::load_geometry(project, drawn);
@@ -343,7 +343,7 @@ CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_
     std::optional<segmentation::SegmentationGrid> grid;
     if (grow && !scan.is_scattered()) {  // a scattered scan has no grid to grow on
       segmentation::GridSettings grid_settings;
-      grid_settings.range_noise = noise;
+      grid_settings.range_noise = noise.value_or(geometry->range_noise);
       grid = segmentation::prepare_grid(scan, *geometry, grid_settings);
     }
     std::vector<std::uint32_t> other = load_membership(project, stored.id, scan.pixel_count());

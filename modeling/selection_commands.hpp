@@ -44,7 +44,9 @@ struct SelectSettings {
   SelectMode mode = SelectMode::kReplace;
   segmentation::GrowSettings grow;
   segmentation::Constraints constraints;  // image coordinates (constraints.hpp)
-  acquisition::RangeNoise range_noise;    // the scanner's
+  // The scan's σ(range) for the range channel's tests; none: the one its
+  // geometry estimated (ScanGeometry::range_noise).
+  std::optional<acquisition::RangeNoise> range_noise;
 };
 
 struct SelectResult {
@@ -84,7 +86,9 @@ struct CommitSettings {
   // object's box (object_carry.hpp). None: only the points on the surfaces
   // the selection covers.
   std::optional<segmentation::GrowSettings> grow = std::nullopt;
-  acquisition::RangeNoise range_noise = {};  // the scanner's
+  // One σ(range) for every scan; none: each scan's own, as its geometry
+  // estimated it.
+  std::optional<acquisition::RangeNoise> range_noise = std::nullopt;
 };
 
 // Makes `selection`, of scan settings.scan_id, a new object: its pixels
@@ -118,7 +122,7 @@ struct ProposeSettings {
   std::string group_name = "proposals";  // the group that receives them
   std::optional<std::int64_t> parent;    // of that group; none: a root
   segmentation::ProposalSettings proposals;
-  acquisition::RangeNoise range_noise;
+  std::optional<acquisition::RangeNoise> range_noise;  // none: the scan's own
 };
 
 // Automatic proposals (segmentation/proposals.hpp) on the scan's pixels still

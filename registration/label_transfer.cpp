@@ -16,7 +16,9 @@ Sightings sight_in_source(const PreparedScan& source, const PreparedScan& target
   const auto range_sigmas = static_cast<float>(settings.range_sigmas);
   const auto min_normal_cos =
       static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0));
-  const acquisition::RangeNoise& noise = settings.noise;
+  // The source measures p's place, the target measured p.
+  const acquisition::RangeNoise& source_noise = range_noise_of(source, settings.noise);
+  const acquisition::RangeNoise& target_noise = range_noise_of(target, settings.noise);
   Sightings out;
   out.pixel.assign(target.in_model.size(), -1);
   out.sighting.assign(target.in_model.size(), Sighting::kUnseen);
@@ -33,8 +35,8 @@ Sightings sight_in_source(const PreparedScan& source, const PreparedScan& target
           out.pixel[q] = static_cast<std::int32_t>(pixel);  // grids hold < 2^31 pixels
           const auto k = static_cast<std::size_t>(pixel);
           const float range = p.norm();
-          const float sigma_p = noise.sigma(range);
-          const float sigma_q = noise.sigma(target.scan->range_m[q]);
+          const float sigma_p = source_noise.sigma(range);
+          const float sigma_q = target_noise.sigma(target.scan->range_m[q]);
           const float sigma = std::sqrt(sigma_p * sigma_p + sigma_q * sigma_q);
           // The place first (no normal), then the surface.
           if (!same_surface(source, k, range, sigma, nullptr, R, range_sigmas, min_normal_cos))

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -18,8 +19,10 @@
 namespace scanbench::registration {
 
 struct LabelTransferSettings {
-  acquisition::RangeNoise noise;  // the scanner's
-  double range_sigmas = 4.0;      // as MergeSettings
+  // One σ(range) model for both scans; none: each scan's own (its
+  // geometry's range_noise).
+  std::optional<acquisition::RangeNoise> noise;
+  double range_sigmas = 4.0;  // as MergeSettings
   double max_normal_angle_deg = 30.0;
   int threads = 0;  // 0 = all cores; results do not depend on it
 };

@@ -47,9 +47,12 @@ struct Thresholds {
   float min_normal_cos;
   float tie_low;   // A_o < A_s · tie_low: o is finer (1 / tie_high: symmetric)
   float tie_high;  // A_o ≤ A_s · tie_high (and not finer): a tie
-  acquisition::RangeNoise noise;
+  std::optional<acquisition::RangeNoise> noise;  // MergeSettings::noise
 
-  float range_sigma(float range) const { return noise.sigma(range); }
+  // σ of a range `scan` measured.
+  float range_sigma(const PreparedScan& scan, float range) const {
+    return range_noise_of(scan, noise).sigma(range);
+  }
 };
 
 // True when spherical o samples the surface at point p (s's point, in o's
@@ -107,12 +110,12 @@ std::size_t merge_row(std::span<const PreparedScan> scans, int s_index,
   for (int col = 0; col < columns; ++col) {
     const std::size_t i = s.scan->index(row, col);
     if (!s.in_model[i]) continue;
-    const float sigma_s = t.range_sigma(s.scan->range_m[i]);
+    const float sigma_s = t.range_sigma(s, s.scan->range_m[i]);
     bool keep = true;
     for (const OtherScan& o : others) {
       const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
       const float range = p.norm();
-      const float sigma_p = t.range_sigma(range);
+      const float sigma_p = t.range_sigma(*o.scan, range);  // what o measures there
       if (coarser_by_bound(p, range, sigma_p, sigma_s, s.sample_area_m2[i], o, t)) {
         ++bounded;
       } else if (finer_elsewhere(s, s_index, i, p, range, sigma_p, sigma_s, o, t)) {

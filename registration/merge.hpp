@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -15,7 +16,9 @@
 namespace scanbench::registration {
 
 struct MergeSettings {
-  acquisition::RangeNoise noise;
+  // One σ(range) model for every scan; none: each scan's own (its
+  // geometry's range_noise, estimated from the scan).
+  std::optional<acquisition::RangeNoise> noise;
   // Same surface: the ranges along the other scan's beam agree within
   // range_sigmas combined noise σ plus that beam's footprint (the beam
   // centre and the point may be half a pixel apart on a slanted surface)...

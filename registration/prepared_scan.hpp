@@ -50,6 +50,14 @@ PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::Scan
 // there is none. The pixel may be unusable; callers check.
 std::int64_t associate(const PreparedScan& target, const Eigen::Vector3f& p_target);
 
+// The σ(range) of `scan`'s measurements: `one_for_all` when given (a model
+// the user set for every scan), else the scan's own (ScanGeometry::
+// range_noise, estimated by the geometry stage).
+inline const acquisition::RangeNoise& range_noise_of(
+    const PreparedScan& scan, const std::optional<acquisition::RangeNoise>& one_for_all) {
+  return one_for_all ? *one_for_all : scan.geometry->range_noise;
+}
+
 // The same-surface test of seed 004 §4.3, shared by the merge and the
 // transfer of labels: pixel k of scan o sampled the surface of a point p of
 // another scan when o's range there agrees with p's range from o, range_p,

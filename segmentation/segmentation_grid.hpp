@@ -86,7 +86,7 @@ struct SegmentationGrid {
 };
 
 struct GridSettings {
-  acquisition::RangeNoise range_noise;  // the scanner's (acquisition/range_noise.hpp)
+  acquisition::RangeNoise range_noise;  // the scan's (ScanGeometry::range_noise, or a model given)
   int threads = 0;                      // 0 = all cores; results do not depend on it
 };
 

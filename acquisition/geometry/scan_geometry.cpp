@@ -540,6 +540,7 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
   }
   GeometryResult result = scan.is_scattered() ? compute_scattered_geometry(scan, used)
                                               : compute_grid_geometry(scan, used);
+  result.geometry.range_noise = noise.noise;
   result.noise = std::move(noise);
   result.seconds = core::seconds_since(start);
   return result;

@@ -36,6 +36,11 @@ struct ScanGeometry {
   // normal is invalid.
   std::vector<float> confidence;
   std::vector<std::uint8_t> flags;
+  // The scan's σ(range), with which the flags were decided: estimated from
+  // the scan (GeometrySettings::estimate_range_noise) or the settings'.
+  // Later stages that compare this scan's ranges with another's (the
+  // merge, carrying objects, growing regions) take it from here.
+  RangeNoise range_noise;
 
   bool has_normal(std::size_t i) const { return confidence[i] > 0.0f; }
   bool is_mixed(std::size_t i) const { return (flags[i] & kFlagMixedPixel) != 0; }

@@ -388,6 +388,10 @@ class Project {
   // The result of the newest done command called `name`, or none.
   std::optional<std::string> latest_result(std::string_view name) const;
 
+  // The journal entry of the command that wrote the current version of
+  // layer `name` of scan `id` (verified), or none when no done command did.
+  std::optional<CommandRecord> layer_writer(std::int64_t id, std::string_view name) const;
+
   // ---- Integrity ---------------------------------------------------------
 
   // Checks the whole file (`scanbench check`): SQLite's integrity and

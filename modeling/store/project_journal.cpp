@@ -340,6 +340,17 @@ std::optional<std::string> Project::latest_result(std::string_view name) const {
   return read_command(select, file_name()).result;  // verified
 }
 
+std::optional<CommandRecord> Project::layer_writer(std::int64_t id, std::string_view name) const {
+  const std::string sql = kSelectCommands + R"sql( WHERE id = (
+  SELECT l.command_id FROM scan_layers l JOIN commands c ON c.id = l.command_id
+  WHERE l.scan_id = ?1 AND l.name = ?2 AND c.state = 'done'
+  ORDER BY c.seq DESC LIMIT 1))sql";
+  sqlite::Statement select(db(), sql.c_str(), file_name());
+  select.bind_int(1, id).bind_text(2, name);
+  if (!select.step()) return std::nullopt;
+  return read_command(select, file_name());  // verified
+}
+
 Project::ReadSnapshot Project::read_snapshot() const {
   assert(!connection_->edit && !connection_->snapshot && "a snapshot inside an Edit or another");
   if (connection_->batch) return ReadSnapshot(nullptr, nullptr);  // one state already

@@ -1,8 +1,58 @@
 #include "modeling/store/typed_layers.hpp"
 
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <utility>
+
 #include "core/errors.hpp"
 
 namespace scanbench::store {
+namespace {
+
+// The model at `j` (an object of noise_m, noise_per_m, noise_per_m2), or
+// none when it is not one.
+std::optional<acquisition::RangeNoise> range_noise_at(const nlohmann::json& j) {
+  if (!j.is_object()) return std::nullopt;
+  acquisition::RangeNoise noise;
+  for (auto [key, term] :
+       {std::pair{"noise_m", &noise.noise_m}, std::pair{"noise_per_m", &noise.noise_per_m},
+        std::pair{"noise_per_m2", &noise.noise_per_m2}}) {
+    const auto value = j.find(key);
+    if (value == j.end()) continue;  // a term added later: the default
+    if (!value->is_number() || !std::isfinite(value->get<double>()) || value->get<double>() < 0)
+      return std::nullopt;
+    *term = value->get<double>();
+  }
+  return noise;
+}
+
+// The σ(range) the geometry command `writer` used for scan `id`: its
+// result's entry for the scan (the estimate), else its settings' model
+// (commands from before the estimate), else the default.
+acquisition::RangeNoise recorded_range_noise(const CommandRecord& writer, std::int64_t id) {
+  const nlohmann::json result = nlohmann::json::parse(writer.result, nullptr, false);
+  if (result.is_object() && result.contains("scans") && result["scans"].is_array()) {
+    for (const nlohmann::json& scan : result["scans"]) {
+      const auto scan_id = scan.find("id");  // end() for a non-object
+      if (scan_id == scan.end() || !scan_id->is_number_integer() ||
+          scan_id->get<std::int64_t>() != id) {
+        continue;
+      }
+      if (const auto noise = range_noise_at(scan.value("range_noise", nlohmann::json()))) {
+        return *noise;
+      }
+    }
+  }
+  const nlohmann::json settings = nlohmann::json::parse(writer.settings, nullptr, false);
+  if (settings.is_object()) {
+    if (const auto noise = range_noise_at(settings.value("range_noise", nlohmann::json()))) {
+      return *noise;
+    }
+  }
+  return {};
+}
+
+}  // namespace
 
 std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& g) {
   std::vector<EncodedLayer> layers;
@@ -32,6 +82,9 @@ std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, s
   g.normal = std::move(*normal);
   g.confidence = std::move(*confidence);
   g.flags = std::move(*flags);
+  if (const std::optional<CommandRecord> writer = project.layer_writer(id, layer::kNormal)) {
+    g.range_noise = recorded_range_noise(*writer, id);
+  }
   return g;
 }
 

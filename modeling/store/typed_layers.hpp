@@ -15,8 +15,10 @@ namespace scanbench::store {
 std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& geometry);
 
 // The stored geometry of scan `id`, or none when `scanbench geometry` has
-// not run on it (or was undone). Throws core::InputError naming the scan
-// when only some of the four layers are there or one is damaged.
+// not run on it (or was undone). Its range_noise is the one the command
+// that computed it recorded for the scan (its estimate; for commands older
+// than estimates, its settings' model). Throws core::InputError naming the
+// scan when only some of the four layers are there or one is damaged.
 std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, std::int64_t id);
 
 // The merge's keep mask of scan `id` (one byte per pixel, 1 = in the merged

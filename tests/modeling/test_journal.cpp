@@ -96,6 +96,29 @@ TEST(Journal, UndoAndRedoWorkAcrossConnectionsAndRestoreTheStateExactly) {
   EXPECT_FALSE(project.redo().has_value());
 }
 
+// The σ(range) a geometry command used is stored with the scan's geometry
+// (in the command's journal entry) and undone with it: the merge, carried
+// objects and region growing read it from there.
+TEST(Journal, TheGeometrysRangeNoiseComesBackWithItAndGoesWithItsUndo) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  core::Progress quiet;
+  import_scans(project, kTwoScans, {}, quiet);
+  acquisition::GeometrySettings fixed = small_windows();
+  fixed.range_noise = {0.002, 1e-4, 0.0};
+  geometry_project(project, fixed, quiet);
+  EXPECT_EQ(store::load_geometry(project, 1)->range_noise, fixed.range_noise);
+  acquisition::GeometrySettings estimating = small_windows();
+  estimating.range_noise = {0.004, 0.0, 0.0};
+  estimating.estimate_range_noise = true;
+  const GeometryCommandResult estimated = geometry_project(project, estimating, quiet);
+  for (const GeometryCommandScan& scan : estimated.scans) {
+    EXPECT_EQ(store::load_geometry(project, scan.id)->range_noise, scan.range_noise) << scan.id;
+  }
+  ASSERT_TRUE(project.undo().has_value());
+  EXPECT_EQ(store::load_geometry(project, 2)->range_noise, fixed.range_noise);
+}
+
 TEST(Journal, ANewCommandEndsTheRedoBranch) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");

@@ -256,6 +256,23 @@ TEST(MergeBySamplingRate, AnotherSurfaceOnTheBeamIsNotTheSameSurface) {
   EXPECT_EQ(result.scans[1].kept, 900u);
 }
 
+TEST(MergeBySamplingRate, EachScanIsJudgedWithinItsOwnNoise) {
+  // The far scan reads 0.3 m long. With the default σ (5 mm), that is
+  // another surface; from a sensor whose geometry estimated σ = 8 cm, it
+  // is the same wall within 4 σ, and the near scan samples it more finely.
+  std::vector<HandScan> hand{wall_scan(pose_at(5.0)), wall_scan(pose_at(0.0))};
+  for (float& range : hand[1].scan.range_m) range += 0.3f;
+  EXPECT_EQ(merge(hand).scans[1].kept, 900u);
+  hand[1].geometry.range_noise = acquisition::RangeNoise{0.08, 0.0, 0.0};
+  const MergeResult noisy = merge(hand);
+  EXPECT_EQ(noisy.scans[0].kept, 900u);
+  EXPECT_GT(noisy.scans[1].redundant, 13u * 13u);
+  // One model for every scan, when the settings give it, overrides both.
+  MergeSettings one_model;
+  one_model.noise = acquisition::RangeNoise{};
+  EXPECT_EQ(merge(hand, one_model).scans[1].kept, 900u);
+}
+
 TEST(MergeBySamplingRate, ResultsDoNotDependOnTheThreadCount) {
   const std::vector<HandScan> hand{wall_scan(pose_at(5.0)), wall_scan(pose_at(0.0)),
                                    wall_scan(pose_at(2.0, 10.0))};
