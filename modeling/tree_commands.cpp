@@ -140,7 +140,8 @@ NodeCommandResult delete_node(store::Project& project, const DeleteSettings& set
   roots.insert(roots.end(), settings.others.begin(), settings.others.end());
   for (const std::int64_t root : roots) require_node(tree, root);
   std::vector<std::int64_t> gone;
-  for (const auto& [id, node] : tree) {
+  for (const auto& entry : tree) {
+    const std::int64_t id = entry.first;  // a plain variable: clang 14 captures no bindings
     if (std::any_of(roots.begin(), roots.end(),
                     [&](std::int64_t root) { return is_at_or_above(tree, root, id); }))
       gone.push_back(id);
