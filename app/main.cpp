@@ -65,17 +65,13 @@ std::string unknown_word(const CLI::App& app, int argc, char** argv) {
 // `scanbench bench …` runs as `scanbench-bench bench …`, the same command
 // line with the benches, beside this executable: the benches link PCL, whose
 // libraries would cost every other command 0.1 s of dynamic linking before
-// main(). Returns only when that executable cannot start.
+// main(). Returns only when that executable is not there (a build without
+// the benches: the `bench` stub then answers) or cannot start.
 int run_benches(char** argv) {
   std::error_code error;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
   const std::filesystem::path benches = self.parent_path() / "scanbench-bench";
-  if (error || !std::filesystem::exists(benches)) {
-    return report_error("usage",
-                        "this scanbench was built without the benchmark suites "
-                        "(scanbench-bench is not beside it; configure with -DSCANBENCH_BENCH=ON)",
-                        scanbench::app::kExitBadInput, 1);
-  }
+  if (error || !std::filesystem::exists(benches)) return -1;
   ::execv(benches.c_str(), argv);
   return report_error("error",
                       "could not start " + benches.string() + " (" + std::strerror(errno) + ")",
@@ -112,9 +108,16 @@ int main(int argc, char** argv) {
 #ifdef SCANBENCH_WITH_BENCH
   sb::add_bench_command(app);
 #else
-  // Listed in --help; the call itself goes to scanbench-bench before parsing.
-  app.add_subcommand("bench", sb::kBenchDescription);
-  if (argc >= 2 && std::string_view(argv[1]) == "bench") return run_benches(argv);
+  // Listed in --help; a call goes to scanbench-bench before parsing, or,
+  // where it was not built, is refused here.
+  app.add_subcommand("bench", sb::kBenchDescription)->allow_extras()->callback([] {
+    throw CLI::ValidationError("bench",
+                               "this scanbench was built without the benchmark suites "
+                               "(configure with -DSCANBENCH_BENCH=ON)");
+  });
+  if (argc >= 2 && std::string_view(argv[1]) == "bench") {
+    if (const int failed = run_benches(argv); failed >= 0) return failed;
+  }
 #endif
   try {
     app.parse(argc, argv);
