@@ -20,9 +20,9 @@ function(scanbench_target_settings target)
                                              -fno-sanitize-recover=undefined -UNDEBUG)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
     # Eigen switches to its own aligned allocator under AddressSanitizer; the
-    # prebuilt PCL and Ceres libraries use malloc. Objects crossing that line
-    # (PCL's feature estimators own Eigen matrices) would be freed by the
-    # other allocator. glibc's and ASan's malloc both align to 16 bytes, which
+    # prebuilt Ceres (and the benches' PCL) libraries use malloc. Objects
+    # crossing that line (Eigen matrices inside their objects) would be freed
+    # by the other allocator. glibc's and ASan's malloc both align to 16 bytes, which
     # is all Eigen needs here, so keep malloc everywhere.
     target_compile_definitions(${target} PRIVATE EIGEN_MALLOC_ALREADY_ALIGNED=1)
     # No AVX2 clones (acquisition/geometry/branch_free.hpp): their ifunc resolvers run

@@ -294,6 +294,7 @@ void check(const ImportSettings& s, const Bounds& b) {
   const acquisition::LocalOriginSettings& grid = s.readers.ptx.grid;
   b.positive(grid.angle_fit.max_deviation_m, 1, "readers.ptx.grid.angle_fit.max_deviation_m");
   b.positive(grid.max_per_pixel_range_m, 1e5, "readers.ptx.grid.max_per_pixel_range_m");
+  b.positive(grid.max_error_m, 1, "readers.ptx.grid.max_error_m");
 }
 
 void check(const acquisition::GeometrySettings& s, const Bounds& b) {

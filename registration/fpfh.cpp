@@ -10,7 +10,8 @@
 // by the inverse of their distance ω_k (eq. 2):
 //   FPFH(p) = SPFH(p) + 1/k Σ_k SPFH(p_k) / ω_k
 // and each of the three histograms is rescaled to sum to 100, so that
-// features of sparse and dense neighbourhoods compare.
+// features of sparse and dense neighbourhoods compare. This is the paper's
+// weighting; PCL's FPFH weights by 1/ω_k² and leaves SPFH(p) out.
 #include "registration/fpfh.hpp"
 
 #include <Eigen/Geometry>
@@ -111,6 +112,9 @@ FpfhResult compute_fpfh(const SampleCloud& cloud, const FpfhSettings& settings) 
       [&](int k) {
         const auto i = static_cast<std::size_t>(k);
         index.within(cloud.points[i].data(), radius, neighbours[i]);
+        // In index order, not the tree's: the sums below then do not
+        // depend on how the tree split the points.
+        std::sort(neighbours[i].begin(), neighbours[i].end());
         result.described[i] = spfh(cloud, i, neighbours[i], simple[i]) ? 1 : 0;
       },
       256);

@@ -30,6 +30,7 @@ class NearestRows {
  public:
   explicit NearestRows(const std::vector<Row>& rows)
       : view_{rows}, tree_(Dim, view_, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
+  NearestRows(std::vector<Row>&&) = delete;  // the tree reads the rows where they are
   NearestRows(const NearestRows&) = delete;
   NearestRows& operator=(const NearestRows&) = delete;
 

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <new>
 
 #include "acquisition/formats/image_decoder.hpp"
 #include "acquisition/formats/output_file.hpp"
@@ -36,8 +37,16 @@ struct PngOutput {
   std::string problem;
 };
 
+// No exception may cross libpng's C frames: running out of memory becomes
+// a libpng error.
 void on_png_write(png_structp png, png_bytep data, png_size_t size) {
-  static_cast<PngOutput*>(png_get_io_ptr(png))->bytes.append(reinterpret_cast<char*>(data), size);
+  bool stored = true;
+  try {
+    static_cast<PngOutput*>(png_get_io_ptr(png))->bytes.append(reinterpret_cast<char*>(data), size);
+  } catch (const std::bad_alloc&) {
+    stored = false;
+  }
+  if (!stored) png_error(png, "out of memory");
 }
 void on_png_flush(png_structp) {}
 void on_png_error(png_structp png, png_const_charp message) {
@@ -102,7 +111,12 @@ tmsize_t on_tiff_read(thandle_t handle, void* data, tmsize_t size) {
 tmsize_t on_tiff_write(thandle_t handle, void* data, tmsize_t size) {
   auto* file = static_cast<TiffMemory*>(handle);
   const auto end = file->position + static_cast<toff_t>(size);
-  if (end > file->bytes.size()) file->bytes.resize(end);
+  try {
+    if (end > file->bytes.size()) file->bytes.resize(end);
+  } catch (const std::bad_alloc&) {
+    file->problem = "out of memory";
+    return -1;  // libtiff fails the write; no exception crosses its C frames
+  }
   std::memcpy(file->bytes.data() + file->position, data, static_cast<std::size_t>(size));
   file->position = end;
   return size;

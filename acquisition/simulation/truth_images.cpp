@@ -2,6 +2,8 @@
 
 #include <cassert>
 #include <opencv2/core.hpp>
+#include <string>
+#include <system_error>
 
 #include "acquisition/formats/image_decoder.hpp"
 #include "acquisition/formats/image_file.hpp"
@@ -11,12 +13,18 @@ namespace scanbench::acquisition::sim {
 namespace {
 
 cv::Mat read_image(const std::filesystem::path& path, int type, int rows, int columns) {
-  if (!std::filesystem::exists(path))
-    throw core::InputError(path.string(), {}, "missing truth image");
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    throw core::InputError(path.string(), {}, "missing or unreadable truth image");
+  }
   DecodedImage image = decode_image(path, rows, columns);
   if (image.pixels.empty()) throw core::InputError(path.string(), {}, "truth " + image.problem);
-  if (image.pixels.type() != type)
-    throw core::InputError(path.string(), {}, "truth image has the wrong type");
+  if (image.pixels.type() != type) {
+    throw core::InputError(path.string(), {},
+                           "truth image has the wrong type (OpenCV type " +
+                               std::to_string(image.pixels.type()) + ", expected " +
+                               std::to_string(type) + ")");
+  }
   return image.pixels;
 }
 
