@@ -1,21 +1,27 @@
 // Footprints and normals from pixel adjacency (seed 004 §4.2).
 //
-// Normals of spherical scans come from the gradient of log-range over the
-// angles. With p = r·u(θ, φ) and the orthonormal frame (u, e_θ, e_φ),
-//   ∂p/∂θ = r_θ u + r cos φ e_θ,   ∂p/∂φ = r_φ u + r e_φ,
-//   ∂p/∂θ × ∂p/∂φ ∝ u − (∂ln r/∂θ) / cos φ · e_θ − (∂ln r/∂φ) · e_φ,
-// so a normal needs only the two slopes of ln r, which a least-squares plane
-// fit of ln r over the pixel window gives from integral images of its moments
-// (window_moments.hpp): constant time per pixel for any window size. That fit
-// is exact to second order only in a full, symmetric window; windows cut by a
-// depth discontinuity, by invalid pixels or by the grid's border get a
-// covariance fit of their 3D points instead (grid_covariance.hpp), leaving
-// out the neighbours across the discontinuity. Scans with per-pixel
-// directions have no angle model and always take the covariance fit.
+// Normals of spherical scans come from the inverse range w = 1/r over the
+// angles. A plane n·p = 1 seen along the unit beam u(θ, φ) (azimuth θ,
+// elevation φ) has w = n·u = cos φ (n_x cos θ + n_y sin θ) + n_z sin φ: a
+// sinusoid of each angle. So the window sums of w, dx·w and dy·w over a full,
+// symmetric pixel window are those of the plane's three components at the
+// centre, each scaled by a sum of cosines or sines of the window's angle
+// offsets that depends on the window size and the angle steps alone (see
+// window_normals): the plane comes back exactly, at any incidence and any
+// window size, from the three moments a least-squares fit over the window
+// gives from integral images (window_moments.hpp), in constant time per
+// pixel. (The slopes of ln r that an earlier version fitted are exact to
+// second order only: their third-order term cost a few hundredths of a
+// degree at grazing incidence, more than a phase-shift scanner's noise.)
+// Windows cut by a depth discontinuity, by invalid pixels or by the grid's
+// border get a covariance fit of their 3D points instead
+// (grid_covariance.hpp), leaving out the neighbours across the
+// discontinuity. Scans with per-pixel directions have no angle model and
+// always take the covariance fit.
 //
 // The stage runs as three passes over the grid, each parallel and each
-// touching a pixel's data once: mixed pixels; mask, log-range and depth
-// jumps; then tile by tile the window slopes, normals, confidences and
+// touching a pixel's data once: mixed pixels; mask, log-range, inverse
+// range and depth jumps; then tile by tile the window slopes, normals, confidences and
 // footprints, so a tile's data is still in cache when its pixels finish.
 #include "acquisition/geometry/scan_geometry.hpp"
 
@@ -60,12 +66,14 @@ struct FitInputs {
   std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive finite range
   std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
   std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
+  std::unique_ptr<float[]> inverse_range;  // 1 / range where masked, else 0
 
   explicit FitInputs(std::size_t n)
       : mixed(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
         mask(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
         clean(std::make_unique_for_overwrite<std::uint8_t[]>(n)),
-        log_range(std::make_unique_for_overwrite<float[]>(n)) {}
+        log_range(std::make_unique_for_overwrite<float[]>(n)),
+        inverse_range(std::make_unique_for_overwrite<float[]>(n)) {}
 
   // The mixed-pixel and edge flags of pixel i (an edge: masked, not clean).
   std::uint8_t flags(std::size_t i) const {
@@ -74,13 +82,14 @@ struct FitInputs {
   }
 };
 
-// mask and log_range of n pixels of a row. Branch-free over plain,
-// unaliased arrays, so that it vectorizes. A range that is not a positive
-// normal float (or is infinite) is no return here.
+// mask, log_range and inverse_range of n pixels of a row. Branch-free over
+// plain, unaliased arrays, so that it vectorizes. A range that is not a
+// positive normal float (or is infinite) is no return here.
 SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict valid,
                                       const std::uint8_t* __restrict mixed,
                                       const float* __restrict range_m,
-                                      std::uint8_t* __restrict mask, float* __restrict log_range) {
+                                      std::uint8_t* __restrict mask, float* __restrict log_range,
+                                      float* __restrict inverse_range) {
   constexpr std::uint32_t kNaN = 0x7fc00000u;
   for (int i = 0; i < n; ++i) {
     const bool masked = (valid[i] != 0) & (mixed[i] == 0) &
@@ -90,10 +99,12 @@ SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict vali
     mask[i] = masked;
     log_range[i] = std::bit_cast<float>(
         (std::bit_cast<std::uint32_t>(log_positive(range_m[i])) & keep) | (kNaN & ~keep));
+    const float divisor = select_bits(range_m[i], keep) + select_bits(1.0f, ~keep);
+    inverse_range[i] = select_bits(1.0f / divisor, keep);
   }
 }
 
-// mixed, mask and log_range of every pixel.
+// mixed, mask, log_range and inverse_range of every pixel.
 void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, FitInputs& in) {
   const std::span<std::uint8_t> mixed(in.mixed.get(), scan.pixel_count());
   if (settings.flag_mixed_pixels) detect_mixed_pixels(scan, settings, mixed);
@@ -101,7 +112,7 @@ void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, Fit
     const std::size_t i = scan.index(row, 0);
     if (!settings.flag_mixed_pixels) std::fill(&mixed[i], &mixed[i] + scan.columns, 0);
     mask_row(scan.columns, scan.valid.data() + i, &mixed[i], scan.range_m.data() + i,
-             in.mask.get() + i, in.log_range.get() + i);
+             in.mask.get() + i, in.log_range.get() + i, in.inverse_range.get() + i);
   });
 }
 
@@ -184,10 +195,11 @@ void mark_jumps(const Scan& scan, const GeometrySettings& settings, FitInputs& i
 // Per-row factors of a spherical scan, so the per-pixel work is free of
 // trigonometry and division.
 struct RowFactors {
-  std::vector<float> azimuth_gradient;  // 1 / (Δaz · cos el): d ln r / d col → ∂ ln r/∂az / cos el
+  std::vector<float> azimuth_gradient;  // 1 / (Δaz · cos el): d w / d col → ∂w/∂az / cos el
   // Half the pixel cell's diagonal [rad]: the footprint [m] per metre of range.
   std::vector<float> half_spacing_rad;
   float elevation_gradient = 0.0f;  // 1 / Δel
+  float azimuth_step_sq = 0.0f, elevation_step_sq = 0.0f;  // Δaz², Δel² [rad²]
 
   explicit RowFactors(const Scan& scan) {
     const auto* a = std::get_if<SphericalAngles>(&scan.angles);
@@ -200,6 +212,8 @@ struct RowFactors {
       half_spacing_rad.push_back(static_cast<float>(0.5 * std::sqrt(az * az + el * el)));
     }
     elevation_gradient = static_cast<float>(1.0 / a->elevation_step_rad);
+    azimuth_step_sq = static_cast<float>(a->azimuth_step_rad * a->azimuth_step_rad);
+    elevation_step_sq = static_cast<float>(a->elevation_step_rad * a->elevation_step_rad);
   }
 };
 
@@ -265,6 +279,7 @@ void count_pixels(const StageContext& c, std::size_t first, int count) {
 struct RowConstants {
   float cos_el, sin_el;
   float az_gradient, el_gradient;  // slope per pixel → per radian (see RowFactors)
+  float az_step_sq, el_step_sq;    // see RowFactors
   float half_spacing_rad;          // see RowFactors
   float max_stretch;
   std::uint16_t min_used;  // pixels a window fit needs
@@ -274,7 +289,8 @@ struct RowConstants {
 // each, and those it writes. No output overlaps another array: the
 // __restrict members say so, which GCC uses for a struct passed by value.
 struct WindowNormalInputs {
-  // The window fits (WindowSlopeRow).
+  // The window fits of the inverse range (WindowSlopeRow).
+  const float* __restrict mean;
   const float* __restrict per_column;
   const float* __restrict per_row;
   const std::uint16_t* __restrict used;
@@ -298,33 +314,53 @@ struct WindowNormalOutputs {
   std::uint8_t* __restrict flags;
 };
 
-// The normal towards the scanner is −u + g_az·e_az + g_el·e_el in the
-// orthonormal frame (u, e_az, e_el), with g the log-range slopes per radian
-// (see the top of the file); its length is √(1 + g_az² + g_el²), the cosine
-// of the incidence angle is one over it, so the footprint's stretch is the
-// length itself. Writes n pixels' normals (as three arrays), confidences,
-// footprints and flags. Branch-free over plain, unaliased arrays, so that
-// the loop vectorizes. Masked pixels without a clean window are left for the
-// covariance fit (no flag).
+// The normal of one pixel's window fit of the inverse range. About the
+// window's centre (azimuth θ0, elevation φ0) a plane n·p = 1 has
+//   w = cos φ (A cos dθ + B sin dθ) + E sin φ,
+// with A, B its components along the beam's horizontal direction and across
+// it, E the vertical one. Over a full window of radius k, steps hθ and hφ:
+//   Σ w      = Cφ (A Cθ cos φ0 + E N sin φ0),
+//   Σ dy·w   = Sφ (−A Cθ sin φ0 + E N cos φ0),
+//   Σ dx·w   = Cφ cos φ0 · B Sθ,
+// where N = 2k + 1, C = Σ cos(d·h) and S = Σ d·sin(d·h) over d in [−k, k].
+// The least-squares fit divides them by N², N·Σd² and N·Σd², so relative to
+// its plain values, with K = k(k + 1) = (N² − 1)/4 and to h⁴K² (< 10⁻⁸):
+//   C / N = 1 − h²K/6,   S / (h Σd²) = 1 − h²(3K − 1)/30.
+// Solving the rotation by φ0 gives A and E, the column slope gives B; n
+// points away from the scanner (w = n·u > 0), its cosine with the beam is
+// w / |n|, the footprint's stretch the inverse. Writes n pixels' normals
+// (as three arrays), confidences, footprints and flags. Branch-free over
+// plain, unaliased arrays, so that the loop vectorizes. Masked pixels
+// without a clean window are left for the covariance fit (no flag).
 SCANBENCH_VECTOR_CLONES void window_normals(int n, const RowConstants& constants,
                                             WindowNormalInputs in, WindowNormalOutputs out) {
+  const float cos_el = constants.cos_el, sin_el = constants.sin_el;
   for (int j = 0; j < n; ++j) {
-    const float g_az = in.per_column[j] * constants.az_gradient,
-                g_el = in.per_row[j] * constants.el_gradient;
-    const float q = 1.0f + g_az * g_az + g_el * g_el;
-    const float inverse = inverse_sqrt(q), length = q * inverse;
-    const std::uint32_t ok = all_bits((in.used[j] >= constants.min_used) &
-                                      (length <= std::numeric_limits<float>::max()));
+    const float k2 = (static_cast<float>(in.used[j]) - 1.0f) * 0.25f;  // k(k + 1)
+    const float mean_az = 1.0f - constants.az_step_sq * k2 * (1.0f / 6.0f);
+    const float mean_el = 1.0f - constants.el_step_sq * k2 * (1.0f / 6.0f);
+    const float slope_az = 1.0f - constants.az_step_sq * (3.0f * k2 - 1.0f) * (1.0f / 30.0f);
+    const float slope_el = 1.0f - constants.el_step_sq * (3.0f * k2 - 1.0f) * (1.0f / 30.0f);
+    // The rotated pair (A Cθ/N cos φ0 + E sin φ0, −A Cθ/N sin φ0 + E cos φ0).
+    const float u = in.mean[j] / mean_el;
+    const float v = in.per_row[j] * constants.el_gradient / slope_el;
+    const float along = (u * cos_el - v * sin_el) / mean_az;                               // A
+    const float up = u * sin_el + v * cos_el;                                              // E
+    const float across = in.per_column[j] * constants.az_gradient / (mean_el * slope_az);  // B
+    const float ca = in.cos_az[j], sa = in.sin_az[j];
+    const float px = along * ca - across * sa, py = along * sa + across * ca;
+    const float q = px * px + py * py + up * up;
+    const float inverse = inverse_sqrt(q);
+    const float cos_incidence = (along * cos_el + up * sin_el) * inverse;  // w / |n|
+    const std::uint32_t ok = all_bits((in.used[j] >= constants.min_used) & (cos_incidence > 0.0f) &
+                                      (q <= std::numeric_limits<float>::max()));
     const std::uint32_t is_valid = all_bits(in.valid[j] != 0);
     const std::uint32_t pending = all_bits((in.used[j] == 0) & (in.mask[j] != 0));
-    const float ca = in.cos_az[j], sa = in.sin_az[j];
-    out.nx[j] = select_bits(
-        (-constants.cos_el * ca - g_az * sa - g_el * constants.sin_el * ca) * inverse, ok);
-    out.ny[j] = select_bits(
-        (-constants.cos_el * sa + g_az * ca - g_el * constants.sin_el * sa) * inverse, ok);
-    out.nz[j] = select_bits((-constants.sin_el + g_el * constants.cos_el) * inverse, ok);
-    out.confidence[j] = select_bits(std::max(1e-6f, inverse), ok);
-    const float stretch = select_bits(length, ok) + select_bits(1.0f, ~ok);
+    out.nx[j] = select_bits(-px * inverse, ok);
+    out.ny[j] = select_bits(-py * inverse, ok);
+    out.nz[j] = select_bits(-up * inverse, ok);
+    out.confidence[j] = select_bits(std::max(1e-6f, cos_incidence), ok);
+    const float stretch = select_bits(1.0f / cos_incidence, ok) + select_bits(1.0f, ~ok);
     out.footprint_m[j] = select_bits(
         in.range_m[j] * constants.half_spacing_rad * std::min(stretch, constants.max_stretch),
         is_valid);
@@ -340,6 +376,8 @@ RowConstants row_constants(const StageContext& c, int row) {
           c.directions.sin_el[row],
           c.factors.azimuth_gradient[row],
           c.factors.elevation_gradient,
+          c.factors.azimuth_step_sq,
+          c.factors.elevation_step_sq,
           c.factors.half_spacing_rad[row],
           static_cast<float>(c.settings.max_footprint_stretch),
           static_cast<std::uint16_t>(std::clamp(c.settings.min_neighbours, 1, 65535))};
@@ -404,7 +442,8 @@ void store_window_fits(const StageContext& c, int row, int begin, int end,
     const int n = std::min(kChunk, end - begin - j0);
     const std::size_t i0 = first + j0;
     float nx[kChunk], ny[kChunk], nz[kChunk];
-    const WindowNormalInputs inputs{s.per_column + j0,
+    const WindowNormalInputs inputs{s.mean + j0,
+                                    s.per_column + j0,
                                     s.per_row + j0,
                                     s.used + j0,
                                     c.directions.cos_az.data() + begin + j0,
@@ -510,7 +549,7 @@ GeometryResult compute_grid_geometry(const Scan& scan, const GeometrySettings& s
   if (scan.is_spherical()) {
     const std::vector<int> radii = cascade_radii(settings);
     visit_window_slopes(scan.rows, scan.columns, radii, {in.clean.get(), scan.pixel_count()},
-                        {in.log_range.get(), scan.pixel_count()}, settings.threads,
+                        {in.inverse_range.get(), scan.pixel_count()}, settings.threads,
                         [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
                           store_window_fits(context, row, begin, end, slopes);
                         });

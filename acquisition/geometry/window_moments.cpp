@@ -156,25 +156,27 @@ T box(const T* top, const T* bottom, int left, int right) {
 
 // One row segment's fits as parallel arrays.
 struct SlopeBuffers {
-  std::vector<float> per_column, per_row;
+  std::vector<float> mean, per_column, per_row;
   std::vector<std::uint16_t> used;
 
-  explicit SlopeBuffers(std::size_t n) : per_column(n), per_row(n), used(n) {}
-  WindowSlopeRow row() const { return {per_column.data(), per_row.data(), used.data()}; }
+  explicit SlopeBuffers(std::size_t n) : mean(n), per_column(n), per_row(n), used(n) {}
+  WindowSlopeRow row() const {
+    return {mean.data(), per_column.data(), per_row.data(), used.data()};
+  }
 };
 
-// The count of unclean pixels and the centred moments Σ dx·v, Σ dy·v of the
-// window of radius k around region pixel (y, x); `b` bounds its rows.
+// The count of unclean pixels, Σ v and the centred moments Σ dx·v, Σ dy·v of
+// the window of radius k around region pixel (y, x); `b` bounds its rows.
 struct Window {
   std::int32_t unclean;
-  double sxv, syv;
+  double sv, sxv, syv;
 };
 
 inline Window window_at(const IntegralRing::Bounds& b, int y, int x, int k) {
   const int left = x - k, right = x + k + 1;
   // Moments about the window's centre: Σ dx·v = Σ x·v − x·Σ v, likewise dy.
   const double sv = box(b.top_v, b.bottom_v, left, right);
-  return {box(b.top_unclean, b.bottom_unclean, left, right),
+  return {box(b.top_unclean, b.bottom_unclean, left, right), sv,
           box(b.top_xv, b.bottom_xv, left, right) - x * sv,
           box(b.top_yv, b.bottom_yv, left, right) - y * sv};
 }
@@ -190,12 +192,14 @@ std::uint16_t window_pixels(int k) {
 SCANBENCH_VECTOR_CLONES void fit_radius(int n, int x0, int y, int k, double inverse,
                                         const IntegralRing::Bounds& b,
                                         const std::uint8_t* __restrict clean,
-                                        float* __restrict per_column, float* __restrict per_row,
-                                        std::uint16_t* __restrict used) {
+                                        float* __restrict mean, float* __restrict per_column,
+                                        float* __restrict per_row, std::uint16_t* __restrict used) {
   const std::uint16_t full = window_pixels(k);
+  const double inverse_count = 1.0 / full;
   for (int j = 0; j < n; ++j) {
     const Window w = window_at(b, y, x0 + j, k);
     const std::uint32_t ok = all_bits((clean[j] != 0) & (w.unclean == 0));
+    mean[j] = select_bits(static_cast<float>(w.sv * inverse_count), ok);
     per_column[j] = select_bits(static_cast<float>(w.sxv * inverse), ok);
     per_row[j] = select_bits(static_cast<float>(w.syv * inverse), ok);
     used[j] = static_cast<std::uint16_t>(full & ok);
@@ -209,6 +213,7 @@ void fit_narrower(std::span<const IntegralRing::Bounds> bounds, std::span<const 
   for (std::size_t r = 1; r < radii.size(); ++r) {
     const Window w = window_at(bounds[r], y, x, radii[r]);
     if (w.unclean != 0) continue;
+    out.mean[j] = static_cast<float>(w.sv / window_pixels(radii[r]));
     out.per_column[j] = static_cast<float>(w.sxv * inverse[r]);
     out.per_row[j] = static_cast<float>(w.syv * inverse[r]);
     out.used[j] = window_pixels(radii[r]);
@@ -231,7 +236,7 @@ void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
     // Widest radius for the whole segment, then the narrower ones for the
     // clean pixels it left without a window.
     fit_radius(n, halo, y, radii[0], inverse[0], bounds[0], grid.clean + offset + tile.col_begin,
-               out.per_column.data(), out.per_row.data(), out.used.data());
+               out.mean.data(), out.per_column.data(), out.per_row.data(), out.used.data());
     for (int j = 0; j < n; ++j) {
       if (out.used[j] == 0 && grid.clean[offset + tile.col_begin + j])
         fit_narrower(bounds, radii, inverse, y, halo + j, out, static_cast<std::size_t>(j));
@@ -266,7 +271,8 @@ std::vector<WindowSlope> window_slopes(int rows, int columns, std::span<const in
       [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
         WindowSlope* out = result.data() + static_cast<std::size_t>(row) * columns;
         for (int j = 0; j < end - begin; ++j)
-          out[begin + j] = {slopes.per_column[j], slopes.per_row[j], slopes.used[j]};
+          out[begin + j] = {slopes.mean[j], slopes.per_column[j], slopes.per_row[j],
+                            slopes.used[j]};
       });
   return result;
 }

@@ -6,7 +6,8 @@
 // clean — and a clean window is full and symmetric, so for window offsets
 // dx = c − col, dy = r − row in [−k, k] the plane fit v ≈ a + b·dx + c·dy
 // decouples (Σdx = Σdy = Σdx·dy = 0):
-//   b = Σ dx·v / Σ dx²,   c = Σ dy·v / Σ dy²,   Σ dx² = Σ dy² = (2k+1)² k(k+1) / 3,
+//   a = Σ v / (2k+1)²,   b = Σ dx·v / Σ dx²,   c = Σ dy·v / Σ dy²,
+//   Σ dx² = Σ dy² = (2k+1)² k(k+1) / 3,
 // and needs three moments of v (Σv, Σx·v, Σy·v) and the count of unclean
 // pixels. Each tile of the grid builds its own integral images, in double
 // precision and tile-local coordinates, so every sum stays small (no
@@ -23,6 +24,7 @@ namespace scanbench::acquisition {
 
 // The fit of the widest clean window around one pixel.
 struct WindowSlope {
+  float mean = 0.0f;        // the window's mean value
   float per_column = 0.0f;  // d value / d col
   float per_row = 0.0f;     // d value / d row
   std::uint16_t used = 0;   // pixels in the window, (2k + 1)²; 0 = no clean window
@@ -31,6 +33,7 @@ struct WindowSlope {
 // The fits of one row segment as parallel arrays, one entry per pixel (the
 // loops that consume them vectorize).
 struct WindowSlopeRow {
+  const float* mean;
   const float* per_column;
   const float* per_row;
   const std::uint16_t* used;
