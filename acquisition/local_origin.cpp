@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace scanbench::acquisition {
@@ -21,58 +22,55 @@ std::vector<Eigen::Vector3d> relative_to(std::span<const Eigen::Vector3d> points
   return out;
 }
 
-// The largest distance [m] of a valid point from the origin.
-double farthest(std::span<const Eigen::Vector3d> points, const std::vector<std::uint8_t>& valid) {
-  double largest = 0.0;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (valid[i]) largest = std::max(largest, points[i].squaredNorm());
-  }
-  return std::sqrt(largest);
-}
+// Where the valid points lie, from one pass: how far from the file's origin,
+// and their centroid.
+struct Spread {
+  double farthest_m = 0.0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+};
 
-// The valid points' centroid rounded to whole metres, moved by a metre in z
-// while a point sits on it.
-Eigen::Vector3d centroid_origin(std::span<const Eigen::Vector3d> points,
-                                const std::vector<std::uint8_t>& valid) {
+Spread spread_of(std::span<const Eigen::Vector3d> points, const std::vector<std::uint8_t>& valid) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double farthest_sq = 0.0;
   std::size_t count = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (valid[i]) {
-      sum += points[i];
-      ++count;
-    }
+    if (!valid[i]) continue;
+    sum += points[i];
+    farthest_sq = std::max(farthest_sq, points[i].squaredNorm());
+    ++count;
   }
-  if (count == 0) return Eigen::Vector3d::Zero();
-  Eigen::Vector3d origin = (sum / static_cast<double>(count)).array().round().matrix();
-  for (bool clear = false; !clear;) {
-    clear = true;
-    for (std::size_t i = 0; i < points.size() && clear; ++i) {
-      if (valid[i] && (points[i] - origin).norm() < kMinRangeM) clear = false;
-    }
-    // A metre, or the next double where a metre is below its precision.
-    if (!clear) origin.z() = std::max(origin.z() + 1.0, std::nextafter(origin.z(), HUGE_VAL));
-  }
-  return origin;
+  if (count == 0) return {};
+  return {std::sqrt(farthest_sq), sum / static_cast<double>(count)};
 }
 
+struct RangeSpan {
+  double nearest_m = std::numeric_limits<double>::infinity(), farthest_m = 0.0;
+};
+
 // Ranges (and, for per-pixel grids, directions) of the points measured from
-// `origin`, in one pass; returns the largest range [m].
-double set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points,
-                  const Eigen::Vector3d& origin, bool directions) {
-  double farthest = 0.0;
-  scan.range_m.assign(points.size(), 0.0f);
+// `origin`, in one pass; returns the valid points' least and largest range.
+RangeSpan set_ranges(Scan& scan, std::span<const Eigen::Vector3d> points,
+                     const Eigen::Vector3d& origin, bool directions) {
+  RangeSpan span;
+  scan.range_m.resize(points.size());  // every entry is written below
+  // A scattered scan's directions are rewritten in place (every entry).
   std::vector<Eigen::Vector3f> unit;
-  if (directions) unit.assign(points.size(), Eigen::Vector3f::Zero());
+  if (auto* grid = std::get_if<PerPixelDirections>(&scan.angles); directions && grid != nullptr)
+    unit = std::move(grid->directions);
+  if (directions) unit.resize(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!scan.valid[i]) continue;
     const Eigen::Vector3d p = points[i] - origin;
-    const double range = p.norm();
-    farthest = std::max(farthest, range);
+    const double range = scan.valid[i] ? p.norm() : 0.0;
+    span.farthest_m = std::max(span.farthest_m, range);
+    if (scan.valid[i]) span.nearest_m = std::min(span.nearest_m, range);
     scan.range_m[i] = static_cast<float>(range);
-    if (directions) unit[i] = (p / range).cast<float>();
+    if (directions) {
+      unit[i] =
+          scan.valid[i] ? Eigen::Vector3f((p / range).cast<float>()) : Eigen::Vector3f::Zero();
+    }
   }
   if (directions) scan.angles = PerPixelDirections{std::move(unit), scan.is_scattered()};
-  return farthest;
+  return span;
 }
 
 // The largest distance [m] between a valid point of `points` and where the
@@ -95,17 +93,25 @@ double largest_round_trip_error(const Scan& scan, std::span<const Eigen::Vector3
 // fit moved points by `panorama_deviation_m`, per-pixel directions; then
 // the round trip of every point bounded, or checked where the bound does
 // not settle it. A float range errs by 6e-8 of itself, a float unit
-// direction by 1e-7 of the range.
+// direction by 1e-7 of the range. Per-pixel directions fail unchecked
+// (max_error_m infinite) when a point lies within kMinRangeM of the origin
+// (it has no direction) or farther than `max_range_m`.
 LocalOriginResult place(Scan& scan, std::span<const Eigen::Vector3d> points,
                         const Eigen::Vector3d& origin, std::optional<double> panorama_deviation_m,
-                        const LocalOriginSettings& settings) {
+                        const LocalOriginSettings& settings,
+                        double max_range_m = std::numeric_limits<double>::infinity()) {
   const bool spherical = panorama_deviation_m.has_value();
   LocalOriginResult result{origin, spherical};
-  result.farthest_m = set_ranges(scan, points, origin, !spherical);
+  const RangeSpan span = set_ranges(scan, points, origin, !spherical);
+  result.farthest_m = span.farthest_m;
   const double bound =
-      spherical ? *panorama_deviation_m + 6e-8 * result.farthest_m : 1.6e-7 * result.farthest_m;
-  result.max_error_m =
-      bound <= settings.max_error_m ? bound : largest_round_trip_error(scan, points, origin);
+      spherical ? *panorama_deviation_m + 6e-8 * span.farthest_m : 1.6e-7 * span.farthest_m;
+  if (!spherical && (span.nearest_m < kMinRangeM || span.farthest_m > max_range_m)) {
+    result.max_error_m = std::numeric_limits<double>::infinity();
+  } else {
+    result.max_error_m =
+        bound <= settings.max_error_m ? bound : largest_round_trip_error(scan, points, origin);
+  }
   return result;
 }
 
@@ -140,13 +146,18 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
     if (result->max_error_m <= settings.max_error_m) break;
     result.reset();
   }
-  if (!result && farthest(points_file, scan.valid) <= settings.max_per_pixel_range_m) {
+  const Spread spread = result ? Spread{} : spread_of(points_file, scan.valid);
+  if (!result && spread.farthest_m <= settings.max_per_pixel_range_m) {
     result = place(scan, points_file, Eigen::Vector3d::Zero(), std::nullopt, settings);
     if (result->max_error_m > settings.max_error_m) result.reset();
   }
-  if (!result) {
-    result =
-        place(scan, points_file, centroid_origin(points_file, scan.valid), std::nullopt, settings);
+  // The centroid rounded to whole metres, moved by a metre in z (or to the
+  // next double, where a metre is below its precision) while a point sits
+  // on it.
+  for (Eigen::Vector3d origin = spread.centroid.array().round().matrix(); !result;
+       origin.z() = std::max(origin.z() + 1.0, std::nextafter(origin.z(), HUGE_VAL))) {
+    result = place(scan, points_file, origin, std::nullopt, settings);
+    if (!std::isfinite(result->max_error_m)) result.reset();
   }
   scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result->origin_file);
   return *result;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/memory.hpp"
+
 namespace scanbench::acquisition {
 
 Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color) {
@@ -13,10 +15,10 @@ Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color
   scan.rows = rows;
   scan.columns = columns;
   const std::size_t n = scan.pixel_count();
-  scan.range_m.assign(n, 0.0f);
-  scan.valid.assign(n, 0);
-  if (with_intensity) scan.intensity.assign(n, 0.0f);
-  if (with_color) scan.rgb.assign(3 * n, 0);
+  core::assign_mapped(scan.range_m, n, 0.0f);
+  core::assign_mapped(scan.valid, n, std::uint8_t{0});
+  if (with_intensity) core::assign_mapped(scan.intensity, n, 0.0f);
+  if (with_color) core::assign_mapped(scan.rgb, 3 * n, std::uint8_t{0});
   return scan;
 }
 
@@ -41,8 +43,9 @@ Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_colo
   Scan scan = make_empty_scan(static_cast<int>(rows), static_cast<int>(columns), with_intensity,
                               with_color);
   std::fill_n(scan.valid.begin(), points, std::uint8_t{1});
-  scan.angles = PerPixelDirections{
-      std::vector<Eigen::Vector3f>(scan.pixel_count(), Eigen::Vector3f::Zero()), true};
+  std::vector<Eigen::Vector3f> directions;
+  core::assign_mapped(directions, scan.pixel_count(), Eigen::Vector3f::Zero().eval());
+  scan.angles = PerPixelDirections{std::move(directions), true};
   return scan;
 }
 

@@ -1,6 +1,8 @@
 #include "core/memory.hpp"
 
+#include <sys/mman.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -115,6 +117,21 @@ void check_memory(std::uint64_t bytes, const std::string& file) {
                          "reading it needs " + gigabytes(bytes) + " of memory, " +
                              gigabytes(*available) + " are available");
   }
+}
+
+void map_now(const void* data, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+  constexpr std::size_t kWorthIt = std::size_t{1} << 20;  // below, a few faults
+  if (data == nullptr || bytes < kWorthIt) return;
+  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+  const auto begin = reinterpret_cast<std::uintptr_t>(data) & ~(page - 1);
+  const auto end = reinterpret_cast<std::uintptr_t>(data) + bytes;
+  void* const region = reinterpret_cast<void*>(begin);
+  madvise(region, end - begin, MADV_HUGEPAGE);  // fails harmlessly without THP
+  madvise(region, end - begin, MADV_POPULATE_WRITE);
+#else
+  (void)data, (void)bytes;
+#endif
 }
 
 }  // namespace scanbench::core

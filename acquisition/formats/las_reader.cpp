@@ -202,11 +202,15 @@ ImportedScan read_las(const std::filesystem::path& path) {
   out.source.points_in_file = h.points;
   out.source.coordinate_metadata = coordinate_system(file, h);
   const std::size_t colour_at = kColourAt[static_cast<std::size_t>(h.format)];
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(scattered_pixel_count(h.points));  // set_scattered_points pads it
-  points.resize(h.points);
-  std::vector<float> intensity(h.points);
-  std::vector<std::uint16_t> colour(colour_at > 0 ? 3 * h.points : 0);
+  const std::size_t pixels = scattered_pixel_count(h.points);  // the scan pads to its last row
+  PointCloud cloud;
+  core::reserve_mapped(cloud.points, pixels);
+  cloud.points.resize(h.points);
+  std::vector<Eigen::Vector3d>& points = cloud.points;
+  core::reserve_mapped(cloud.intensity, pixels);
+  cloud.intensity.resize(h.points);
+  std::vector<std::uint16_t> colour;
+  if (colour_at > 0) core::assign_mapped(colour, 3 * h.points, std::uint16_t{0});
   std::vector<unsigned char> block;
   for (std::uint64_t first = 0; first < h.points; first += kBlock) {
     const std::uint64_t count = std::min(kBlock, h.points - first);
@@ -225,7 +229,7 @@ ImportedScan read_las(const std::filesystem::path& path) {
                   "record " + std::to_string(i) +
                       ": coordinate beyond 10^8 m (a corrupt value, scale or offset?)");
       }
-      intensity[i] = static_cast<float>(at<std::uint16_t>(block, r + 12) / 65535.0);
+      cloud.intensity[i] = static_cast<float>(at<std::uint16_t>(block, r + 12) / 65535.0);
       for (std::size_t c = 0; c < (colour_at > 0 ? 3u : 0u); ++c) {
         colour[3 * i + c] = at<std::uint16_t>(block, r + colour_at + 2 * c);
       }
@@ -233,7 +237,7 @@ ImportedScan read_las(const std::filesystem::path& path) {
   }
   const bool wide_colour =
       std::any_of(colour.begin(), colour.end(), [](std::uint16_t v) { return v > 255; });
-  PointCloud cloud{std::move(points), std::move(intensity), {}};
+  if (!colour.empty()) core::reserve_mapped(cloud.rgb, 3 * pixels);
   cloud.rgb.resize(colour.size());
   for (std::size_t k = 0; k < colour.size(); ++k) {
     cloud.rgb[k] = static_cast<std::uint8_t>(wide_colour ? (colour[k] + 128) / 257 : colour[k]);

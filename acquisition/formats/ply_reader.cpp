@@ -211,7 +211,7 @@ T load(const unsigned char* p, bool swap) {
   return std::bit_cast<T>(bytes);
 }
 
-double value_at(const unsigned char* p, Type type, bool swap) {
+inline double value_at(const unsigned char* p, Type type, bool swap) {
   switch (type) {
     case Type::kI8:
       return static_cast<std::int8_t>(*p);
@@ -233,7 +233,7 @@ double value_at(const unsigned char* p, Type type, bool swap) {
   return 0.0;
 }
 
-std::uint8_t colour_byte(double value, Type type) {
+inline std::uint8_t colour_byte(double value, Type type) {
   if (type == Type::kU8 && value >= 0.0 && value <= 255.0) return static_cast<std::uint8_t>(value);
   double unit = value / 255.0;
   if (type == Type::kU16 || type == Type::kI16) unit = value / 65535.0;
@@ -342,6 +342,70 @@ std::size_t fixed_record_size(const Element& element) {
   return size;
 }
 
+// One property of a fixed-size record: where it starts, how it is stored.
+struct Field {
+  std::size_t offset = 0;
+  Type type = Type::kF32;
+};
+
+// The vertices of fixed-size records, `count` of them from vertex `first`,
+// decoded straight into the cloud: the common case (every exporter writes
+// one), without the per-property buffer that records with lists need.
+class FixedVertices {
+ public:
+  FixedVertices(const Element& vertex, const Channels& c, bool swap) : swap_(swap) {
+    std::vector<std::size_t> offsets;
+    std::size_t offset = 0;
+    for (const Property& p : vertex.properties) {
+      offsets.push_back(offset);
+      offset += size_of(p.type);
+    }
+    const auto field = [&](int k) {
+      return Field{offsets[static_cast<std::size_t>(k)],
+                   vertex.properties[static_cast<std::size_t>(k)].type};
+    };
+    for (int axis = 0; axis < 3; ++axis) xyz_[axis] = field(c.xyz[axis]);
+    if (c.intensity >= 0) intensity_ = field(c.intensity);
+    if (c.rgb[0] >= 0) {
+      rgb_.emplace();
+      for (int k = 0; k < 3; ++k) (*rgb_)[static_cast<std::size_t>(k)] = field(c.rgb[k]);
+    }
+  }
+
+  // Appends the block's vertices; the index of the first one beyond
+  // kMaxCoordinateM, if any, is returned instead of being appended.
+  std::optional<std::uint64_t> add(const unsigned char* block, std::size_t record,
+                                   std::uint64_t count, std::uint64_t first,
+                                   PointCloud& cloud) const {
+    for (std::uint64_t k = 0; k < count; ++k) {
+      const unsigned char* r = block + k * record;
+      const Eigen::Vector3d p(value(r, xyz_[0]), value(r, xyz_[1]), value(r, xyz_[2]));
+      if (!p.allFinite()) continue;  // no return
+      if (!(p.cwiseAbs().maxCoeff() <= kMaxCoordinateM)) return first + k;
+      cloud.points.push_back(p);
+      if (intensity_) {
+        constexpr double kLargest = std::numeric_limits<float>::max();
+        cloud.intensity.push_back(
+            static_cast<float>(std::clamp(value(r, *intensity_), -kLargest, kLargest)));
+      }
+      if (rgb_) {
+        for (const Field& f : *rgb_) cloud.rgb.push_back(colour_byte(value(r, f), f.type));
+      }
+    }
+    return std::nullopt;
+  }
+
+ private:
+  double value(const unsigned char* record, const Field& f) const {
+    return value_at(record + f.offset, f.type, swap_);
+  }
+
+  bool swap_;
+  Field xyz_[3];
+  std::optional<Field> intensity_;
+  std::optional<std::array<Field, 3>> rgb_;
+};
+
 void read_binary(const std::filesystem::path& path, std::uint64_t file_size, const Header& h,
                  const Channels& c, PointCloud& cloud) {
   const bool swap = (h.body == Body::kBigEndian) != (std::endian::native == std::endian::big);
@@ -352,16 +416,6 @@ void read_binary(const std::filesystem::path& path, std::uint64_t file_size, con
     if (element.properties.empty()) continue;  // records of no bytes
     values.assign(element.properties.size(), 0.0);
     const std::size_t fixed = fixed_record_size(element);
-    // Of fixed-size vertices, only the properties read, at their offsets.
-    std::vector<std::pair<std::size_t, std::size_t>> used;  // (property, byte offset)
-    for (std::size_t q = 0, offset = 0; fixed > 0 && q < element.properties.size(); ++q) {
-      const int index = static_cast<int>(q);
-      if (std::count(c.xyz, c.xyz + 3, index) + std::count(c.rgb, c.rgb + 3, index) > 0 ||
-          c.intensity == index) {
-        used.emplace_back(q, offset);
-      }
-      offset += size_of(element.properties[q].type);
-    }
     // Fixed-size records in blocks; records with lists one property at a time.
     constexpr std::uint64_t kBlock = 1 << 16;
     for (std::uint64_t first = 0; first < element.count;) {
@@ -370,15 +424,9 @@ void read_binary(const std::filesystem::path& path, std::uint64_t file_size, con
         const std::uint64_t count = std::min(kBlock, element.count - first);
         const unsigned char* block = body.take(fixed * count, what);
         if (is_vertex) {
-          for (std::uint64_t k = 0; k < count; ++k) {
-            const unsigned char* record = block + k * fixed;
-            for (const auto& [q, offset] : used) {
-              values[q] = value_at(record + offset, element.properties[q].type, swap);
-            }
-            if (!add_vertex(element, c, values.data(), cloud)) {
-              body.fail("vertex " + std::to_string(first + k) + kTooFar);
-            }
-          }
+          if (const auto far =
+                  FixedVertices(element, c, swap).add(block, fixed, count, first, cloud))
+            body.fail("vertex " + std::to_string(*far) + kTooFar);
         }
         first += count;
         continue;
@@ -427,9 +475,10 @@ ImportedScan read_ply(const std::filesystem::path& path) {
   if (vertex->count > reader.file_size()) reader.fail("the vertex count exceeds the file's size");
   core::check_memory(vertex->count * 64, reader.file_name());
   PointCloud cloud;
-  cloud.points.reserve(scattered_pixel_count(vertex->count));
-  if (channels.intensity >= 0) cloud.intensity.reserve(vertex->count);
-  if (channels.rgb[0] >= 0) cloud.rgb.reserve(3 * vertex->count);
+  const std::size_t pixels = scattered_pixel_count(vertex->count);  // the scan pads to its last row
+  core::reserve_mapped(cloud.points, pixels);
+  if (channels.intensity >= 0) core::reserve_mapped(cloud.intensity, pixels);
+  if (channels.rgb[0] >= 0) core::reserve_mapped(cloud.rgb, 3 * pixels);
   if (header.body == Body::kAscii) {
     read_ascii(reader, header, channels, cloud);
   } else {

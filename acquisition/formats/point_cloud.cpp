@@ -16,9 +16,16 @@ Scan scattered_scan(PointCloud&& cloud, const std::filesystem::path& path) {
     throw core::InputError(path.string(), {}, "holds no points: there is nothing to import");
   assert((cloud.intensity.empty() || cloud.intensity.size() == n) &&
          (cloud.rgb.empty() || cloud.rgb.size() == 3 * n) && "channels of one value per point");
-  Scan scan = make_scattered_scan(n, !cloud.intensity.empty(), !cloud.rgb.empty());
-  std::copy(cloud.intensity.begin(), cloud.intensity.end(), scan.intensity.begin());
-  std::copy(cloud.rgb.begin(), cloud.rgb.end(), scan.rgb.begin());
+  Scan scan = make_scattered_scan(n, false, false);
+  // The channels become the scan's, padded to its last row.
+  if (!cloud.intensity.empty()) {
+    cloud.intensity.resize(scan.pixel_count(), 0.0f);
+    scan.intensity = std::move(cloud.intensity);
+  }
+  if (!cloud.rgb.empty()) {
+    cloud.rgb.resize(3 * scan.pixel_count(), 0);
+    scan.rgb = std::move(cloud.rgb);
+  }
   set_scattered_points(scan, std::move(cloud.points));
   const std::u8string stem = path.stem().u8string();
   const std::u8string utf8 = path.u8string();

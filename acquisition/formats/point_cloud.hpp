@@ -11,6 +11,8 @@
 
 namespace scanbench::acquisition {
 
+// Readers reserve scattered_pixel_count(points) entries (three for rgb), so
+// that the scan takes the vectors without copying them.
 struct PointCloud {
   std::vector<Eigen::Vector3d> points;  // in the file's frame [m], its order
   std::vector<float> intensity;         // empty, or one per point

@@ -37,16 +37,12 @@
 #include <limits>
 #include <memory>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#include <unistd.h>
-#endif
-
 #include "acquisition/geometry/branch_free.hpp"
 #include "acquisition/geometry/grid_covariance.hpp"
 #include "acquisition/geometry/mixed_pixels.hpp"
 #include "acquisition/geometry/scattered_geometry.hpp"
 #include "acquisition/geometry/window_moments.hpp"
+#include "core/memory.hpp"
 #include "core/parallel.hpp"
 #include "core/timing.hpp"
 
@@ -492,35 +488,14 @@ std::vector<int> cascade_radii(const GeometrySettings& settings) {
   return radii;
 }
 
-// Maps the pages of [data, data + bytes) in one system call (Linux ≥ 5.14),
-// instead of one page fault per 4 KB at the first write; it runs beside the
-// first passes (see compute_geometry). A no-op elsewhere or on failure.
-void prefault(const void* data, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
-  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
-  const auto begin = reinterpret_cast<std::uintptr_t>(data) & ~(page - 1);
-  const auto end = reinterpret_cast<std::uintptr_t>(data) + bytes;
-  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
-#else
-  (void)data, (void)bytes;
-#endif
-}
-
-// Reserves, maps in bulk, then fills.
-template <typename T>
-void allocate_filled(std::vector<T>& v, std::size_t n, T value) {
-  v.reserve(n);
-  prefault(v.data(), n * sizeof(T));
-  v.assign(n, value);
-}
-
 // The outputs; every pixel is written by the passes below.
 void allocate(ScanGeometry& g, std::size_t n) {
-  allocate_filled(g.footprint_m, n, 0.0f);
+  core::assign_mapped(g.footprint_m, n, 0.0f);
+  g.normal.reserve(n);
+  core::map_now(g.normal.data(), n * sizeof(Eigen::Vector3f));
   g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
-  prefault(g.normal.data(), n * sizeof(Eigen::Vector3f));
-  allocate_filled(g.confidence, n, 0.0f);
-  allocate_filled(g.flags, n, std::uint8_t{0});
+  core::assign_mapped(g.confidence, n, 0.0f);
+  core::assign_mapped(g.flags, n, std::uint8_t{0});
 }
 
 }  // namespace

@@ -102,6 +102,22 @@ TEST(PlyReader, AsciiWithAFaceElementAndCloudCompareNames) {
   EXPECT_EQ(read.scan.rgb[4], 255);
 }
 
+TEST(PlyReader, APointAtTheFilesOriginKeepsItsPlace) {
+  // Measured from the file's origin, that point would have no direction:
+  // the scan's origin moves to the centroid instead.
+  const ScratchDir dir;
+  write_bytes(dir / "o.ply",
+              "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+              "property double z\nend_header\n0 0 0\n2.5 -1 0.25\n-3 4 1\n");
+  const ImportedScan read = read_ply(dir / "o.ply");
+  ASSERT_EQ(count_valid(read.scan), 3u);
+  const Eigen::Vector3d expected[3] = {{0, 0, 0}, {2.5, -1, 0.25}, {-3, 4, 1}};
+  for (std::size_t k = 0; k < 3; ++k) {
+    ASSERT_TRUE(point_k(read.scan, k).allFinite()) << k;
+    EXPECT_LT((point_k(read.scan, k) - expected[k]).norm(), 1e-6) << k;
+  }
+}
+
 TEST(PlyReader, BigEndianWithAListBeforeTheVerticesAndSixteenBitColour) {
   const ScratchDir dir;
   std::string ply =
