@@ -25,7 +25,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GeometrySettings, window_radius,
                                                 depth_jump_sigmas, depth_jump_relative,
                                                 min_neighbours, max_footprint_stretch,
                                                 flag_mixed_pixels, range_noise, mixed_pixel_sigmas,
-                                                estimate_range_noise)
+                                                mixed_pixel_relative, estimate_range_noise)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SphericalFitSettings, max_deviation_m)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(LocalOriginSettings, angle_fit,
                                                 max_per_pixel_range_m, max_error_m, try_spherical)
@@ -305,6 +305,7 @@ void check(const acquisition::GeometrySettings& s, const Bounds& b) {
   b.in(s.min_neighbours, 3, kMaxCount, "min_neighbours");
   b.in(s.max_footprint_stretch, 1, kMaxRatio, "max_footprint_stretch");
   b.positive(s.mixed_pixel_sigmas, kMaxRatio, "mixed_pixel_sigmas");
+  b.in(s.mixed_pixel_relative, 0, 10, "mixed_pixel_relative");
   check(s.range_noise, b, "range_noise.");
 }
 

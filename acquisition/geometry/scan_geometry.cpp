@@ -59,7 +59,11 @@ void parallel_rows(int rows, int threads, Body&& body) {
 // their pages are faulted in by the threads that use them.
 struct FitInputs {
   std::unique_ptr<std::uint8_t[]> mixed;  // 1 = mixed pixel
-  std::unique_ptr<std::uint8_t[]> mask;   // valid, not mixed, positive finite range
+  // Valid with a positive finite range. Mixed pixels stay in: the depth-jump
+  // test keeps the fits off the edges that blend, and a pixel flagged where
+  // there is none (a noise excursion under a noisy sensor) would otherwise
+  // cut every wide window around it.
+  std::unique_ptr<std::uint8_t[]> mask;
   std::unique_ptr<std::uint8_t[]> clean;  // masked and no depth jump
   std::unique_ptr<float[]> log_range;     // ln range where masked, else NaN
   std::unique_ptr<float[]> inverse_range;  // 1 / range where masked, else 0
@@ -82,14 +86,12 @@ struct FitInputs {
 // plain, unaliased arrays, so that it vectorizes. A range that is not a
 // positive normal float (or is infinite) is no return here.
 SCANBENCH_VECTOR_CLONES void mask_row(int n, const std::uint8_t* __restrict valid,
-                                      const std::uint8_t* __restrict mixed,
                                       const float* __restrict range_m,
                                       std::uint8_t* __restrict mask, float* __restrict log_range,
                                       float* __restrict inverse_range) {
   constexpr std::uint32_t kNaN = 0x7fc00000u;
   for (int i = 0; i < n; ++i) {
-    const bool masked = (valid[i] != 0) & (mixed[i] == 0) &
-                        (range_m[i] >= std::numeric_limits<float>::min()) &
+    const bool masked = (valid[i] != 0) & (range_m[i] >= std::numeric_limits<float>::min()) &
                         (range_m[i] <= std::numeric_limits<float>::max());
     const std::uint32_t keep = all_bits(masked);
     mask[i] = masked;
@@ -107,8 +109,8 @@ void mark_mixed_and_mask(const Scan& scan, const GeometrySettings& settings, Fit
   parallel_rows(scan.rows, settings.threads, [&](int row) {
     const std::size_t i = scan.index(row, 0);
     if (!settings.flag_mixed_pixels) std::fill(&mixed[i], &mixed[i] + scan.columns, 0);
-    mask_row(scan.columns, scan.valid.data() + i, &mixed[i], scan.range_m.data() + i,
-             in.mask.get() + i, in.log_range.get() + i, in.inverse_range.get() + i);
+    mask_row(scan.columns, scan.valid.data() + i, scan.range_m.data() + i, in.mask.get() + i,
+             in.log_range.get() + i, in.inverse_range.get() + i);
   });
 }
 
@@ -326,8 +328,9 @@ struct WindowNormalOutputs {
 // points away from the scanner (w = n·u > 0), its cosine with the beam is
 // w / |n|, the footprint's stretch the inverse. Writes n pixels' normals
 // (as three arrays), confidences, footprints and flags. Branch-free over
-// plain, unaliased arrays, so that the loop vectorizes. Masked pixels
-// without a clean window are left for the covariance fit (no flag).
+// plain, unaliased arrays, so that the loop vectorizes. Masked pixels that
+// are not mixed and have no clean window are left for the covariance fit
+// (no flag).
 SCANBENCH_VECTOR_CLONES void window_normals(int n, const RowConstants& constants,
                                             WindowNormalInputs in, WindowNormalOutputs out) {
   const float cos_el = constants.cos_el, sin_el = constants.sin_el;
@@ -348,10 +351,13 @@ SCANBENCH_VECTOR_CLONES void window_normals(int n, const RowConstants& constants
     const float q = px * px + py * py + up * up;
     const float inverse = inverse_sqrt(q);
     const float cos_incidence = (along * cos_el + up * sin_el) * inverse;  // w / |n|
-    const std::uint32_t ok = all_bits((in.used[j] >= constants.min_used) & (cos_incidence > 0.0f) &
-                                      (q <= std::numeric_limits<float>::max()));
+    // A blend lies on no surface: a mixed pixel gets no normal of its own.
+    const std::uint32_t ok =
+        all_bits((in.used[j] >= constants.min_used) & (cos_incidence > 0.0f) &
+                 (q <= std::numeric_limits<float>::max()) & (in.mixed[j] == 0));
     const std::uint32_t is_valid = all_bits(in.valid[j] != 0);
-    const std::uint32_t pending = all_bits((in.used[j] == 0) & (in.mask[j] != 0));
+    const std::uint32_t pending =
+        all_bits((in.used[j] == 0) & (in.mask[j] != 0) & (in.mixed[j] == 0));
     out.nx[j] = select_bits(-px * inverse, ok);
     out.ny[j] = select_bits(-py * inverse, ok);
     out.nz[j] = select_bits(-up * inverse, ok);
@@ -387,9 +393,9 @@ struct RowSegment {
   const std::uint16_t* used;
   float half_spacing_rad;  // see RowFactors
 
-  // Segment pixel j is masked and has no window fit.
+  // Segment pixel j is masked, not mixed, and has no window fit.
   bool pending(const StageContext& c, int j) const {
-    return j < n && used[j] == 0 && c.in.mask[first + j];
+    return j < n && used[j] == 0 && c.in.mask[first + j] && !c.in.mixed[first + j];
   }
 };
 
@@ -466,7 +472,7 @@ void store_covariance_fits(const StageContext& c, int row) {
     c.g.flags[i] = c.in.flags(i);
     if (!c.scan.valid[i]) continue;
     NormalFit fit;
-    if (c.in.mask[i]) {
+    if (c.in.mask[i] && !c.in.mixed[i]) {
       fit = covariance_fit(c.directions, c.scan.range_m.data(), c.in.mask.get(),
                            c.in.log_range.get(), row, col, c.scan.rows, c.settings);
     }

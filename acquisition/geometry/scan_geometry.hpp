@@ -86,14 +86,17 @@ struct GeometrySettings {
   // them out of the model).
   bool flag_mixed_pixels = true;
   // The scanner's range noise σ. A pixel is a mixed pixel when, along some
-  // grid line, it lies between its neighbours and off the linear continuation
-  // of both sides by more than mixed_pixel_sigmas · σ.
+  // grid line, it lies between its neighbours, off the linear continuation
+  // of both sides by more than mixed_pixel_sigmas · σ and
+  // mixed_pixel_relative · range, and the two continuations are
+  // depth_jump_relative · range apart (mixed_pixels.hpp).
   RangeNoise range_noise;
   // Estimate σ(range) from the scan (noise_estimate.hpp) and use that;
   // range_noise is then only the fallback for a scan that gives no
   // estimate. `scanbench geometry` does so unless told the noise.
   bool estimate_range_noise = false;
-  double mixed_pixel_sigmas = 8.0;
+  double mixed_pixel_sigmas = 3.0;
+  double mixed_pixel_relative = 0.004;
   // Worker threads; 0 = all cores. Results do not depend on it.
   int threads = 0;
 };

@@ -182,7 +182,7 @@ TEST(ScanGeometry, DepthStepKeepsEachSideClean) {
   EXPECT_EQ(edges, 2 * scan.rows);  // one pixel on each side of the step, every row
 }
 
-TEST(ScanGeometry, AMixedPixelAtTheStepIsFlaggedAndLeftOutOfItsNeighboursFits) {
+TEST(ScanGeometry, AMixedPixelAtTheStepIsFlaggedWithoutANormalAndLeftOutOfItsNeighboursFits) {
   Scan scan = step_scan();
   // Column 19 is the last near pixel of every row; make row 10's a blend.
   const std::size_t i = scan.index(10, 19);
@@ -191,9 +191,47 @@ TEST(ScanGeometry, AMixedPixelAtTheStepIsFlaggedAndLeftOutOfItsNeighboursFits) {
   const GeometryResult result = compute_geometry(scan, exact_settings());
   EXPECT_TRUE(result.geometry.is_mixed(i));
   EXPECT_EQ(result.mixed_pixels, 1u);
+  EXPECT_FALSE(result.geometry.has_normal(i));
+  EXPECT_TRUE(result.geometry.flags[i] & kFlagNoNormal);
   EXPECT_LT(angle_deg(result.geometry.normal[scan.index(10, 18)],
                       -Eigen::Vector3f(1, 0.2f, 0).normalized()),
             0.05);
+}
+
+TEST(ScanGeometry, ABlendWithinAFewSigmasOfItsSurfaceIsFoundUnderANoisySensor) {
+  // σ = 10 cm (a structured-light sensor's at 8 m): a blend 40 cm behind the
+  // near wall is 4 σ off it, and 1.3 m in front of the far one.
+  Scan scan = step_scan();
+  const std::size_t i = scan.index(10, 19), behind = scan.index(10, 20);
+  scan.range_m[i] = 0.96f * scan.range_m[i] + 0.04f * scan.range_m[behind];
+  GeometrySettings settings = exact_settings();
+  settings.range_noise = {0.1, 0.0, 0.0};
+  const GeometryResult result = compute_geometry(scan, settings);
+  EXPECT_TRUE(result.geometry.is_mixed(i));
+  EXPECT_EQ(result.mixed_pixels, 1u);
+}
+
+// A wall at 10 m with a step of `step_m` down its middle and, in every row,
+// the pixel at the step halfway between the two sides.
+Scan halfway_step_scan(double step_m) {
+  Scan scan = cast_scan(20, 40, 0.2, [&](const Eigen::Vector3d& d) {
+    return plane(d, Eigen::Vector3d::UnitX(), d.y() > 0 ? 10.0 : 10.0 + step_m);
+  });
+  for (int row = 0; row < scan.rows; ++row) {
+    const std::size_t i = scan.index(row, 19), behind = scan.index(row, 20);
+    scan.range_m[i] = 0.5f * (scan.range_m[i] + scan.range_m[behind]);
+  }
+  return scan;
+}
+
+TEST(ScanGeometry, ReliefSmallerThanADepthDiscontinuityIsNoBlend) {
+  // σ = 1 mm (a phase-shift scanner's): the halfway pixels miss both sides
+  // by 50 σ, yet the sides are 1 % of the range apart, no discontinuity (a
+  // moulding, a leaf); at 3 % they are one, and the pixels are blends.
+  GeometrySettings settings = exact_settings();
+  settings.range_noise = {0.001, 0.0, 0.0};
+  EXPECT_EQ(compute_geometry(halfway_step_scan(0.1), settings).mixed_pixels, 0u);
+  EXPECT_EQ(compute_geometry(halfway_step_scan(0.3), settings).mixed_pixels, 20u);
 }
 
 TEST(ScanGeometry, NoisyPlaneHasFewFalseMixedPixelsAndSmallErrors) {
