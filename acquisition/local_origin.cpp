@@ -160,6 +160,7 @@ LocalOriginResult set_grid_from_points(Scan& scan, std::span<const Eigen::Vector
     if (!std::isfinite(result->max_error_m)) result.reset();
   }
   scan.T_world_scan = scan.T_world_scan * Eigen::Translation3d(result->origin_file);
+  scan.import_round_trip_m = result->max_error_m;
   return *result;
 }
 

@@ -79,6 +79,12 @@ struct Scan {
   AngleModel angles = SphericalAngles{};
   Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();
   ScannerMetadata scanner;
+  // How far [m] a point of the file the scan was read from lies from where
+  // the scan puts it, at most (LocalOriginResult::max_error_m, set by the
+  // reader): within 0.1 mm unless the points spread beyond float ranges'
+  // reach (about 900 m around their centroid). 0 for scans not placed from
+  // points. Not stored with the scan; ScanSource::round_trip_error_m is.
+  double import_round_trip_m = 0.0;
 
   std::size_t pixel_count() const { return static_cast<std::size_t>(rows) * columns; }
   std::size_t index(int row, int col) const {

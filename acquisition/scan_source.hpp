@@ -69,6 +69,10 @@ struct ScanSource {
   // unstructured scan places every point: scan.hpp's scattered scans).
   std::uint64_t points_in_file = 0;
   std::uint64_t unplaced_points = 0;
+  // The farthest any placed point lies from its value in the file [m]
+  // (Scan::import_round_trip_m); 0 for grids of ranges and angles (image
+  // triplets) and for projects imported before it was recorded.
+  double round_trip_error_m = 0.0;
   // The files the reader read besides the one it was given (a triplet's
   // images), as it found them.
   std::vector<std::filesystem::path> companion_files;
@@ -76,6 +80,11 @@ struct ScanSource {
   // import (identify_source_files), not by the readers.
   std::vector<SourceFile> files;
 };
+
+// What every import promises of round_trip_error_m [m]: 0.1 mm, met unless
+// a cloud spreads beyond float ranges' reach; `import` and `info` say so
+// where it is not.
+inline constexpr double kPromisedRoundTripM = 1e-4;
 
 // Sets source.files: `path`, the file the scan was read from, and
 // source.companion_files, identified (identify_source_file).

@@ -8,6 +8,7 @@
 
 #include "app/commands.hpp"
 #include "app/progress_bar.hpp"
+#include "core/errors.hpp"
 #include "modeling/import_command.hpp"
 
 namespace scanbench::app {
@@ -33,6 +34,13 @@ void run_import(const ImportOptions& options) {
         "  {} record(s) not placed in the scan grids: later returns, or records repeating a "
         "pixel of a structured scan (see `scanbench info PROJECT`)\n",
         result.unplaced_points);
+  }
+  for (const modeling::ImportResult::RoundTrip& r : result.beyond_promise) {
+    fmt::print(
+        "  warning: {} (scan \"{}\"): points come back up to {:.2f} mm from their values in the "
+        "file, beyond 0.1 mm: they spread too far around their centroid for float ranges\n",
+        core::one_line(r.file.string(), core::kMaxMessagePart),
+        core::one_line(r.scan, core::kMaxMessagePart), 1e3 * r.error_m);
   }
 }
 

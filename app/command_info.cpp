@@ -128,7 +128,8 @@ nlohmann::json to_json(const Entry& entry) {
                                          {"guid", entry.source->guid},
                                          {"coordinate_metadata", entry.source->coordinate_metadata},
                                          {"points_in_file", entry.source->points_in_file},
-                                         {"unplaced_points", entry.source->unplaced_points}}
+                                         {"unplaced_points", entry.source->unplaced_points},
+                                         {"round_trip_error_m", entry.source->round_trip_error_m}}
                         : nlohmann::json(nullptr)}};
 }
 
@@ -150,6 +151,10 @@ void print_table(const std::string& path, const Contents& contents) {
           "      {} of the file's {} records not placed in the grid (later returns, or "
           "records repeating a pixel)\n",
           e.source->unplaced_points, e.source->points_in_file);
+    }
+    if (e.source && e.source->round_trip_error_m > acquisition::kPromisedRoundTripM) {
+      fmt::print("      points up to {:.2f} mm from their values in the file (beyond 0.1 mm)\n",
+                 1e3 * e.source->round_trip_error_m);
     }
   }
   if (contents.images.empty()) return;

@@ -197,8 +197,11 @@ ImportResult store_checked_scans(store::Project& project, const CheckedImport& c
     } else {
       store_read_again(project, command, file, settings, result);
     }
-    for (const CheckedImport::Scan& scan : file.scans)
+    for (const CheckedImport::Scan& scan : file.scans) {
       result.unplaced_points += scan.source.unplaced_points;
+      if (scan.source.round_trip_error_m > acquisition::kPromisedRoundTripM)
+        result.beyond_promise.push_back({file.path, scan.name, scan.source.round_trip_error_m});
+    }
     progress.update({kStage, checked.files.size() + f + 1, 2 * checked.files.size(),
                      file.path.filename().string()});
   }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "acquisition/formats/scan_files.hpp"
@@ -28,6 +29,15 @@ struct ImportResult {
   std::size_t images = 0;              // stored with the scans (E57 images2D)
   // Records the grids could not place (acquisition::ScanSource), all scans.
   std::uint64_t unplaced_points = 0;
+  // The scans whose points come back farther than 0.1 mm from the file's
+  // values (acquisition::kPromisedRoundTripM): the file, the scan's name and
+  // its round_trip_error_m. Imported all the same; `import` says so.
+  struct RoundTrip {
+    std::filesystem::path file;
+    std::string scan;
+    double error_m = 0.0;
+  };
+  std::vector<RoundTrip> beyond_promise;
   bool created_project = false;  // import_scan_files only
   double seconds = 0.0;
 };

@@ -48,8 +48,12 @@ ImportedScan plain(Scan&& scan, const char* format) {
 }  // namespace
 
 void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& settings,
-                    const std::function<void(ImportedScan&&)>& on_scan,
+                    const std::function<void(ImportedScan&&)>& deliver,
                     const std::function<void(ScanImage&&)>& on_loose_image) {
+  const auto on_scan = [&deliver](ImportedScan&& imported) {
+    imported.source.round_trip_error_m = imported.scan.import_round_trip_m;
+    deliver(std::move(imported));
+  };
   switch (scan_file_format(path)) {
     case ScanFileFormat::kPtx:
       read_ptx(path, settings.ptx,

@@ -39,7 +39,8 @@ std::string to_json(const acquisition::ScanSource& source) {
                          {"guid", source.guid},
                          {"coordinate_metadata", source.coordinate_metadata},
                          {"points_in_file", source.points_in_file},
-                         {"unplaced_points", source.unplaced_points}};
+                         {"unplaced_points", source.unplaced_points},
+                         {"round_trip_error_m", source.round_trip_error_m}};
   if (!source.files.empty()) {
     nlohmann::json& files = json["files"] = nlohmann::json::array();
     for (const acquisition::SourceFile& file : source.files)
@@ -56,6 +57,7 @@ acquisition::ScanSource source_from_json(const std::string& text) {
   source.coordinate_metadata = json.value("coordinate_metadata", "");
   source.points_in_file = json.at("points_in_file").get<std::uint64_t>();
   source.unplaced_points = json.at("unplaced_points").get<std::uint64_t>();
+  source.round_trip_error_m = json.value("round_trip_error_m", 0.0);
   if (json.contains("files")) {  // imports since the source files were recorded
     for (const nlohmann::json& file : json["files"]) {
       source.files.push_back({file.at("path").get<std::string>(),

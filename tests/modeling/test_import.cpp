@@ -3,7 +3,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -53,6 +56,40 @@ TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
   EXPECT_THROW(import_files(project, files), core::InputError);
   EXPECT_EQ(store::Project::open(project).history().size(), 1u);
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
+}
+
+// An ASCII PLY of 200 points scattered over a cube of side `extent_m`.
+void write_cloud_ply(const std::filesystem::path& path, double extent_m) {
+  std::ofstream out(path, std::ios::binary);
+  out << "ply\nformat ascii 1.0\nelement vertex 200\nproperty double x\n"
+         "property double y\nproperty double z\nend_header\n";
+  for (int k = 0; k < 200; ++k) {
+    const auto coordinate = [&](double phase) {
+      return extent_m * (std::fmod(k * 0.6180339887 + phase, 1.0) - 0.5);
+    };
+    char line[96];
+    std::snprintf(line, sizeof line, "%.4f %.4f %.4f\n", coordinate(0.1), coordinate(0.37),
+                  coordinate(0.73));
+    out << line;
+  }
+}
+
+TEST(ImportScans, ACloudTooWideForFloatRangesIsImportedWithAWarningItKeeps) {
+  // Points 20 km apart cannot all come back within 0.1 mm from float ranges
+  // around one centre (a float range errs by up to 0.5 mm at 15 km); 30 m
+  // apart they do.
+  ScratchDir dir;
+  write_cloud_ply(dir / "wide.ply", 20000.0);
+  write_cloud_ply(dir / "near.ply", 30.0);
+  const ImportResult result = import_files(dir / "p.sbproj", {dir / "wide.ply", dir / "near.ply"});
+  ASSERT_EQ(result.beyond_promise.size(), 1u);
+  EXPECT_EQ(result.beyond_promise[0].file, dir / "wide.ply");
+  EXPECT_EQ(result.beyond_promise[0].scan, "wide");
+  EXPECT_GT(result.beyond_promise[0].error_m, acquisition::kPromisedRoundTripM);
+  EXPECT_LT(result.beyond_promise[0].error_m, 1e-2);
+  const auto sources = store::Project::open(dir / "p.sbproj").scan_sources();
+  EXPECT_EQ(sources.at(result.scan_ids[0]).round_trip_error_m, result.beyond_promise[0].error_m);
+  EXPECT_LE(sources.at(result.scan_ids[1]).round_trip_error_m, acquisition::kPromisedRoundTripM);
 }
 
 // Blocks the import once its first file is stored (after every file was
