@@ -94,19 +94,18 @@ double largest_round_trip_error(const Scan& scan, std::span<const Eigen::Vector3
 // the round trip of every point bounded, or checked where the bound does
 // not settle it. A float range errs by 6e-8 of itself, a float unit
 // direction by 1e-7 of the range. Per-pixel directions fail unchecked
-// (max_error_m infinite) when a point lies within kMinRangeM of the origin
-// (it has no direction) or farther than `max_range_m`.
+// (max_error_m infinite) when a point lies within kMinRangeM of the origin:
+// it has no direction.
 LocalOriginResult place(Scan& scan, std::span<const Eigen::Vector3d> points,
                         const Eigen::Vector3d& origin, std::optional<double> panorama_deviation_m,
-                        const LocalOriginSettings& settings,
-                        double max_range_m = std::numeric_limits<double>::infinity()) {
+                        const LocalOriginSettings& settings) {
   const bool spherical = panorama_deviation_m.has_value();
   LocalOriginResult result{origin, spherical};
   const RangeSpan span = set_ranges(scan, points, origin, !spherical);
   result.farthest_m = span.farthest_m;
   const double bound =
       spherical ? *panorama_deviation_m + 6e-8 * span.farthest_m : 1.6e-7 * span.farthest_m;
-  if (!spherical && (span.nearest_m < kMinRangeM || span.farthest_m > max_range_m)) {
+  if (!spherical && span.nearest_m < kMinRangeM) {
     result.max_error_m = std::numeric_limits<double>::infinity();
   } else {
     result.max_error_m =

@@ -38,7 +38,7 @@ void run_import(const ImportOptions& options) {
   for (const modeling::ImportResult::RoundTrip& r : result.beyond_promise) {
     fmt::print(
         "  warning: {} (scan \"{}\"): points come back up to {:.2f} mm from their values in the "
-        "file, beyond 0.1 mm: they spread too far around their centroid for float ranges\n",
+        "file, beyond 0.1 mm (a cloud spread too far for float ranges, or loosened settings)\n",
         core::one_line(r.file.string(), core::kMaxMessagePart),
         core::one_line(r.scan, core::kMaxMessagePart), 1e3 * r.error_m);
   }

@@ -1,6 +1,7 @@
 // Refusing work that cannot fit in memory before allocating for it: a file
 // header that declares 2 billion points must not end in std::bad_alloc
-// (or the kernel's out-of-memory killer) halfway through.
+// (or the kernel's out-of-memory killer) halfway through. And mapping a
+// large fresh array in bulk rather than a page fault at a time.
 #pragma once
 
 #include <cstddef>

@@ -11,7 +11,7 @@
 namespace scanbench::acquisition {
 namespace {
 
-// Rows per task: the block's padded copy (block + 4 rows) stays in cache.
+// Rows per task: the block's padded copy (block + 6 rows) stays in cache.
 constexpr int kBlockRows = 16;
 
 // Ranges [m] of rows [row_begin − 3, row_end + 3) with a border of three pixels,

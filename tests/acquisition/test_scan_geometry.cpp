@@ -183,19 +183,24 @@ TEST(ScanGeometry, DepthStepKeepsEachSideClean) {
 }
 
 TEST(ScanGeometry, AMixedPixelAtTheStepIsFlaggedWithoutANormalAndLeftOutOfItsNeighboursFits) {
-  Scan scan = step_scan();
-  // Column 19 is the last near pixel of every row; make row 10's a blend.
-  const std::size_t i = scan.index(10, 19);
-  const std::size_t behind = scan.index(10, 20);
-  scan.range_m[i] = 0.5f * (scan.range_m[i] + scan.range_m[behind]);
-  const GeometryResult result = compute_geometry(scan, exact_settings());
-  EXPECT_TRUE(result.geometry.is_mixed(i));
-  EXPECT_EQ(result.mixed_pixels, 1u);
-  EXPECT_FALSE(result.geometry.has_normal(i));
-  EXPECT_TRUE(result.geometry.flags[i] & kFlagNoNormal);
-  EXPECT_LT(angle_deg(result.geometry.normal[scan.index(10, 18)],
-                      -Eigen::Vector3f(1, 0.2f, 0).normalized()),
-            0.05);
+  // Halfway to the far wall, and 1 % of the way: the second is within the
+  // covariance fallback's 2 % of its neighbour, which must still leave it out.
+  for (const float share : {0.5f, 0.01f}) {
+    Scan scan = step_scan();
+    // Column 19 is the last near pixel of every row; make row 10's a blend.
+    const std::size_t i = scan.index(10, 19);
+    const std::size_t behind = scan.index(10, 20);
+    scan.range_m[i] = (1.0f - share) * scan.range_m[i] + share * scan.range_m[behind];
+    const GeometryResult result = compute_geometry(scan, exact_settings());
+    EXPECT_TRUE(result.geometry.is_mixed(i)) << share;
+    EXPECT_EQ(result.mixed_pixels, 1u) << share;
+    EXPECT_FALSE(result.geometry.has_normal(i)) << share;
+    EXPECT_TRUE(result.geometry.flags[i] & kFlagNoNormal) << share;
+    EXPECT_LT(angle_deg(result.geometry.normal[scan.index(10, 18)],
+                        -Eigen::Vector3f(1, 0.2f, 0).normalized()),
+              0.05)
+        << share;
+  }
 }
 
 TEST(ScanGeometry, ABlendWithinAFewSigmasOfItsSurfaceIsFoundUnderANoisySensor) {
