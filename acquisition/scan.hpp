@@ -99,6 +99,21 @@ struct Scan {
   }
 };
 
+// Per-point geometry a file recorded beside its points (a PLY's nx, ny, nz
+// and radius, a LAS's NormalX, NormalY, NormalZ and Footprint extra bytes,
+// as our exports write them), per pixel of a scattered scan. Each vector is
+// empty when the file has none, else pixel_count() long: a unit normal in
+// the scan frame, the zero vector where the file gives none, and a
+// footprint radius [m], 0 where none. The geometry stage keeps them
+// (scattered_geometry.hpp): they may come from a better neighbourhood than
+// the cloud still has (the scan grid it was exported from, a mesh).
+struct RecordedGeometry {
+  std::vector<Eigen::Vector3f> normal;
+  std::vector<float> footprint_m;
+
+  bool empty() const { return normal.empty() && footprint_m.empty(); }
+};
+
 // Allocates every channel of a rows × columns scan: range 0, all pixels
 // invalid, intensity / rgb only when requested. Asserts rows, columns ≥ 0.
 Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color);

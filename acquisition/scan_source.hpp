@@ -95,6 +95,7 @@ struct ImportedScan {
   Scan scan;
   ScanSource source;
   std::vector<ScanImage> images;  // those the file ties to this scan
+  RecordedGeometry recorded;      // what the file recorded of it (scattered scans)
 };
 
 // "pinhole", "spherical", "cylindrical" or "visual_reference".

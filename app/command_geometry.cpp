@@ -46,6 +46,10 @@ void run_geometry(GeometryOptions& options) {
     fmt::print("{:>4}  {:<24} {:>10} {:>10} {:>8} {:>8}  {:<30} {:>8.3f}\n", s.id, s.name,
                s.valid_points, s.normals, s.mixed_pixels, s.edge_pixels, noise, s.seconds);
   }
+  for (const modeling::GeometryCommandScan& s : result.scans) {
+    if (s.recorded_normals > 0)
+      fmt::print("scan {}: {} normals kept as its file recorded them\n", s.id, s.recorded_normals);
+  }
   fmt::print("geometry of {} scan(s) stored in {} ({:.2f} s)\n", result.scans.size(),
              options.project, result.seconds);
 }

@@ -54,6 +54,7 @@ nlohmann::json to_report(const GeometryCommandResult& result) {
     scans.push_back({{"id", s.id},
                      {"valid_points", s.valid_points},
                      {"normals", s.normals},
+                     {"recorded_normals", s.recorded_normals},
                      {"mixed_pixels", s.mixed_pixels},
                      {"edge_pixels", s.edge_pixels},
                      {"range_noise",

@@ -31,14 +31,15 @@ GeometryCommandResult geometry_project(store::Project& project,
   for (const store::StoredScanSummary& stored : scans) {
     progress.throw_if_cancelled(kStage);
     const acquisition::Scan scan = project.load_scan(stored.id);
-    const acquisition::GeometryResult geometry = acquisition::compute_geometry(scan, settings);
+    const acquisition::GeometryResult geometry = acquisition::compute_geometry(
+        scan, settings, store::load_recorded_geometry(project, stored.id));
     const std::vector<store::EncodedLayer> layers = store::encode_geometry(geometry.geometry);
     store::Project::Edit part = command.part();
     for (const store::EncodedLayer& layer : layers) project.put_layer(part, stored.id, layer);
     part.commit_part();
     result.scans.push_back({stored.id, scan.name, geometry.valid_points, geometry.normals,
-                            geometry.mixed_pixels, geometry.edge_pixels, geometry.noise.noise,
-                            geometry.noise.estimated, geometry.seconds});
+                            geometry.recorded_normals, geometry.mixed_pixels, geometry.edge_pixels,
+                            geometry.noise.noise, geometry.noise.estimated, geometry.seconds});
     progress.update({kStage, result.scans.size(), scans.size(), scan.name});
   }
   progress.throw_if_cancelled(kStage);

@@ -18,6 +18,7 @@ struct GeometryCommandScan {
   std::string name;
   std::size_t valid_points = 0;
   std::size_t normals = 0;
+  std::size_t recorded_normals = 0;  // of them, as the scan's file recorded them
   std::size_t mixed_pixels = 0;
   std::size_t edge_pixels = 0;
   // The σ(range) the depth-jump and mixed-pixel tests used: estimated from

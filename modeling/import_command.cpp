@@ -8,6 +8,7 @@
 #include "core/memory.hpp"
 #include "core/timing.hpp"
 #include "modeling/command_json.hpp"
+#include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
 namespace {
@@ -33,6 +34,14 @@ std::string settings_json(std::span<const std::filesystem::path> files,
       (twin ? "is already in the project as scan " + std::to_string(*twin)
             : std::string("appears twice in this import")) +
           "; importing it again would add a twin (--allow-duplicate imports it anyway)");
+}
+
+// The scan with what its file recorded of its geometry, ready to store.
+store::EncodedScan encode_imported(const acquisition::ImportedScan& imported) {
+  store::EncodedScan encoded = store::encode_scan(imported.scan);
+  for (store::EncodedLayer& layer : store::encode_recorded_geometry(imported.recorded))
+    encoded.layers.push_back(std::move(layer));
+  return encoded;
 }
 
 // Encoded scans the check may keep in memory [bytes]: a quarter of what is
@@ -105,7 +114,7 @@ void store_read_again(store::Project& project, store::Project::LongCommand& comm
                       ImportResult& result) {
   std::size_t next = 0;
   const auto on_scan = [&](acquisition::ImportedScan&& imported) {
-    const store::EncodedScan encoded = store::encode_scan(imported.scan);
+    const store::EncodedScan encoded = encode_imported(imported);
     if (next >= file.scans.size() || file.scans[next].digest != encoded.content_digest) {
       throw core::InputError(file.path.string(), {},
                              "the file changed while it was imported; nothing was stored");
@@ -148,7 +157,7 @@ CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
       scan.source = std::move(imported.source);
       acquisition::identify_source_files(file.path, scan.source);
       if (!file.kept) return;
-      scan.encoded = store::encode_scan(imported.scan);
+      scan.encoded = encode_imported(imported);
       scan.images = std::move(imported.images);
       keep_within(file, encoded_bytes(*scan.encoded) + image_bytes(scan.images), budget);
     };

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -161,26 +164,160 @@ std::string epsg_from_geokeys(const std::vector<unsigned char>& keys) {
   return geographic;
 }
 
-// The coordinate system the variable length records name: OGC WKT first,
-// then GeoTIFF keys.
-std::string coordinate_system(LasFile& file, const Header& h) {
+// One field of the extra bytes the Extra Bytes record describes, which
+// the reader keeps: where it lies in a record and how to read it.
+struct ExtraField {
+  std::size_t at = 0;  // byte offset in the record
+  int type = 0;        // 1–10: u8, i8, u16, i16, u32, i32, u64, i64, f32, f64
+  double scale = 1.0, offset = 0.0;
+  std::optional<double> no_data;
+};
+
+// Bytes of an extra bytes data type (LAS 1.4 table 24): 0 is `options`
+// undocumented bytes, 1–10 scalars, 11–30 deprecated arrays of two and
+// three; 0 for a type the table does not have.
+std::size_t extra_type_size(int type, int options) {
+  static constexpr std::array<std::size_t, 11> kScalar = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+  if (type == 0) return static_cast<std::size_t>(options);
+  if (type <= 10) return kScalar[static_cast<std::size_t>(type)];
+  if (type <= 20) return 2 * kScalar[static_cast<std::size_t>(type - 10)];
+  if (type <= 30) return 3 * kScalar[static_cast<std::size_t>(type - 20)];
+  return 0;
+}
+
+double extra_value(const unsigned char* p, int type) {
+  const auto load = [p](auto value) {
+    std::memcpy(&value, p, sizeof value);
+    return static_cast<double>(value);
+  };
+  switch (type) {
+    case 1:
+      return load(std::uint8_t{});
+    case 2:
+      return load(std::int8_t{});
+    case 3:
+      return load(std::uint16_t{});
+    case 4:
+      return load(std::int16_t{});
+    case 5:
+      return load(std::uint32_t{});
+    case 6:
+      return load(std::int32_t{});
+    case 7:
+      return load(std::uint64_t{});
+    case 8:
+      return load(std::int64_t{});
+    case 9:
+      return load(float{});
+    default:
+      return load(double{});
+  }
+}
+
+// The recorded geometry among the extra bytes: normal x, y, z and
+// footprint, by the names our export and other tools give them.
+struct ExtraGeometry {
+  std::array<std::optional<ExtraField>, 3> normal;
+  std::optional<ExtraField> footprint;
+};
+
+std::string squeezed_lower(const std::string& name) {
+  std::string out;
+  for (const char c : name) {
+    if (c != '_' && c != ' ') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return out;
+}
+
+// Reads the Extra Bytes record (`data`, at file offset `offset`): the
+// fields of the recorded geometry, laid out after the `base` bytes of the
+// point format in records of `record_length` bytes.
+ExtraGeometry extra_geometry(LasFile& file, std::uint64_t offset,
+                             const std::vector<unsigned char>& data, std::size_t base,
+                             std::size_t record_length) {
+  constexpr std::size_t kDescriptor = 192;
+  if (data.size() % kDescriptor != 0) {
+    file.fail(offset, "an extra bytes record of " + std::to_string(data.size()) +
+                          " bytes, not a whole number of 192-byte descriptors");
+  }
+  ExtraGeometry out;
+  std::size_t next = base;
+  for (std::size_t d = 0; d < data.size(); d += kDescriptor) {
+    const int type = data[d + 2], options = data[d + 3];
+    const std::string name = text(data, d + 4, 32);
+    const std::size_t size = extra_type_size(type, options);
+    if (size == 0) {
+      file.fail(offset + d + 2,
+                "extra bytes field \"" + name + "\" has unknown data type " + std::to_string(type));
+    }
+    if (next + size > record_length) {
+      file.fail(offset + d, "extra bytes field \"" + name + "\" ends at byte " +
+                                std::to_string(next + size) + " of " +
+                                std::to_string(record_length) + "-byte records");
+    }
+    ExtraField field;
+    field.at = next;
+    field.type = type;
+    // no_data is an "anytype": a scalar widened to 64 bits (u64, i64, f64).
+    const int wide_type = type >= 9 ? 10 : type % 2 == 1 ? 7 : 8;
+    if ((options & 0x01) && type >= 1 && type <= 10)
+      field.no_data = extra_value(data.data() + d + 40, wide_type);
+    if (options & 0x08) field.scale = at<double>(data, d + 112);
+    if (options & 0x10) field.offset = at<double>(data, d + 136);
+    next += size;
+    if (type < 1 || type > 10) continue;  // not a scalar: not geometry
+    const std::string key = squeezed_lower(name);
+    for (int axis = 0; axis < 3; ++axis) {
+      const char letter = static_cast<char>('x' + axis);
+      if (key == std::string("normal") + letter || key == std::string("n") + letter)
+        out.normal[static_cast<std::size_t>(axis)] = field;
+    }
+    if (key == "footprint" || key == "radius") out.footprint = field;
+  }
+  const auto found = std::count_if(out.normal.begin(), out.normal.end(),
+                                   [](const auto& f) { return f.has_value(); });
+  if (found != 3) out.normal = {};  // a part of a normal is no normal
+  return out;
+}
+
+// What the variable length records say: the coordinate system (OGC WKT
+// first, then GeoTIFF keys) and the recorded geometry in the extra bytes.
+struct Records {
+  std::string coordinate_system;
+  ExtraGeometry extra;
+};
+
+Records read_records(LasFile& file, const Header& h) {
   std::string wkt, geotiff;
+  Records out;
   std::uint64_t offset = h.header_size;
   for (std::uint32_t k = 0; k < h.vlr_count; ++k) {
-    const std::vector<unsigned char> vlr =
-        file.read(offset, kVlrHeaderSize, "variable length record " + std::to_string(k));
+    const std::string what = "variable length record " + std::to_string(k);
+    const std::vector<unsigned char> vlr = file.read(offset, kVlrHeaderSize, what);
     const std::string user = text(vlr, 2, 16);
     const auto record = at<std::uint16_t>(vlr, 18);
     const auto length = at<std::uint16_t>(vlr, 20);
+    const std::uint64_t data_at = offset + kVlrHeaderSize;
     if (user == "LASF_Projection" && (record == 2112 || record == 34735)) {
-      const std::vector<unsigned char> data =
-          file.read(offset + kVlrHeaderSize, length, "variable length record " + std::to_string(k));
+      const std::vector<unsigned char> data = file.read(data_at, length, what);
       if (record == 2112) wkt = text(data, 0, data.size());
       if (record == 34735) geotiff = epsg_from_geokeys(data);
     }
+    if (user == "LASF_Spec" && record == 4) {
+      out.extra = extra_geometry(file, data_at, file.read(data_at, length, what),
+                                 kRecordSize[static_cast<std::size_t>(h.format)], h.record_length);
+    }
     offset += kVlrHeaderSize + length;
   }
-  return wkt.empty() ? geotiff : wkt;
+  out.coordinate_system = wkt.empty() ? geotiff : wkt;
+  return out;
+}
+
+// The value of `field` in the record at `r`; NaN for its no-data value.
+float extra_at(const std::vector<unsigned char>& block, std::size_t r, const ExtraField& field) {
+  const double raw = extra_value(block.data() + r + field.at, field.type);
+  if (field.no_data && raw == *field.no_data) return std::numeric_limits<float>::quiet_NaN();
+  return static_cast<float>(raw * field.scale + field.offset);
 }
 
 }  // namespace
@@ -197,10 +334,8 @@ ImportedScan read_las(const std::filesystem::path& path) {
   }
   // Each point in double, 16-bit colour, and the scan's layers.
   core::check_memory(h.points * 64, path.string());
-  ImportedScan out;
-  out.source.format = "las";
-  out.source.points_in_file = h.points;
-  out.source.coordinate_metadata = coordinate_system(file, h);
+  const Records records = read_records(file, h);
+  const ExtraGeometry& extra = records.extra;
   const std::size_t colour_at = kColourAt[static_cast<std::size_t>(h.format)];
   const std::size_t pixels = scattered_pixel_count(h.points);  // the scan pads to its last row
   PointCloud cloud;
@@ -209,6 +344,14 @@ ImportedScan read_las(const std::filesystem::path& path) {
   std::vector<Eigen::Vector3d>& points = cloud.points;
   core::reserve_mapped(cloud.intensity, pixels);
   cloud.intensity.resize(h.points);
+  if (extra.normal[0]) {
+    core::reserve_mapped(cloud.normal, pixels);
+    cloud.normal.resize(h.points);
+  }
+  if (extra.footprint) {
+    core::reserve_mapped(cloud.footprint_m, pixels);
+    cloud.footprint_m.resize(h.points);
+  }
   std::vector<std::uint16_t> colour;
   if (colour_at > 0) core::assign_mapped(colour, 3 * h.points, std::uint16_t{0});
   std::vector<unsigned char> block;
@@ -233,6 +376,11 @@ ImportedScan read_las(const std::filesystem::path& path) {
       for (std::size_t c = 0; c < (colour_at > 0 ? 3u : 0u); ++c) {
         colour[3 * i + c] = at<std::uint16_t>(block, r + colour_at + 2 * c);
       }
+      if (extra.normal[0]) {
+        for (int axis = 0; axis < 3; ++axis)
+          cloud.normal[i][axis] = extra_at(block, r, *extra.normal[static_cast<std::size_t>(axis)]);
+      }
+      if (extra.footprint) cloud.footprint_m[i] = extra_at(block, r, *extra.footprint);
     }
   }
   const bool wide_colour =
@@ -242,7 +390,10 @@ ImportedScan read_las(const std::filesystem::path& path) {
   for (std::size_t k = 0; k < colour.size(); ++k) {
     cloud.rgb[k] = static_cast<std::uint8_t>(wide_colour ? (colour[k] + 128) / 257 : colour[k]);
   }
-  out.scan = scattered_scan(std::move(cloud), path);
+  ImportedScan out = scattered_scan(std::move(cloud), path);
+  out.source.format = "las";
+  out.source.points_in_file = h.points;
+  out.source.coordinate_metadata = records.coordinate_system;
   return out;
 }
 

@@ -173,6 +173,8 @@ struct Channels {
   int xyz[3] = {-1, -1, -1};
   int rgb[3] = {-1, -1, -1};
   int intensity = -1;
+  int normal[3] = {-1, -1, -1};
+  int footprint = -1;
 };
 
 Channels find_channels(TextLineReader& reader, const Element& vertex) {
@@ -190,12 +192,24 @@ Channels find_channels(TextLineReader& reader, const Element& vertex) {
       }
     }
     if (name == "intensity" || name == "scalar_intensity") c.intensity = index;
+    for (int axis = 0; axis < 3; ++axis) {
+      const char letter = static_cast<char>('x' + axis);
+      if (name == std::string("n") + letter || name == std::string("normal_") + letter) {
+        c.normal[axis] = index;
+      }
+    }
+    if (name == "radius" || name == "footprint") c.footprint = index;
   }
   for (const int axis : c.xyz) {
     if (axis < 0) reader.fail("the vertex element has no x, y and z properties");
-    if (vertex.properties[static_cast<std::size_t>(axis)].list) {
-      reader.fail("the vertex coordinates are lists");
-    }
+  }
+  for (const int k : {c.xyz[0], c.xyz[1], c.xyz[2], c.rgb[0], c.rgb[1], c.rgb[2], c.intensity,
+                      c.normal[0], c.normal[1], c.normal[2], c.footprint}) {
+    const Property* p = k >= 0 ? &vertex.properties[static_cast<std::size_t>(k)] : nullptr;
+    if (p != nullptr && p->list) reader.fail("the vertex property \"" + p->name + "\" is a list");
+  }
+  if (std::count(c.normal, c.normal + 3, -1) % 3 != 0) {
+    reader.fail("the vertex element has some but not all of nx, ny and nz");
   }
   if (std::count(c.rgb, c.rgb + 3, -1) % 3 != 0) {
     reader.fail("the vertex element has some but not all of red, green and blue");
@@ -241,24 +255,29 @@ inline std::uint8_t colour_byte(double value, Type type) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(unit, 0.0, 1.0) * 255.0));
 }
 
-// Adds one vertex from its property values (values[k] of property k);
-// false for a coordinate beyond kMaxCoordinateM.
-bool add_vertex(const Element& vertex, const Channels& c, const double* values, PointCloud& cloud) {
-  const Eigen::Vector3d p(values[c.xyz[0]], values[c.xyz[1]], values[c.xyz[2]]);
+// Adds one vertex; value(k) is the value of its property k. False for a
+// coordinate beyond kMaxCoordinateM.
+template <typename Value>
+bool add_vertex(const Element& vertex, const Channels& c, const Value& value, PointCloud& cloud) {
+  const Eigen::Vector3d p(value(c.xyz[0]), value(c.xyz[1]), value(c.xyz[2]));
   if (!p.allFinite()) return true;  // no return
   if (!(p.cwiseAbs().maxCoeff() <= kMaxCoordinateM)) return false;
   cloud.points.push_back(p);
-  if (c.intensity >= 0) {
-    constexpr double kLargest = std::numeric_limits<float>::max();
-    cloud.intensity.push_back(
-        static_cast<float>(std::clamp(values[c.intensity], -kLargest, kLargest)));
-  }
+  constexpr double kLargest = std::numeric_limits<float>::max();
+  const auto as_float = [&](int k) {
+    return static_cast<float>(std::clamp(value(k), -kLargest, kLargest));
+  };
+  if (c.intensity >= 0) cloud.intensity.push_back(as_float(c.intensity));
   if (c.rgb[0] >= 0) {
     for (const int k : c.rgb) {
       cloud.rgb.push_back(
-          colour_byte(values[k], vertex.properties[static_cast<std::size_t>(k)].type));
+          colour_byte(value(k), vertex.properties[static_cast<std::size_t>(k)].type));
     }
   }
+  if (c.normal[0] >= 0) {
+    cloud.normal.emplace_back(as_float(c.normal[0]), as_float(c.normal[1]), as_float(c.normal[2]));
+  }
+  if (c.footprint >= 0) cloud.footprint_m.push_back(as_float(c.footprint));
   return true;
 }
 
@@ -293,7 +312,8 @@ void read_ascii(TextLineReader& reader, const Header& h, const Channels& c, Poin
           at += static_cast<int>(values[p]);
         }
       }
-      if (!add_vertex(element, c, values.data(), cloud)) {
+      const auto value = [&values](int q) { return values[static_cast<std::size_t>(q)]; };
+      if (!add_vertex(element, c, value, cloud)) {
         reader.fail("vertex " + std::to_string(k) + kTooFar);
       }
     }
@@ -348,63 +368,36 @@ struct Field {
   Type type = Type::kF32;
 };
 
-// The vertices of fixed-size records, `count` of them from vertex `first`,
-// decoded straight into the cloud: the common case (every exporter writes
-// one), without the per-property buffer that records with lists need.
-class FixedVertices {
- public:
-  FixedVertices(const Element& vertex, const Channels& c, bool swap) : swap_(swap) {
-    std::vector<std::size_t> offsets;
-    std::size_t offset = 0;
-    for (const Property& p : vertex.properties) {
-      offsets.push_back(offset);
-      offset += size_of(p.type);
-    }
-    const auto field = [&](int k) {
-      return Field{offsets[static_cast<std::size_t>(k)],
-                   vertex.properties[static_cast<std::size_t>(k)].type};
+// The fields of a fixed-size record, property by property.
+std::vector<Field> record_fields(const Element& element) {
+  std::vector<Field> fields;
+  std::size_t offset = 0;
+  for (const Property& p : element.properties) {
+    fields.push_back({offset, p.type});
+    offset += size_of(p.type);
+  }
+  return fields;
+}
+
+// Appends `count` fixed-size vertex records of `block`, the first being
+// vertex `first`: the common case (every exporter writes one), without the
+// per-property buffer that records with lists need. Returns the index of
+// the first vertex beyond kMaxCoordinateM, if any, which is not appended.
+std::optional<std::uint64_t> add_fixed_vertices(const Element& vertex, const Channels& c,
+                                                const std::vector<Field>& fields, bool swap,
+                                                const unsigned char* block, std::size_t record,
+                                                std::uint64_t count, std::uint64_t first,
+                                                PointCloud& cloud) {
+  for (std::uint64_t k = 0; k < count; ++k) {
+    const unsigned char* r = block + k * record;
+    const auto value = [&](int q) {
+      const Field& f = fields[static_cast<std::size_t>(q)];
+      return value_at(r + f.offset, f.type, swap);
     };
-    for (int axis = 0; axis < 3; ++axis) xyz_[axis] = field(c.xyz[axis]);
-    if (c.intensity >= 0) intensity_ = field(c.intensity);
-    if (c.rgb[0] >= 0) {
-      rgb_.emplace();
-      for (int k = 0; k < 3; ++k) (*rgb_)[static_cast<std::size_t>(k)] = field(c.rgb[k]);
-    }
+    if (!add_vertex(vertex, c, value, cloud)) return first + k;
   }
-
-  // Appends the block's vertices; the index of the first one beyond
-  // kMaxCoordinateM, if any, is returned instead of being appended.
-  std::optional<std::uint64_t> add(const unsigned char* block, std::size_t record,
-                                   std::uint64_t count, std::uint64_t first,
-                                   PointCloud& cloud) const {
-    for (std::uint64_t k = 0; k < count; ++k) {
-      const unsigned char* r = block + k * record;
-      const Eigen::Vector3d p(value(r, xyz_[0]), value(r, xyz_[1]), value(r, xyz_[2]));
-      if (!p.allFinite()) continue;  // no return
-      if (!(p.cwiseAbs().maxCoeff() <= kMaxCoordinateM)) return first + k;
-      cloud.points.push_back(p);
-      if (intensity_) {
-        constexpr double kLargest = std::numeric_limits<float>::max();
-        cloud.intensity.push_back(
-            static_cast<float>(std::clamp(value(r, *intensity_), -kLargest, kLargest)));
-      }
-      if (rgb_) {
-        for (const Field& f : *rgb_) cloud.rgb.push_back(colour_byte(value(r, f), f.type));
-      }
-    }
-    return std::nullopt;
-  }
-
- private:
-  double value(const unsigned char* record, const Field& f) const {
-    return value_at(record + f.offset, f.type, swap_);
-  }
-
-  bool swap_;
-  Field xyz_[3];
-  std::optional<Field> intensity_;
-  std::optional<std::array<Field, 3>> rgb_;
-};
+  return std::nullopt;
+}
 
 void read_binary(const std::filesystem::path& path, std::uint64_t file_size, const Header& h,
                  const Channels& c, PointCloud& cloud) {
@@ -416,6 +409,7 @@ void read_binary(const std::filesystem::path& path, std::uint64_t file_size, con
     if (element.properties.empty()) continue;  // records of no bytes
     values.assign(element.properties.size(), 0.0);
     const std::size_t fixed = fixed_record_size(element);
+    const std::vector<Field> fields = record_fields(element);
     // Fixed-size records in blocks; records with lists one property at a time.
     constexpr std::uint64_t kBlock = 1 << 16;
     for (std::uint64_t first = 0; first < element.count;) {
@@ -425,7 +419,7 @@ void read_binary(const std::filesystem::path& path, std::uint64_t file_size, con
         const unsigned char* block = body.take(fixed * count, what);
         if (is_vertex) {
           if (const auto far =
-                  FixedVertices(element, c, swap).add(block, fixed, count, first, cloud))
+                  add_fixed_vertices(element, c, fields, swap, block, fixed, count, first, cloud))
             body.fail("vertex " + std::to_string(*far) + kTooFar);
         }
         first += count;
@@ -442,7 +436,8 @@ void read_binary(const std::filesystem::path& path, std::uint64_t file_size, con
         body.take(static_cast<std::size_t>(items) * size_of(p.type), what);
         values[q] = items;
       }
-      if (is_vertex && !add_vertex(element, c, values.data(), cloud)) {
+      const auto value = [&values](int q) { return values[static_cast<std::size_t>(q)]; };
+      if (is_vertex && !add_vertex(element, c, value, cloud)) {
         body.fail("vertex " + std::to_string(first) + kTooFar);
       }
       ++first;
@@ -479,15 +474,16 @@ ImportedScan read_ply(const std::filesystem::path& path) {
   core::reserve_mapped(cloud.points, pixels);
   if (channels.intensity >= 0) core::reserve_mapped(cloud.intensity, pixels);
   if (channels.rgb[0] >= 0) core::reserve_mapped(cloud.rgb, 3 * pixels);
+  if (channels.normal[0] >= 0) core::reserve_mapped(cloud.normal, pixels);
+  if (channels.footprint >= 0) core::reserve_mapped(cloud.footprint_m, pixels);
   if (header.body == Body::kAscii) {
     read_ascii(reader, header, channels, cloud);
   } else {
     read_binary(path, reader.file_size(), header, channels, cloud);
   }
-  ImportedScan out;
+  ImportedScan out = scattered_scan(std::move(cloud), path);
   out.source.format = "ply";
   out.source.points_in_file = vertex->count;
-  out.scan = scattered_scan(std::move(cloud), path);
   return out;
 }
 

@@ -6,10 +6,10 @@
 // both its names (char/int8 … double/float64). Read from the vertex element:
 // x, y, z; red, green, blue (8-bit as they are, 16-bit scaled to 8, float
 // [0, 1] scaled to 255; diffuse_red … accepted); intensity (also
-// scalar_intensity, any case) as the file gives it. Other properties
-// (normals, our footprints, alpha) and other elements (faces) are skipped:
-// geometry is computed from the points. List properties before and in the
-// vertex element are skipped by their counts.
+// scalar_intensity, any case) as the file gives it; normals nx, ny, nz (or
+// normal_x …) and the footprint radius (or footprint) as ImportedScan::
+// recorded. Other properties (alpha, ours) and other elements (faces) are
+// skipped, list properties before and in the vertex element by their counts.
 #pragma once
 
 #include <filesystem>
@@ -21,7 +21,8 @@ namespace scanbench::acquisition {
 // Reads `path` into one scan (format "ply", points_in_file the vertex
 // count). Throws core::InputError naming the file, the line or byte
 // offset, and the problem for a missing signature, an unknown format or
-// type, a vertex element without x, y and z, a truncated body, or a value
+// type, a vertex element without x, y and z, a channel stored as a list,
+// some but not all of a normal's components, a truncated body, or a value
 // that is not a number (ASCII).
 ImportedScan read_ply(const std::filesystem::path& path);
 

@@ -559,8 +559,10 @@ GeometryResult compute_grid_geometry(const Scan& scan, const GeometrySettings& s
 
 }  // namespace
 
-GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings) {
-  assert(check_consistency(scan).empty() && settings.edge_window_radius >= 1 &&
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings,
+                                const RecordedGeometry& recorded) {
+  assert(check_consistency(scan).empty() && (recorded.empty() || scan.is_scattered()) &&
+         settings.edge_window_radius >= 1 &&
          settings.window_radius >= settings.edge_window_radius &&
          settings.window_radius <= kMaxWindowRadius);
   const auto start = std::chrono::steady_clock::now();
@@ -571,7 +573,7 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
     noise = estimate_range_noise(scan, settings.range_noise, settings.threads);
     used.range_noise = noise.noise;
   }
-  GeometryResult result = scan.is_scattered() ? compute_scattered_geometry(scan, used)
+  GeometryResult result = scan.is_scattered() ? compute_scattered_geometry(scan, used, recorded)
                                               : compute_grid_geometry(scan, used);
   result.geometry.range_noise = noise.noise;
   result.noise = std::move(noise);

@@ -28,7 +28,8 @@ struct ScanGeometry {
   // Radius [m] of the disk that closes the gap to the neighbouring samples;
   // 0 where the pixel is invalid.
   std::vector<float> footprint_m;
-  // Unit normal in the scan frame pointing towards the scanner; the zero
+  // Unit normal in the scan frame pointing towards the scanner (those a
+  // scattered scan's file recorded face as the file has them); the zero
   // vector where the normal is invalid (invalid pixel or kFlagNoNormal).
   std::vector<Eigen::Vector3f> normal;
   // [0, 1]: the share of the window the fit used times the cosine of the
@@ -105,7 +106,8 @@ struct GeometryResult {
   ScanGeometry geometry;
   NoiseEstimate noise;  // the σ(range) used: estimated, or the settings'.
   std::size_t valid_points = 0;
-  std::size_t normals = 0;  // valid points given a normal
+  std::size_t normals = 0;           // valid points given a normal
+  std::size_t recorded_normals = 0;  // of them, normals the file recorded
   std::size_t mixed_pixels = 0;
   std::size_t edge_pixels = 0;
   double seconds = 0.0;
@@ -114,7 +116,10 @@ struct GeometryResult {
 // Computes footprints, normals, confidences and flags for every pixel. Works
 // on spherical and per-pixel-direction scans (for the latter the fit runs on
 // the points themselves), and on scattered scans from each point's nearest
-// neighbours (scattered_geometry.hpp). Asserts the scan is consistent.
-GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings = {});
+// neighbours (scattered_geometry.hpp), keeping what its file `recorded`.
+// Asserts the scan is consistent, and `recorded` empty for a grid (or one
+// value per pixel).
+GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings = {},
+                                const RecordedGeometry& recorded = {});
 
 }  // namespace scanbench::acquisition

@@ -69,8 +69,12 @@ Fit fit_plane(const std::vector<Eigen::Vector3f>& points, const std::uint32_t* f
 
 }  // namespace
 
-GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings) {
+GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings,
+                                          const RecordedGeometry& recorded) {
   assert(scan.is_scattered() && "a scattered scan");
+  assert((recorded.normal.empty() || recorded.normal.size() == scan.pixel_count()) &&
+         (recorded.footprint_m.empty() || recorded.footprint_m.size() == scan.pixel_count()) &&
+         "recorded geometry of one value per pixel");
   const auto start = std::chrono::steady_clock::now();
   const std::size_t n = count_valid(scan);  // the points fill pixels 0 … n − 1
   std::vector<Eigen::Vector3f> points(n);
@@ -149,8 +153,23 @@ GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettin
     g.confidence[i] = std::max(1e-6f, share * fit.normal.dot(towards_viewpoint));
     ++normals;
   });
+  std::atomic<std::size_t> kept{0};
+  if (!recorded.empty()) {
+    for_each_point([&](std::size_t i) {
+      if (!recorded.footprint_m.empty() && recorded.footprint_m[i] > 0.0f)
+        g.footprint_m[i] = recorded.footprint_m[i];
+      if (recorded.normal.empty() || recorded.normal[i].isZero()) return;
+      if (!g.has_normal(i)) ++normals;
+      ++kept;
+      g.normal[i] = recorded.normal[i];
+      g.flags[i] = static_cast<std::uint8_t>(g.flags[i] & ~kFlagNoNormal);
+      const float cosine = std::abs(g.normal[i].dot(points[i].normalized()));
+      g.confidence[i] = std::max(1e-6f, std::isfinite(cosine) ? cosine : 0.0f);
+    });
+  }
   result.valid_points = n;
   result.normals = normals;
+  result.recorded_normals = kept;
   result.seconds = core::seconds_since(start);
   return result;
 }

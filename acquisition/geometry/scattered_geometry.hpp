@@ -26,8 +26,15 @@ namespace scanbench::acquisition {
 // that bridges the gap. Confidence is the share of neighbours the fit kept
 // times the cosine of the incidence angle.
 // Mixed pixels and depth edges are properties of a beam's neighbours in a
-// grid: none is flagged. Asserts scan.is_scattered().
-GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings);
+// grid: none is flagged.
+// Where the file `recorded` a normal, the point has it, facing as the file
+// has it (a cloud's viewpoint is a guess; the file's side is the one its
+// maker meant, outward on a scanned object), with the confidence of the
+// cosine of its incidence, in either direction; where it recorded a
+// footprint, the point has that one.
+// Asserts scan.is_scattered() and each of `recorded` empty or one per pixel.
+GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings,
+                                          const RecordedGeometry& recorded = {});
 
 // The surface [m²] a point of a scattered scan stands for: the square of
 // the sampling step its footprint was made from.

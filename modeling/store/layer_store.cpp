@@ -49,19 +49,22 @@ struct KnownLayer {
   const char* name;
   ElementType type;
 };
-constexpr std::array<KnownLayer, 13> kKnownLayers = {{{layer::kRange, ElementType::kF32},
-                                                      {layer::kValid, ElementType::kU8},
-                                                      {layer::kIntensity, ElementType::kF32},
-                                                      {layer::kRgb, ElementType::kU8x3},
-                                                      {layer::kDirections, ElementType::kF32x3},
-                                                      {layer::kFootprint, ElementType::kF32},
-                                                      {layer::kNormal, ElementType::kF32x3},
-                                                      {layer::kConfidence, ElementType::kF32},
-                                                      {layer::kGeometryFlags, ElementType::kU8},
-                                                      {layer::kKeep, ElementType::kU8},
-                                                      {layer::kSelection, ElementType::kU8},
-                                                      {layer::kMembership, ElementType::kU32},
-                                                      {layer::kCarried, ElementType::kU8}}};
+constexpr std::array<KnownLayer, 15> kKnownLayers = {
+    {{layer::kRange, ElementType::kF32},
+     {layer::kValid, ElementType::kU8},
+     {layer::kIntensity, ElementType::kF32},
+     {layer::kRgb, ElementType::kU8x3},
+     {layer::kDirections, ElementType::kF32x3},
+     {layer::kRecordedNormal, ElementType::kF32x3},
+     {layer::kRecordedFootprint, ElementType::kF32},
+     {layer::kFootprint, ElementType::kF32},
+     {layer::kNormal, ElementType::kF32x3},
+     {layer::kConfidence, ElementType::kF32},
+     {layer::kGeometryFlags, ElementType::kU8},
+     {layer::kKeep, ElementType::kU8},
+     {layer::kSelection, ElementType::kU8},
+     {layer::kMembership, ElementType::kU32},
+     {layer::kCarried, ElementType::kU8}}};
 
 [[maybe_unused]] bool has_its_type(const EncodedLayer& layer) {
   for (const KnownLayer& known : kKnownLayers) {

@@ -11,6 +11,9 @@
 //   intensity       f32    only when the scan has intensity
 //   rgb             u8x3   only when the scan has colour
 //   directions      f32x3  unit directions, per-pixel angle models only
+//   recorded_normal f32x3  the normals a scattered scan's file recorded
+//                          (acquisition::RecordedGeometry), scan frame
+//   recorded_footprint_m f32  the footprints it recorded [m]
 //   footprint_m     f32    `scanbench geometry`: footprint radius [m]
 //   normal          f32x3  `scanbench geometry`: unit normal, scan frame
 //   confidence      f32    `scanbench geometry`
@@ -53,6 +56,8 @@ inline constexpr const char* kValid = "valid";
 inline constexpr const char* kIntensity = "intensity";
 inline constexpr const char* kRgb = "rgb";
 inline constexpr const char* kDirections = "directions";
+inline constexpr const char* kRecordedNormal = "recorded_normal";
+inline constexpr const char* kRecordedFootprint = "recorded_footprint_m";
 inline constexpr const char* kFootprint = "footprint_m";
 inline constexpr const char* kNormal = "normal";
 inline constexpr const char* kConfidence = "confidence";

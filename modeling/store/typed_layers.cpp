@@ -88,6 +88,32 @@ std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, s
   return g;
 }
 
+std::vector<EncodedLayer> encode_recorded_geometry(const acquisition::RecordedGeometry& recorded) {
+  std::vector<EncodedLayer> layers;
+  if (!recorded.normal.empty()) {
+    layers.push_back(encode_layer<Eigen::Vector3f>(layer::kRecordedNormal, ElementType::kF32x3,
+                                                   recorded.normal));
+  }
+  if (!recorded.footprint_m.empty()) {
+    layers.push_back(
+        encode_layer<float>(layer::kRecordedFootprint, ElementType::kF32, recorded.footprint_m));
+  }
+  return layers;
+}
+
+acquisition::RecordedGeometry load_recorded_geometry(const Project& project, std::int64_t id) {
+  acquisition::RecordedGeometry recorded;
+  if (auto normal =
+          project.load_layer<Eigen::Vector3f>(id, layer::kRecordedNormal, ElementType::kF32x3)) {
+    recorded.normal = std::move(*normal);
+  }
+  if (auto footprint =
+          project.load_layer<float>(id, layer::kRecordedFootprint, ElementType::kF32)) {
+    recorded.footprint_m = std::move(*footprint);
+  }
+  return recorded;
+}
+
 std::optional<std::vector<std::uint8_t>> load_keep_mask(const Project& project, std::int64_t id) {
   return project.load_layer<std::uint8_t>(id, layer::kKeep, ElementType::kU8);
 }

@@ -21,6 +21,15 @@ std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& geome
 // scan when only some of the four layers are there or one is damaged.
 std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, std::int64_t id);
 
+// The layers of what a scattered scan's file recorded (none for what it
+// did not), stored with the scan on import.
+std::vector<EncodedLayer> encode_recorded_geometry(const acquisition::RecordedGeometry& recorded);
+
+// What the file of scan `id` recorded: empty vectors where it recorded
+// nothing (every grid scan). Throws core::InputError naming the scan when a
+// layer is damaged.
+acquisition::RecordedGeometry load_recorded_geometry(const Project& project, std::int64_t id);
+
 // The merge's keep mask of scan `id` (one byte per pixel, 1 = in the merged
 // model), or none when `scanbench merge` has not run since the scan's pose
 // or geometry last changed.

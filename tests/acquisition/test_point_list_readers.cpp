@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -15,6 +16,7 @@
 #include "acquisition/formats/ply_reader.hpp"
 #include "acquisition/formats/point_export.hpp"
 #include "acquisition/formats/scan_files.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/local_origin.hpp"
 #include "core/errors.hpp"
 #include "support/test_support.hpp"
@@ -144,6 +146,82 @@ TEST(PlyReader, BigEndianWithAListBeforeTheVerticesAndSixteenBitColour) {
   EXPECT_EQ(read.scan.rgb[2], 128);
 }
 
+// The normals and footprints `read` recorded are those `geometry` of
+// `written` exported: in the world frame, within float rounding.
+void expect_recorded_geometry(const ImportedScan& read, const Scan& written,
+                              const ScanGeometry& geometry) {
+  const std::size_t n = count_valid(written);
+  ASSERT_EQ(read.recorded.normal.size(), read.scan.pixel_count());
+  ASSERT_EQ(read.recorded.footprint_m.size(), read.scan.pixel_count());
+  const Eigen::Matrix3f to_world_read = read.scan.T_world_scan.linear().cast<float>();
+  const Eigen::Matrix3f to_world_written = written.T_world_scan.linear().cast<float>();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3f expected = to_world_written * geometry.normal[k];
+    EXPECT_LT((to_world_read * read.recorded.normal[k] - expected).norm(), 1e-6f) << k;
+    EXPECT_EQ(read.recorded.footprint_m[k], geometry.footprint_m[k]) << k;
+  }
+}
+
+// The geometry of `read` keeps what its file recorded, even a normal facing
+// away from the viewpoint, and finds one where the file has none.
+void expect_recorded_geometry_kept(ImportedScan read) {
+  const std::size_t n = count_valid(read.scan);
+  read.recorded.normal[0] = -read.recorded.normal[0];
+  const Eigen::Vector3f exported = read.recorded.normal[1];
+  read.recorded.normal[1].setZero();
+  read.recorded.footprint_m[2] = 0.0f;
+  const GeometryResult result = compute_geometry(read.scan, {}, read.recorded);
+  EXPECT_EQ(result.normals, n);
+  EXPECT_EQ(result.recorded_normals, n - 1);
+  const ScanGeometry& g = result.geometry;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k == 1) continue;
+    EXPECT_EQ(g.normal[k], read.recorded.normal[k]) << k;
+    EXPECT_GT(g.confidence[k], 0.0f) << k;
+    EXPECT_EQ(g.flags[k] & kFlagNoNormal, 0) << k;
+    if (k != 2) {
+      EXPECT_EQ(g.footprint_m[k], read.recorded.footprint_m[k]) << k;
+    }
+  }
+  EXPECT_TRUE(g.has_normal(1));  // fitted to its neighbours instead
+  EXPECT_GT(std::abs(g.normal[1].dot(exported)), 0.99f);
+  EXPECT_GT(g.footprint_m[2], 0.0f);
+}
+
+TEST(PlyReader, OurExportsNormalsAndFootprintsAreKept) {
+  const ScratchDir dir;
+  const Scan sphere = sphere_scan();
+  const ScanGeometry geometry = compute_geometry(sphere).geometry;
+  const std::vector<const ScanGeometry*> geometry_of = {&geometry};
+  write_ply(dir / "sphere.ply", std::span(&sphere, 1), geometry_of);
+  const ImportedScan read = read_ply(dir / "sphere.ply");
+  expect_same_cloud(read.scan, sphere, false);
+  expect_recorded_geometry(read, sphere, geometry);
+  expect_recorded_geometry_kept(read);
+}
+
+TEST(PlyReader, NormalsOfAnyLengthAndFootprintsOfCloudCompareNames) {
+  const ScratchDir dir;
+  write_bytes(dir / "n.ply",
+              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+              "property float z\nproperty float Nx\nproperty float Ny\nproperty float Nz\n"
+              "property float footprint\nend_header\n"
+              "1 0 0 0 0 2 0.01\n0 1 0 0 0 0 0\n0 0 1 3 -4 0 -1\n");
+  const ImportedScan read = read_ply(dir / "n.ply");
+  ASSERT_EQ(read.recorded.normal.size(), read.scan.pixel_count());
+  const Eigen::Matrix3f to_world = read.scan.T_world_scan.linear().cast<float>();
+  EXPECT_LT((to_world * read.recorded.normal[0] - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6f);
+  EXPECT_TRUE(read.recorded.normal[1].isZero()) << "0 0 0 is no normal";
+  EXPECT_LT((to_world * read.recorded.normal[2] - Eigen::Vector3f(0.6f, -0.8f, 0)).norm(), 1e-6f);
+  EXPECT_FLOAT_EQ(read.recorded.footprint_m[0], 0.01f);
+  EXPECT_EQ(read.recorded.footprint_m[1], 0.0f) << "0 is no footprint";
+  EXPECT_EQ(read.recorded.footprint_m[2], 0.0f) << "nor is a negative one";
+  write_bytes(dir / "plain.ply",
+              "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+              "property float z\nend_header\n1 2 3\n");
+  EXPECT_TRUE(read_ply(dir / "plain.ply").recorded.empty());
+}
+
 TEST(PlyReader, BadFilesAreRefusedWithTheirPlace) {
   const ScratchDir dir;
   const auto refused = [&](const std::string& bytes, const std::string& problem) {
@@ -153,6 +231,15 @@ TEST(PlyReader, BadFilesAreRefusedWithTheirPlace) {
         << bytes;
   };
   refused("plx\n", "not a PLY file");
+  refused(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nproperty list uchar uchar red\nproperty uchar green\n"
+      "property uchar blue\nend_header\n1 2 3 1 9 4 5\n",
+      "the vertex property \"red\" is a list");
+  refused(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float nx\nproperty float nz\nend_header\n1 2 3 0 1\n",
+      "some but not all of nx, ny and nz");
   refused(
       "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
       "property float z\nend_header\n",
@@ -183,10 +270,29 @@ TEST(PlyReader, BadFilesAreRefusedWithTheirPlace) {
       "vertex 0: coordinate beyond 10^8 m");
 }
 
+// One extra bytes descriptor (LAS 1.4 R15 table 24): `type`, and a
+// no-data value, scale and offset where given.
+std::string extra_descriptor(const std::string& name, std::uint8_t type,
+                             std::optional<std::int64_t> no_data = std::nullopt,
+                             std::optional<double> scale = std::nullopt,
+                             std::optional<double> offset = std::nullopt) {
+  std::string d(192, '\0');
+  d[2] = static_cast<char>(type);
+  d[3] = static_cast<char>((no_data ? 0x01 : 0) | (scale ? 0x08 : 0) | (offset ? 0x10 : 0));
+  std::copy(name.begin(), name.end(), d.begin() + 4);
+  if (no_data) std::memcpy(d.data() + 40, &*no_data, 8);  // an anytype: widened to 64 bits
+  if (scale) std::memcpy(d.data() + 112, &*scale, 8);
+  if (offset) std::memcpy(d.data() + 136, &*offset, 8);
+  return d;
+}
+
 // A LAS 1.2 file of point data format 3, laid out as the specification
-// says, with a GeoTIFF key directory naming EPSG:25832 and 16-bit colour.
-std::string las_1_2(std::uint32_t points_in_header) {
-  const std::uint16_t header_size = 227, record = 34;
+// says, with a GeoTIFF key directory naming EPSG:25832 and 16-bit colour;
+// with `descriptors`, an extra bytes record and `extra[k]` after record k.
+std::string las_1_2(std::uint32_t points_in_header, const std::string& descriptors = {},
+                    const std::vector<std::string>& extra = {}) {
+  const std::uint16_t header_size = 227;
+  const auto record = static_cast<std::uint16_t>(34 + (extra.empty() ? 0 : extra[0].size()));
   std::string vlr;
   put<std::uint16_t>(vlr, 0);
   vlr += std::string("LASF_Projection").append(1, '\0');
@@ -195,6 +301,14 @@ std::string las_1_2(std::uint32_t points_in_header) {
   put<std::uint16_t>(vlr, sizeof keys);
   vlr += std::string(32, '\0');
   for (const std::uint16_t k : keys) put<std::uint16_t>(vlr, k);
+  if (!descriptors.empty()) {
+    put<std::uint16_t>(vlr, 0);
+    vlr += std::string("LASF_Spec").append(7, '\0');
+    put<std::uint16_t>(vlr, 4);
+    put<std::uint16_t>(vlr, static_cast<std::uint16_t>(descriptors.size()));
+    vlr += std::string(32, '\0');
+    vlr += descriptors;
+  }
   std::string h = "LASF";
   h += std::string(20, '\0');
   h += '\x01';
@@ -202,7 +316,7 @@ std::string las_1_2(std::uint32_t points_in_header) {
   h += std::string(68, '\0');
   put<std::uint16_t>(h, header_size);
   put<std::uint32_t>(h, static_cast<std::uint32_t>(header_size + vlr.size()));
-  put<std::uint32_t>(h, 1);
+  put<std::uint32_t>(h, descriptors.empty() ? 1 : 2);
   h += '\x03';
   put<std::uint16_t>(h, record);
   put<std::uint32_t>(h, points_in_header);
@@ -217,6 +331,7 @@ std::string las_1_2(std::uint32_t points_in_header) {
     body += std::string(6, '\0');  // return bits, class, angle, user data, source id
     put<double>(body, 0.0);        // GPS time
     for (const std::uint16_t c : {65535, 32896, 0}) put<std::uint16_t>(body, c);
+    if (!extra.empty()) body += extra[static_cast<std::size_t>(k)];
   }
   return h + vlr + body;
 }
@@ -244,6 +359,64 @@ TEST(LasReader, OurVersionOneFourExportComesBackWholeInItsOrder) {
   const ImportedScan read = read_las(dir / "sphere.las");
   EXPECT_EQ(read.source.points_in_file, 3000u);
   expect_same_cloud(read.scan, sphere, true);
+}
+
+TEST(LasReader, OurExportsNormalsAndFootprintsAreKept) {
+  const ScratchDir dir;
+  const Scan sphere = sphere_scan();
+  const ScanGeometry geometry = compute_geometry(sphere).geometry;
+  const std::vector<const ScanGeometry*> geometry_of = {&geometry};
+  const std::uint16_t source = 1;
+  write_las(dir / "sphere.las", std::span(&sphere, 1), std::span(&source, 1), geometry_of);
+  const ImportedScan read = read_las(dir / "sphere.las");
+  expect_same_cloud(read.scan, sphere, true);
+  expect_recorded_geometry(read, sphere, geometry);
+  expect_recorded_geometry_kept(read);
+}
+
+TEST(LasReader, ExtraBytesScaledWithNoDataAndOtherFieldsAround) {
+  // A byte of another field, then normals as scaled 16-bit integers with a
+  // no-data value, and a footprint in millimetres with an offset.
+  const std::string descriptors = extra_descriptor("classification_confidence", 1) +
+                                  extra_descriptor("normal_x", 4, -32768, 1.0 / 32767) +
+                                  extra_descriptor("normal_y", 4, -32768, 1.0 / 32767) +
+                                  extra_descriptor("Normal Z", 4, -32768, 1.0 / 32767) +
+                                  extra_descriptor("Footprint", 3, std::nullopt, 0.001, 0.0005);
+  std::vector<std::string> extra(2);
+  put<std::uint8_t>(extra[0], 7);
+  for (const std::int16_t v : {0, 0, 32767}) put<std::int16_t>(extra[0], v);
+  put<std::uint16_t>(extra[0], 12);
+  put<std::uint8_t>(extra[1], 7);
+  for (const std::int16_t v : {-32768, 0, 0}) put<std::int16_t>(extra[1], v);  // no data
+  put<std::uint16_t>(extra[1], 0);
+  const ScratchDir dir;
+  write_bytes(dir / "x.las", las_1_2(2, descriptors, extra));
+  const ImportedScan read = read_las(dir / "x.las");
+  EXPECT_EQ(read.source.coordinate_metadata, "EPSG:25832");
+  ASSERT_EQ(count_valid(read.scan), 2u);
+  EXPECT_LT((point_k(read.scan, 1) - Eigen::Vector3d(512001.235, 5399994.322, 300.25)).norm(),
+            1e-4);
+  ASSERT_EQ(read.recorded.normal.size(), read.scan.pixel_count());
+  const Eigen::Matrix3f to_world = read.scan.T_world_scan.linear().cast<float>();
+  EXPECT_LT((to_world * read.recorded.normal[0] - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6f);
+  EXPECT_TRUE(read.recorded.normal[1].isZero()) << "a no-data component: no normal";
+  EXPECT_FLOAT_EQ(read.recorded.footprint_m[0], 0.0125f);
+  EXPECT_FLOAT_EQ(read.recorded.footprint_m[1], 0.0005f);
+  EXPECT_TRUE(read_las(dir / "x.las").recorded.footprint_m.size() == read.scan.pixel_count());
+
+  // Only two components of a normal are no normal; a field beyond the
+  // record is a damaged file.
+  write_bytes(dir / "y.las",
+              las_1_2(2, extra_descriptor("NormalX", 9) + extra_descriptor("NormalY", 9),
+                      {std::string(8, '\0'), std::string(8, '\0')}));
+  EXPECT_TRUE(read_las(dir / "y.las").recorded.empty());
+  write_bytes(dir / "z.las", las_1_2(2, extra_descriptor("Footprint", 10), {"1234", "5678"}));
+  EXPECT_THAT([&] { read_las(dir / "z.las"); },
+              ThrowsMessage<core::InputError>(
+                  HasSubstr("extra bytes field \"Footprint\" ends at byte 42 of 38-byte records")));
+  write_bytes(dir / "w.las", las_1_2(2, extra_descriptor("odd", 31), {"1234", "5678"}));
+  EXPECT_THAT([&] { read_las(dir / "w.las"); },
+              ThrowsMessage<core::InputError>(HasSubstr("unknown data type 31")));
 }
 
 TEST(LasReader, OurExportNamesItsCoordinateSystemInWkt) {

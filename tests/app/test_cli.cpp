@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/formats/las_reader.hpp"
+#include "acquisition/formats/ply_reader.hpp"
 #include "app/cli_runner.hpp"
 #include "support/test_support.hpp"
 
@@ -30,6 +32,13 @@ nlohmann::json info_json(const ScratchDir& dir, const std::filesystem::path& pat
   const CliResult info = run_cli(dir, {"info", path.string(), "--json"});
   EXPECT_EQ(info.exit_code, 0) << info.err;
   return nlohmann::json::parse(info.out);
+}
+
+// Runs a call that must succeed.
+CliResult expect_ok(const ScratchDir& dir, const std::vector<std::string>& args) {
+  CliResult result = run_cli(dir, args);
+  EXPECT_EQ(result.exit_code, 0) << args[0] << ": " << result.err;
+  return result;
 }
 
 TEST(Cli, HelpSucceedsForEverySubcommand) {
@@ -416,6 +425,50 @@ TEST(Cli, ExportPtxRoundTripsThroughASecondProject) {
   EXPECT_EQ(a, b);
 }
 
+// A scan's normals and footprints, exported as PLY and LAS, come back from
+// a second project's import and geometry as they were: a cloud keeps the
+// normals its scan grid gave it.
+TEST(Cli, NormalsAndFootprintsSurviveAPlyAndLasRoundTrip) {
+  ScratchDir dir;
+  ASSERT_EQ(expect_ok(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
+                            "--scans", "1", "--columns", "240", "--rows", "60"})
+                .exit_code,
+            0);
+  const std::string first = (dir / "a.sbproj").string(), second = (dir / "b.sbproj").string();
+  const auto ok = [&](const std::vector<std::string>& args) { return expect_ok(dir, args); };
+  const auto out = [&](const char* name) { return (dir / name).string(); };
+  ok({"import", first, (dir / "sim/campus_scan_01.json").string()});
+  ok({"geometry", first});
+  ok({"export", first, "--format", "ply", "--scan", "1", "-o", out("a.ply")});
+  ok({"export", first, "--format", "las", "--scan", "1", "-o", out("a.las")});
+  ok({"import", second, out("a.ply"), out("a.las")});
+  const CliResult geometry = ok({"geometry", second});
+  EXPECT_NE(geometry.out.find("scan 1: "), std::string::npos) << geometry.out;
+  EXPECT_NE(geometry.out.find("normals kept as its file recorded them"), std::string::npos);
+  ok({"export", second, "--format", "ply", "--scan", "1", "-o", out("b.ply")});
+  ok({"export", second, "--format", "las", "--scan", "2", "-o", out("b.las")});
+  const auto expect_same_geometry = [](const acquisition::ImportedScan& a,
+                                       const acquisition::ImportedScan& b) {
+    ASSERT_EQ(a.source.points_in_file, b.source.points_in_file);
+    ASSERT_EQ(a.recorded.normal.size(), a.scan.pixel_count());
+    ASSERT_EQ(b.recorded.normal.size(), b.scan.pixel_count());
+    const Eigen::Matrix3f to_world_a = a.scan.T_world_scan.linear().cast<float>();
+    const Eigen::Matrix3f to_world_b = b.scan.T_world_scan.linear().cast<float>();
+    std::size_t normals = 0;
+    for (std::size_t k = 0; k < a.source.points_in_file; ++k) {
+      if (a.recorded.normal[k].isZero()) continue;  // none in the grid: fitted in the cloud
+      ++normals;
+      EXPECT_LT((to_world_a * a.recorded.normal[k] - to_world_b * b.recorded.normal[k]).norm(),
+                1e-5f)
+          << k;
+      EXPECT_EQ(a.recorded.footprint_m[k], b.recorded.footprint_m[k]) << k;
+    }
+    EXPECT_GT(normals, a.source.points_in_file * 9 / 10);
+  };
+  expect_same_geometry(acquisition::read_ply(dir / "a.ply"), acquisition::read_ply(dir / "b.ply"));
+  expect_same_geometry(acquisition::read_las(dir / "a.las"), acquisition::read_las(dir / "b.las"));
+}
+
 TEST(Cli, ExportCsvWritesOneLinePerValidPoint) {
   ScratchDir dir;
   const std::filesystem::path project = dir / "p.sbproj", csv = dir / "points.csv";
@@ -587,11 +640,7 @@ TEST(Cli, UndoRedoAndHistoryWorkAcrossProcesses) {
                 .exit_code,
             0);
   const std::string project = (dir / "p.sbproj").string();
-  const auto ok = [&](std::vector<std::string> args) {
-    const CliResult result = run_cli(dir, args);
-    EXPECT_EQ(result.exit_code, 0) << args[0] << ": " << result.err;
-    return result;
-  };
+  const auto ok = [&](const std::vector<std::string>& args) { return expect_ok(dir, args); };
   ok({"import", project, (dir / "sim/campus_scan_01.json").string(),
       (dir / "sim/campus_scan_02.json").string()});
   const std::string imported = ok({"info", project, "--json"}).out;
