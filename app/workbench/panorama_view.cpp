@@ -48,7 +48,7 @@ void panorama_view(WorkbenchState& s) {
   draw->PushClipRect(low, high, true);
   draw->AddRectFilled(low, high, IM_COL32(20, 20, 24, 255));
   const std::string missing = s.session.missing();
-  if (!s.session.has_scan()) {
+  if (!s.session.has_grid()) {
     draw->AddText(ImVec2(low.x + s.px(12), low.y + s.px(10)), IM_COL32(255, 200, 120, 255),
                   missing.c_str());
     draw->PopClipRect();

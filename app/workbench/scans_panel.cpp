@@ -39,8 +39,13 @@ void scans_panel(WorkbenchState& s) {
     s.probe("scan " + std::to_string(scan.id));
     if (ImGui::IsItemHovered()) {
       const Eigen::Vector3d t = scan.summary.T_world_scan.translation();
-      ImGui::SetTooltip("%d × %d, %zu valid points\nat %.3f %.3f %.3f m", scan.summary.rows,
-                        scan.summary.columns, scan.summary.valid_points, t.x(), t.y(), t.z());
+      if (scan.summary.scattered) {
+        ImGui::SetTooltip("unstructured cloud of %zu points\norigin at %.3f %.3f %.3f m",
+                          scan.summary.valid_points, t.x(), t.y(), t.z());
+      } else {
+        ImGui::SetTooltip("%d × %d, %zu valid points\nat %.3f %.3f %.3f m", scan.summary.rows,
+                          scan.summary.columns, scan.summary.valid_points, t.x(), t.y(), t.z());
+      }
     }
   }
   if (chosen && s.run("Opening scan " + std::to_string(*chosen),

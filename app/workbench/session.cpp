@@ -75,6 +75,9 @@ std::string Session::missing() const {
   if (scans_.empty())
     return "the project has no scans: import some with `scanbench import`, or redo (Ctrl+Y) an "
            "undone import";
+  if (!has_grid())
+    return "this scan is an unstructured cloud (imported without a scan grid): it has no range "
+           "image to segment; the 3D view shows it";
   if (normal_.empty())
     return "this scan has no geometry: run `scanbench geometry`, or redo (Ctrl+Y) an undone one";
   return "";
@@ -139,6 +142,10 @@ void Session::show_selection() {
 }
 
 void Session::click(double x, double y) {
+  if (!has_grid()) {
+    status_ = "refused: " + missing();
+    return;
+  }
   const Eigen::Vector2d xy(x, y);
   const segmentation::GridPixel pixel = segmentation::nearest_pixel(xy);
   if (pixel.row < 0 || pixel.col < 0 || pixel.row >= scan_.rows || pixel.col >= scan_.columns)
@@ -397,6 +404,7 @@ void Session::show_first_scan_again() {
 }
 
 std::optional<Eigen::Vector3d> Session::world_point(int row, int col) const {
+  if (!has_grid()) return std::nullopt;  // a cloud's pixels are not a picture
   if (row < 0 || col < 0 || row >= scan_.rows || col >= scan_.columns) return std::nullopt;
   const std::size_t p = scan_.index(row, col);
   if (scan_.valid[p] == 0) return std::nullopt;

@@ -47,9 +47,14 @@ class Session {
   const acquisition::Scan& scan() const { return scan_; }
   bool has_scan() const { return scan_id_ != 0; }
   void open_scan(std::int64_t id);
-  // What the panoramic tools lack, and how to get it: no scans, or no
-  // geometry for the scan shown; empty when nothing is missing.
+  // What the panoramic tools lack, and how to get it: no scans, a scan
+  // without a range image (an unstructured cloud), or no geometry for the
+  // scan shown; empty when nothing is missing.
   std::string missing() const;
+  // Whether the scan shown has a range image for the panoramic view and
+  // its tools (an unstructured cloud has none: acquisition::Scan::
+  // is_scattered).
+  bool has_grid() const { return has_scan() && !scan_.is_scattered(); }
 
   // ---- Tools (image coordinates: x = column, y = row, pixel centres at
   // integers: segmentation/constraints.hpp) --------------------------------
@@ -76,7 +81,8 @@ class Session {
   // ---- Measuring in the panorama --------------------------------------
   // The world point [m] of pixel (row, col) of the scan shown, for a
   // measurement: none outside the scan, where it has no return, or where
-  // its geometry found no surface (a mixed pixel at an edge has no normal).
+  // its geometry found no surface (a mixed pixel at an edge has no normal),
+  // and for an unstructured cloud (no range image).
   std::optional<Eigen::Vector3d> world_point(int row, int col) const;
   // Where world point `p` lies in the scan shown, in image coordinates (x =
   // column, y = row, pixel centres at integers; a full circle wraps): none

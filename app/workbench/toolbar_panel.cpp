@@ -10,6 +10,8 @@ namespace {
 // and how a region joins the selection.
 void tools_row(WorkbenchState& s) {
   Session& session = s.session;
+  // An unstructured cloud has no range image to click on.
+  ImGui::BeginDisabled(!session.has_grid());
   int tool = static_cast<int>(session.tool);
   ImGui::RadioButton("seed (S)", &tool, 0);
   s.probe("tool seed");
@@ -47,6 +49,7 @@ void tools_row(WorkbenchState& s) {
   session.mode = static_cast<modeling::SelectMode>(mode);
   ImGui::SameLine();
   if (ImGui::Button("Clear lasso")) session.clear_constraints();
+  ImGui::EndDisabled();
 }
 
 // The second row: the name for commits, groups and renames, commit,

@@ -153,14 +153,15 @@ class Workbench {
     acquisition::write_rgb_picture(file, width, height, rgb);
   }
 
-  // The centres of the named widgets, the scan shown and where the views
-  // are, for tests that write replays.
+  // The centres of the named widgets, the scan shown, the status line and
+  // where the views are, for tests that write replays.
   void write_layout(const std::filesystem::path& file) const {
     const WorkbenchState& s = state_;
     nlohmann::json widgets = nlohmann::json::object();
     for (const auto& [name, at] : s.probes) widgets[name] = {at[0], at[1]};
     const nlohmann::json out = {{"widgets", widgets},
                                 {"scan", s.session.scan_id()},
+                                {"status", s.session.status()},
                                 {"ui_scale", s.ui_scale},
                                 {"selected", s.selected},
                                 {"panorama",

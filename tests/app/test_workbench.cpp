@@ -731,6 +731,16 @@ TEST(Workbench, ReadOnlyWritesNothing) {
   EXPECT_EQ(journal(dir, project), before);
 }
 
+// The layout the workbench opens `project` with, written to `file`.
+Layout opening_layout(const ScratchDir& dir, const std::filesystem::path& project,
+                      const std::filesystem::path& file) {
+  const CliResult run = run_on_display(
+      dir, {project.string(), "--replay", events(dir, "look.json", {{{"wait", 1}}}).string(),
+            "--layout", file.string()});
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return Layout{read_json(file)};
+}
+
 // Clicking another scan in the Scans panel opens it: the panel's list,
 // which opening a scan reloads, was walked while it was replaced
 // (std::bad_alloc or SIGSEGV, 5 times in 5).
@@ -742,12 +752,7 @@ TEST(Workbench, ClickingAnotherScanOpensIt) {
             0);
   ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
   const std::filesystem::path layout = dir / "layout.json";
-  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
-                                 events(dir, "look.json", {{{"wait", 1}}}).string(), "--layout",
-                                 layout.string()})
-                .exit_code,
-            0);
-  const json click = Layout{read_json(layout)}.widget("scan 2");
+  const json click = opening_layout(dir, project, layout).widget("scan 2");
   const CliResult run = run_on_display(dir, {project.string(), "--replay",
                                              events(dir, "open.json",
                                                     {{{"screenshot", "a.png"}},
@@ -759,6 +764,35 @@ TEST(Workbench, ClickingAnotherScanOpensIt) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_TRUE(std::filesystem::exists(dir / "b.png"));
   EXPECT_EQ(read_json(layout)["scan"], 2);
+}
+
+// An unstructured cloud has no range image: the panoramic view says so
+// instead of showing its points in file order, and a click there grows
+// nothing, while the 3D view draws the cloud.
+TEST(Workbench, AnUnstructuredCloudSaysItHasNoRangeImage) {
+  const ScratchDir dir;
+  const std::filesystem::path project = dir / "cloud.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string(),
+                          fixture("good/ply/unorganized_binary.ply").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
+  const std::filesystem::path layout = dir / "layout.json";
+  const Layout grid = opening_layout(dir, project, layout);
+  const json open = grid.widget("scan 2");
+  const json corner = grid.pixel(0, 0);
+  const CliResult run = run_on_display(
+      dir, {project.string(), "--replay",
+            events(dir, "cloud.json",
+                   {{{"click", open}}, {{"wait", 2}}, {{"click", corner}}, {{"wait", 1}}})
+                .string(),
+            "--layout", layout.string(), "--screenshot", (dir / "workbench_cloud.png").string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  keep_screenshot(dir / "workbench_cloud.png");
+  const json after = read_json(layout);
+  EXPECT_EQ(after["scan"], 2);
+  EXPECT_THAT(after["status"].get<std::string>(),
+              HasSubstr("refused: this scan is an unstructured cloud"));
 }
 
 // On a screen twice as large each way, the panels, fonts and widgets are
