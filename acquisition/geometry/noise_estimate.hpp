@@ -45,7 +45,8 @@ struct NoiseEstimate {
 // relative to each band's σ and weighted by its residuals, a term added only
 // where the bands support it (one band: a constant). The percentile of
 // tiles' medians runs a few per cent low (measured: 0.94–0.98 of the truth).
-// A scan with no usable band (a scattered scan, which has no grid lines; a
+// A scan with no usable band (a scattered scan, which has no grid lines and
+// is estimated from its points' planes instead, scattered_geometry.hpp; a
 // tiny, empty or coarsely quantised one) keeps `fallback`. The result does
 // not depend on `threads` (0: all cores).
 NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback = {},

@@ -566,17 +566,21 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
          settings.window_radius >= settings.edge_window_radius &&
          settings.window_radius <= kMaxWindowRadius);
   const auto start = std::chrono::steady_clock::now();
-  GeometrySettings used = settings;
-  NoiseEstimate noise;
-  noise.noise = settings.range_noise;
-  if (settings.estimate_range_noise) {
-    noise = estimate_range_noise(scan, settings.range_noise, settings.threads);
-    used.range_noise = noise.noise;
+  GeometryResult result;
+  if (scan.is_scattered()) {
+    result = compute_scattered_geometry(scan, settings, recorded);  // estimates its own noise
+  } else {
+    GeometrySettings used = settings;
+    NoiseEstimate noise;
+    noise.noise = settings.range_noise;
+    if (settings.estimate_range_noise) {
+      noise = estimate_range_noise(scan, settings.range_noise, settings.threads);
+      used.range_noise = noise.noise;
+    }
+    result = compute_grid_geometry(scan, used);
+    result.noise = std::move(noise);
   }
-  GeometryResult result = scan.is_scattered() ? compute_scattered_geometry(scan, used, recorded)
-                                              : compute_grid_geometry(scan, used);
-  result.geometry.range_noise = noise.noise;
-  result.noise = std::move(noise);
+  result.geometry.range_noise = result.noise.noise;
   result.seconds = core::seconds_since(start);
   return result;
 }

@@ -92,7 +92,8 @@ struct GeometrySettings {
   // mixed_pixel_relative · range, and the two continuations are
   // depth_jump_relative · range apart (mixed_pixels.hpp).
   RangeNoise range_noise;
-  // Estimate σ(range) from the scan (noise_estimate.hpp) and use that;
+  // Estimate σ(range) from the scan (noise_estimate.hpp; a scattered
+  // scan's from its points' planes, scattered_geometry.hpp) and use that;
   // range_noise is then only the fallback for a scan that gives no
   // estimate. `scanbench geometry` does so unless told the noise.
   bool estimate_range_noise = false;

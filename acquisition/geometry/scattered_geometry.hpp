@@ -27,6 +27,16 @@ namespace scanbench::acquisition {
 // times the cosine of the incidence angle.
 // Mixed pixels and depth edges are properties of a beam's neighbours in a
 // grid: none is flagged.
+// With settings.estimate_range_noise, the noise is estimated from the
+// points (GeometryResult::noise): each point whose 16 nearest neighbours
+// all span a plane gets σ = √(λ₀ / 13), λ₀ the sum of their squared
+// distances to it; the cloud's σ is the 30th percentile of those, divided
+// by that percentile of √(χ²₁₃ / 13) (0.874), so that rough surfaces
+// (foliage, rubble) on up to about two thirds of the cloud do not drag it
+// up. It is a constant: a cloud's distance from its origin need not be a
+// range (a cloud unified from many stations), and it is noise across the
+// surface, which is range noise times the cosine of the incidence. At least
+// 0.1 mm; fewer than 100 such points keep settings.range_noise.
 // Where the file `recorded` a normal, the point has it, facing as the file
 // has it (a cloud's viewpoint is a guess; the file's side is the one its
 // maker meant, outward on a scanned object), with the confidence of the

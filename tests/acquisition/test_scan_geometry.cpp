@@ -558,6 +558,47 @@ TEST(ScatteredGeometry, RepeatedPointsTakeTheirSpacingFromTheDistinctNeighbours)
   }
 }
 
+// Ground 1.5 m below the origin, 8 × 8 m sampled every 4 cm (jittered),
+// each point off it by Gaussian noise of `sigma_m`, and a bush: 6 000
+// points strewn through a 1 m cube.
+Scan noisy_cloud(double sigma_m) {
+  std::mt19937 random(11);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 200; ++i) {
+    for (int j = 0; j < 200; ++j) {
+      points.emplace_back(-4.0 + 0.04 * (i + 0.6 * unit(random)),
+                          -4.0 + 0.04 * (j + 0.6 * unit(random)), -1.5 + sigma_m * noise(random));
+    }
+  }
+  for (int k = 0; k < 6000; ++k)
+    points.emplace_back(2.0 + unit(random), 1.0 + unit(random), -1.5 + unit(random));
+  std::shuffle(points.begin(), points.end(), random);
+  Scan scan = make_scattered_scan(points.size(), false, false);
+  set_scattered_points(scan, points);
+  return scan;
+}
+
+TEST(ScatteredGeometry, TheNoiseIsEstimatedFromThePointsPlanes) {
+  GeometrySettings settings;
+  settings.estimate_range_noise = true;
+  settings.range_noise = RangeNoise{0.02, 0.0, 0.0};  // far off: the estimate must not be it
+  for (const double sigma : {0.001, 0.003}) {
+    const GeometryResult result = compute_geometry(noisy_cloud(sigma), settings);
+    ASSERT_TRUE(result.noise.estimated) << sigma;
+    EXPECT_NEAR(result.noise.noise.noise_m, sigma, 0.1 * sigma) << "despite the bush";
+    EXPECT_EQ(result.noise.noise.noise_per_m, 0.0);
+    EXPECT_EQ(result.noise.noise.noise_per_m2, 0.0);
+    EXPECT_EQ(result.geometry.range_noise, result.noise.noise);
+    EXPECT_GT(result.noise.samples, 30000u);
+  }
+  // A noiseless plane: the floor of 0.1 mm, not zero.
+  EXPECT_EQ(compute_geometry(noisy_cloud(0.0), settings).noise.noise.noise_m, 1e-4);
+  // Not told to estimate: the settings' model.
+  EXPECT_EQ(compute_geometry(noisy_cloud(0.003)).noise.noise, RangeNoise{});
+}
+
 TEST(ScatteredGeometry, LinesDenserAlongThanAcrossStillSpanAPlane) {
   // A profiler's sampling: lines 2 cm apart, a point every millimetre along
   // them. The 16 nearest neighbours lie on the point's own line; the plane
