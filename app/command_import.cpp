@@ -31,8 +31,9 @@ void run_import(const ImportOptions& options) {
   if (result.images > 0) fmt::print("  {} image(s) stored with the scans\n", result.images);
   if (result.unplaced_points > 0) {
     fmt::print(
-        "  {} record(s) not placed in the scan grids: later returns, or records repeating a "
-        "pixel of a structured scan (see `scanbench info PROJECT`)\n",
+        "  {} record(s) not placed in the scan grids (later returns, or records repeating a "
+        "pixel of a structured scan): those with a return are kept beside their grids as "
+        "scattered scans named SCAN-unplaced (see `scanbench info PROJECT`)\n",
         result.unplaced_points);
   }
   for (const modeling::ImportResult::RoundTrip& r : result.beyond_promise) {

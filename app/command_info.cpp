@@ -149,8 +149,9 @@ void print_table(const std::string& path, const Contents& contents) {
     if (e.source && e.source->unplaced_points > 0) {
       fmt::print(
           "      {} of the file's {} records not placed in the grid (later returns, or "
-          "records repeating a pixel)\n",
-          e.source->unplaced_points, e.source->points_in_file);
+          "records repeating a pixel): those with a return are the scan \"{}-unplaced\"\n",
+          e.source->unplaced_points, e.source->points_in_file,
+          core::one_line(s.name, core::kMaxMessagePart));
     }
     if (e.source && e.source->round_trip_error_m > acquisition::kPromisedRoundTripM) {
       fmt::print("      points up to {:.2f} mm from their values in the file (beyond 0.1 mm)\n",

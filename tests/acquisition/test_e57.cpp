@@ -166,7 +166,7 @@ TEST(E57Fixture, StructuredSphericalScanKeepsItsGridValuesPoseAndImages) {
   std::vector<ScanImage> loose;
   const std::vector<ImportedScan> scans =
       read_all(test::fixture("good/e57/structured_spherical.e57"), &loose);
-  ASSERT_EQ(scans.size(), 1u);
+  ASSERT_EQ(scans.size(), 2u) << "the grid, and the record it has no pixel for";
   const Scan& scan = scans[0].scan;
   ASSERT_EQ(scan.rows, 5);
   ASSERT_EQ(scan.columns, 7);
@@ -217,6 +217,23 @@ TEST(E57Fixture, StructuredSphericalScanKeepsItsGridValuesPoseAndImages) {
   EXPECT_EQ(loose[0].data.size(), 662u);
   EXPECT_EQ(loose[0].data[0], 0xFF);
   EXPECT_EQ(loose[0].data[1], 0xD8);
+
+  // The second return of pixel (2, 3), kept beside the grid.
+  const ImportedScan& unplaced = scans[1];
+  ASSERT_TRUE(unplaced.scan.is_scattered());
+  EXPECT_EQ(count_valid(unplaced.scan), 1u);
+  EXPECT_EQ(unplaced.scan.name, "structured-unplaced");
+  EXPECT_EQ(unplaced.source.guid, "{scan-structured}-unplaced");
+  EXPECT_EQ(unplaced.source.points_in_file, 1u);
+  EXPECT_EQ(unplaced.source.unplaced_points, 0u);
+  EXPECT_TRUE(unplaced.images.empty());
+  const double az = 0.3 + 0.02 * 3, el = static_cast<float>(0.2 - 0.015 * 2);
+  const Eigen::Vector3d second =
+      pose * (9.0 * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                                    std::sin(el)));
+  EXPECT_LT((point_in_world(unplaced.scan, 0, 0) - second).norm(), 1e-4);
+  EXPECT_FLOAT_EQ(unplaced.scan.intensity[0], static_cast<float>((2 * 7 + 3) * 100) / 4095.0f);
+  EXPECT_EQ(unplaced.scan.rgb[0], 30);
 }
 
 // The points fixtures/generate_e57_fixtures.py puts in the unstructured

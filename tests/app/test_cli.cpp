@@ -322,13 +322,18 @@ TEST(Cli, E57ImportReportsUnplacedRecordsAndImagesAndExportsBack) {
   ASSERT_EQ(imported.exit_code, 0) << imported.err;
   EXPECT_THAT(imported.out, ::testing::HasSubstr("2 image(s) stored with the scans"));
   EXPECT_THAT(imported.out, ::testing::HasSubstr("1 record(s) not placed in the scan grids"));
+  EXPECT_THAT(imported.out, ::testing::HasSubstr("scattered scans named SCAN-unplaced"));
   const nlohmann::json info = info_json(dir, project);
-  ASSERT_EQ(info["scans"].size(), 2u);
+  ASSERT_EQ(info["scans"].size(), 3u);
   EXPECT_EQ(info["scans"][0]["source"]["unplaced_points"], 1);
-  EXPECT_EQ(info["scans"][1]["source"]["unplaced_points"], 0) << "an unstructured scan keeps all";
-  EXPECT_EQ(info["scans"][1]["source"]["points_in_file"], 605);
-  EXPECT_EQ(info["scans"][1]["valid_points"], 602) << "all but the 3 records without a return";
+  // That record is kept, as a scan of its own beside the grid.
+  EXPECT_EQ(info["scans"][1]["name"], "structured-unplaced");
+  EXPECT_EQ(info["scans"][1]["valid_points"], 1);
   EXPECT_EQ(info["scans"][1]["layout"], "scattered");
+  EXPECT_EQ(info["scans"][2]["source"]["unplaced_points"], 0) << "an unstructured scan keeps all";
+  EXPECT_EQ(info["scans"][2]["source"]["points_in_file"], 605);
+  EXPECT_EQ(info["scans"][2]["valid_points"], 602) << "all but the 3 records without a return";
+  EXPECT_EQ(info["scans"][2]["layout"], "scattered");
   EXPECT_EQ(info["scans"][0]["layout"], "grid");
   EXPECT_EQ(info["scans"][0]["source"]["guid"], "{scan-structured}");
   ASSERT_EQ(info["images"].size(), 2u);

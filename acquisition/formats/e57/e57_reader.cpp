@@ -139,9 +139,9 @@ void read_e57(const std::filesystem::path& path, const std::function<void(Import
   std::vector<bool> image_taken(document.images.size(), false);
   for (std::size_t k = 0; k < document.scans.size(); ++k) {
     const E57ScanEntry& entry = document.scans[k];
-    ImportedScan scan = scan_from_records(
+    std::vector<ImportedScan> scans = scans_from_records(
         path, entry, k, read_e57_streams(file, entry.points, "points of " + entry.path));
-    scan.source.coordinate_metadata = document.coordinate_metadata;
+    ImportedScan& scan = scans.front();
     for (std::size_t i = 0; i < document.images.size(); ++i) {
       // An image goes with the first scan of its guid.
       if (image_taken[i] || entry.guid.empty() ||
@@ -151,7 +151,10 @@ void read_e57(const std::filesystem::path& path, const std::function<void(Import
       scan.images.push_back(read_image(file, document.images[i]));
       image_taken[i] = true;
     }
-    on_scan(std::move(scan));
+    for (ImportedScan& each : scans) {
+      each.source.coordinate_metadata = document.coordinate_metadata;
+      on_scan(std::move(each));
+    }
   }
   for (std::size_t i = 0; i < document.images.size(); ++i) {
     if (!image_taken[i] && on_loose_image) on_loose_image(read_image(file, document.images[i]));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -304,8 +305,60 @@ void set_grid(const PixelCoordinates& pixels, Scan& scan) {
   set_grid_from_points(scan, points, std::nullopt);
 }
 
-ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEntry& entry,
-                             const PointFields& fields) {
+// Records with a return gathered compactly, in the file's order, with their
+// channels: what becomes a scattered scan, which keeps every one (scan.hpp).
+class Returns {
+ public:
+  Returns(const PointFields& fields, const ChannelScales& scales)
+      : fields_(fields),
+        scales_(scales),
+        channels_(make_empty_scan(0, 0, static_cast<bool>(fields.intensity),
+                                  static_cast<bool>(fields.color[0]))) {}
+
+  void reserve(std::uint64_t records) { points_.reserve(scattered_pixel_count(records)); }
+  std::size_t size() const { return points_.size(); }
+
+  // Adds the records of `block` that `take` (a record's index in the block)
+  // accepts and that have a return.
+  template <typename Take>
+  void add(const Block& block, const Take& take) {
+    slot_.assign(block.count, -1);
+    for (std::size_t i = 0; i < block.count; ++i) {
+      if (block.state[i] != 0 || !take(i)) continue;
+      slot_[i] = static_cast<std::int64_t>(points_.size());
+      points_.push_back(point_of(fields_.spherical, block.coordinates[0][i],
+                                 block.coordinates[1][i], block.coordinates[2][i]));
+    }
+    channels_.valid.resize(points_.size());
+    if (fields_.intensity) channels_.intensity.resize(points_.size());
+    if (fields_.color[0]) channels_.rgb.resize(3 * points_.size());
+    fill_pixels(block, slot_, scales_, channels_);
+  }
+
+  // The scattered scan of the returns gathered (asserts there is one).
+  ImportedScan scan() && {
+    assert(!points_.empty() && "a scattered scan of at least one point");
+    ImportedScan out;
+    Scan& scan = out.scan;
+    scan = make_scattered_scan(points_.size(), channels_.has_intensity(), channels_.has_color());
+    std::copy(channels_.intensity.begin(), channels_.intensity.end(), scan.intensity.begin());
+    std::copy(channels_.rgb.begin(), channels_.rgb.end(), scan.rgb.begin());
+    set_scattered_points(scan, std::move(points_));
+    return out;
+  }
+
+ private:
+  const PointFields& fields_;
+  const ChannelScales& scales_;
+  std::vector<Eigen::Vector3d> points_;
+  Scan channels_;
+  std::vector<std::int64_t> slot_;  // of each record of a block in the compact arrays
+};
+
+// The grid of a structured scan, then, when some records with a return
+// found no pixel of their own, the scattered scan that keeps them.
+std::vector<ImportedScan> structured_scan(const std::filesystem::path& path,
+                                          const E57ScanEntry& entry, const PointFields& fields) {
   const IndexRange range = index_range(entry, fields);
   const std::uint64_t rows = extent(range.row_min, range.row_max);
   const std::uint64_t columns = extent(range.col_min, range.col_max);
@@ -321,16 +374,18 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
   // The scan's channels, the file's coordinates per pixel, and points
   // where the grid is not a regular panorama: about 64 bytes per pixel.
   core::check_memory(rows * columns * 64, path.string());
-  ImportedScan out;
-  Scan& scan = out.scan;
+  std::vector<ImportedScan> out(1);
+  Scan& scan = out[0].scan;
   scan = make_empty_scan(static_cast<int>(rows), static_cast<int>(columns),
                          static_cast<bool>(fields.intensity), static_cast<bool>(fields.color[0]));
   const ChannelScales scales = channel_scales(entry, fields);
   PixelCoordinates pixels(fields.spherical, scan.pixel_count());
   std::vector<std::uint8_t> taken(scan.pixel_count(), 0);
   std::vector<std::int64_t> pixel;
+  Returns unplaced(fields, scales);
   for_each_block(fields, entry.points.record_count, [&](const Block& block) {
     pixel.assign(block.count, -1);
+    bool any_unplaced = false;
     for (std::size_t i = 0; i < block.count; ++i) {
       const std::int64_t r = index_value(block.row[i]) - range.row_min;
       const std::int64_t c = index_value(block.column[i]) - range.col_min;
@@ -343,7 +398,8 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
       const std::int64_t p = r * scan.columns + c;
       const bool later_return = !block.returns.empty() && block.returns[i] > 0;
       if (later_return || taken[p]) {
-        ++out.source.unplaced_points;
+        ++out[0].source.unplaced_points;
+        any_unplaced = true;
         continue;
       }
       taken[p] = 1;
@@ -351,8 +407,14 @@ ImportedScan structured_scan(const std::filesystem::path& path, const E57ScanEnt
       pixels.set(static_cast<std::size_t>(p), block, i, scan);
     }
     fill_pixels(block, pixel, scales, scan);
+    if (any_unplaced) unplaced.add(block, [&pixel](std::size_t i) { return pixel[i] < 0; });
   });
   set_grid(pixels, scan);
+  if (unplaced.size() > 0) {
+    const std::size_t kept = unplaced.size();
+    out.push_back(std::move(unplaced).scan());
+    out.back().source.points_in_file = kept;
+  }
   return out;
 }
 
@@ -361,59 +423,48 @@ ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanE
   // Each point in double, its channels, and the scattered scan's own
   // channels and directions: about 64 bytes per record.
   core::check_memory(entry.points.record_count * 64, path.string());
-  // The returns in the file's order, compactly, with their channels: a
-  // scattered scan keeps every one (scan.hpp).
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(scattered_pixel_count(entry.points.record_count));
-  Scan channels = make_empty_scan(0, 0, static_cast<bool>(fields.intensity),
-                                  static_cast<bool>(fields.color[0]));
   const ChannelScales scales = channel_scales(entry, fields);
-  std::vector<std::int64_t> slot;  // of each record of a block in the compact arrays
-  for_each_block(fields, entry.points.record_count, [&](const Block& block) {
-    slot.assign(block.count, -1);
-    for (std::size_t i = 0; i < block.count; ++i) {
-      if (block.state[i] != 0) continue;
-      slot[i] = static_cast<std::int64_t>(points.size());
-      points.push_back(point_of(fields.spherical, block.coordinates[0][i], block.coordinates[1][i],
-                                block.coordinates[2][i]));
-    }
-    channels.valid.resize(points.size());
-    if (fields.intensity) channels.intensity.resize(points.size());
-    if (fields.color[0]) channels.rgb.resize(3 * points.size());
-    fill_pixels(block, slot, scales, channels);
-  });
-  if (points.empty()) {
+  Returns returns(fields, scales);
+  returns.reserve(entry.points.record_count);
+  for_each_block(fields, entry.points.record_count,
+                 [&](const Block& block) { returns.add(block, [](std::size_t) { return true; }); });
+  if (returns.size() == 0) {
     throw core::InputError(path.string(), {{}, {}, "scan \"" + entry.name + "\""},
                            "an unstructured scan with no valid point: there is nothing to import");
   }
-  ImportedScan out;
-  Scan& scan = out.scan;
-  scan = make_scattered_scan(points.size(), channels.has_intensity(), channels.has_color());
-  std::copy(channels.intensity.begin(), channels.intensity.end(), scan.intensity.begin());
-  std::copy(channels.rgb.begin(), channels.rgb.end(), scan.rgb.begin());
-  set_scattered_points(scan, std::move(points));
+  ImportedScan out = std::move(returns).scan();
+  out.source.points_in_file = entry.points.record_count;
   return out;
 }
 
 }  // namespace
 
-ImportedScan scan_from_records(const std::filesystem::path& path, const E57ScanEntry& entry,
-                               std::size_t index,
-                               const std::vector<std::vector<std::byte>>& streams) {
+std::vector<ImportedScan> scans_from_records(const std::filesystem::path& path,
+                                             const E57ScanEntry& entry, std::size_t index,
+                                             const std::vector<std::vector<std::byte>>& streams) {
   const PointFields fields = point_fields(path, entry, streams);
   const bool structured = fields.row && fields.column;
-  ImportedScan out =
-      structured ? structured_scan(path, entry, fields) : unstructured_scan(path, entry, fields);
-  Scan& scan = out.scan;
-  scan.name = entry.name.empty() ? path.stem().string() + "#" + std::to_string(index) : entry.name;
-  scan.scanner.name = entry.sensor_model;
-  scan.scanner.source_file = path.string();
-  scan.scanner.position_world = entry.pose.translation();
-  // The grid's local origin (set_grid_from_points) already moved the pose.
-  scan.T_world_scan = entry.pose * scan.T_world_scan;
-  out.source.format = "e57";
-  out.source.guid = entry.guid;
-  out.source.points_in_file = entry.points.record_count;
+  std::vector<ImportedScan> out;
+  if (structured) {
+    out = structured_scan(path, entry, fields);
+    out[0].source.points_in_file = entry.points.record_count;
+  } else {
+    out.push_back(unstructured_scan(path, entry, fields));
+  }
+  const std::string name =
+      entry.name.empty() ? path.stem().string() + "#" + std::to_string(index) : entry.name;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    Scan& scan = out[k].scan;
+    const bool grid = k == 0;
+    scan.name = grid ? name : name + "-unplaced";
+    scan.scanner.name = entry.sensor_model;
+    scan.scanner.source_file = path.string();
+    scan.scanner.position_world = entry.pose.translation();
+    // The grid's local origin (set_grid_from_points) already moved the pose.
+    scan.T_world_scan = entry.pose * scan.T_world_scan;
+    out[k].source.format = "e57";
+    out[k].source.guid = grid || entry.guid.empty() ? entry.guid : entry.guid + "-unplaced";
+  }
   return out;
 }
 

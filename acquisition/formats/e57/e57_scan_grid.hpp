@@ -13,15 +13,18 @@
 
 namespace scanbench::acquisition {
 
-// The scan of `entry`, the `index`-th of the file at `path`, from its
+// The scans of `entry`, the `index`-th of the file at `path`, from its
 // fields' bytestreams (one per prototype field, complete: read_e57_streams
-// checked their lengths). Throws core::InputError naming the file and the
-// record or element for a prototype without coordinates or with grid
+// checked their lengths): its grid or scattered scan, and for a grid whose
+// records with a return did not all find a pixel of their own (later
+// returns, records repeating a pixel), a scattered scan of those, named
+// NAME-unplaced, with the same pose (its GUID the entry's + "-unplaced"). Throws core::InputError
+// naming the file and the record or element for a prototype without coordinates or with grid
 // indices that are not Integer fields, indices outside the index bounds, or
 // bounds of more than 16 pixels per record (or 2^30 pixels); throws
 // core::MemoryShortage when the grid would not fit in memory.
-ImportedScan scan_from_records(const std::filesystem::path& path, const E57ScanEntry& entry,
-                               std::size_t index,
-                               const std::vector<std::vector<std::byte>>& streams);
+std::vector<ImportedScan> scans_from_records(const std::filesystem::path& path,
+                                             const E57ScanEntry& entry, std::size_t index,
+                                             const std::vector<std::vector<std::byte>>& streams);
 
 }  // namespace scanbench::acquisition
