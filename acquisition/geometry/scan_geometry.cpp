@@ -510,8 +510,7 @@ std::vector<int> cascade_radii(const GeometrySettings& settings) {
 // The outputs; every pixel is written by the passes below.
 void allocate(ScanGeometry& g, std::size_t n) {
   core::assign_mapped(g.footprint_m, n, 0.0f);
-  g.normal.reserve(n);
-  core::map_now(g.normal.data(), n * sizeof(Eigen::Vector3f));
+  core::reserve_mapped(g.normal, n);
   g.normal.resize(n);  // Eigen leaves it uninitialised; every pixel is written below
   core::assign_mapped(g.confidence, n, 0.0f);
   core::assign_mapped(g.flags, n, std::uint8_t{0});
