@@ -322,7 +322,7 @@ float extra_at(const std::vector<unsigned char>& block, std::size_t r, const Ext
 
 }  // namespace
 
-ImportedScan read_las(const std::filesystem::path& path) {
+std::vector<ImportedScan> read_las(const std::filesystem::path& path) {
   LasFile file(path);
   const Header h = read_header(file);
   const std::uint64_t bytes = h.points * h.record_length;
@@ -390,10 +390,12 @@ ImportedScan read_las(const std::filesystem::path& path) {
   for (std::size_t k = 0; k < colour.size(); ++k) {
     cloud.rgb[k] = static_cast<std::uint8_t>(wide_colour ? (colour[k] + 128) / 257 : colour[k]);
   }
-  ImportedScan out = scattered_scan(std::move(cloud), path);
-  out.source.format = "las";
-  out.source.points_in_file = h.points;
-  out.source.coordinate_metadata = records.coordinate_system;
+  std::vector<ImportedScan> out = scattered_scans(std::move(cloud), path);
+  for (ImportedScan& scan : out) {
+    scan.source.format = "las";
+    if (out.size() == 1) scan.source.points_in_file = h.points;
+    scan.source.coordinate_metadata = records.coordinate_system;
+  }
   return out;
 }
 

@@ -17,16 +17,18 @@
 #pragma once
 
 #include <filesystem>
+#include <vector>
 
 #include "acquisition/scan_source.hpp"
 
 namespace scanbench::acquisition {
 
-// Reads `path` into one scan (format "las", points_in_file the records).
+// Reads `path` into one scan (format "las", points_in_file the records), or
+// into tiles when it is too wide for one (point_cloud.hpp: scattered_scans).
 // Throws core::InputError naming the file, the byte offset and the
 // problem for a missing signature, a LAZ file, an unknown point format, a
 // record shorter than its format, an extra bytes field of an unknown type
 // or beyond the record, a header or records cut short.
-ImportedScan read_las(const std::filesystem::path& path);
+std::vector<ImportedScan> read_las(const std::filesystem::path& path);
 
 }  // namespace scanbench::acquisition

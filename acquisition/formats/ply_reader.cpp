@@ -448,7 +448,7 @@ void read_binary(const std::filesystem::path& path, std::uint64_t file_size, con
 
 }  // namespace
 
-ImportedScan read_ply(const std::filesystem::path& path) {
+std::vector<ImportedScan> read_ply(const std::filesystem::path& path) {
   TextLineReader reader(path);
   if (reader.file_size() == 0) reader.fail("empty file");
   const Header header = read_header(reader);
@@ -481,9 +481,11 @@ ImportedScan read_ply(const std::filesystem::path& path) {
   } else {
     read_binary(path, reader.file_size(), header, channels, cloud);
   }
-  ImportedScan out = scattered_scan(std::move(cloud), path);
-  out.source.format = "ply";
-  out.source.points_in_file = vertex->count;
+  std::vector<ImportedScan> out = scattered_scans(std::move(cloud), path);
+  for (ImportedScan& scan : out) {
+    scan.source.format = "ply";
+    if (out.size() == 1) scan.source.points_in_file = vertex->count;
+  }
   return out;
 }
 

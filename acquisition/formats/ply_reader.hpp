@@ -13,17 +13,19 @@
 #pragma once
 
 #include <filesystem>
+#include <vector>
 
 #include "acquisition/scan_source.hpp"
 
 namespace scanbench::acquisition {
 
 // Reads `path` into one scan (format "ply", points_in_file the vertex
-// count). Throws core::InputError naming the file, the line or byte
+// count), or into tiles when it is too wide for one (point_cloud.hpp:
+// scattered_scans). Throws core::InputError naming the file, the line or byte
 // offset, and the problem for a missing signature, an unknown format or
 // type, a vertex element without x, y and z, a channel stored as a list,
 // some but not all of a normal's components, a truncated body, or a value
 // that is not a number (ASCII).
-ImportedScan read_ply(const std::filesystem::path& path);
+std::vector<ImportedScan> read_ply(const std::filesystem::path& path);
 
 }  // namespace scanbench::acquisition

@@ -1,10 +1,13 @@
 #include "acquisition/formats/point_cloud.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
+#include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "acquisition/local_origin.hpp"
 #include "core/errors.hpp"
@@ -35,17 +38,9 @@ RecordedGeometry recorded_geometry(PointCloud& cloud, const Scan& scan) {
   return recorded;
 }
 
-}  // namespace
-
-ImportedScan scattered_scan(PointCloud&& cloud, const std::filesystem::path& path) {
+// One scan of `cloud`, as scattered_scans describes.
+ImportedScan one_scan(PointCloud&& cloud, const std::filesystem::path& path) {
   const std::size_t n = cloud.points.size();
-  if (n == 0)
-    throw core::InputError(path.string(), {}, "holds no points: there is nothing to import");
-  assert((cloud.intensity.empty() || cloud.intensity.size() == n) &&
-         (cloud.rgb.empty() || cloud.rgb.size() == 3 * n) &&
-         (cloud.normal.empty() || cloud.normal.size() == n) &&
-         (cloud.footprint_m.empty() || cloud.footprint_m.size() == n) &&
-         "channels of one value per point");
   ImportedScan out;
   Scan& scan = out.scan;
   scan = make_scattered_scan(n, false, false);
@@ -64,7 +59,83 @@ ImportedScan scattered_scan(PointCloud&& cloud, const std::filesystem::path& pat
   const std::u8string utf8 = path.u8string();
   scan.name = std::string(stem.begin(), stem.end());
   scan.scanner.source_file = std::string(utf8.begin(), utf8.end());
+  out.source.points_in_file = n;
   return out;
+}
+
+// The points of `cloud` that `take` lists, with their channels.
+PointCloud part_of(const PointCloud& cloud, const std::vector<std::size_t>& take) {
+  PointCloud part;
+  const auto gather = [&take](const auto& from, auto& to, std::size_t width) {
+    if (from.empty()) return;
+    to.reserve(width * take.size());
+    for (const std::size_t i : take) {
+      for (std::size_t k = 0; k < width; ++k) to.push_back(from[width * i + k]);
+    }
+  };
+  gather(cloud.points, part.points, 1);
+  gather(cloud.intensity, part.intensity, 1);
+  gather(cloud.rgb, part.rgb, 3);
+  gather(cloud.normal, part.normal, 1);
+  gather(cloud.footprint_m, part.footprint_m, 1);
+  return part;
+}
+
+// One scan per cube of kCloudTileM that `cloud` touches.
+std::vector<ImportedScan> tiles(const PointCloud& cloud, const std::filesystem::path& path) {
+  Eigen::Vector3d low = cloud.points.front();
+  for (const Eigen::Vector3d& p : cloud.points) low = low.cwiseMin(p);
+  std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> cubes;  // x, then y, then z
+  for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+    const Eigen::Vector3d cell = ((cloud.points[i] - low) / kCloudTileM).array().floor();
+    cubes[{static_cast<std::int64_t>(cell.x()), static_cast<std::int64_t>(cell.y()),
+           static_cast<std::int64_t>(cell.z())}]
+        .push_back(i);
+  }
+  std::vector<ImportedScan> out;
+  for (const auto& [cube, take] : cubes) out.push_back(one_scan(part_of(cloud, take), path));
+  const std::string stem = out.front().scan.name;  // a copy: naming changes it
+  name_tiles(out, stem);
+  return out;
+}
+
+}  // namespace
+
+void name_tiles(std::span<ImportedScan> tiles, const std::string& name) {
+  for (std::size_t k = 0; k < tiles.size(); ++k) {
+    std::string& to = tiles[k].scan.name;
+    to = name;
+    if (tiles.size() > 1) to.append(1, '-').append(std::to_string(k + 1));
+  }
+}
+
+std::vector<ImportedScan> scattered_scans(PointCloud&& cloud, const std::filesystem::path& path) {
+  const std::size_t n = cloud.points.size();
+  if (n == 0)
+    throw core::InputError(path.string(), {}, "holds no points: there is nothing to import");
+  assert((cloud.intensity.empty() || cloud.intensity.size() == n) &&
+         (cloud.rgb.empty() || cloud.rgb.size() == 3 * n) &&
+         (cloud.normal.empty() || cloud.normal.size() == n) &&
+         (cloud.footprint_m.empty() || cloud.footprint_m.size() == n) &&
+         "channels of one value per point");
+  // Within 625 m of the centroid, the bound of a float range and direction
+  // (1.6e-7 of the range) keeps 0.1 mm: one scan for sure. Farther, one scan
+  // is tried on a copy, and the cloud is tiled if it fails.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : cloud.points) centroid += p;
+  centroid /= static_cast<double>(n);
+  double farthest = 0.0;
+  for (const Eigen::Vector3d& p : cloud.points)
+    farthest = std::max(farthest, (p - centroid).norm());
+  std::vector<ImportedScan> out;  // filled by moves: a braced list would copy the scan
+  if (1.6e-7 * farthest <= kPromisedRoundTripM) {
+    out.push_back(one_scan(std::move(cloud), path));
+    return out;
+  }
+  PointCloud copy = cloud;
+  out.push_back(one_scan(std::move(copy), path));
+  if (out.front().scan.import_round_trip_m <= kPromisedRoundTripM) return out;
+  return tiles(cloud, path);
 }
 
 }  // namespace scanbench::acquisition

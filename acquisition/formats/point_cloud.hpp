@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "acquisition/scan.hpp"
@@ -25,12 +27,27 @@ struct PointCloud {
   std::vector<float> footprint_m;
 };
 
+// Cubes a cloud too wide for one scan is split into [m]: no point of a
+// cube lies farther than 693 m from its centroid, where float ranges and
+// directions keep 0.1 mm.
+inline constexpr double kCloudTileM = 400.0;
+
 // The scattered scan of `cloud` (its points taken), named after the stem
 // of `path`, with `path` as its source file, and the geometry the cloud
 // recorded, its normals turned into the scan frame and made unit length.
-// Throws core::InputError naming `path` when the cloud has no point (a
-// 0 × 0 scan is no scan). Asserts the channels are empty or one per point.
-// The caller fills the rest of the source.
-ImportedScan scattered_scan(PointCloud&& cloud, const std::filesystem::path& path);
+// A cloud so wide that one scan would put a point more than 0.1 mm from
+// its value in the file (kPromisedRoundTripM: spread over more than about
+// a kilometre) becomes one scan per cube of kCloudTileM it touches instead,
+// named STEM-1, STEM-2, … (the cubes in x, then y, then z order, each with
+// its points in the file's order and points_in_file its point count), so
+// that every point keeps 0.1 mm. Throws core::InputError naming `path`
+// when the cloud has no point (a 0 × 0 scan is no scan). Asserts the
+// channels are empty or one per point. The caller fills the rest of the
+// sources.
+std::vector<ImportedScan> scattered_scans(PointCloud&& cloud, const std::filesystem::path& path);
+
+// Names the scans of one cloud: `name` when there is one, else NAME-1,
+// NAME-2, … (scattered_scans' tiles).
+void name_tiles(std::span<ImportedScan> tiles, const std::string& name);
 
 }  // namespace scanbench::acquisition

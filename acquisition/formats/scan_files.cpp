@@ -73,10 +73,10 @@ void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& s
       read_e57(path, on_scan, on_loose_image);
       return;
     case ScanFileFormat::kPly:
-      on_scan(read_ply(path));
+      for (ImportedScan& scan : read_ply(path)) on_scan(std::move(scan));
       return;
     case ScanFileFormat::kLas:
-      on_scan(read_las(path));
+      for (ImportedScan& scan : read_las(path)) on_scan(std::move(scan));
       return;
   }
 }

@@ -251,6 +251,28 @@ std::vector<Eigen::Vector3d> unstructured_points(double scale = 1.0) {
   return points;
 }
 
+TEST(E57Fixture, AnUnstructuredScanTooWideForOneIsTiledWithinATenthOfAMillimetre) {
+  const std::vector<ImportedScan> scans = read_all(test::fixture("good/e57/unstructured_wide.e57"));
+  ASSERT_EQ(scans.size(), 2u) << "one scan per 400 m cube";
+  for (std::size_t s = 0; s < 2; ++s) {
+    const ImportedScan& tile = scans[s];
+    EXPECT_EQ(tile.scan.name, "wide-" + std::to_string(s + 1));
+    EXPECT_EQ(tile.source.guid, "{scan-wide}-" + std::to_string(s + 1));
+    EXPECT_EQ(tile.source.points_in_file, 100u);
+    ASSERT_EQ(count_valid(tile.scan), 100u);
+    EXPECT_LE(tile.scan.import_round_trip_m, kPromisedRoundTripM);
+    for (int j = 0; j < 100; ++j) {  // the fixture's record 2j + s, in the file's order
+      const int k = 2 * j + static_cast<int>(s);
+      const Eigen::Vector3d expected(3000.0 * s + 0.25 * (k % 10), 4000.0 * s + 0.5 * (k / 20),
+                                     1.0 + 0.001 * k);
+      EXPECT_LT((point_in_world(tile.scan, j / tile.scan.columns, j % tile.scan.columns) - expected)
+                    .norm(),
+                1e-4)
+          << s << " " << j;
+    }
+  }
+}
+
 TEST(E57Fixture, AnUnstructuredScanKeepsEveryPointWithAReturn) {
   const std::vector<ImportedScan> scans =
       read_all(test::fixture("good/e57/unstructured_cartesian.e57"));

@@ -28,6 +28,12 @@ using test::ScratchDir;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
+// The one scan a reader makes of a cloud narrow enough for one.
+ImportedScan only(std::vector<ImportedScan> scans) {
+  EXPECT_EQ(scans.size(), 1u);
+  return std::move(scans.at(0));
+}
+
 void write_bytes(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
@@ -81,7 +87,7 @@ TEST(PlyReader, OurBinaryExportComesBackWholeInItsOrder) {
   const ScratchDir dir;
   const Scan sphere = sphere_scan();
   write_ply(dir / "sphere.ply", std::span(&sphere, 1));
-  const ImportedScan read = read_ply(dir / "sphere.ply");
+  const ImportedScan read = only(read_ply(dir / "sphere.ply"));
   EXPECT_EQ(read.source.format, "ply");
   EXPECT_EQ(read.source.points_in_file, 3000u);
   EXPECT_EQ(read.scan.name, "sphere");
@@ -97,7 +103,7 @@ TEST(PlyReader, AsciiWithAFaceElementAndCloudCompareNames) {
               "property float scalar_Intensity\nelement face 1\n"
               "property list uchar int vertex_indices\nend_header\n"
               "1 0 0 255 0 0 0.5\n0 1.5 0 0 255 0 0.25\n0 0 2 0 0 255 1\n3 0 1 2\n");
-  const ImportedScan read = read_ply(dir / "a.ply");
+  const ImportedScan read = only(read_ply(dir / "a.ply"));
   ASSERT_EQ(count_valid(read.scan), 3u);
   EXPECT_LT((point_k(read.scan, 1) - Eigen::Vector3d(0, 1.5, 0)).norm(), 1e-6);
   EXPECT_FLOAT_EQ(read.scan.intensity[2], 1.0f);
@@ -111,7 +117,7 @@ TEST(PlyReader, APointAtTheFilesOriginKeepsItsPlace) {
   write_bytes(dir / "o.ply",
               "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
               "property double z\nend_header\n0 0 0\n2.5 -1 0.25\n-3 4 1\n");
-  const ImportedScan read = read_ply(dir / "o.ply");
+  const ImportedScan read = only(read_ply(dir / "o.ply"));
   ASSERT_EQ(count_valid(read.scan), 3u);
   const Eigen::Vector3d expected[3] = {{0, 0, 0}, {2.5, -1, 0.25}, {-3, 4, 1}};
   for (std::size_t k = 0; k < 3; ++k) {
@@ -137,7 +143,7 @@ TEST(PlyReader, BigEndianWithAListBeforeTheVerticesAndSixteenBitColour) {
   for (int c = 0; c < 3; ++c) put<std::uint16_t>(ply, 0, true);
   put<std::int8_t>(ply, 0);
   write_bytes(dir / "b.ply", ply);
-  const ImportedScan read = read_ply(dir / "b.ply");
+  const ImportedScan read = only(read_ply(dir / "b.ply"));
   EXPECT_EQ(read.source.points_in_file, 2u);
   ASSERT_EQ(count_valid(read.scan), 1u);
   EXPECT_LT((point_k(read.scan, 0) - Eigen::Vector3d(10.25, -3.5, 1.125)).norm(), 1e-5);
@@ -194,7 +200,7 @@ TEST(PlyReader, OurExportsNormalsAndFootprintsAreKept) {
   const ScanGeometry geometry = compute_geometry(sphere).geometry;
   const std::vector<const ScanGeometry*> geometry_of = {&geometry};
   write_ply(dir / "sphere.ply", std::span(&sphere, 1), geometry_of);
-  const ImportedScan read = read_ply(dir / "sphere.ply");
+  const ImportedScan read = only(read_ply(dir / "sphere.ply"));
   expect_same_cloud(read.scan, sphere, false);
   expect_recorded_geometry(read, sphere, geometry);
   expect_recorded_geometry_kept(read);
@@ -207,7 +213,7 @@ TEST(PlyReader, NormalsOfAnyLengthAndFootprintsOfCloudCompareNames) {
               "property float z\nproperty float Nx\nproperty float Ny\nproperty float Nz\n"
               "property float footprint\nend_header\n"
               "1 0 0 0 0 2 0.01\n0 1 0 0 0 0 0\n0 0 1 3 -4 0 -1\n");
-  const ImportedScan read = read_ply(dir / "n.ply");
+  const ImportedScan read = only(read_ply(dir / "n.ply"));
   ASSERT_EQ(read.recorded.normal.size(), read.scan.pixel_count());
   const Eigen::Matrix3f to_world = read.scan.T_world_scan.linear().cast<float>();
   EXPECT_LT((to_world * read.recorded.normal[0] - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6f);
@@ -219,14 +225,46 @@ TEST(PlyReader, NormalsOfAnyLengthAndFootprintsOfCloudCompareNames) {
   write_bytes(dir / "plain.ply",
               "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
               "property float z\nend_header\n1 2 3\n");
-  EXPECT_TRUE(read_ply(dir / "plain.ply").recorded.empty());
+  EXPECT_TRUE(only(read_ply(dir / "plain.ply")).recorded.empty());
+}
+
+TEST(PlyReader, ACloudTooWideForOneScanIsTiledKeepingEveryPointAndItsNormal) {
+  // Two groups 5 km apart, interleaved in the file: float ranges from one
+  // centre would put the far ones 0.15 mm off; one scan per 400 m cube
+  // keeps them, each group in the file's order.
+  const ScratchDir dir;
+  write_bytes(dir / "c.ply",
+              "ply\nformat ascii 1.0\nelement vertex 6\nproperty double x\nproperty double y\n"
+              "property double z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+              "end_header\n"
+              "1.0001 2 3 1 0 0\n5000.0003 2 3 0 1 0\n1 2.5 3.0002 1 0 0\n"
+              "5001.25 2.0001 3 0 1 0\n1 3 3 1 0 0\n5000 2 3.75 0 1 0\n");
+  const std::vector<ImportedScan> scans = read_ply(dir / "c.ply");
+  ASSERT_EQ(scans.size(), 2u);
+  const Eigen::Vector3d near[3] = {{1.0001, 2, 3}, {1, 2.5, 3.0002}, {1, 3, 3}};
+  const Eigen::Vector3d far[3] = {{5000.0003, 2, 3}, {5001.25, 2.0001, 3}, {5000, 2, 3.75}};
+  for (std::size_t s = 0; s < 2; ++s) {
+    const ImportedScan& tile = scans[s];
+    EXPECT_EQ(tile.scan.name, "c-" + std::to_string(s + 1));
+    EXPECT_EQ(tile.source.points_in_file, 3u);
+    EXPECT_LE(tile.scan.import_round_trip_m, kPromisedRoundTripM);
+    ASSERT_EQ(count_valid(tile.scan), 3u);
+    const Eigen::Matrix3f to_world = tile.scan.T_world_scan.linear().cast<float>();
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_LT((point_k(tile.scan, k) - (s == 0 ? near : far)[k]).norm(), 1e-4) << s << k;
+      EXPECT_LT((to_world * tile.recorded.normal[k] -
+                 (s == 0 ? Eigen::Vector3f::UnitX() : Eigen::Vector3f::UnitY()))
+                    .norm(),
+                1e-6f);
+    }
+  }
 }
 
 TEST(PlyReader, BadFilesAreRefusedWithTheirPlace) {
   const ScratchDir dir;
   const auto refused = [&](const std::string& bytes, const std::string& problem) {
     write_bytes(dir / "bad.ply", bytes);
-    EXPECT_THAT([&] { read_ply(dir / "bad.ply"); },
+    EXPECT_THAT([&] { only(read_ply(dir / "bad.ply")); },
                 ThrowsMessage<core::InputError>(HasSubstr(problem)))
         << bytes;
   };
@@ -339,7 +377,7 @@ std::string las_1_2(std::uint32_t points_in_header, const std::string& descripto
 TEST(LasReader, AVersionOneTwoFileKeepsItsPointsChannelsAndCoordinateSystem) {
   const ScratchDir dir;
   write_bytes(dir / "a.las", las_1_2(2));
-  const ImportedScan read = read_las(dir / "a.las");
+  const ImportedScan read = only(read_las(dir / "a.las"));
   EXPECT_EQ(read.source.format, "las");
   EXPECT_EQ(read.source.coordinate_metadata, "EPSG:25832");
   ASSERT_EQ(count_valid(read.scan), 2u);
@@ -356,7 +394,7 @@ TEST(LasReader, OurVersionOneFourExportComesBackWholeInItsOrder) {
   const Scan sphere = sphere_scan();
   const std::uint16_t source = 1;
   write_las(dir / "sphere.las", std::span(&sphere, 1), std::span(&source, 1));
-  const ImportedScan read = read_las(dir / "sphere.las");
+  const ImportedScan read = only(read_las(dir / "sphere.las"));
   EXPECT_EQ(read.source.points_in_file, 3000u);
   expect_same_cloud(read.scan, sphere, true);
 }
@@ -368,7 +406,7 @@ TEST(LasReader, OurExportsNormalsAndFootprintsAreKept) {
   const std::vector<const ScanGeometry*> geometry_of = {&geometry};
   const std::uint16_t source = 1;
   write_las(dir / "sphere.las", std::span(&sphere, 1), std::span(&source, 1), geometry_of);
-  const ImportedScan read = read_las(dir / "sphere.las");
+  const ImportedScan read = only(read_las(dir / "sphere.las"));
   expect_same_cloud(read.scan, sphere, true);
   expect_recorded_geometry(read, sphere, geometry);
   expect_recorded_geometry_kept(read);
@@ -391,7 +429,7 @@ TEST(LasReader, ExtraBytesScaledWithNoDataAndOtherFieldsAround) {
   put<std::uint16_t>(extra[1], 0);
   const ScratchDir dir;
   write_bytes(dir / "x.las", las_1_2(2, descriptors, extra));
-  const ImportedScan read = read_las(dir / "x.las");
+  const ImportedScan read = only(read_las(dir / "x.las"));
   EXPECT_EQ(read.source.coordinate_metadata, "EPSG:25832");
   ASSERT_EQ(count_valid(read.scan), 2u);
   EXPECT_LT((point_k(read.scan, 1) - Eigen::Vector3d(512001.235, 5399994.322, 300.25)).norm(),
@@ -402,20 +440,20 @@ TEST(LasReader, ExtraBytesScaledWithNoDataAndOtherFieldsAround) {
   EXPECT_TRUE(read.recorded.normal[1].isZero()) << "a no-data component: no normal";
   EXPECT_FLOAT_EQ(read.recorded.footprint_m[0], 0.0125f);
   EXPECT_FLOAT_EQ(read.recorded.footprint_m[1], 0.0005f);
-  EXPECT_TRUE(read_las(dir / "x.las").recorded.footprint_m.size() == read.scan.pixel_count());
+  EXPECT_TRUE(only(read_las(dir / "x.las")).recorded.footprint_m.size() == read.scan.pixel_count());
 
   // Only two components of a normal are no normal; a field beyond the
   // record is a damaged file.
   write_bytes(dir / "y.las",
               las_1_2(2, extra_descriptor("NormalX", 9) + extra_descriptor("NormalY", 9),
                       {std::string(8, '\0'), std::string(8, '\0')}));
-  EXPECT_TRUE(read_las(dir / "y.las").recorded.empty());
+  EXPECT_TRUE(only(read_las(dir / "y.las")).recorded.empty());
   write_bytes(dir / "z.las", las_1_2(2, extra_descriptor("Footprint", 10), {"1234", "5678"}));
-  EXPECT_THAT([&] { read_las(dir / "z.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "z.las")); },
               ThrowsMessage<core::InputError>(
                   HasSubstr("extra bytes field \"Footprint\" ends at byte 42 of 38-byte records")));
   write_bytes(dir / "w.las", las_1_2(2, extra_descriptor("odd", 31), {"1234", "5678"}));
-  EXPECT_THAT([&] { read_las(dir / "w.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "w.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("unknown data type 31")));
 }
 
@@ -434,7 +472,7 @@ TEST(LasReader, OurExportNamesItsCoordinateSystemInWkt) {
   EXPECT_FALSE(looks_like_wkt("EPSG:25832"));
   EXPECT_FALSE(looks_like_wkt("[]"));
   write_las(dir / "sphere.las", std::span(&sphere, 1), std::span(&source, 1), {}, {}, wkt);
-  const ImportedScan read = read_las(dir / "sphere.las");
+  const ImportedScan read = only(read_las(dir / "sphere.las"));
   EXPECT_EQ(read.source.coordinate_metadata, wkt);
   expect_same_cloud(read.scan, sphere, true);
 }
@@ -444,16 +482,16 @@ TEST(LasReader, BadFilesAreRefusedWithTheirPlace) {
   std::string laz = las_1_2(2);
   laz[104] = static_cast<char>(0x83);
   write_bytes(dir / "a.las", laz);
-  EXPECT_THAT([&] { read_las(dir / "a.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "a.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("LAZ (LASzip-compressed)")));
   write_bytes(dir / "b.las", las_1_2(3));
-  EXPECT_THAT([&] { read_las(dir / "b.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "b.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("records are cut short")));
   write_bytes(dir / "c.las", "LASX" + las_1_2(2).substr(4));
-  EXPECT_THAT([&] { read_las(dir / "c.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "c.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("not a LAS file")));
   write_bytes(dir / "d.las", las_1_2(2).substr(0, 100));
-  EXPECT_THAT([&] { read_las(dir / "d.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "d.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("the header is cut short")));
   std::string far = las_1_2(2);
   for (int k = 0; k < 3; ++k) {  // a scale of 10^12
@@ -461,21 +499,21 @@ TEST(LasReader, BadFilesAreRefusedWithTheirPlace) {
     std::memcpy(far.data() + 131 + 8 * k, &scale, 8);
   }
   write_bytes(dir / "f.las", far);
-  EXPECT_THAT([&] { read_las(dir / "f.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "f.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("record 0: coordinate beyond 10^8 m")));
   std::string small_header = las_1_2(2);
   small_header[94] = static_cast<char>(200);  // header size 200 < 227
   write_bytes(dir / "g.las", small_header);
-  EXPECT_THAT([&] { read_las(dir / "g.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "g.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("a header size of 200 bytes, less than")));
   std::string inside = las_1_2(2);
   inside[96] = static_cast<char>(100);  // points at byte 100, inside the header
   inside[97] = 0;
   write_bytes(dir / "h.las", inside);
-  EXPECT_THAT([&] { read_las(dir / "h.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "h.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("inside the 227-byte header")));
   write_bytes(dir / "i.las", las_1_2(0).substr(0, las_1_2(0).size() - 2 * 34));
-  EXPECT_THAT([&] { read_las(dir / "i.las"); },
+  EXPECT_THAT([&] { only(read_las(dir / "i.las")); },
               ThrowsMessage<core::InputError>(HasSubstr("holds no points")));
   write_bytes(dir / "e.laz", "");
   EXPECT_THAT([&] { scan_file_format(dir / "e.laz"); },

@@ -58,8 +58,9 @@ TEST(ImportScans, ABadFileRollsBackTheWholeCall) {
   EXPECT_EQ(scan_names(project), std::vector<std::string>{"tiny_color"});
 }
 
-// An ASCII PLY of 200 points scattered over a cube of side `extent_m`.
-void write_cloud_ply(const std::filesystem::path& path, double extent_m) {
+// An ASCII PLY of 100 points scattered over a cube of side `extent_m`
+// around the origin, and, `apart_m` along x, 100 more.
+void write_cloud_ply(const std::filesystem::path& path, double extent_m, double apart_m = 0.0) {
   std::ofstream out(path, std::ios::binary);
   out << "ply\nformat ascii 1.0\nelement vertex 200\nproperty double x\n"
          "property double y\nproperty double z\nend_header\n";
@@ -68,28 +69,33 @@ void write_cloud_ply(const std::filesystem::path& path, double extent_m) {
       return extent_m * (std::fmod(k * 0.6180339887 + phase, 1.0) - 0.5);
     };
     char line[96];
-    std::snprintf(line, sizeof line, "%.4f %.4f %.4f\n", coordinate(0.1), coordinate(0.37),
+    std::snprintf(line, sizeof line, "%.4f %.4f %.4f\n",
+                  coordinate(0.1) + (k % 2 == 1 ? apart_m : 0.0), coordinate(0.37),
                   coordinate(0.73));
     out << line;
   }
 }
 
-TEST(ImportScans, ACloudTooWideForFloatRangesIsImportedWithAWarningItKeeps) {
-  // Points 20 km apart cannot all come back within 0.1 mm from float ranges
-  // around one centre (a float range errs by up to 0.5 mm at 15 km); 30 m
-  // apart they do.
+TEST(ImportScans, ACloudTooWideForFloatRangesIsTiledAndKeepsATenthOfAMillimetre) {
+  // Points 5 km apart cannot all come back within 0.1 mm from float ranges
+  // around one centre (a float range errs by up to 0.15 mm at 2.5 km): the
+  // cloud becomes one scan per 400 m cube it touches; 30 m apart, one scan.
   ScratchDir dir;
-  write_cloud_ply(dir / "wide.ply", 20000.0);
+  write_cloud_ply(dir / "wide.ply", 30.0, 5000.0);
   write_cloud_ply(dir / "near.ply", 30.0);
   const ImportResult result = import_files(dir / "p.sbproj", {dir / "wide.ply", dir / "near.ply"});
-  ASSERT_EQ(result.beyond_promise.size(), 1u);
-  EXPECT_EQ(result.beyond_promise[0].file, dir / "wide.ply");
-  EXPECT_EQ(result.beyond_promise[0].scan, "wide");
-  EXPECT_GT(result.beyond_promise[0].error_m, acquisition::kPromisedRoundTripM);
-  EXPECT_LT(result.beyond_promise[0].error_m, 1e-2);
-  const auto sources = store::Project::open(dir / "p.sbproj").scan_sources();
-  EXPECT_EQ(sources.at(result.scan_ids[0]).round_trip_error_m, result.beyond_promise[0].error_m);
-  EXPECT_LE(sources.at(result.scan_ids[1]).round_trip_error_m, acquisition::kPromisedRoundTripM);
+  EXPECT_TRUE(result.beyond_promise.empty());
+  ASSERT_EQ(result.scan_ids.size(), 3u);
+  const store::Project project = store::Project::open(dir / "p.sbproj");
+  const auto sources = project.scan_sources();
+  std::vector<std::string> names;
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    names.push_back(stored.summary.name);
+    EXPECT_EQ(stored.summary.valid_points, stored.id == result.scan_ids[2] ? 200u : 100u);
+    EXPECT_EQ(sources.at(stored.id).points_in_file, stored.summary.valid_points);
+    EXPECT_LE(sources.at(stored.id).round_trip_error_m, acquisition::kPromisedRoundTripM);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"wide-1", "wide-2", "near"}));
 }
 
 // Blocks the import once its first file is stored (after every file was

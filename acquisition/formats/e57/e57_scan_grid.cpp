@@ -8,6 +8,7 @@
 #include <optional>
 #include <string_view>
 
+#include "acquisition/formats/point_cloud.hpp"
 #include "acquisition/local_origin.hpp"
 #include "acquisition/spherical_fit.hpp"
 #include "core/errors.hpp"
@@ -335,16 +336,15 @@ class Returns {
     fill_pixels(block, slot_, scales_, channels_);
   }
 
-  // The scattered scan of the returns gathered (asserts there is one).
-  ImportedScan scan() && {
-    assert(!points_.empty() && "a scattered scan of at least one point");
-    ImportedScan out;
-    Scan& scan = out.scan;
-    scan = make_scattered_scan(points_.size(), channels_.has_intensity(), channels_.has_color());
-    std::copy(channels_.intensity.begin(), channels_.intensity.end(), scan.intensity.begin());
-    std::copy(channels_.rgb.begin(), channels_.rgb.end(), scan.rgb.begin());
-    set_scattered_points(scan, std::move(points_));
-    return out;
+  // The scattered scans of the returns gathered (point_cloud.hpp: one, or
+  // tiles of a cloud too wide for one). Throws core::InputError naming
+  // `path` when there is none.
+  std::vector<ImportedScan> scans(const std::filesystem::path& path) && {
+    PointCloud cloud;
+    cloud.points = std::move(points_);
+    cloud.intensity = std::move(channels_.intensity);
+    cloud.rgb = std::move(channels_.rgb);
+    return scattered_scans(std::move(cloud), path);
   }
 
  private:
@@ -411,15 +411,14 @@ std::vector<ImportedScan> structured_scan(const std::filesystem::path& path,
   });
   set_grid(pixels, scan);
   if (unplaced.size() > 0) {
-    const std::size_t kept = unplaced.size();
-    out.push_back(std::move(unplaced).scan());
-    out.back().source.points_in_file = kept;
+    for (ImportedScan& part : std::move(unplaced).scans(path)) out.push_back(std::move(part));
   }
   return out;
 }
 
-ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanEntry& entry,
-                               const PointFields& fields) {
+// The scattered scan of an unstructured entry (or its tiles).
+std::vector<ImportedScan> unstructured_scan(const std::filesystem::path& path,
+                                            const E57ScanEntry& entry, const PointFields& fields) {
   // Each point in double, its channels, and the scattered scan's own
   // channels and directions: about 64 bytes per record.
   core::check_memory(entry.points.record_count * 64, path.string());
@@ -432,8 +431,8 @@ ImportedScan unstructured_scan(const std::filesystem::path& path, const E57ScanE
     throw core::InputError(path.string(), {{}, {}, "scan \"" + entry.name + "\""},
                            "an unstructured scan with no valid point: there is nothing to import");
   }
-  ImportedScan out = std::move(returns).scan();
-  out.source.points_in_file = entry.points.record_count;
+  std::vector<ImportedScan> out = std::move(returns).scans(path);
+  if (out.size() == 1) out[0].source.points_in_file = entry.points.record_count;
   return out;
 }
 
@@ -445,25 +444,27 @@ std::vector<ImportedScan> scans_from_records(const std::filesystem::path& path,
   const PointFields fields = point_fields(path, entry, streams);
   const bool structured = fields.row && fields.column;
   std::vector<ImportedScan> out;
+  const std::string name =
+      entry.name.empty() ? path.stem().string() + "#" + std::to_string(index) : entry.name;
   if (structured) {
     out = structured_scan(path, entry, fields);
     out[0].source.points_in_file = entry.points.record_count;
+    out[0].scan.name = name;
+    name_tiles(std::span(out).subspan(1), name + "-unplaced");
   } else {
-    out.push_back(unstructured_scan(path, entry, fields));
+    out = unstructured_scan(path, entry, fields);
+    name_tiles(out, name);
   }
-  const std::string name =
-      entry.name.empty() ? path.stem().string() + "#" + std::to_string(index) : entry.name;
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    Scan& scan = out[k].scan;
-    const bool grid = k == 0;
-    scan.name = grid ? name : name + "-unplaced";
+  for (ImportedScan& part : out) {
+    Scan& scan = part.scan;
     scan.scanner.name = entry.sensor_model;
     scan.scanner.source_file = path.string();
     scan.scanner.position_world = entry.pose.translation();
     // The grid's local origin (set_grid_from_points) already moved the pose.
     scan.T_world_scan = entry.pose * scan.T_world_scan;
-    out[k].source.format = "e57";
-    out[k].source.guid = grid || entry.guid.empty() ? entry.guid : entry.guid + "-unplaced";
+    part.source.format = "e57";
+    // Unique per part: the entry's, with the part's suffix ("-unplaced", "-2").
+    if (!entry.guid.empty()) part.source.guid = entry.guid + scan.name.substr(name.size());
   }
   return out;
 }

@@ -18,7 +18,10 @@ namespace scanbench::acquisition {
 // checked their lengths): its grid or scattered scan, and for a grid whose
 // records with a return did not all find a pixel of their own (later
 // returns, records repeating a pixel), a scattered scan of those, named
-// NAME-unplaced, with the same pose (its GUID the entry's + "-unplaced"). Throws core::InputError
+// NAME-unplaced, with the same pose. A scattered scan too wide for one is
+// tiled (point_cloud.hpp: scattered_scans), NAME-1, NAME-2, … (or
+// NAME-unplaced-1, …). Each part's GUID is the entry's with the same
+// suffix as its name. Throws core::InputError
 // naming the file and the record or element for a prototype without coordinates or with grid
 // indices that are not Integer fields, indices outside the index bounds, or
 // bounds of more than 16 pixels per record (or 2^30 pixels); throws
