@@ -58,15 +58,18 @@ bool names_source_file(const std::filesystem::path& output, const SourceFile& so
 
 // The source file's description of a scan.
 struct ScanSource {
-  std::string format;  // "e57", "ptx", "triplet", "pcd"
+  std::string format;  // "e57", "ptx", "triplet", "pcd", "las", "ply"
   std::string guid;    // E57: the data3D guid; else empty
   // E57: the file's coordinateMetadata (its coordinate reference system,
   // as the file words it: an EPSG code, WKT, …); else empty.
   std::string coordinate_metadata;
   // Records the file held for the scan (returns or not; for the grid
-  // formats, rows × columns), and how many of them the grid could
-  // not place: a structured scan's later returns and repeated indices (an
-  // unstructured scan places every point: scan.hpp's scattered scans).
+  // formats, rows × columns), and how many of them the grid could not
+  // place: a structured scan's later returns and repeated indices, those
+  // with a return kept in the scattered scan NAME-unplaced beside it (an
+  // unstructured scan places every point: scan.hpp's scattered scans). A
+  // part of a file's scan (NAME-unplaced, a tile of a cloud too wide for
+  // one scan: point_cloud.hpp) counts the points it holds.
   std::uint64_t points_in_file = 0;
   std::uint64_t unplaced_points = 0;
   // The farthest any placed point lies from its value in the file [m]

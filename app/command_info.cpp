@@ -149,7 +149,8 @@ void print_table(const std::string& path, const Contents& contents) {
     if (e.source && e.source->unplaced_points > 0) {
       fmt::print(
           "      {} of the file's {} records not placed in the grid (later returns, or "
-          "records repeating a pixel): those with a return are the scan \"{}-unplaced\"\n",
+          "records repeating a pixel): those with a return, if any, are the scan "
+          "\"{}-unplaced\" (-unplaced-1, … when tiled)\n",
           e.source->unplaced_points, e.source->points_in_file,
           core::one_line(s.name, core::kMaxMessagePart));
     }

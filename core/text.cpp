@@ -32,4 +32,12 @@ bool has_control_characters(std::string_view text) {
   return std::any_of(text.begin(), text.end(), is_control_character);
 }
 
+std::string ascii_lower(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return out;
+}
+
 }  // namespace scanbench::core

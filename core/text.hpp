@@ -2,6 +2,7 @@
 // what it must be before it is stored.
 #pragma once
 
+#include <string>
 #include <string_view>
 
 namespace scanbench::core {
@@ -20,5 +21,9 @@ inline bool is_control_character(char c) {
 
 // True when `text` holds a control character (is_control_character).
 bool has_control_characters(std::string_view text);
+
+// `text` with A–Z made a–z, every other byte as it is (names of file
+// extensions, format keywords and fields, compared without case).
+std::string ascii_lower(std::string_view text);
 
 }  // namespace scanbench::core

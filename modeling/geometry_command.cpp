@@ -31,8 +31,17 @@ GeometryCommandResult geometry_project(store::Project& project,
   for (const store::StoredScanSummary& stored : scans) {
     progress.throw_if_cancelled(kStage);
     const acquisition::Scan scan = project.load_scan(stored.id);
-    const acquisition::GeometryResult geometry = acquisition::compute_geometry(
-        scan, settings, store::load_recorded_geometry(project, stored.id));
+    const acquisition::RecordedGeometry recorded =
+        store::load_recorded_geometry(project, stored.id);
+    if (!recorded.empty() && !scan.is_scattered()) {
+      core::FilePosition position;
+      position.detail = "scan " + std::to_string(stored.id);
+      throw core::InputError(project.path().string(), position,
+                             "project is damaged: a scan grid has recorded normals or footprints, "
+                             "which only an unstructured cloud's file gives");
+    }
+    const acquisition::GeometryResult geometry =
+        acquisition::compute_geometry(scan, settings, recorded);
     const std::vector<store::EncodedLayer> layers = store::encode_geometry(geometry.geometry);
     store::Project::Edit part = command.part();
     for (const store::EncodedLayer& layer : layers) project.put_layer(part, stored.id, layer);

@@ -8,7 +8,6 @@
 #include <tiffio.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
@@ -19,15 +18,13 @@
 #include "acquisition/formats/image_decoder.hpp"
 #include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
+#include "core/text.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
 std::string lower_extension(const std::filesystem::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
+  return core::ascii_lower(path.extension().string());
 }
 
 // ---- PNG -------------------------------------------------------------

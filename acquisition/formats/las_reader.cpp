@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -15,6 +14,7 @@
 #include "acquisition/formats/point_cloud.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
+#include "core/text.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -221,11 +221,10 @@ struct ExtraGeometry {
   std::optional<ExtraField> footprint;
 };
 
+// `name` without case, underscores and spaces: NormalX, normal_x, Normal X.
 std::string squeezed_lower(const std::string& name) {
-  std::string out;
-  for (const char c : name) {
-    if (c != '_' && c != ' ') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
+  std::string out = core::ascii_lower(name);
+  std::erase_if(out, [](char c) { return c == '_' || c == ' '; });
   return out;
 }
 
@@ -247,8 +246,9 @@ ExtraGeometry extra_geometry(LasFile& file, std::uint64_t offset,
     const std::string name = text(data, d + 4, 32);
     const std::size_t size = extra_type_size(type, options);
     if (size == 0) {
-      file.fail(offset + d + 2,
-                "extra bytes field \"" + name + "\" has unknown data type " + std::to_string(type));
+      file.fail(offset + d + 2, "extra bytes field \"" + name + "\" " +
+                                    (type == 0 ? std::string("has no bytes")
+                                               : "has unknown data type " + std::to_string(type)));
     }
     if (next + size > record_length) {
       file.fail(offset + d, "extra bytes field \"" + name + "\" ends at byte " +
@@ -276,7 +276,9 @@ ExtraGeometry extra_geometry(LasFile& file, std::uint64_t offset,
   }
   const auto found = std::count_if(out.normal.begin(), out.normal.end(),
                                    [](const auto& f) { return f.has_value(); });
-  if (found != 3) out.normal = {};  // a part of a normal is no normal
+  if (found % 3 != 0) {
+    file.fail(offset, "the extra bytes hold some but not all of NormalX, NormalY and NormalZ");
+  }
   return out;
 }
 
@@ -316,8 +318,12 @@ Records read_records(LasFile& file, const Header& h) {
 // The value of `field` in the record at `r`; NaN for its no-data value.
 float extra_at(const std::vector<unsigned char>& block, std::size_t r, const ExtraField& field) {
   const double raw = extra_value(block.data() + r + field.at, field.type);
-  if (field.no_data && raw == *field.no_data) return std::numeric_limits<float>::quiet_NaN();
-  return static_cast<float>(raw * field.scale + field.offset);
+  const double value = raw * field.scale + field.offset;
+  // No data, or beyond a float: no value (NaN, which the cloud reads as none).
+  constexpr double kLargest = std::numeric_limits<float>::max();
+  if ((field.no_data && raw == *field.no_data) || !(std::abs(value) <= kLargest))
+    return std::numeric_limits<float>::quiet_NaN();
+  return static_cast<float>(value);
 }
 
 }  // namespace

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +18,7 @@
 #include "acquisition/formats/text_lines.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
+#include "core/text.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -161,13 +161,6 @@ Header read_header(TextLineReader& reader) {
   return h;
 }
 
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
-
 // Where the vertex element's channels are: property indices, -1 for none.
 struct Channels {
   int xyz[3] = {-1, -1, -1};
@@ -180,7 +173,7 @@ struct Channels {
 Channels find_channels(TextLineReader& reader, const Element& vertex) {
   Channels c;
   for (std::size_t k = 0; k < vertex.properties.size(); ++k) {
-    const std::string name = lower(vertex.properties[k].name);
+    const std::string name = core::ascii_lower(vertex.properties[k].name);
     const int index = static_cast<int>(k);
     for (int axis = 0; axis < 3; ++axis) {
       if (name == std::string(1, static_cast<char>('x' + axis))) c.xyz[axis] = index;

@@ -11,6 +11,7 @@
 
 #include "acquisition/local_origin.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 
 namespace scanbench::acquisition {
 
@@ -132,9 +133,13 @@ std::vector<ImportedScan> scattered_scans(PointCloud&& cloud, const std::filesys
     out.push_back(one_scan(std::move(cloud), path));
     return out;
   }
+  // The copy and the scan tried on it, then the tiles beside the cloud:
+  // about as much again as the cloud and its scan.
+  core::check_memory(n * 64, path.string());
   PointCloud copy = cloud;
   out.push_back(one_scan(std::move(copy), path));
   if (out.front().scan.import_round_trip_m <= kPromisedRoundTripM) return out;
+  out.clear();
   return tiles(cloud, path);
 }
 

@@ -1,7 +1,6 @@
 #include "acquisition/formats/scan_files.hpp"
 
 #include <algorithm>
-#include <cctype>
 
 #include "acquisition/formats/e57/e57_reader.hpp"
 #include "acquisition/formats/las_reader.hpp"
@@ -9,13 +8,12 @@
 #include "acquisition/formats/ply_reader.hpp"
 #include "acquisition/formats/triplet_reader.hpp"
 #include "core/errors.hpp"
+#include "core/text.hpp"
 
 namespace scanbench::acquisition {
 
 ScanFileFormat scan_file_format(const std::filesystem::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string extension = core::ascii_lower(path.extension().string());
   if (extension == ".ptx") return ScanFileFormat::kPtx;
   if (extension == ".json") return ScanFileFormat::kTriplet;
   if (extension == ".pcd") return ScanFileFormat::kPcd;

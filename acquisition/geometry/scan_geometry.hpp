@@ -28,9 +28,10 @@ struct ScanGeometry {
   // Radius [m] of the disk that closes the gap to the neighbouring samples;
   // 0 where the pixel is invalid.
   std::vector<float> footprint_m;
-  // Unit normal in the scan frame pointing towards the scanner (those a
-  // scattered scan's file recorded face as the file has them); the zero
-  // vector where the normal is invalid (invalid pixel or kFlagNoNormal).
+  // Unit normal in the scan frame pointing towards the scanner (a scattered
+  // scan's: to its origin, or to the side of the normals its file
+  // recorded, scattered_geometry.hpp); the zero vector where the normal is
+  // invalid (invalid pixel or kFlagNoNormal).
   std::vector<Eigen::Vector3f> normal;
   // [0, 1]: the share of the window the fit used times the cosine of the
   // incidence angle (grazing views estimate normals poorly); 0 where the

@@ -192,10 +192,19 @@ GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettin
       g.flags[i] |= kFlagNoNormal;
       return;
     }
-    if (fit.normal.dot(towards_viewpoint) < 0.0f) fit.normal = -fit.normal;
+    // The side: that of the normals the file recorded around the point,
+    // where there are any (they face the scanner that saw the surface),
+    // else the viewpoint's.
+    Eigen::Vector3f side = towards_viewpoint;
+    if (!recorded.normal.empty()) {
+      Eigen::Vector3f around_sum = Eigen::Vector3f::Zero();
+      for (std::size_t k = 0; k < count; ++k) around_sum += recorded.normal[found[k]];
+      if (!around_sum.isZero()) side = around_sum;
+    }
+    if (fit.normal.dot(side) < 0.0f) fit.normal = -fit.normal;
     g.normal[i] = fit.normal;
     const float share = static_cast<float>(fit.used) / static_cast<float>(count);
-    g.confidence[i] = std::max(1e-6f, share * fit.normal.dot(towards_viewpoint));
+    g.confidence[i] = std::max(1e-6f, share * std::abs(fit.normal.dot(towards_viewpoint)));
     ++normals;
   });
   std::atomic<std::size_t> kept{0};

@@ -37,11 +37,14 @@ namespace scanbench::acquisition {
 // range (a cloud unified from many stations), and it is noise across the
 // surface, which is range noise times the cosine of the incidence. At least
 // 0.1 mm; fewer than 100 such points keep settings.range_noise.
-// Where the file `recorded` a normal, the point has it, facing as the file
-// has it (a cloud's viewpoint is a guess; the file's side is the one its
-// maker meant, outward on a scanned object), with the confidence of the
-// cosine of its incidence, in either direction; where it recorded a
-// footprint, the point has that one.
+// Where the file `recorded` a normal, the point has it as the file has it,
+// with the confidence of the cosine of its incidence; where it recorded a
+// footprint, the point has that one. A cloud's origin need not be where it
+// was seen from (a cloud unified from many stations), so a recorded
+// normal's side, which faces the scanner that saw the surface, is kept
+// rather than turned to the origin; a fitted normal among recorded ones
+// takes their side, so that neighbours agree (registration's matches,
+// picking and backface culling compare sides).
 // Asserts scan.is_scattered() and each of `recorded` empty or one per pixel.
 GeometryResult compute_scattered_geometry(const Scan& scan, const GeometrySettings& settings,
                                           const RecordedGeometry& recorded = {});

@@ -169,7 +169,8 @@ void expect_recorded_geometry(const ImportedScan& read, const Scan& written,
 }
 
 // The geometry of `read` keeps what its file recorded, even a normal facing
-// away from the viewpoint, and finds one where the file has none.
+// away from the viewpoint, and fits one where the file has none, on the
+// side of the recorded ones around it.
 void expect_recorded_geometry_kept(ImportedScan read) {
   const std::size_t n = count_valid(read.scan);
   read.recorded.normal[0] = -read.recorded.normal[0];
@@ -190,8 +191,13 @@ void expect_recorded_geometry_kept(ImportedScan read) {
     }
   }
   EXPECT_TRUE(g.has_normal(1));  // fitted to its neighbours instead
-  EXPECT_GT(std::abs(g.normal[1].dot(exported)), 0.99f);
+  EXPECT_GT(g.normal[1].dot(exported), 0.99f) << "the side of its neighbours'";
   EXPECT_GT(g.footprint_m[2], 0.0f);
+  // Every recorded normal facing away from the viewpoint (outward on the
+  // sphere, as a mesh has them): the fitted one faces away too.
+  for (Eigen::Vector3f& normal : read.recorded.normal) normal = -normal;
+  const ScanGeometry outward = compute_geometry(read.scan, {}, read.recorded).geometry;
+  EXPECT_GT(outward.normal[1].dot(-exported), 0.99f);
 }
 
 TEST(PlyReader, OurExportsNormalsAndFootprintsAreKept) {
@@ -440,14 +446,29 @@ TEST(LasReader, ExtraBytesScaledWithNoDataAndOtherFieldsAround) {
   EXPECT_TRUE(read.recorded.normal[1].isZero()) << "a no-data component: no normal";
   EXPECT_FLOAT_EQ(read.recorded.footprint_m[0], 0.0125f);
   EXPECT_FLOAT_EQ(read.recorded.footprint_m[1], 0.0005f);
-  EXPECT_TRUE(only(read_las(dir / "x.las")).recorded.footprint_m.size() == read.scan.pixel_count());
 
-  // Only two components of a normal are no normal; a field beyond the
-  // record is a damaged file.
+  // A value beyond a float is none.
+  std::vector<std::string> huge(2);
+  for (std::string& record : huge) put<double>(record, 1e300);
+  write_bytes(dir / "h.las", las_1_2(2, extra_descriptor("Footprint", 10), huge));
+  const ImportedScan beyond = only(read_las(dir / "h.las"));
+  EXPECT_EQ(beyond.recorded.footprint_m[0], 0.0f);
+
+  // Damaged records: a part of a normal, a field beyond the record, a
+  // field of no bytes or of an unknown type, a record of part of a
+  // descriptor.
   write_bytes(dir / "y.las",
               las_1_2(2, extra_descriptor("NormalX", 9) + extra_descriptor("NormalY", 9),
                       {std::string(8, '\0'), std::string(8, '\0')}));
-  EXPECT_TRUE(only(read_las(dir / "y.las")).recorded.empty());
+  EXPECT_THAT([&] { only(read_las(dir / "y.las")); },
+              ThrowsMessage<core::InputError>(HasSubstr("some but not all of NormalX")));
+  write_bytes(dir / "v.las", las_1_2(2, extra_descriptor("empty", 0), {"", ""}));
+  EXPECT_THAT([&] { only(read_las(dir / "v.las")); },
+              ThrowsMessage<core::InputError>(HasSubstr("field \"empty\" has no bytes")));
+  write_bytes(dir / "u.las",
+              las_1_2(2, extra_descriptor("Footprint", 9).substr(0, 100), {"1234", "5678"}));
+  EXPECT_THAT([&] { only(read_las(dir / "u.las")); },
+              ThrowsMessage<core::InputError>(HasSubstr("not a whole number of 192-byte")));
   write_bytes(dir / "z.las", las_1_2(2, extra_descriptor("Footprint", 10), {"1234", "5678"}));
   EXPECT_THAT([&] { only(read_las(dir / "z.las")); },
               ThrowsMessage<core::InputError>(

@@ -407,6 +407,11 @@ std::vector<ImportedScan> structured_scan(const std::filesystem::path& path,
       pixels.set(static_cast<std::size_t>(p), block, i, scan);
     }
     fill_pixels(block, pixel, scales, scan);
+    if (any_unplaced && unplaced.size() == 0) {
+      // Up to every record but a pixel's first: a point and its channels
+      // each, and their scattered scan.
+      core::check_memory(entry.points.record_count * 64, path.string());
+    }
     if (any_unplaced) unplaced.add(block, [&pixel](std::size_t i) { return pixel[i] < 0; });
   });
   set_grid(pixels, scan);
