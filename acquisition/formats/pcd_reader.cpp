@@ -16,6 +16,7 @@
 
 #include "acquisition/formats/lzf.hpp"
 #include "acquisition/formats/pcd_header.hpp"
+#include "acquisition/formats/point_cloud.hpp"
 #include "acquisition/formats/text_lines.hpp"
 #include "acquisition/local_origin.hpp"
 #include "core/memory.hpp"
@@ -238,27 +239,29 @@ Eigen::Vector3d coordinates(const std::uint8_t* point, const Fields& f, bool flo
 }
 
 // An unorganized cloud (HEIGHT 1) read as one row: its points with a
-// return, in the file's order, as a scattered scan (scan.hpp).
-Scan scattered(const Scan& row, const std::vector<Eigen::Vector3d>& points) {
-  std::vector<Eigen::Vector3d> returns;
-  returns.reserve(scattered_pixel_count(points.size()));
+// return, in the file's order, as a scattered scan (scan.hpp), or tiles of
+// a cloud too wide for one (point_cloud.hpp), in the row's pose.
+std::vector<ImportedScan> scattered(const Scan& row, const std::vector<Eigen::Vector3d>& points,
+                                    const std::filesystem::path& path) {
+  PointCloud cloud;
+  const std::size_t returns = count_valid(row);
+  cloud.points.reserve(scattered_pixel_count(returns));
+  if (row.has_intensity()) cloud.intensity.reserve(scattered_pixel_count(returns));
+  if (row.has_color()) cloud.rgb.reserve(3 * scattered_pixel_count(returns));
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (row.valid[i]) returns.push_back(points[i]);
-  }
-  Scan scan = make_scattered_scan(returns.size(), row.has_intensity(), row.has_color());
-  for (std::size_t i = 0, k = 0; i < points.size(); ++i) {
     if (!row.valid[i]) continue;
-    if (row.has_intensity()) scan.intensity[k] = row.intensity[i];
-    if (row.has_color()) std::copy_n(&row.rgb[3 * i], 3, &scan.rgb[3 * k]);
-    ++k;
+    cloud.points.push_back(points[i]);
+    if (row.has_intensity()) cloud.intensity.push_back(row.intensity[i]);
+    if (row.has_color()) cloud.rgb.insert(cloud.rgb.end(), &row.rgb[3 * i], &row.rgb[3 * i + 3]);
   }
-  scan.T_world_scan = row.T_world_scan;
-  set_scattered_points(scan, std::move(returns));
-  return scan;
+  std::vector<ImportedScan> out = scattered_scans(std::move(cloud), path);
+  for (ImportedScan& part : out) part.scan.T_world_scan = row.T_world_scan * part.scan.T_world_scan;
+  return out;
 }
 
-Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, const PcdHeader& h,
-             const Fields& f) {
+std::vector<ImportedScan> to_scans(TextLineReader& reader, const std::filesystem::path& path,
+                                   const std::vector<std::uint8_t>& body, const PcdHeader& h,
+                                   const Fields& f) {
   Scan scan = make_empty_scan(static_cast<int>(h.height), static_cast<int>(h.width),
                               f.intensity != nullptr, f.rgb != nullptr);
   const std::size_t n = scan.pixel_count();
@@ -286,17 +289,19 @@ Scan to_scan(TextLineReader& reader, const std::vector<std::uint8_t>& body, cons
   scan.T_world_scan = h.viewpoint;
   if (h.height == 1) {
     if (count_valid(scan) == 0) reader.fail("no point with a return: there is nothing to import");
-    return scattered(scan, points);
+    return scattered(scan, points, path);
   }
   LocalOriginSettings grid;
   grid.try_spherical = false;  // depth-camera grids are pinhole images, not panoramas
   set_grid_from_points(scan, points, std::nullopt, grid);
-  return scan;
+  std::vector<ImportedScan> out(1);
+  out[0].scan = std::move(scan);
+  return out;
 }
 
 }  // namespace
 
-Scan read_pcd(const std::filesystem::path& path) {
+std::vector<ImportedScan> read_pcd(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
     const std::u8string utf8 = path.u8string();
@@ -325,14 +330,18 @@ Scan read_pcd(const std::filesystem::path& path) {
       body = read_compressed_body({reader, path}, header);
       break;
   }
-  Scan scan = to_scan(reader, body, header, fields);
+  std::vector<ImportedScan> out = to_scans(reader, path, body, header, fields);
   const std::u8string stem = path.stem().u8string();
   const std::u8string utf8 = path.u8string();
-  scan.name = std::string(stem.begin(), stem.end());
-  scan.scanner = ScannerMetadata{.name = "",
-                                 .source_file = std::string(utf8.begin(), utf8.end()),
-                                 .position_world = header.viewpoint.translation()};
-  return scan;
+  name_tiles(out, std::string(stem.begin(), stem.end()));
+  for (ImportedScan& part : out) {
+    part.scan.scanner = ScannerMetadata{.name = "",
+                                        .source_file = std::string(utf8.begin(), utf8.end()),
+                                        .position_world = header.viewpoint.translation()};
+    part.source.format = "pcd";
+    if (out.size() == 1) part.source.points_in_file = header.points;  // returns or not
+  }
+  return out;
 }
 
 }  // namespace scanbench::acquisition

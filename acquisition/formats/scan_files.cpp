@@ -65,7 +65,7 @@ void read_scan_file(const std::filesystem::path& path, const ScanFileSettings& s
       return;
     }
     case ScanFileFormat::kPcd:
-      on_scan(plain(read_pcd(path), "pcd"));
+      for (ImportedScan& scan : read_pcd(path)) on_scan(std::move(scan));
       return;
     case ScanFileFormat::kE57:
       read_e57(path, on_scan, on_loose_image);

@@ -18,6 +18,12 @@ namespace {
 using test::fixture;
 using test::ScratchDir;
 
+// The scan of a file that makes one.
+Scan only_scan(std::vector<ImportedScan> scans) {
+  EXPECT_EQ(scans.size(), 1u);
+  return std::move(scans.at(0).scan);
+}
+
 const std::vector<Eigen::Vector3f>& directions(const Scan& scan) {
   return std::get<PerPixelDirections>(scan.angles).directions;
 }
@@ -33,7 +39,7 @@ std::vector<std::uint8_t> rgb_of(const Scan& scan, std::size_t i) {
 }
 
 TEST(PcdReader, ReadsHandWrittenOrganizedAsciiWithExactValues) {
-  const Scan scan = read_pcd(fixture("good/pcd/organized_ascii.pcd"));
+  const Scan scan = only_scan(read_pcd(fixture("good/pcd/organized_ascii.pcd")));
   ASSERT_EQ(scan.rows, 3);
   ASSERT_EQ(scan.columns, 4);
   ASSERT_FALSE(scan.is_spherical());
@@ -58,7 +64,7 @@ TEST(PcdReader, ReadsHandWrittenOrganizedAsciiWithExactValues) {
 }
 
 TEST(PcdReader, AnUnorganizedCloudKeepsEveryReturnInItsOrder) {
-  const Scan scan = read_pcd(fixture("good/pcd/unorganized_ascii.pcd"));
+  const Scan scan = only_scan(read_pcd(fixture("good/pcd/unorganized_ascii.pcd")));
   ASSERT_TRUE(scan.is_scattered());
   ASSERT_TRUE(check_consistency(scan).empty()) << check_consistency(scan);
   ASSERT_EQ(count_valid(scan), 10u) << "12 records, one NaN and one (0, 0, 0)";
@@ -73,6 +79,32 @@ TEST(PcdReader, AnUnorganizedCloudKeepsEveryReturnInItsOrder) {
   EXPECT_EQ(scan.intensity[4], 0.125f);
 }
 
+TEST(PcdReader, AnUnorganizedCloudTooWideForOneScanIsTiled) {
+  // Doubles 5 km apart: one scan would put the far ones 0.15 mm off.
+  const ScratchDir dir;
+  const std::filesystem::path path = dir / "wide.pcd";
+  std::ofstream(path) << "VERSION 0.7\nFIELDS x y z intensity\nSIZE 8 8 8 4\nTYPE F F F F\n"
+                         "COUNT 1 1 1 1\nWIDTH 4\nHEIGHT 1\nPOINTS 4\n"
+                         "VIEWPOINT 10 0 0 1 0 0 0\nDATA ascii\n"
+                         "1.0001 2 3 0.5\n3000.0003 4000 3 0.25\n1 2.5 3.0002 1\n"
+                         "3001.25 4000.0001 3 0\n";
+  const std::vector<ImportedScan> scans = read_pcd(path);
+  ASSERT_EQ(scans.size(), 2u);
+  const Eigen::Vector3d expected[2][2] = {{{11.0001, 2, 3}, {11, 2.5, 3.0002}},
+                                          {{3010.0003, 4000, 3}, {3011.25, 4000.0001, 3}}};
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_EQ(scans[s].scan.name, "wide-" + std::to_string(s + 1));
+    EXPECT_EQ(scans[s].source.format, "pcd");
+    EXPECT_EQ(scans[s].source.points_in_file, 2u);
+    ASSERT_EQ(count_valid(scans[s].scan), 2u);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_LT((point_in_world(scans[s].scan, 0, k) - expected[s][k]).norm(), 1e-4) << s << k;
+    }
+  }
+  EXPECT_EQ(scans[1].scan.intensity[1], 0.0f);
+  EXPECT_EQ(scans[0].scan.intensity[1], 1.0f);
+}
+
 TEST(PcdReader, AnUnorganizedCloudWithoutAReturnIsRefused) {
   const ScratchDir dir;
   const std::filesystem::path path = dir / "nothing.pcd";
@@ -84,7 +116,7 @@ TEST(PcdReader, AnUnorganizedCloudWithoutAReturnIsRefused) {
 }
 
 TEST(PcdReader, TakesPoseFromViewpointAndNameFromStem) {
-  const Scan scan = read_pcd(fixture("good/pcd/organized_ascii.pcd"));
+  const Scan scan = only_scan(read_pcd(fixture("good/pcd/organized_ascii.pcd")));
   // VIEWPOINT 1 2 3 0.70710678 0 0 0.70710678: 90 degrees about z.
   EXPECT_EQ(scan.T_world_scan.translation(), Eigen::Vector3d(1, 2, 3));
   EXPECT_TRUE((scan.T_world_scan.linear() * Eigen::Vector3d::UnitX())
@@ -118,18 +150,18 @@ void expect_pcl_written_cloud(const Scan& scan) {
 }
 
 TEST(PcdReader, ReadsBinaryWrittenByPcl) {
-  expect_pcl_written_cloud(read_pcd(fixture("good/pcd/organized_binary.pcd")));
+  expect_pcl_written_cloud(only_scan(read_pcd(fixture("good/pcd/organized_binary.pcd"))));
 }
 
 TEST(PcdReader, ReadsBinaryCompressedWrittenByPcl) {
-  expect_pcl_written_cloud(read_pcd(fixture("good/pcd/organized_compressed.pcd")));
+  expect_pcl_written_cloud(only_scan(read_pcd(fixture("good/pcd/organized_compressed.pcd"))));
 }
 
 TEST(PcdReader, ReadsPathWithSpacesAndNonAscii) {
   const ScratchDir dir;  // its name already holds a space and an é
   const auto copy = dir / "capture ü 1.pcd";
   std::filesystem::copy_file(fixture("good/pcd/organized_binary.pcd"), copy);
-  const Scan scan = read_pcd(copy);
+  const Scan scan = only_scan(read_pcd(copy));
   EXPECT_EQ(scan.name, "capture ü 1");
   expect_pcl_written_cloud(scan);
 }
@@ -192,7 +224,7 @@ TEST(PcdReader, RefusesADamagedCompressedBody) {
 // moves near the points.
 TEST(PcdReader, WorldCoordinatesKeepATenthOfAMillimetre) {
   const std::filesystem::path path = fixture("good/pcd/world_utm_double.pcd");
-  const Scan scan = read_pcd(path);
+  const Scan scan = only_scan(read_pcd(path));
   std::ifstream in(path);
   std::string line;
   for (int k = 0; k < 11; ++k) std::getline(in, line);
