@@ -112,7 +112,8 @@ echo "JSON description: $out/info.json"
 phase "export"
 "$scanbench" export "$project" --format ply --scan 1 -o "$out/campus_scan_1.ply"
 "$scanbench" export "$project" --format ply --merged -o "$out/campus_merged.ply"
-"$scanbench" export "$samples" --format ptx -o "$out/samples.ptx"
+# A PTX holds scan grids: the first sample scan (the clouds go to CSV and E57).
+"$scanbench" export "$samples" --format ptx --scan 1 -o "$out/samples.ptx"
 "$scanbench" export "$samples" --format csv -o "$out/samples.csv"
 # The merged campus for survey tools (LAS) and scanner software (E57), and
 # the E57 read back into a project of its own.
