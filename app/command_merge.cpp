@@ -1,4 +1,4 @@
-// scanbench merge PROJECT [--settings FILE] [--threads N] [--json]
+// scanbench merge PROJECT [--settings FILE] [--threads N] [--memory-limit SIZE] [--json]
 #include <fmt/core.h>
 
 #include <memory>
@@ -18,6 +18,7 @@ struct MergeOptions {
   registration::MergeSettings settings;
   std::string settings_file;
   bool json = false;
+  std::uint64_t memory_limit = 0;
 };
 
 void run_merge(const MergeOptions& options) {
@@ -28,7 +29,9 @@ void run_merge(const MergeOptions& options) {
   }
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::MergeCommandResult out = modeling::merge_project(project, settings, progress);
+  const modeling::MergeCommandResult out = modeling::merge_project(
+      project, settings, progress,
+      options.memory_limit > 0 ? std::optional(options.memory_limit) : std::nullopt);
   if (options.json) {
     fmt::print("{}\n", modeling::result_json(out));
     return;
@@ -58,6 +61,7 @@ void add_merge_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   add_settings_option(command, options->settings_file);
   add_threads_option(command, options->settings.threads);
+  add_memory_limit_option(command, options->memory_limit);
   command->add_flag("--json", options->json, "Print one JSON object");
   command->callback([options] { run_merge(*options); });
 }

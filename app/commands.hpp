@@ -54,6 +54,18 @@ inline void add_threads_option(CLI::App* command, int& threads) {
       ->check(CLI::Range(0, core::kMaxThreads));
 }
 
+// The --memory-limit option of every streamed stage: how much memory the
+// scans it holds at once may take, with a unit ("6GB", "512MB"; kB = 1000
+// bytes, KiB = 1024); 0 or absent: three quarters of the memory available
+// (modeling::memory_limit_or_default).
+inline void add_memory_limit_option(CLI::App* command, std::uint64_t& bytes) {
+  command
+      ->add_option("--memory-limit", bytes,
+                   "Memory for the scans held at once, e.g. 6GB (default: 3/4 of what is "
+                   "available); a stage that needs more says so and changes nothing")
+      ->transform(CLI::AsSizeValue(true));
+}
+
 // A choice among named values of `Enum`, any case: the option's text
 // becomes the value's number for CLI11 to read, and a text that names none
 // is a usage error that lists the names ("--format: xyz is not one of csv,

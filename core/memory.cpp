@@ -18,12 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string gigabytes(std::uint64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f GB", static_cast<double>(bytes) / 1e9);
-  return text;
-}
-
 void keep_least(std::optional<std::uint64_t>& least, std::uint64_t value) {
   least = least ? std::min(*least, value) : value;
 }
@@ -101,6 +95,12 @@ std::optional<std::uint64_t> address_space_headroom() {
 
 }  // namespace
 
+std::string gigabytes(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GB", static_cast<double>(bytes) / 1e9);
+  return text;
+}
+
 std::optional<std::uint64_t> available_memory_bytes() {
   std::optional<std::uint64_t> least;
   if (const auto system = keyed_number("/proc/meminfo", "MemAvailable:"))
@@ -108,6 +108,12 @@ std::optional<std::uint64_t> available_memory_bytes() {
   if (const auto cgroups = cgroups_headroom()) keep_least(least, *cgroups);
   if (const auto address_space = address_space_headroom()) keep_least(least, *address_space);
   return least;
+}
+
+std::optional<std::uint64_t> peak_resident_bytes() {
+  const std::optional<std::uint64_t> kilobytes = keyed_number("/proc/self/status", "VmHWM:");
+  if (!kilobytes) return std::nullopt;
+  return *kilobytes * 1024;
 }
 
 void check_memory(std::uint64_t bytes, const std::string& file) {

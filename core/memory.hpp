@@ -12,12 +12,21 @@
 
 namespace scanbench::core {
 
+// "1.5 GB": a memory size in messages (decimal gigabytes, one decimal).
+std::string gigabytes(std::uint64_t bytes);
+
 // The memory this process can still be given [bytes]: the least of the
 // system's (MemAvailable of /proc/meminfo), what the memory cgroups of the
 // process and their ancestors still allow (v1 or v2: limit less usage,
 // reclaimable file cache not counted as used), and what RLIMIT_AS leaves of
 // the address space. None where none of them can be told.
 std::optional<std::uint64_t> available_memory_bytes();
+
+// The most memory this process has had resident since it started
+// [bytes]: the kernel's high-water mark (VmHWM of /proc/self/status), for
+// this program image only (a parent's pages before exec do not count).
+// None where it cannot be read.
+std::optional<std::uint64_t> peak_resident_bytes();
 
 // Throws MemoryShortage naming `file` and saying "reading it needs N GB of
 // memory, M GB are available" when `bytes` exceeds what is available.

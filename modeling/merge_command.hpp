@@ -30,10 +30,15 @@ struct MergeCommandResult {
 };
 
 // Computes the keep mask of every scan at its current pose and stores them
-// as one command (new versions of the "keep" layers). Throws as
-// register_project does.
+// as one command (new versions of the "keep" layers). Streams: each scan is
+// compared only with the scans whose bounds reach it (scan_overlaps.hpp),
+// and at most `memory_limit` bytes of scans are loaded at once (default:
+// memory_limit_or_default). Throws core::InputError for a project without
+// scans or a scan without geometry, core::MemoryShortage when two scans do
+// not fit in the limit, core::Cancelled; nothing is stored then.
 MergeCommandResult merge_project(store::Project& project,
                                  const registration::MergeSettings& settings,
-                                 core::Progress& progress);
+                                 core::Progress& progress,
+                                 std::optional<std::uint64_t> memory_limit = std::nullopt);
 
 }  // namespace scanbench::modeling

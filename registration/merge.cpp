@@ -99,36 +99,51 @@ bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Ei
   return area_o <= area_s * t.tie_high && o.index < s_index;
 }
 
-// Decides row `row` of scan s; returns how many (point, other scan) tests
-// the area bound decided.
-std::size_t merge_row(std::span<const PreparedScan> scans, int s_index,
-                      const std::vector<OtherScan>& others, const Thresholds& t, int row,
-                      MergeScanResult& out) {
-  const PreparedScan& s = scans[static_cast<std::size_t>(s_index)];
+// Decides row `row` of scan s against one other scan o, for the points no
+// earlier comparison dropped; returns how many (point, o) tests the area
+// bound decided.
+std::size_t merge_row(const PreparedScan& s, int s_index, const OtherScan& o, const Thresholds& t,
+                      int row, MergeScanResult& out) {
   const int columns = s.scan->columns;
   std::size_t bounded = 0;
   for (int col = 0; col < columns; ++col) {
     const std::size_t i = s.scan->index(row, col);
-    if (!s.in_model[i]) continue;
+    if (!out.keep[i]) continue;
     const float sigma_s = t.range_sigma(s, s.scan->range_m[i]);
-    bool keep = true;
-    for (const OtherScan& o : others) {
-      const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
-      const float range = p.norm();
-      const float sigma_p = t.range_sigma(*o.scan, range);  // what o measures there
-      if (coarser_by_bound(p, range, sigma_p, sigma_s, s.sample_area_m2[i], o, t)) {
-        ++bounded;
-      } else if (finer_elsewhere(s, s_index, i, p, range, sigma_p, sigma_s, o, t)) {
-        keep = false;
-        break;
-      }
+    const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
+    const float range = p.norm();
+    const float sigma_p = t.range_sigma(*o.scan, range);  // what o measures there
+    if (coarser_by_bound(p, range, sigma_p, sigma_s, s.sample_area_m2[i], o, t)) {
+      ++bounded;
+    } else if (finer_elsewhere(s, s_index, i, p, range, sigma_p, sigma_s, o, t)) {
+      out.keep[i] = 0;
     }
-    out.keep[i] = keep ? 1 : 0;
   }
   return bounded;
 }
 
-// The largest footprint per metre of range among the model points of `scan`.
+OtherScan other_scan(const MergeOperand& s, const MergeOperand& o, bool bound) {
+  const Eigen::Isometry3d T_o_s = o.T_world_scan.inverse() * s.T_world_scan;
+  OtherScan entry{o.scan, o.index, T_o_s.linear().cast<float>(), T_o_s.translation().cast<float>()};
+  const auto* angles = std::get_if<acquisition::SphericalAngles>(&o.scan->scan->angles);
+  if (angles != nullptr && bound) {
+    entry.step_solid_angle =
+        static_cast<float>(std::abs(angles->azimuth_step_rad * angles->elevation_step_rad));
+    entry.elevation_step = static_cast<float>(std::abs(angles->elevation_step_rad));
+    entry.inverse_footprint_growth = 1.0f / (1.0f + o.footprint_per_m);
+  }
+  return entry;
+}
+
+Thresholds thresholds_of(const MergeSettings& settings) {
+  return {static_cast<float>(settings.range_sigmas),
+          static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0)),
+          static_cast<float>(1.0 / (1.0 + settings.tie_tolerance)),
+          static_cast<float>(1.0 + settings.tie_tolerance), settings.noise};
+}
+
+}  // namespace
+
 float max_footprint_per_m(const PreparedScan& scan) {
   float largest = 0.0f;
   for (std::size_t k = 0; k < scan.in_model.size(); ++k) {
@@ -139,31 +154,30 @@ float max_footprint_per_m(const PreparedScan& scan) {
   return largest;
 }
 
-std::vector<OtherScan> others_of(std::span<const PreparedScan> scans,
-                                 std::span<const Eigen::Isometry3d> T_world_scan, int s_index,
-                                 std::span<const float> footprint_per_m, bool bound) {
-  std::vector<OtherScan> others;
-  for (int o = 0; o < static_cast<int>(scans.size()); ++o) {
-    if (o == s_index) continue;
-    const Eigen::Isometry3d T_o_s = T_world_scan[static_cast<std::size_t>(o)].inverse() *
-                                    T_world_scan[static_cast<std::size_t>(s_index)];
-    const PreparedScan& other = scans[static_cast<std::size_t>(o)];
-    OtherScan entry{&other, o, T_o_s.linear().cast<float>(), T_o_s.translation().cast<float>()};
-    const auto* angles = std::get_if<acquisition::SphericalAngles>(&other.scan->angles);
-    if (angles != nullptr && bound) {
-      entry.step_solid_angle =
-          static_cast<float>(std::abs(angles->azimuth_step_rad * angles->elevation_step_rad));
-      entry.elevation_step = static_cast<float>(std::abs(angles->elevation_step_rad));
-      entry.inverse_footprint_growth = 1.0f / (1.0f + footprint_per_m[static_cast<std::size_t>(o)]);
-    }
-    others.push_back(entry);
-  }
-  return others;
+MergeScanResult start_merge(const PreparedScan& scan) {
+  MergeScanResult out;
+  out.keep = scan.in_model;
+  return out;
 }
 
-void count(const PreparedScan& s, MergeScanResult& out) {
+void merge_with(MergeScanResult& out, const MergeOperand& s, const MergeOperand& o,
+                const MergeSettings& settings) {
+  assert(out.keep.size() == s.scan->in_model.size() && "start_merge(s) made `out`");
+  const Thresholds thresholds = thresholds_of(settings);
+  const OtherScan other = other_scan(s, o, settings.bound_coarser_scans);
+  std::atomic<std::size_t> bounded{0};
+  core::parallel_for_index(
+      s.scan->scan->rows, settings.threads,
+      [&](int row) { bounded += merge_row(*s.scan, s.index, other, thresholds, row, out); }, 4);
+  out.decided_by_bound += bounded;
+}
+
+void finish_merge(MergeScanResult& out, const PreparedScan& scan) {
+  out.in_model = 0;
+  out.kept = 0;
+  out.redundant = 0;
   for (std::size_t i = 0; i < out.keep.size(); ++i) {
-    if (!s.in_model[i]) continue;
+    if (!scan.in_model[i]) continue;
     ++out.in_model;
     if (out.keep[i]) {
       ++out.kept;
@@ -173,38 +187,24 @@ void count(const PreparedScan& s, MergeScanResult& out) {
   }
 }
 
-}  // namespace
-
 MergeResult merge_by_sampling_rate(std::span<const PreparedScan> scans,
                                    std::span<const Eigen::Isometry3d> T_world_scan,
                                    const MergeSettings& settings) {
   assert(scans.size() == T_world_scan.size() && "one pose per scan");
   const auto start = std::chrono::steady_clock::now();
-  const Thresholds thresholds{
-      static_cast<float>(settings.range_sigmas),
-      static_cast<float>(std::cos(settings.max_normal_angle_deg * std::numbers::pi / 180.0)),
-      static_cast<float>(1.0 / (1.0 + settings.tie_tolerance)),
-      static_cast<float>(1.0 + settings.tie_tolerance), settings.noise};
-  std::vector<float> footprint_per_m(scans.size(), 0.0f);
-  if (settings.bound_coarser_scans) {
-    core::parallel_for_index(static_cast<int>(scans.size()), settings.threads, [&](int s) {
-      footprint_per_m[static_cast<std::size_t>(s)] =
-          max_footprint_per_m(scans[static_cast<std::size_t>(s)]);
-    });
-  }
+  std::vector<MergeOperand> operands(scans.size());
+  core::parallel_for_index(static_cast<int>(scans.size()), settings.threads, [&](int s) {
+    const auto k = static_cast<std::size_t>(s);
+    operands[k] = {&scans[k], s, T_world_scan[k],
+                   settings.bound_coarser_scans ? max_footprint_per_m(scans[k]) : 0.0f};
+  });
   MergeResult result;
-  for (int s = 0; s < static_cast<int>(scans.size()); ++s) {
-    const PreparedScan& scan = scans[static_cast<std::size_t>(s)];
-    const std::vector<OtherScan> others =
-        others_of(scans, T_world_scan, s, footprint_per_m, settings.bound_coarser_scans);
-    MergeScanResult out;
-    out.keep.assign(scan.in_model.size(), 0);
-    std::atomic<std::size_t> bounded{0};
-    core::parallel_for_index(
-        scan.scan->rows, settings.threads,
-        [&](int row) { bounded += merge_row(scans, s, others, thresholds, row, out); }, 4);
-    out.decided_by_bound = bounded;
-    count(scan, out);
+  for (const MergeOperand& s : operands) {
+    MergeScanResult out = start_merge(*s.scan);
+    for (const MergeOperand& o : operands) {
+      if (o.index != s.index) merge_with(out, s, o, settings);
+    }
+    finish_merge(out, *s.scan);
     result.points += out.in_model;
     result.scans.push_back(std::move(out));
   }

@@ -55,6 +55,31 @@ struct MergeResult {
   double seconds = 0.0;
 };
 
+// A scan as one side of a comparison: the prepared scan, its position in
+// the scan list (ties go to the scan listed first), its pose, and
+// max_footprint_per_m of it (0 when settings.bound_coarser_scans is off).
+struct MergeOperand {
+  const PreparedScan* scan = nullptr;
+  int index = 0;
+  Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();
+  float footprint_per_m = 0.0f;
+};
+
+// The largest footprint per metre of range among the model points of
+// `scan`: what the area bound of bound_coarser_scans needs of it.
+float max_footprint_per_m(const PreparedScan& scan);
+
+// The merge of one scan s, one other scan at a time, so that a campaign
+// need not be in memory at once: start_merge keeps every in-model point of
+// s, each merge_with drops the kept points that scan o samples more finely,
+// finish_merge counts. Comparing s with every other scan in list order
+// gives merge_by_sampling_rate's result for s, counts included; a scan
+// that cannot share a surface with s (disjoint bounds) may be left out.
+MergeScanResult start_merge(const PreparedScan& scan);
+void merge_with(MergeScanResult& out, const MergeOperand& s, const MergeOperand& o,
+                const MergeSettings& settings);
+void finish_merge(MergeScanResult& out, const PreparedScan& scan);
+
 // Decides, for every in-model point of every scan, whether another scan
 // observed the same surface (projection into its grid, range and normal
 // agreement) with a smaller sample area (PreparedScan::sample_area_m2, the

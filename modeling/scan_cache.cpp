@@ -1,0 +1,171 @@
+#include "modeling/scan_cache.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <limits>
+#include <utility>
+
+#include "core/errors.hpp"
+#include "core/memory.hpp"
+#include "modeling/store/typed_layers.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+constexpr std::size_t kNever = std::numeric_limits<std::size_t>::max();
+
+// Before the first load: a scan with colour, intensity, geometry and its
+// prepared view takes about this much per pixel; later loads use the most
+// measured.
+constexpr double kFirstBytesPerPixel = 64.0;
+// A point index (kd-tree of a grid without a spherical model) per point.
+constexpr std::size_t kIndexBytesPerPoint = 32;
+
+template <typename T>
+std::size_t heap_bytes(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+
+std::size_t heap_bytes_of(const LoadedScan& loaded) {
+  const acquisition::Scan& s = loaded.scan;
+  std::size_t bytes =
+      heap_bytes(s.range_m) + heap_bytes(s.valid) + heap_bytes(s.intensity) + heap_bytes(s.rgb);
+  if (const auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&s.angles))
+    bytes += heap_bytes(per_pixel->directions);
+  const acquisition::ScanGeometry& g = loaded.geometry;
+  bytes += heap_bytes(g.footprint_m) + heap_bytes(g.normal) + heap_bytes(g.confidence) +
+           heap_bytes(g.flags);
+  const registration::PreparedScan& p = loaded.prepared;
+  bytes += heap_bytes(p.points) + heap_bytes(p.in_model) + heap_bytes(p.usable) +
+           heap_bytes(p.sample_area_m2);
+  if (p.tree) bytes += kIndexBytesPerPoint * p.points.size();
+  return bytes;
+}
+
+}  // namespace
+
+std::uint64_t memory_limit_or_default(std::optional<std::uint64_t> requested) {
+  if (requested) return *requested;
+  constexpr std::uint64_t kUnknown = std::uint64_t{4} << 30;
+  const std::optional<std::uint64_t> available = core::available_memory_bytes();
+  return available ? *available / 4 * 3 : kUnknown;
+}
+
+std::vector<store::StoredScanSummary> scans_with_geometry(const store::Project& project) {
+  std::vector<store::StoredScanSummary> scans = project.scans();
+  if (scans.empty())
+    throw core::InputError(project.path().string(), {}, "the project has no scans");
+  for (const store::StoredScanSummary& stored : scans) {
+    const std::vector<std::string> layers = project.layer_names(stored.id);
+    if (std::find(layers.begin(), layers.end(), store::layer::kNormal) == layers.end()) {
+      throw core::InputError(project.path().string(), {},
+                             "scan " + std::to_string(stored.id) + " (" + stored.summary.name +
+                                 ") has no geometry: run scanbench geometry first");
+    }
+  }
+  return scans;
+}
+
+ScanCache::ScanCache(const store::Project& project, std::vector<std::int64_t> plan,
+                     std::uint64_t memory_limit_bytes, int threads, std::string stage,
+                     core::Progress& progress)
+    : project_(project),
+      plan_(std::move(plan)),
+      next_use_(plan_.size(), kNever),
+      limit_(memory_limit_bytes),
+      threads_(threads),
+      stage_(std::move(stage)),
+      progress_(progress),
+      bytes_per_pixel_(kFirstBytesPerPixel) {
+  std::map<std::int64_t, std::size_t> later;
+  for (std::size_t k = plan_.size(); k-- > 0;) {
+    const auto found = later.find(plan_[k]);
+    if (found != later.end()) next_use_[k] = found->second;
+    later[plan_[k]] = k;
+  }
+  for (const store::StoredScanSummary& stored : project_.scans()) {
+    pixels_[stored.id] = static_cast<std::size_t>(stored.summary.rows) *
+                         static_cast<std::size_t>(stored.summary.columns);
+  }
+}
+
+std::uint64_t ScanCache::bytes_in_hand() const {
+  std::uint64_t bytes = 0;
+  for (const std::weak_ptr<const LoadedScan>& given : given_) {
+    if (const std::shared_ptr<const LoadedScan> scan = given.lock()) bytes += scan->bytes;
+  }
+  return bytes;
+}
+
+// Drops kept scans, farthest next use first, until `bytes` more fit under
+// the limit or only held scans are left.
+void ScanCache::make_room(std::uint64_t bytes) {
+  std::erase_if(given_, [](const auto& given) { return given.expired(); });
+  while (bytes_in_hand() + bytes > limit_) {
+    auto farthest = kept_.end();
+    for (auto it = kept_.begin(); it != kept_.end(); ++it) {
+      if (it->second.scan.use_count() > 1) continue;  // held by the stage
+      if (farthest == kept_.end() || it->second.next_use > farthest->second.next_use) farthest = it;
+    }
+    if (farthest == kept_.end()) return;
+    kept_.erase(farthest);
+  }
+}
+
+std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
+  const auto pixels = pixels_.find(id);
+  if (pixels == pixels_.end())
+    throw core::InputError(project_.path().string(), {}, "no scan with id " + std::to_string(id));
+  const auto estimate =
+      static_cast<std::uint64_t>(bytes_per_pixel_ * static_cast<double>(pixels->second));
+  make_room(estimate);
+  const std::uint64_t in_hand = bytes_in_hand();
+  if (in_hand + estimate > limit_) {
+    throw core::MemoryShortage(project_.path().string(), {},
+                               stage_ + " needs about " + core::gigabytes(in_hand + estimate) +
+                                   " for the scans it works on " + "together (scan " +
+                                   std::to_string(id) +
+                                   " and those in hand), more than its memory " + "limit of " +
+                                   core::gigabytes(limit_) + " (--memory-limit)");
+  }
+  auto loaded = std::make_shared<LoadedScan>();
+  loaded->id = id;
+  std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project_, id);
+  if (!geometry) {
+    throw core::InputError(
+        project_.path().string(), {},
+        "scan " + std::to_string(id) + " has no geometry: run scanbench geometry first");
+  }
+  loaded->geometry = std::move(*geometry);
+  loaded->scan = project_.load_scan(id);
+  loaded->prepared = registration::prepare_scan(loaded->scan, loaded->geometry, threads_);
+  loaded->bytes = heap_bytes_of(*loaded);
+  if (pixels->second > 0) {
+    bytes_per_pixel_ = std::max(
+        bytes_per_pixel_, static_cast<double>(loaded->bytes) / static_cast<double>(pixels->second));
+  }
+  ++loads_;
+  given_.emplace_back(loaded);
+  peak_bytes_ = std::max(peak_bytes_, bytes_in_hand());
+  return loaded;
+}
+
+std::shared_ptr<const LoadedScan> ScanCache::get(std::int64_t id) {
+  assert(position_ < plan_.size() && plan_[position_] == id && "get() follows the plan");
+  const std::size_t next = next_use_[position_++];
+  progress_.throw_if_cancelled(stage_);
+  std::shared_ptr<const LoadedScan> scan;
+  if (const auto found = kept_.find(id); found != kept_.end()) {
+    scan = found->second.scan;
+  } else {
+    scan = load(id);
+  }
+  if (next == kNever) {
+    kept_.erase(id);  // the stage is its last holder
+  } else {
+    kept_[id] = {scan, next};
+  }
+  return scan;
+}
+
+}  // namespace scanbench::modeling

@@ -1,0 +1,102 @@
+// The scans a streamed stage holds at once. A stage plans the order in which
+// it will use the project's scans, then takes them one `get` at a time; the
+// cache loads each scan with its geometry and prepared view when it is
+// needed, drops it as soon as the plan no longer needs it, and, when the
+// scans in hand would exceed the memory limit, gives up the one whose next
+// use is farthest away (Belady's rule, optimal for a known order). Peak
+// memory is then set by how many scans the stage needs together, not by how
+// many the project holds. Internal to modeling/.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "acquisition/geometry/scan_geometry.hpp"
+#include "acquisition/scan.hpp"
+#include "core/progress.hpp"
+#include "modeling/store/project.hpp"
+#include "registration/prepared_scan.hpp"
+
+namespace scanbench::modeling {
+
+// One scan as a stage works on it. Neither copied nor moved: `prepared`
+// points into `scan` and `geometry`.
+struct LoadedScan {
+  std::int64_t id = 0;
+  acquisition::Scan scan;
+  acquisition::ScanGeometry geometry;
+  registration::PreparedScan prepared;
+  std::size_t bytes = 0;  // the heap memory of all three
+
+  LoadedScan() = default;
+  LoadedScan(const LoadedScan&) = delete;
+  LoadedScan& operator=(const LoadedScan&) = delete;
+};
+
+// The memory a stage may fill with loaded scans [bytes]: `requested` when
+// given, else three quarters of what the process can still be given
+// (core::available_memory_bytes), else 4 GB when that cannot be told.
+std::uint64_t memory_limit_or_default(std::optional<std::uint64_t> requested);
+
+// The project's scans (project.scans()), after checking that there is one
+// and that each has its geometry, so that a stage refuses before it works
+// rather than at the scan that lacks it. Throws core::InputError ("run
+// scanbench geometry first").
+std::vector<store::StoredScanSummary> scans_with_geometry(const store::Project& project);
+
+class ScanCache {
+ public:
+  // Scans of `project` (which must outlive the cache) prepared on `threads`
+  // workers; each load is one step of `progress` under `stage`, and checks
+  // for cancellation first. `plan` lists scan ids in the order get() will
+  // be called (an id may repeat).
+  ScanCache(const store::Project& project, std::vector<std::int64_t> plan,
+            std::uint64_t memory_limit_bytes, int threads, std::string stage,
+            core::Progress& progress);
+
+  // The next scan of the plan, which must be `id` (asserted), loaded if it
+  // is not in hand. The caller holds it as long as it uses it; the cache
+  // never drops a scan that is held. Throws core::MemoryShortage, before
+  // loading, when the scans held plus this one would exceed the limit (the
+  // stage needs more at once than it may have), core::InputError when the
+  // scan has no geometry ("run scanbench geometry first") or is damaged,
+  // core::Cancelled when cancelled.
+  std::shared_ptr<const LoadedScan> get(std::int64_t id);
+
+  std::size_t loads() const { return loads_; }
+  // The most memory the scans in hand (held or kept) took at once [bytes].
+  std::uint64_t peak_bytes() const { return peak_bytes_; }
+
+ private:
+  struct Entry {
+    std::shared_ptr<const LoadedScan> scan;
+    std::size_t next_use = 0;  // position in the plan; kNever when none
+  };
+
+  std::uint64_t bytes_in_hand() const;
+  void make_room(std::uint64_t bytes);
+  std::shared_ptr<const LoadedScan> load(std::int64_t id);
+
+  const store::Project& project_;
+  std::vector<std::int64_t> plan_;
+  std::vector<std::size_t> next_use_;  // per plan position: the next one with the same id
+  std::size_t position_ = 0;
+  std::uint64_t limit_;
+  int threads_;
+  std::string stage_;
+  core::Progress& progress_;
+  std::map<std::int64_t, Entry> kept_;
+  // Scans given out, kept or not: memory is theirs until the last holder
+  // lets go.
+  std::vector<std::weak_ptr<const LoadedScan>> given_;
+  std::map<std::int64_t, std::size_t> pixels_;  // per scan, from the summaries
+  double bytes_per_pixel_ = 0.0;                // the most seen so far
+  std::size_t loads_ = 0;
+  std::uint64_t peak_bytes_ = 0;
+};
+
+}  // namespace scanbench::modeling

@@ -1,0 +1,149 @@
+// The streamed stages: the cache of loaded scans, the pairs of scans that
+// may share a surface, and a merge that holds only a few scans at once yet
+// decides as the merge of every scan in memory does.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "modeling/merge_command.hpp"
+#include "modeling/scan_cache.hpp"
+#include "modeling/scan_overlaps.hpp"
+#include "modeling/store/typed_layers.hpp"
+#include "registration/merge.hpp"
+#include "room_project.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::modeling {
+namespace {
+
+using test::ScratchDir;
+
+store::StoredScanSummary summary_with_box(std::int64_t id, Eigen::Vector3d lo, Eigen::Vector3d hi) {
+  store::StoredScanSummary stored;
+  stored.id = id;
+  stored.summary.bbox_world = Eigen::AlignedBox3d(lo, hi);
+  return stored;
+}
+
+TEST(OverlappingPairs, PairsTheBoxesThatReachEachOtherWithinTheMargin) {
+  const std::vector<store::StoredScanSummary> scans{
+      summary_with_box(1, {0, 0, 0}, {10, 10, 3}),
+      summary_with_box(2, {40, 0, 0}, {50, 10, 3}),     // 30 m from the first
+      summary_with_box(3, {8, 8, 0}, {20, 20, 3}),      // overlaps the first
+      summary_with_box(4, {23, 0, 0}, {30, 5, 3}),      // 3 m from the third
+      summary_with_box(5, {0, 0, 100}, {10, 10, 103}),  // above everything
+      store::StoredScanSummary{}};                      // no valid point
+  const std::vector<ScanPair> pairs = overlapping_pairs(scans, 5.0);
+  EXPECT_EQ(pairs, (std::vector<ScanPair>{{0, 2}, {2, 3}}));
+  EXPECT_EQ(overlapping_pairs(scans, 11.0), (std::vector<ScanPair>{{0, 2}, {1, 3}, {2, 3}}));
+}
+
+// Four rooms a few centimetres apart (they share every surface) and one a
+// kilometre away (it shares none), with their geometry.
+class StreamedMergeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const test::RoomScan& room = test::shared_room();
+    for (const double x : {0.0, 0.05, 0.1, 0.15, 1000.0}) {
+      acquisition::Scan scan = room.scan;
+      scan.name = "room at " + std::to_string(x);
+      scan.T_world_scan =
+          Eigen::Translation3d(x, 0.02 * x, 0.0) * Eigen::AngleAxisd(x, Eigen::Vector3d::UnitZ());
+      ids_.push_back(test::insert_committed(project_, scan));
+    }
+    store::Project::Edit edit = project_.begin_command("geometry", "{}");
+    for (const std::int64_t id : ids_) {
+      for (const store::EncodedLayer& layer : store::encode_geometry(room.geometry))
+        project_.put_layer(edit, id, layer);
+    }
+    edit.commit("{}");
+  }
+
+  // The keep masks of the merge of every scan in memory.
+  std::vector<std::vector<std::uint8_t>> merged_in_memory() const {
+    std::vector<acquisition::Scan> scans;
+    std::vector<acquisition::ScanGeometry> geometry;
+    std::vector<Eigen::Isometry3d> poses;
+    for (const std::int64_t id : ids_) {
+      scans.push_back(project_.load_scan(id));
+      geometry.push_back(*store::load_geometry(project_, id));
+      poses.push_back(scans.back().T_world_scan);
+    }
+    std::vector<registration::PreparedScan> prepared;
+    for (std::size_t k = 0; k < scans.size(); ++k)
+      prepared.push_back(registration::prepare_scan(scans[k], geometry[k], 1));
+    registration::MergeResult result = registration::merge_by_sampling_rate(prepared, poses, {});
+    std::vector<std::vector<std::uint8_t>> keep;
+    for (registration::MergeScanResult& scan : result.scans) keep.push_back(std::move(scan.keep));
+    return keep;
+  }
+
+  std::vector<std::uint8_t> stored_keep(std::int64_t id) const {
+    return project_.load_layer<std::uint8_t>(id, store::layer::kKeep, store::ElementType::kU8)
+        .value_or(std::vector<std::uint8_t>{});
+  }
+
+  // The memory one loaded room takes [bytes].
+  std::uint64_t room_bytes() const {
+    core::Progress progress;
+    ScanCache cache(project_, {ids_[0]}, std::uint64_t{1} << 40, 1, "test", progress);
+    return cache.get(ids_[0])->bytes;
+  }
+
+  ScratchDir dir_;
+  store::Project project_ = store::Project::create(dir_ / "rooms.sbproj");
+  std::vector<std::int64_t> ids_;
+};
+
+TEST_F(StreamedMergeTest, TheCacheKeepsWhatThePlanNeedsAndDropsTheRest) {
+  core::Progress progress;
+  const std::vector<std::int64_t> plan{ids_[0], ids_[1], ids_[0], ids_[2], ids_[0], ids_[1]};
+  ScanCache cache(project_, plan, std::uint64_t{1} << 40, 1, "test", progress);
+  for (const std::int64_t id : plan) EXPECT_EQ(cache.get(id)->id, id);
+  EXPECT_EQ(cache.loads(), 3u);  // everything fits: each scan once
+  // Room for two: the third scan pushes out the one needed last (scan 1,
+  // not scan 0), which is loaded again at its turn.
+  ScanCache tight(project_, plan, room_bytes() * 5 / 2, 1, "test", progress);
+  for (const std::int64_t id : plan) EXPECT_EQ(tight.get(id)->id, id);
+  EXPECT_EQ(tight.loads(), 4u);
+  EXPECT_LE(tight.peak_bytes(), room_bytes() * 5 / 2);
+}
+
+TEST_F(StreamedMergeTest, DecidesAsTheMergeOfEveryScanInMemoryWhateverItsLimit) {
+  const std::vector<std::vector<std::uint8_t>> expected = merged_in_memory();
+  std::size_t redundant = 0;
+  for (const auto& keep : expected) redundant += std::count(keep.begin(), keep.end(), 0);
+  ASSERT_GT(redundant, 0u);  // the rooms do share surfaces
+  for (const std::uint64_t limit : {room_bytes() * 5 / 2, std::uint64_t{1} << 40}) {
+    core::Progress progress;
+    const MergeCommandResult out = merge_project(project_, {}, progress, limit);
+    ASSERT_EQ(out.scans.size(), ids_.size());
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      const std::vector<std::uint8_t> keep = stored_keep(ids_[k]);
+      ASSERT_EQ(keep.size(), expected[k].size());
+      EXPECT_TRUE(keep == expected[k]) << "scan " << k << " at limit " << limit;
+      EXPECT_EQ(out.scans[k].counts.kept,
+                static_cast<std::size_t>(std::count(keep.begin(), keep.end(), 1)));
+    }
+    // The far room keeps everything: no scan reaches it.
+    EXPECT_EQ(out.scans.back().counts.redundant, 0u);
+  }
+}
+
+TEST_F(StreamedMergeTest, ALimitTooSmallForTwoScansIsRefusedAndChangesNothing) {
+  const std::int64_t revision = project_.revision();
+  core::Progress progress;
+  try {
+    merge_project(project_, {}, progress, room_bytes() * 3 / 2);
+    FAIL() << "a pair of rooms does not fit";
+  } catch (const core::MemoryShortage& e) {
+    EXPECT_NE(std::string(e.what()).find("--memory-limit"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(project_.revision(), revision);
+  for (const std::int64_t id : ids_) EXPECT_TRUE(stored_keep(id).empty());
+}
+
+}  // namespace
+}  // namespace scanbench::modeling
