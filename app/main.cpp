@@ -7,15 +7,18 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/core/utils/logger.hpp>
 #include <string>
 #include <string_view>
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 
 namespace {
 
@@ -79,9 +82,19 @@ int run_benches(char** argv) {
 }
 #endif
 
-}  // namespace
+// For `bench scale`: the peak memory of this command, written as a number
+// of bytes to the file SCANBENCH_PEAK_RSS_FILE names, when it names one.
+// The parent cannot measure it itself: a child's maximum resident set as
+// wait4 reports it includes the parent's pages it shared until exec.
+void report_peak_memory() {
+  const char* file = std::getenv("SCANBENCH_PEAK_RSS_FILE");
+  if (file == nullptr || *file == '\0') return;
+  if (const std::optional<std::uint64_t> bytes = scanbench::core::peak_resident_bytes()) {
+    std::ofstream(file) << *bytes << '\n';
+  }
+}
 
-int main(int argc, char** argv) {
+int run_command(int argc, char** argv) {
   namespace sb = scanbench::app;
   // Libraries report through our errors; their own logging would print
   // before our one line (a process-wide setting: it belongs here, not in them).
@@ -139,4 +152,12 @@ int main(int argc, char** argv) {
     return report_error("error", e.what(), sb::kExitFailure, 1);
   }
   return sb::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int code = run_command(argc, argv);
+  report_peak_memory();
+  return code;
 }

@@ -1,12 +1,6 @@
 #include "bench/bench_io.hpp"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -25,6 +19,7 @@
 #include "acquisition/formats/point_export.hpp"
 #include "acquisition/formats/ptx_reader.hpp"
 #include "acquisition/formats/ptx_writer.hpp"
+#include "bench/child_process.hpp"
 #include "bench/pcl_io.hpp"
 #include "bench/scratch_folder.hpp"
 #include "modeling/store/project.hpp"
@@ -126,32 +121,14 @@ nlohmann::json compare_pcd_readers(const std::filesystem::path& pcd, double poin
 // exit, in ms: the median of `runs`. What a user waits for a command that
 // does nothing: dynamic linking, static initialisers, parsing. NaN when a
 // run does not exit with `expected_exit` (a crash is no fast start).
-double median_run_ms(const std::filesystem::path& program, std::vector<std::string> arguments,
-                     int expected_exit, int runs) {
-  arguments.insert(arguments.begin(), program.string());
-  std::vector<char*> argv;
-  for (std::string& argument : arguments) argv.push_back(argument.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+double median_run_ms(const std::filesystem::path& program,
+                     const std::vector<std::string>& arguments, int expected_exit, int runs) {
   std::vector<double> ms;
   for (int r = 0; r < runs; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    pid_t child = 0;
-    if (posix_spawn(&child, program.c_str(), &actions, nullptr, argv.data(), environ) != 0) break;
-    int status = 0;
-    while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != expected_exit) {
-      ms.clear();
-      break;
-    }
-    ms.push_back(1e3 *
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    const ChildRun run = run_process(program, arguments, "/dev/null", "/dev/null");
+    if (run.exit_code != expected_exit) return std::numeric_limits<double>::quiet_NaN();
+    ms.push_back(1e3 * run.seconds);
   }
-  posix_spawn_file_actions_destroy(&actions);
   if (ms.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
   return ms[ms.size() / 2];
@@ -161,10 +138,8 @@ double median_run_ms(const std::filesystem::path& program, std::vector<std::stri
 // under 50 ms), for --help, a usage error and a missing file. Null figures
 // when it is not there.
 nlohmann::json startup_times(const std::filesystem::path& dir, bool smoke) {
-  std::error_code error;
-  const std::filesystem::path scanbench =
-      std::filesystem::read_symlink("/proc/self/exe", error).parent_path() / "scanbench";
-  if (error || !std::filesystem::exists(scanbench)) return {{"scanbench", nullptr}};
+  const std::filesystem::path scanbench = scanbench_beside_this();
+  if (scanbench.empty()) return {{"scanbench", nullptr}};
   const int runs = smoke ? 3 : 21;
   const double help = median_run_ms(scanbench, {"--help"}, 0, runs);
   const double usage = median_run_ms(scanbench, {"frobnicate"}, 2, runs);

@@ -8,12 +8,13 @@
 #include "bench/bench_merge.hpp"
 #include "bench/bench_registration.hpp"
 #include "bench/bench_render.hpp"
+#include "bench/bench_scale.hpp"
 #include "bench/bench_segmentation.hpp"
 
 namespace scanbench::bench {
 
 std::vector<std::string> suite_names() {
-  return {"io", "geometry", "registration", "merge", "segmentation", "render", "color"};
+  return {"io", "geometry", "registration", "merge", "segmentation", "render", "color", "scale"};
 }
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
@@ -24,6 +25,7 @@ nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "segmentation") return run_segmentation_bench(options);
   if (name == "render") return run_render_bench(options);
   if (name == "color") return run_color_bench(options);
+  if (name == "scale") return run_scale_bench(options);
   assert(false && "unknown bench suite");
   return {};
 }

@@ -16,6 +16,11 @@ struct BenchOptions {
   bool smoke = false;
   // Where a suite that draws pictures (render) writes them; empty: nowhere.
   std::filesystem::path pictures;
+  // scale: campaign sizes [stations], the scans' resolution and the site.
+  std::vector<int> sizes{1, 4, 16, 64};
+  int columns = 3600;
+  int rows = 900;
+  std::string site = "campus";
 };
 
 std::vector<std::string> suite_names();

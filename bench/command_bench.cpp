@@ -1,4 +1,5 @@
-// scanbench bench SUITE [--json] [--smoke] [--pictures DIR]
+// scanbench bench SUITE [--json] [--smoke] [--pictures DIR] [--sizes N,N,...] [--columns C]
+//                       [--rows R] [--site S]
 #include <fmt/core.h>
 
 #include <memory>
@@ -50,6 +51,16 @@ void add_bench_command(CLI::App& app) {
                     "Tiny inputs: checks the suite runs; figures are not meaningful");
   command->add_option("--pictures", options->bench.pictures,
                       "render: also write each view's truth picture and renders (PNG) here");
+  command
+      ->add_option("--sizes", options->bench.sizes,
+                   "scale: campaign sizes in stations, comma-separated (default 1,4,16,64)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 64));
+  command->add_option("--columns", options->bench.columns, "scale: columns of each scan (3600)")
+      ->check(CLI::Range(8, 36000));
+  command->add_option("--rows", options->bench.rows, "scale: rows of each scan (900)")
+      ->check(CLI::Range(4, 18000));
+  command->add_option("--site", options->bench.site, "scale: simulated site (campus)");
   command->callback([options] { run_bench(*options); });
 }
 

@@ -87,7 +87,8 @@ nlohmann::json to_report(const RegisterCommandResult& out) {
   }
   report["overall"] = {
       {"rms_m", r.rms_m},           {"overlap", r.overlap},     {"inliers", r.correspondences},
-      {"iterations", r.iterations}, {"converged", r.converged}, {"seconds", r.seconds}};
+      {"iterations", r.iterations}, {"converged", r.converged}, {"seconds", r.seconds},
+      {"pair_tests", r.pair_tests}};
   report["poses"] = nlohmann::json::array();
   for (std::size_t k = 0; k < ids.size(); ++k) {
     report["poses"].push_back({{"scan", ids[k]},

@@ -265,7 +265,8 @@ std::vector<ScanEdge> overlapping_edges(std::span<const PreparedScan> scans,
                                         const std::vector<SampleCloud>& samples,
                                         const std::vector<Eigen::Isometry3d>& T_first_scan,
                                         const std::vector<bool>& registered,
-                                        const RegistrationSettings& settings) {
+                                        const RegistrationSettings& settings,
+                                        std::size_t& pair_tests) {
   std::vector<ScanEdge> edges;
   for (int a = 1; a < static_cast<int>(scans.size()); ++a) {
     // A decision on a share: a thinned sample will do.
@@ -279,6 +280,7 @@ std::vector<ScanEdge> overlapping_edges(std::span<const PreparedScan> scans,
                                       T_first_scan[static_cast<std::size_t>(a)];
       const AlignmentQuality quality =
           measure_alignment(estimate, scans[static_cast<std::size_t>(b)], T_b_a, settings.icp);
+      ++pair_tests;
       if (quality.overlap >= settings.min_global_overlap) edges.push_back({a, b});
     }
   }
@@ -381,6 +383,7 @@ Chain register_chain(std::span<const PreparedScan> scans,
     result.coarse_seconds += pair.coarse.seconds;
     result.fine_seconds += pair.seconds - pair.coarse.seconds;
     result.pairs.push_back(std::move(pair));
+    ++result.pair_tests;
     steps.step("registered " + scans[k].scan->name);
   }
   return chain;
@@ -425,8 +428,8 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
   result.coarse_seconds = core::seconds_since(start);
   Chain chain = register_chain(scans, initial_T_world_scan, clouds, settings, steps, result);
 
-  const std::vector<ScanEdge> edges =
-      overlapping_edges(scans, clouds.samples, chain.T_first_scan, chain.registered, settings);
+  const std::vector<ScanEdge> edges = overlapping_edges(
+      scans, clouds.samples, chain.T_first_scan, chain.registered, settings, result.pair_tests);
   if (settings.refine_globally && n > 1 && !edges.empty()) {
     result.global =
         refine_globally(clouds.samples, scans, chain.T_first_scan, edges, settings.global);

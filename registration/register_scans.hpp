@@ -124,6 +124,9 @@ struct RegistrationResult {
   std::size_t correspondences = 0;
   int iterations = 0;
   bool converged = false;
+  // Pairs of scans tested against each other: registered as a pair, or
+  // measured for overlap to decide the global refinement's edges.
+  std::size_t pair_tests = 0;
   // Sampling, features, matching, hypotheses and their verifying ICP runs.
   double coarse_seconds = 0.0;
   double fine_seconds = 0.0;  // ICP of every pair and the global refinement

@@ -232,5 +232,28 @@ TEST(BenchIo, SmokeRunPrintsOneJsonObject) {
   }
 }
 
+TEST(BenchScale, SmokeRunMeasuresEveryStageOfEachCampaignInItsOwnProcess) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "scale", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "scale");
+  ASSERT_EQ(bench["campaigns"].size(), 2u);
+  for (const nlohmann::json& campaign : bench["campaigns"]) {
+    EXPECT_GT(campaign["points"].get<double>(), 0.0);
+    EXPECT_TRUE(campaign["pair_tests"].is_number());
+    EXPECT_TRUE(campaign["max_rotation_error_deg"].is_number());
+    for (const char* stage : {"import", "geometry", "register", "merge", "export_las"}) {
+      const nlohmann::json& figures = campaign["stages"][stage];
+      EXPECT_GT(figures["seconds"].get<double>(), 0.0) << stage;
+      EXPECT_GT(figures["points_per_second"].get<double>(), 0.0) << stage;
+      // Measured in the stage's own process.
+      EXPECT_GT(figures["peak_rss_bytes"].get<double>(), 1e6) << stage;
+    }
+  }
+  EXPECT_TRUE(bench["campaigns"][0]["stages"]["harmonize"].is_null());  // one scan: no pairs
+  EXPECT_GT(bench["campaigns"][1]["stages"]["harmonize"]["seconds"].get<double>(), 0.0);
+}
+
 }  // namespace
 }  // namespace scanbench

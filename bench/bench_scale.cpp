@@ -1,0 +1,179 @@
+#include "bench/bench_scale.hpp"
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bench/child_process.hpp"
+#include "bench/scratch_folder.hpp"
+#include "modeling/store/project.hpp"
+#include "registration/pose_parameters.hpp"
+
+namespace scanbench::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kPoseErrorDeg = "3";
+constexpr const char* kPoseErrorM = "0.5";
+
+// A stage run in its own process; throws naming the stage and quoting its
+// error when it fails.
+ChildRun run_stage(const std::string& stage, const std::vector<std::string>& arguments,
+                   const fs::path& dir) {
+  const fs::path beside = scanbench_beside_this();
+  const ChildRun run = run_process(beside.empty() ? this_executable() : beside, arguments,
+                                   dir / (stage + ".out"), dir / (stage + ".err"));
+  if (run.exit_code != 0) {
+    throw std::runtime_error("bench scale: " + stage + " exited with " +
+                             std::to_string(run.exit_code) + ": " + run.err);
+  }
+  return run;
+}
+
+// The scan files `scanbench simulate` listed ("  scan  PATH" lines).
+std::vector<std::string> simulated_scans(const std::string& out) {
+  std::vector<std::string> files;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    constexpr std::string_view kScan = "  scan  ";
+    if (line.starts_with(kScan)) files.push_back(line.substr(kScan.size()));
+  }
+  return files;
+}
+
+// The true poses of truth.json (docs/simulation.md), in scan order.
+std::vector<Eigen::Isometry3d> true_poses(const fs::path& truth_json) {
+  std::ifstream in(truth_json);
+  const nlohmann::json truth = nlohmann::json::parse(in);
+  std::vector<Eigen::Isometry3d> poses;
+  for (const nlohmann::json& scan : truth.at("scans")) {
+    const auto m = scan.at("T_world_scan").get<std::array<double, 16>>();
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = m[static_cast<std::size_t>(4 * r + c)];
+    }
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+// Registration error of every scan against the truth: the largest rotation
+// [deg] and translation [m].
+std::pair<double, double> registration_errors(const fs::path& project,
+                                              const std::vector<Eigen::Isometry3d>& truth) {
+  const std::vector<store::StoredScanSummary> scans =
+      store::Project::open_read_only(project).scans();
+  double rotation = 0.0;
+  double translation = 0.0;
+  for (std::size_t k = 0; k < scans.size() && k < truth.size(); ++k) {
+    const auto [r, t] = registration::pose_change(truth[k], scans[k].summary.T_world_scan);
+    rotation = std::max(rotation, r * 180.0 / std::numbers::pi);
+    translation = std::max(translation, t);
+  }
+  return {rotation, translation};
+}
+
+std::size_t campaign_points(const fs::path& project) {
+  std::size_t points = 0;
+  for (const store::StoredScanSummary& scan : store::Project::open_read_only(project).scans())
+    points += scan.summary.valid_points;
+  return points;
+}
+
+nlohmann::json stage_json(const ChildRun& run, std::size_t points) {
+  return {{"seconds", run.seconds},
+          {"points_per_second", static_cast<double>(points) / run.seconds},
+          {"peak_rss_bytes", run.peak_rss_bytes}};
+}
+
+nlohmann::json run_campaign(int scans, const BenchOptions& options, const fs::path& dir) {
+  fs::create_directories(dir);
+  const fs::path scan_dir = dir / "scans";
+  const ChildRun simulated =
+      run_stage("simulate",
+                {"simulate", "--site", options.site, "--out", scan_dir.string(), "--scans",
+                 std::to_string(scans), "--columns", std::to_string(options.columns), "--rows",
+                 std::to_string(options.rows), "--pose-error-deg", kPoseErrorDeg, "--pose-error-m",
+                 kPoseErrorM},
+                dir);
+  const std::string project = (dir / "campaign.sbproj").string();
+  std::vector<std::string> import{"import", project};
+  for (const std::string& file : simulated_scans(simulated.out)) import.push_back(file);
+
+  nlohmann::json stages = nlohmann::json::object();
+  const ChildRun imported = run_stage("import", import, dir);
+  const std::size_t points = campaign_points(project);
+  stages["import"] = stage_json(imported, points);
+  stages["geometry"] = stage_json(run_stage("geometry", {"geometry", project}, dir), points);
+  const ChildRun registered = run_stage("register", {"register", project, "--json"}, dir);
+  stages["register"] = stage_json(registered, points);
+  stages["merge"] = stage_json(run_stage("merge", {"merge", project}, dir), points);
+  // One scan has no colour pairs: harmonize refuses it, and rightly.
+  stages["harmonize"] =
+      scans < 2 ? nlohmann::json()
+                : stage_json(run_stage("harmonize", {"harmonize", project}, dir), points);
+  const std::string las = (dir / "merged.las").string();
+  stages["export_las"] = stage_json(
+      run_stage("export_las", {"export", project, "--format", "las", "-o", las, "--merged"}, dir),
+      points);
+
+  const nlohmann::json report = nlohmann::json::parse(registered.out);
+  const auto [rotation, translation] =
+      registration_errors(project, true_poses(scan_dir / "truth.json"));
+  return {{"scans", scans},
+          {"points", points},
+          {"pair_tests", report.at("overall").at("pair_tests")},
+          {"max_rotation_error_deg", rotation},
+          {"max_translation_error_m", translation},
+          {"project_bytes", fs::file_size(project)},
+          {"stages", stages}};
+}
+
+// Per stage, the largest campaign's figure over the 4-station one's.
+nlohmann::json ratios(const nlohmann::json& campaigns, const char* field) {
+  const nlohmann::json* four = nullptr;
+  for (const nlohmann::json& c : campaigns) {
+    if (c["scans"] == 4) four = &c;
+  }
+  const nlohmann::json& largest = campaigns.back();
+  nlohmann::json out = nlohmann::json::object();
+  if (four == nullptr || largest["scans"].get<int>() <= 4) return out;
+  for (const auto& [stage, figures] : largest["stages"].items()) {
+    if (figures.is_null() || (*four)["stages"][stage].is_null()) continue;
+    out[stage] = figures[field].get<double>() / (*four)["stages"][stage][field].get<double>();
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json run_scale_bench(const BenchOptions& requested) {
+  BenchOptions options = requested;
+  if (options.smoke) {
+    options.sizes = {1, 2};
+    options.columns = 720;
+    options.rows = 180;
+  }
+  ScratchFolder scratch("scale");
+  nlohmann::json campaigns = nlohmann::json::array();
+  for (const int size : options.sizes) {
+    campaigns.push_back(run_campaign(size, options, scratch.path() / std::to_string(size)));
+    fs::remove_all(scratch.path() / std::to_string(size));
+  }
+  return {{"suite", "scale"},
+          {"site", options.site},
+          {"columns", options.columns},
+          {"rows", options.rows},
+          {"campaigns", campaigns},
+          {"rss_ratio", ratios(campaigns, "peak_rss_bytes")},
+          {"throughput_ratio", ratios(campaigns, "points_per_second")}};
+}
+
+}  // namespace scanbench::bench
