@@ -108,10 +108,18 @@ std::pair<float, float> intensity_range(const Scan& scan, const std::vector<std:
 }
 
 std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan) {
+  return world_bounds(scan, scan.T_world_scan);
+}
+
+std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan,
+                                                const Eigen::Isometry3d& T_world_scan) {
   Eigen::AlignedBox3d box;  // starts empty
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.columns; ++col) {
-      if (scan.valid[scan.index(row, col)]) box.extend(point_in_world(scan, row, col));
+      const std::size_t i = scan.index(row, col);
+      if (!scan.valid[i]) continue;
+      const double range = scan.range_m[i];
+      box.extend(T_world_scan * (range * direction_precise(scan, row, col)));
     }
   }
   if (box.isEmpty()) return std::nullopt;

@@ -165,6 +165,9 @@ std::pair<float, float> intensity_range(const Scan& scan, const std::vector<std:
 // Axis-aligned bounds of the valid points in the world frame [m]; empty
 // optional when the scan has no valid point.
 std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan);
+// The same with the scan at `T_world_scan` instead of its own pose.
+std::optional<Eigen::AlignedBox3d> world_bounds(const Scan& scan,
+                                                const Eigen::Isometry3d& T_world_scan);
 
 // Checks the channel sizes against rows × columns and the angle model; used by
 // writers and the project before storing. Returns an empty string when the

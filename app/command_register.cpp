@@ -1,5 +1,6 @@
 // scanbench register PROJECT [--coarse features|pairs|none] [--pairs FILE] [--unlevelled]
-//                            [--no-global] [--settings FILE] [--threads N] [--json]
+//                            [--no-global] [--settings FILE] [--threads N]
+//                            [--memory-limit SIZE] [--json]
 #include <fmt/core.h>
 
 #include <map>
@@ -26,6 +27,7 @@ struct RegisterOptions {
   std::string settings_file;
   int threads = 0;
   bool json = false;
+  std::uint64_t memory_limit = 0;
 };
 
 void print_table(const modeling::RegisterCommandResult& out) {
@@ -76,8 +78,9 @@ void run_register(const RegisterOptions& options) {
   s.icp.threads = s.features.threads = s.global.icp.threads = options.threads;
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::RegisterCommandResult out =
-      modeling::register_project(project, settings, progress);
+  const modeling::RegisterCommandResult out = modeling::register_project(
+      project, settings, progress,
+      options.memory_limit > 0 ? std::optional(options.memory_limit) : std::nullopt);
   if (options.json) {
     fmt::print("{}\n", modeling::result_json(out));
   } else {
@@ -120,6 +123,7 @@ void add_register_command(CLI::App& app) {
   command->add_flag("--no-global", options->no_global, "Skip the global refinement")
       ->excludes(settings);
   add_threads_option(command, options->threads);
+  add_memory_limit_option(command, options->memory_limit);
   command->add_flag("--json", options->json, "Print the report as one JSON object");
   command->callback([options] { run_register(*options); });
 }

@@ -83,26 +83,44 @@ std::vector<std::uint8_t> load_carried(const store::Project& project, std::int64
   return stored ? std::move(*stored) : std::vector<std::uint8_t>(pixels, 0);
 }
 
-CarriedAgain carry_objects_again(const store::Project& project, const LoadedScans& loaded,
+CarriedAgain carry_objects_again(const store::Project& project,
+                                 std::span<const store::StoredScanSummary> scans,
+                                 registration::ScanStream& stream,
                                  const std::vector<Eigen::Isometry3d>& poses,
                                  core::Progress& progress) {
   CarriedAgain out;
   const std::map<std::int64_t, CommitSettings> commits = commit_settings_by_node(project);
   if (commits.empty()) return out;
-  const std::size_t n = loaded.ids.size();
+  const int n = static_cast<int>(scans.size());
+  const auto pixels_of = [&scans](int k) {
+    const acquisition::ScanSummary& s = scans[static_cast<std::size_t>(k)].summary;
+    return static_cast<std::size_t>(s.rows) * static_cast<std::size_t>(s.columns);
+  };
   // Each scan's layers are decoded once here, and the drawn pixels kept
   // (a small share of a scan); a target's layers once more below.
-  std::vector<DrawnPixels> drawn(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t pixels = loaded.scans[k].pixel_count();
-    drawn[k] = drawn_pixels(load_membership(project, loaded.ids[k], pixels),
-                            load_carried(project, loaded.ids[k], pixels), commits);
+  std::vector<DrawnPixels> drawn(scans.size());
+  std::vector<int> order;
+  for (int k = 0; k < n; ++k) {
+    const std::int64_t id = scans[static_cast<std::size_t>(k)].id;
+    drawn[static_cast<std::size_t>(k)] =
+        drawn_pixels(load_membership(project, id, pixels_of(k)),
+                     load_carried(project, id, pixels_of(k)), commits);
   }
-  for (std::size_t t = 0; t < n; ++t) {
-    const std::int64_t target_id = loaded.ids[t];
-    progress.update({"register", t, n, "carrying the objects again"});
+  // Each target, then the scans whose drawn objects it may take.
+  for (int t = 0; t < n; ++t) {
+    order.push_back(t);
+    for (int from = 0; from < n; ++from) {
+      if (from != t && !drawn[static_cast<std::size_t>(from)].empty()) order.push_back(from);
+    }
+  }
+  stream.plan(order);
+  for (int t = 0; t < n; ++t) {
+    const std::int64_t target_id = scans[static_cast<std::size_t>(t)].id;
+    progress.update(
+        {"register", static_cast<std::size_t>(t), scans.size(), "carrying the objects again"});
     progress.throw_if_cancelled("register");
-    const std::size_t pixels = loaded.scans[t].pixel_count();
+    const std::shared_ptr<const registration::PreparedScan> target = stream.get(t);
+    const std::size_t pixels = pixels_of(t);
     std::vector<std::uint32_t> membership = load_membership(project, target_id, pixels);
     std::vector<std::uint8_t> carried = load_carried(project, target_id, pixels);
     const std::vector<std::uint32_t> before = membership;
@@ -115,23 +133,24 @@ CarriedAgain carry_objects_again(const store::Project& project, const LoadedScan
       carried[p] = 0;
       open[p] = membership[p] == 0;
     }
-    Grids grids(loaded.scans[t], loaded.geometry[t]);
-    for (std::size_t from = 0; from < n; ++from) {
-      if (from == t) continue;
-      for (const auto& [object, drawn_at] : drawn[from]) {
-        std::vector<std::uint32_t> labels(loaded.scans[from].pixel_count(), 0);
+    Grids grids(*target->scan, *target->geometry);
+    for (int from = 0; from < n; ++from) {
+      if (from == t || drawn[static_cast<std::size_t>(from)].empty()) continue;
+      const std::shared_ptr<const registration::PreparedScan> source = stream.get(from);
+      for (const auto& [object, drawn_at] : drawn[static_cast<std::size_t>(from)]) {
+        std::vector<std::uint32_t> labels(pixels_of(from), 0);
         for (const std::uint32_t p : drawn_at) labels[p] = 1;
         const CommitSettings& commit = commits.at(object);
         CarrySettings settings;
         settings.transfer.noise = commit.range_noise;
         settings.grow = commit.grow;
         // A scattered target has no grid to grow on: it takes the carried points.
-        const segmentation::SegmentationGrid* grid =
-            settings.grow && !loaded.scans[t].is_scattered() ? &grids.with(settings.transfer.noise)
-                                                             : nullptr;
+        const segmentation::SegmentationGrid* grid = settings.grow && !target->scan->is_scattered()
+                                                         ? &grids.with(settings.transfer.noise)
+                                                         : nullptr;
         const segmentation::PixelSet joins =
-            carry_object({&loaded.prepared[from], poses[from], labels},
-                         {&loaded.prepared[t], poses[t], grid, open}, settings);
+            carry_object({source.get(), poses[static_cast<std::size_t>(from)], labels},
+                         {target.get(), poses[static_cast<std::size_t>(t)], grid, open}, settings);
         for (const std::uint32_t q : joins) {
           membership[q] = object;
           carried[q] = 1;

@@ -14,11 +14,12 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
+#include <span>
 #include <vector>
 
 #include "core/progress.hpp"
-#include "modeling/loaded_scans.hpp"
 #include "modeling/store/project.hpp"
+#include "registration/scan_stream.hpp"
 
 namespace scanbench::modeling {
 
@@ -30,13 +31,17 @@ struct CarriedAgain {
   std::size_t carried_points = 0;  // points carried at the new poses
 };
 
-// Carries every object its commit carried again, with the scans `loaded`
-// (register's, with their geometry and prepared views) at `poses` (one per
-// scan, in their order). Decodes each scan's membership and carried layers
-// once, keeping only the pixels its objects were drawn on, and once more as
-// a target; holds the changed layers. Reports progress per target scan as
-// the "register" stage, and throws core::Cancelled when cancelled.
-CarriedAgain carry_objects_again(const store::Project& project, const LoadedScans& loaded,
+// Carries every object its commit carried again, between the project's
+// `scans` (summaries, in order) taken from `stream` (the same scans by
+// position, with their geometry), at `poses` (one per scan, in their
+// order). Decodes each scan's membership and carried layers once, keeping
+// only the pixels its objects were drawn on, and once more as a target;
+// holds the changed layers. Takes each target from the stream with the
+// scans that have drawn objects. Reports progress per target scan as the
+// "register" stage, and throws core::Cancelled when cancelled.
+CarriedAgain carry_objects_again(const store::Project& project,
+                                 std::span<const store::StoredScanSummary> scans,
+                                 registration::ScanStream& stream,
                                  const std::vector<Eigen::Isometry3d>& poses,
                                  core::Progress& progress);
 

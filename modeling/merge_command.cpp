@@ -26,8 +26,10 @@ class StreamedMerge {
         pairs_(overlapping_pairs(scans_)),
         settings_(settings),
         last_pair_(scans_.size()),
-        cache_(project, plan(), memory_limit, settings.threads, kStage, progress),
-        progress_(progress) {}
+        cache_(project, memory_limit, settings.threads, kStage, progress),
+        progress_(progress) {
+    cache_.plan(plan());
+  }
 
   MergeCommandResult run() {
     out_.scans.resize(scans_.size());

@@ -7,8 +7,8 @@
 #include "core/errors.hpp"
 #include "modeling/carried_objects.hpp"
 #include "modeling/command_json.hpp"
-#include "modeling/loaded_scans.hpp"
 #include "modeling/node_tree.hpp"
+#include "modeling/scan_cache.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
@@ -68,37 +68,56 @@ void refuse_when_nothing_registered(const store::Project& project,
                              "no pair of scans registered, nothing stored (" + why + ")");
 }
 
+// Every scan's world bounds at its new pose, each scan taken from the
+// stream once more (those still in hand are not loaded again).
+std::vector<std::optional<Eigen::AlignedBox3d>> world_bounds_at(
+    registration::ScanStream& stream, const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<int> order(stream.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  stream.plan(order);
+  std::vector<std::optional<Eigen::AlignedBox3d>> bounds;
+  for (const int k : order) {
+    bounds.push_back(
+        acquisition::world_bounds(*stream.get(k)->scan, poses[static_cast<std::size_t>(k)]));
+  }
+  return bounds;
+}
+
 }  // namespace
 
 RegisterCommandResult register_project(store::Project& project,
                                        const RegisterCommandSettings& settings,
-                                       core::Progress& progress) {
+                                       core::Progress& progress,
+                                       std::optional<std::uint64_t> memory_limit) {
   constexpr const char* kStage = "register";
   const std::int64_t revision = project.revision();
-  LoadedScans loaded = load_scans(project, settings.registration.icp.threads, kStage, progress);
+  const std::vector<store::StoredScanSummary> scans = scans_with_geometry(project);
+  RegisterCommandResult out;
+  for (const store::StoredScanSummary& stored : scans) {
+    out.ids.push_back(stored.id);
+    out.names.push_back(stored.summary.name);
+    out.initial_T_world_scan.push_back(stored.summary.T_world_scan);
+  }
   registration::RegistrationSettings run = settings.registration;
   if (run.coarse == registration::CoarseMethod::kPointPairs) {
-    run.picks = picks_by_index(settings, loaded.ids, project.path().string());
+    run.picks = picks_by_index(settings, out.ids, project.path().string());
   }
-  RegisterCommandResult out;
-  out.ids = loaded.ids;
-  for (const acquisition::Scan& scan : loaded.scans) {
-    out.names.push_back(scan.name);
-    out.initial_T_world_scan.push_back(scan.T_world_scan);
-  }
-  out.result =
-      registration::register_scans(loaded.prepared, out.initial_T_world_scan, run, &progress);
+  CachedScans stream(project, out.ids, memory_limit_or_default(memory_limit),
+                     settings.registration.icp.threads, kStage, progress);
+  out.result = registration::register_scans(stream, out.initial_T_world_scan, run, &progress);
   progress.throw_if_cancelled(kStage);
   refuse_when_nothing_registered(project, out);
   std::map<std::int64_t, Eigen::Isometry3d> moved;
-  for (std::size_t k = 0; k < loaded.ids.size(); ++k)
-    moved.emplace(loaded.ids[k], out.result.T_world_scan[k]);
+  for (std::size_t k = 0; k < out.ids.size(); ++k)
+    moved.emplace(out.ids[k], out.result.T_world_scan[k]);
   const CarriedAgain carried =
-      carry_objects_again(project, loaded, out.result.T_world_scan, progress);
+      carry_objects_again(project, scans, stream, out.result.T_world_scan, progress);
   out.object_points_released = carried.released;
   out.object_points_carried = carried.carried_points;
   const std::vector<store::ObjectNode> refigured =
       node_figures_after_moving(project, moved, carried.memberships);
+  const std::vector<std::optional<Eigen::AlignedBox3d>> bounds =
+      world_bounds_at(stream, out.result.T_world_scan);
   progress.throw_if_cancelled(kStage);
 
   store::Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);
@@ -111,10 +130,9 @@ RegisterCommandResult register_project(store::Project& project,
         store::encode_layer<std::uint8_t>(store::layer::kCarried, store::ElementType::kU8,
                                           carried.carried.at(scan_id)));
   }
-  for (std::size_t k = 0; k < loaded.scans.size(); ++k) {
-    loaded.scans[k].T_world_scan = out.result.T_world_scan[k];
-    project.set_pose(edit, loaded.ids[k], loaded.scans[k]);
-    project.remove_layer(edit, loaded.ids[k], store::layer::kKeep);
+  for (std::size_t k = 0; k < out.ids.size(); ++k) {
+    project.set_pose(edit, out.ids[k], out.result.T_world_scan[k], bounds[k]);
+    project.remove_layer(edit, out.ids[k], store::layer::kKeep);
   }
   edit.commit(result_json(out));
   return out;

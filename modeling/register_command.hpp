@@ -52,9 +52,13 @@ struct RegisterCommandResult {
 // project, a project without scans, a scan without geometry
 // ("run scanbench geometry first"), or picks that do not name the project's scans as the settings
 // require; core::RuntimeFailure when another process changed data it read
-// meanwhile; core::Cancelled when cancelled. The project is then unchanged.
+// meanwhile; core::MemoryShortage when the scans it needs together exceed
+// `memory_limit` (default: memory_limit_or_default of scan_cache.hpp);
+// core::Cancelled when cancelled. The project is then unchanged. Streams:
+// scans are loaded a few at a time (registration::register_scans).
 RegisterCommandResult register_project(store::Project& project,
                                        const RegisterCommandSettings& settings,
-                                       core::Progress& progress);
+                                       core::Progress& progress,
+                                       std::optional<std::uint64_t> memory_limit = std::nullopt);
 
 }  // namespace scanbench::modeling

@@ -66,27 +66,52 @@ std::vector<store::StoredScanSummary> scans_with_geometry(const store::Project& 
   return scans;
 }
 
-ScanCache::ScanCache(const store::Project& project, std::vector<std::int64_t> plan,
-                     std::uint64_t memory_limit_bytes, int threads, std::string stage,
-                     core::Progress& progress)
+ScanCache::ScanCache(const store::Project& project, std::uint64_t memory_limit_bytes, int threads,
+                     std::string stage, core::Progress& progress)
     : project_(project),
-      plan_(std::move(plan)),
-      next_use_(plan_.size(), kNever),
       limit_(memory_limit_bytes),
       threads_(threads),
       stage_(std::move(stage)),
       progress_(progress),
       bytes_per_pixel_(kFirstBytesPerPixel) {
+  for (const store::StoredScanSummary& stored : project_.scans()) {
+    pixels_[stored.id] = static_cast<std::size_t>(stored.summary.rows) *
+                         static_cast<std::size_t>(stored.summary.columns);
+  }
+}
+
+void ScanCache::plan(std::vector<std::int64_t> order) {
+  plan_ = std::move(order);
+  position_ = 0;
+  next_use_.assign(plan_.size(), kNever);
   std::map<std::int64_t, std::size_t> later;
   for (std::size_t k = plan_.size(); k-- > 0;) {
     const auto found = later.find(plan_[k]);
     if (found != later.end()) next_use_[k] = found->second;
     later[plan_[k]] = k;
   }
-  for (const store::StoredScanSummary& stored : project_.scans()) {
-    pixels_[stored.id] = static_cast<std::size_t>(stored.summary.rows) *
-                         static_cast<std::size_t>(stored.summary.columns);
+  for (auto it = kept_.begin(); it != kept_.end();) {
+    const auto first = later.find(it->first);
+    if (first == later.end()) {
+      it = kept_.erase(it);
+    } else {
+      it->second.next_use = first->second;
+      ++it;
+    }
   }
+}
+
+void CachedScans::plan(std::vector<int> order) {
+  std::vector<std::int64_t> ids;
+  ids.reserve(order.size());
+  for (const int k : order) ids.push_back(ids_[static_cast<std::size_t>(k)]);
+  cache_.plan(std::move(ids));
+}
+
+std::shared_ptr<const registration::PreparedScan> CachedScans::get(int k) {
+  std::shared_ptr<const LoadedScan> loaded = cache_.get(ids_[static_cast<std::size_t>(k)]);
+  const registration::PreparedScan* prepared = &loaded->prepared;
+  return {std::move(loaded), prepared};
 }
 
 std::uint64_t ScanCache::bytes_in_hand() const {

@@ -20,6 +20,7 @@
 #include "core/progress.hpp"
 #include "modeling/store/project.hpp"
 #include "registration/prepared_scan.hpp"
+#include "registration/scan_stream.hpp"
 
 namespace scanbench::modeling {
 
@@ -51,12 +52,14 @@ std::vector<store::StoredScanSummary> scans_with_geometry(const store::Project& 
 class ScanCache {
  public:
   // Scans of `project` (which must outlive the cache) prepared on `threads`
-  // workers; each load is one step of `progress` under `stage`, and checks
-  // for cancellation first. `plan` lists scan ids in the order get() will
-  // be called (an id may repeat).
-  ScanCache(const store::Project& project, std::vector<std::int64_t> plan,
-            std::uint64_t memory_limit_bytes, int threads, std::string stage,
-            core::Progress& progress);
+  // workers; each get checks `progress` for cancellation of `stage`.
+  ScanCache(const store::Project& project, std::uint64_t memory_limit_bytes, int threads,
+            std::string stage, core::Progress& progress);
+
+  // The scan ids in the order the following get() calls will ask for them
+  // (an id may repeat). Replaces the previous plan: scans in hand that it
+  // does not name are let go.
+  void plan(std::vector<std::int64_t> order);
 
   // The next scan of the plan, which must be `id` (asserted), loaded if it
   // is not in hand. The caller holds it as long as it uses it; the cache
@@ -97,6 +100,26 @@ class ScanCache {
   double bytes_per_pixel_ = 0.0;                // the most seen so far
   std::size_t loads_ = 0;
   std::uint64_t peak_bytes_ = 0;
+};
+
+// The project's scans as a registration::ScanStream: position k is the
+// scan ids[k], loaded through a ScanCache.
+class CachedScans final : public registration::ScanStream {
+ public:
+  CachedScans(const store::Project& project, std::vector<std::int64_t> ids,
+              std::uint64_t memory_limit_bytes, int threads, std::string stage,
+              core::Progress& progress)
+      : ids_(std::move(ids)),
+        cache_(project, memory_limit_bytes, threads, std::move(stage), progress) {}
+
+  std::size_t size() const override { return ids_.size(); }
+  void plan(std::vector<int> order) override;
+  std::shared_ptr<const registration::PreparedScan> get(int k) override;
+  const ScanCache& cache() const { return cache_; }
+
+ private:
+  std::vector<std::int64_t> ids_;
+  ScanCache cache_;
 };
 
 }  // namespace scanbench::modeling

@@ -8,6 +8,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "core/parallel.hpp"
@@ -37,22 +38,27 @@ ceres::Solver::Options solver_options(const GlobalSettings& settings) {
 }
 
 // One round: associate every edge at the current poses, then solve jointly.
-// Returns the number of correspondences used.
-std::size_t solve_round(std::span<const SampleCloud> samples, std::span<const PreparedScan> scans,
+// Edges are associated target by target (each target scan taken from the
+// stream once), and enter the problem in their own order. Returns the
+// number of correspondences used.
+std::size_t solve_round(std::span<const SampleCloud> samples, ScanStream& scans,
                         std::span<const ScanEdge> edges, std::vector<PoseParameters>& poses,
                         double gate_m, const GlobalSettings& settings) {
   const double min_cos = std::cos(settings.icp.max_normal_angle_deg * std::numbers::pi / 180.0);
-  std::vector<EdgeMatches> associated;
-  for (const ScanEdge& edge : edges) {
-    const auto a = static_cast<std::size_t>(edge.source);
-    const auto b = static_cast<std::size_t>(edge.target);
+  std::vector<std::vector<PlaneCorrespondence>> matches(edges.size());
+  for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
+    const auto a = static_cast<std::size_t>(edges[e].source);
+    const auto b = static_cast<std::size_t>(edges[e].target);
     const Eigen::Isometry3d T_target_source = poses[b].isometry().inverse() * poses[a].isometry();
-    std::vector<PlaneCorrespondence> matches =
-        plane_correspondences(samples[a], scans[b],
-                              associate_samples(samples[a], scans[b], T_target_source,
-                                                {gate_m, min_cos}, settings.icp.threads));
-    if (matches.size() < settings.icp.min_correspondences) continue;
-    associated.push_back({std::move(matches), &poses[a], &poses[b]});
+    matches[e] = plane_correspondences(samples[a], target,
+                                       associate_samples(samples[a], target, T_target_source,
+                                                         {gate_m, min_cos}, settings.icp.threads));
+  });
+  std::vector<EdgeMatches> associated;
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    if (matches[e].size() < settings.icp.min_correspondences) continue;
+    associated.push_back({std::move(matches[e]), &poses[static_cast<std::size_t>(edges[e].source)],
+                          &poses[static_cast<std::size_t>(edges[e].target)]});
   }
   ceres::Problem problem;
   std::size_t total = 0;
@@ -80,8 +86,20 @@ std::size_t solve_round(std::span<const SampleCloud> samples, std::span<const Pr
 
 }  // namespace
 
-GlobalResult refine_globally(std::span<const SampleCloud> samples,
-                             std::span<const PreparedScan> scans,
+void for_each_target(ScanStream& scans, std::span<const ScanEdge> edges,
+                     const std::function<void(const PreparedScan&, std::size_t)>& visit) {
+  std::map<int, std::vector<std::size_t>> by_target;
+  for (std::size_t e = 0; e < edges.size(); ++e) by_target[edges[e].target].push_back(e);
+  std::vector<int> order;
+  for (const auto& [target, indices] : by_target) order.push_back(target);
+  scans.plan(order);
+  for (const auto& [target, indices] : by_target) {
+    const std::shared_ptr<const PreparedScan> scan = scans.get(target);
+    for (const std::size_t e : indices) visit(*scan, e);
+  }
+}
+
+GlobalResult refine_globally(std::span<const SampleCloud> samples, ScanStream& scans,
                              std::vector<Eigen::Isometry3d> T_first_scan,
                              std::span<const ScanEdge> edges, const GlobalSettings& settings) {
   assert(samples.size() == scans.size() && T_first_scan.size() == scans.size());

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <span>
 #include <vector>
 
 #include "registration/icp.hpp"
+#include "registration/scan_stream.hpp"
 
 namespace scanbench::registration {
 
@@ -43,12 +45,18 @@ struct GlobalResult {
   double seconds = 0.0;
 };
 
+// Calls visit(target scan, edge index) for every edge, target by target in
+// ascending order (each target taken from `scans` once, after announcing
+// the order), the edges of a target in their order.
+void for_each_target(ScanStream& scans, std::span<const ScanEdge> edges,
+                     const std::function<void(const PreparedScan&, std::size_t)>& visit);
+
 // Refines `T_first_scan` (poses of all scans in the first scan's frame;
-// [0] must be the identity, asserted) over `edges`. samples[i] and scans[i]
-// belong to scan i. Edges with too few correspondences in a round add
-// nothing to it.
-GlobalResult refine_globally(std::span<const SampleCloud> samples,
-                             std::span<const PreparedScan> scans,
+// [0] must be the identity, asserted) over `edges`. samples[i] and scan i of
+// `scans` belong to scan i; each round takes every target scan from the
+// stream once. Edges with too few correspondences in a round add nothing to
+// it.
+GlobalResult refine_globally(std::span<const SampleCloud> samples, ScanStream& scans,
                              std::vector<Eigen::Isometry3d> T_first_scan,
                              std::span<const ScanEdge> edges, const GlobalSettings& settings);
 

@@ -199,25 +199,29 @@ bool decided_without_coarse_icp(const IcpResult& best, const SampleCloud& source
   return true;
 }
 
+// The clouds of one scan of a pair: its ICP samples, and its features when
+// the coarse stage uses them.
+struct PairSide {
+  const SampleCloud* samples = nullptr;
+  const FeatureCloud* features = nullptr;
+};
+
 PairReport register_pair(int source, int target, const Eigen::Isometry3d& initial,
-                         std::span<const PreparedScan> scans,
-                         const std::vector<SampleCloud>& samples,
-                         const std::vector<FeatureCloud>& features,
+                         const PairSide& from, const PreparedScan& target_scan, const PairSide& to,
                          const RegistrationSettings& settings) {
   const Clock::time_point start = Clock::now();
   PairReport report;
   report.source = source;
   report.target = target;
-  const auto s = static_cast<std::size_t>(source);
-  const auto t = static_cast<std::size_t>(target);
   std::vector<Candidate> starts = coarse_stage(source, initial, settings, report.coarse);
   // The feature poses' tests are decisions on shares: a thinned sample will do.
   const SampleCloud estimate = settings.coarse == CoarseMethod::kFeatures
-                                   ? thin(samples[s], settings.estimate_samples)
+                                   ? thin(*from.samples, settings.estimate_samples)
                                    : SampleCloud{};
   if (settings.coarse == CoarseMethod::kFeatures) {
-    if (const std::optional<Eigen::Isometry3d> pose = feature_start(
-            features[s], features[t], estimate, scans[t], samples[t], settings, report.coarse)) {
+    if (const std::optional<Eigen::Isometry3d> pose =
+            feature_start(*from.features, *to.features, estimate, target_scan, *to.samples,
+                          settings, report.coarse)) {
       starts.push_back({IcpStart::kCoarse, *pose});
     }
   }
@@ -225,11 +229,11 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
   std::optional<IcpResult> from_coarse;
   for (const Candidate& start : starts) {
     if (start.start == IcpStart::kCoarse && report.coarse.method == CoarseMethod::kFeatures &&
-        best && decided_without_coarse_icp(*best, estimate, scans[t], settings, report.coarse)) {
+        best && decided_without_coarse_icp(*best, estimate, target_scan, settings, report.coarse)) {
       continue;
     }
-    IcpResult icp =
-        point_to_plane_icp(samples[s], scans[t], start.T_target_source, settings.icp, &samples[t]);
+    IcpResult icp = point_to_plane_icp(*from.samples, target_scan, start.T_target_source,
+                                       settings.icp, to.samples);
     if (start.start == IcpStart::kCoarse) from_coarse = icp;
     if (!best || better(icp, *best, settings.max_free_space_violation)) {
       best = icp;
@@ -260,48 +264,91 @@ PairReport register_pair(int source, int target, const Eigen::Isometry3d& initia
   return report;
 }
 
-// Every pair of registered scans that overlaps at the given poses.
-std::vector<ScanEdge> overlapping_edges(std::span<const PreparedScan> scans,
-                                        const std::vector<SampleCloud>& samples,
+// The bounds of a sample cloud in its scan's frame; empty for no sample.
+Eigen::AlignedBox3d bounds_of(const SampleCloud& cloud) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3f& p : cloud.points) box.extend(p.cast<double>());
+  return box;
+}
+
+// Whether `a` (a box in its own frame, moved by T_b_a) comes within
+// margin_m of `b`. Conservative: the moved box's axis-aligned bounds.
+bool boxes_meet(const Eigen::AlignedBox3d& a, const Eigen::Isometry3d& T_b_a,
+                const Eigen::AlignedBox3d& b, double margin_m) {
+  if (a.isEmpty() || b.isEmpty()) return false;
+  Eigen::AlignedBox3d moved;
+  for (int corner = 0; corner < 8; ++corner)
+    moved.extend(T_b_a * a.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)));
+  const Eigen::AlignedBox3d grown(b.min().array() - margin_m, b.max().array() + margin_m);
+  return grown.intersects(moved);
+}
+
+// A source sample matches only within the ICP gate of a target sample's
+// surface, so pairs whose samples' bounds stay farther apart than this
+// cannot overlap [m] (the largest gate of ICP and of the global
+// refinement's first round, with room to spare).
+constexpr double kPairReachM = 2.0;
+
+// Every pair of registered scans that overlaps at the given poses: the
+// pairs whose samples' bounds meet are measured, target by target.
+std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
                                         const std::vector<Eigen::Isometry3d>& T_first_scan,
                                         const std::vector<bool>& registered,
                                         const RegistrationSettings& settings,
                                         std::size_t& pair_tests) {
-  std::vector<ScanEdge> edges;
-  for (int a = 1; a < static_cast<int>(scans.size()); ++a) {
-    // A decision on a share: a thinned sample will do.
-    const SampleCloud estimate =
-        thin(samples[static_cast<std::size_t>(a)], settings.estimate_samples);
+  const int n = static_cast<int>(scans.size());
+  std::vector<Eigen::AlignedBox3d> bounds;
+  for (const SampleCloud& cloud : samples) bounds.push_back(bounds_of(cloud));
+  std::vector<ScanEdge> candidates;  // in (source, target) order
+  for (int a = 1; a < n; ++a) {
     for (int b = 0; b < a; ++b) {
-      if (!registered[static_cast<std::size_t>(a)] || !registered[static_cast<std::size_t>(b)]) {
-        continue;
+      const auto ua = static_cast<std::size_t>(a);
+      const auto ub = static_cast<std::size_t>(b);
+      if (!registered[ua] || !registered[ub]) continue;
+      if (boxes_meet(bounds[ua], T_first_scan[ub].inverse() * T_first_scan[ua], bounds[ub],
+                     kPairReachM)) {
+        candidates.push_back({a, b});
       }
-      const Eigen::Isometry3d T_b_a = T_first_scan[static_cast<std::size_t>(b)].inverse() *
-                                      T_first_scan[static_cast<std::size_t>(a)];
-      const AlignmentQuality quality =
-          measure_alignment(estimate, scans[static_cast<std::size_t>(b)], T_b_a, settings.icp);
-      ++pair_tests;
-      if (quality.overlap >= settings.min_global_overlap) edges.push_back({a, b});
     }
+  }
+  // A decision on a share: a thinned sample will do.
+  std::vector<SampleCloud> estimates(samples.size());
+  std::vector<bool> overlapping(candidates.size(), false);
+  for_each_target(scans, candidates, [&](const PreparedScan& target, std::size_t e) {
+    const auto a = static_cast<std::size_t>(candidates[e].source);
+    const auto b = static_cast<std::size_t>(candidates[e].target);
+    if (estimates[a].points.empty()) estimates[a] = thin(samples[a], settings.estimate_samples);
+    const AlignmentQuality quality = measure_alignment(
+        estimates[a], target, T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
+    ++pair_tests;
+    overlapping[e] = quality.overlap >= settings.min_global_overlap;
+  });
+  std::vector<ScanEdge> edges;
+  for (std::size_t e = 0; e < candidates.size(); ++e) {
+    if (overlapping[e]) edges.push_back(candidates[e]);
   }
   return edges;
 }
 
-void report_edges(std::span<const PreparedScan> scans, const std::vector<SampleCloud>& samples,
+void report_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
                   const std::vector<Eigen::Isometry3d>& T_first_scan,
                   const std::vector<ScanEdge>& edges, const RegistrationSettings& settings,
                   RegistrationResult& result) {
+  std::vector<AlignmentQuality> qualities(edges.size());
+  for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
+    const auto a = static_cast<std::size_t>(edges[e].source);
+    const auto b = static_cast<std::size_t>(edges[e].target);
+    qualities[e] = measure_alignment(samples[a], target,
+                                     T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
+  });
   double sum_squared = 0.0;
   std::size_t sample_count = 0;
-  for (const ScanEdge& edge : edges) {
-    const auto a = static_cast<std::size_t>(edge.source);
-    const auto b = static_cast<std::size_t>(edge.target);
-    const AlignmentQuality quality = measure_alignment(
-        samples[a], scans[b], T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
-    result.edges.push_back({edge.source, edge.target, quality});
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const AlignmentQuality& quality = qualities[e];
+    result.edges.push_back({edges[e].source, edges[e].target, quality});
     sum_squared += quality.rms_m * quality.rms_m * static_cast<double>(quality.correspondences);
     result.correspondences += quality.correspondences;
-    sample_count += samples[a].size();
+    sample_count += samples[static_cast<std::size_t>(edges[e].source)].size();
   }
   if (result.correspondences > 0) result.rms_m = std::sqrt(sum_squared / result.correspondences);
   if (sample_count > 0) result.overlap = static_cast<double>(result.correspondences) / sample_count;
@@ -325,66 +372,77 @@ class StageProgress {
   std::size_t done_ = 0;
 };
 
-// Every scan's ICP samples, and its features when the coarse step uses them.
-struct Clouds {
-  std::vector<SampleCloud> samples;
-  std::vector<FeatureCloud> features;
-};
-
-Clouds prepare_clouds(std::span<const PreparedScan> scans, const RegistrationSettings& settings,
-                      StageProgress& steps) {
-  Clouds clouds;
-  for (const PreparedScan& scan : scans) {
-    clouds.samples.push_back(sample_scan(scan, settings.icp_sample));
-    if (settings.coarse == CoarseMethod::kFeatures) {
-      clouds.features.emplace_back(sample_scan(scan, settings.features.sample), settings.features);
-    }
-    steps.step("features of " + scan.scan->name);
-  }
-  return clouds;
-}
-
-// Every scan's pose in the first scan's frame, and whether it registered
-// (with the whole chain to the first scan).
+// Every scan's pose in the first scan's frame, whether it registered (with
+// the whole chain to the first scan), and its ICP samples.
 struct Chain {
   std::vector<Eigen::Isometry3d> T_first_scan;
   std::vector<bool> registered;
+  std::vector<SampleCloud> samples;
 };
 
-// Registers each scan after the first against its target (the previous
-// scan, or the one its picked point pairs name), chaining the poses; adds
-// each pair's report, iterations and times to `result`.
-Chain register_chain(std::span<const PreparedScan> scans,
-                     std::span<const Eigen::Isometry3d> initial_T_world_scan, const Clouds& clouds,
+// The target of each scan after the first: the previous scan, or the one
+// its picked point pairs name.
+int target_of(int source, const RegistrationSettings& settings) {
+  const PickedPairs* picks =
+      settings.coarse == CoarseMethod::kPointPairs ? picks_for(settings, source) : nullptr;
+  return picks != nullptr ? picks->target : source - 1;
+}
+
+// Registers each scan after the first against its target, chaining the
+// poses, with two scans in hand at a time: each scan is sampled when it is
+// taken as a source (its features kept for the next pair, whose target it
+// is), and its target taken again. Adds each pair's report, iterations and
+// times to `result`.
+Chain register_chain(ScanStream& scans, std::span<const Eigen::Isometry3d> initial_T_world_scan,
                      const RegistrationSettings& settings, StageProgress& steps,
                      RegistrationResult& result) {
-  const std::size_t n = scans.size();
-  Chain chain{std::vector<Eigen::Isometry3d>(n, Eigen::Isometry3d::Identity()),
-              std::vector<bool>(n, true)};
-  for (std::size_t k = 1; k < n; ++k) {
-    const int source = static_cast<int>(k);
-    int target = source - 1;
-    const PickedPairs* picks =
-        settings.coarse == CoarseMethod::kPointPairs ? picks_for(settings, source) : nullptr;
-    if (picks != nullptr) target = picks->target;
+  const int n = static_cast<int>(scans.size());
+  Chain chain{std::vector<Eigen::Isometry3d>(scans.size(), Eigen::Isometry3d::Identity()),
+              std::vector<bool>(scans.size(), true), std::vector<SampleCloud>(scans.size())};
+  std::vector<int> order{0};
+  for (int k = 1; k < n; ++k) order.insert(order.end(), {k, target_of(k, settings)});
+  scans.plan(order);
+  const bool with_features = settings.coarse == CoarseMethod::kFeatures;
+  std::optional<FeatureCloud> previous_features;
+  for (int k = 0; k < n; ++k) {
+    const Clock::time_point start = Clock::now();
+    const auto uk = static_cast<std::size_t>(k);
+    std::shared_ptr<const PreparedScan> source = scans.get(k);
+    chain.samples[uk] = sample_scan(*source, settings.icp_sample);
+    std::optional<FeatureCloud> features;
+    if (with_features)
+      features.emplace(sample_scan(*source, settings.features.sample), settings.features);
+    result.coarse_seconds += core::seconds_since(start);
+    const std::string name = source->scan->name;
+    steps.step("features of " + name);
+    source.reset();
+    if (k == 0) {
+      previous_features = std::move(features);
+      continue;
+    }
+    const int target = target_of(k, settings);
+    assert((!with_features || target == k - 1) && "features chain each scan to the one before");
     const auto t = static_cast<std::size_t>(target);
     // The start: the source's initial pose against the target where the
     // target registered, so that one scan's initial error does not add to
     // the next one's (with a lever arm as long as the distance between them).
     const Eigen::Isometry3d initial_T_first_source =
-        initial_T_world_scan[0].inverse() * initial_T_world_scan[k];
+        initial_T_world_scan[0].inverse() * initial_T_world_scan[uk];
     const Eigen::Isometry3d initial = chain.T_first_scan[t].inverse() * initial_T_first_source;
-    PairReport pair =
-        register_pair(source, target, initial, scans, clouds.samples, clouds.features, settings);
-    chain.T_first_scan[k] =
+    const std::shared_ptr<const PreparedScan> target_scan = scans.get(target);
+    PairReport pair = register_pair(
+        k, target, initial, {&chain.samples[uk], features ? &*features : nullptr}, *target_scan,
+        {&chain.samples[t], previous_features ? &*previous_features : nullptr}, settings);
+    chain.T_first_scan[uk] =
         pair.registered ? chain.T_first_scan[t] * pair.icp.T_target_source : initial_T_first_source;
-    chain.registered[k] = pair.registered && chain.registered[t];
+    chain.registered[uk] = pair.registered && chain.registered[t];
     result.iterations += pair.icp.iterations;
     result.coarse_seconds += pair.coarse.seconds;
     result.fine_seconds += pair.seconds - pair.coarse.seconds;
     result.pairs.push_back(std::move(pair));
     ++result.pair_tests;
-    steps.step("registered " + scans[k].scan->name);
+    previous_features = std::move(features);
+    steps.step("registered " + name);
   }
   return chain;
 }
@@ -416,28 +474,26 @@ const char* icp_start_name(IcpStart start) {
   return start == IcpStart::kCoarse ? "coarse" : "initial";
 }
 
-RegistrationResult register_scans(std::span<const PreparedScan> scans,
+RegistrationResult register_scans(ScanStream& scans,
                                   std::span<const Eigen::Isometry3d> initial_T_world_scan,
                                   const RegistrationSettings& settings, core::Progress* progress) {
-  assert(scans.size() == initial_T_world_scan.size() && !scans.empty());
+  assert(scans.size() == initial_T_world_scan.size() && scans.size() > 0);
   const Clock::time_point start = Clock::now();
   const std::size_t n = scans.size();
   StageProgress steps(progress, 2 * n);  // scans made ready, pairs, the global refinement
-  const Clouds clouds = prepare_clouds(scans, settings, steps);
   RegistrationResult result;
-  result.coarse_seconds = core::seconds_since(start);
-  Chain chain = register_chain(scans, initial_T_world_scan, clouds, settings, steps, result);
+  Chain chain = register_chain(scans, initial_T_world_scan, settings, steps, result);
 
   const std::vector<ScanEdge> edges = overlapping_edges(
-      scans, clouds.samples, chain.T_first_scan, chain.registered, settings, result.pair_tests);
+      scans, chain.samples, chain.T_first_scan, chain.registered, settings, result.pair_tests);
   if (settings.refine_globally && n > 1 && !edges.empty()) {
     result.global =
-        refine_globally(clouds.samples, scans, chain.T_first_scan, edges, settings.global);
+        refine_globally(chain.samples, scans, chain.T_first_scan, edges, settings.global);
     chain.T_first_scan = result.global.T_first_scan;
     result.iterations += result.global.rounds;
     result.fine_seconds += result.global.seconds;
   }
-  report_edges(scans, clouds.samples, chain.T_first_scan, edges, settings, result);
+  report_edges(scans, chain.samples, chain.T_first_scan, edges, settings, result);
   steps.step("global refinement");
 
   for (std::size_t k = 0; k < n; ++k) {
@@ -448,6 +504,13 @@ RegistrationResult register_scans(std::span<const PreparedScan> scans,
       (!settings.refine_globally || n == 1 || result.global.converged);
   result.seconds = core::seconds_since(start);
   return result;
+}
+
+RegistrationResult register_scans(std::span<const PreparedScan> scans,
+                                  std::span<const Eigen::Isometry3d> initial_T_world_scan,
+                                  const RegistrationSettings& settings, core::Progress* progress) {
+  ScansInMemory stream(scans);
+  return register_scans(stream, initial_T_world_scan, settings, progress);
 }
 
 }  // namespace scanbench::registration

@@ -17,6 +17,7 @@
 #include "registration/icp.hpp"
 #include "registration/prepared_scan.hpp"
 #include "registration/rigid_fit.hpp"
+#include "registration/scan_stream.hpp"
 
 namespace scanbench::registration {
 
@@ -140,6 +141,18 @@ struct RegistrationResult {
 // of the result, not errors. With `progress`, reports one unit per scan
 // made ready, per pair and for the global refinement, and throws
 // core::Cancelled between them once cancellation is requested.
+//
+// Scans are taken from `scans` a few at a time: each scan and its target
+// for the pairs (the features of two scans in hand), every target once for
+// the overlap tests of the pairs whose samples' bounds meet, once per round
+// of the global refinement and once for the report. What is kept of every
+// scan is its ICP sample cloud.
+RegistrationResult register_scans(ScanStream& scans,
+                                  std::span<const Eigen::Isometry3d> initial_T_world_scan,
+                                  const RegistrationSettings& settings,
+                                  core::Progress* progress = nullptr);
+
+// The same over scans in memory.
 RegistrationResult register_scans(std::span<const PreparedScan> scans,
                                   std::span<const Eigen::Isometry3d> initial_T_world_scan,
                                   const RegistrationSettings& settings,

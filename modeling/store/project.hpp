@@ -232,6 +232,11 @@ class Project {
   // the scanner position carried along rigidly (T_new · T_old⁻¹ applied to
   // the old one). Throws core::InputError when there is no such scan.
   void set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& scan);
+  // The same with the pose and its world bounds given (acquisition::
+  // world_bounds of the stored scan at that pose), for a stage that no
+  // longer holds the scan.
+  void set_pose(Edit& edit, std::int64_t id, const Eigen::Isometry3d& T_world_scan,
+                const std::optional<Eigen::AlignedBox3d>& bbox_world);
 
   // ---- Layers (modeling/store/layer_store.hpp) -----------------------------------------
 

@@ -260,15 +260,20 @@ std::int64_t Project::insert_scan(Edit& edit, const EncodedScan& scan) {
 
 void Project::set_pose(Edit& edit, std::int64_t id, const acquisition::Scan& scan) {
   check_edit(edit);
-  assert(scan.T_world_scan.matrix().allFinite() && "set_pose takes a finite pose");
   [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);  // throws when none
   assert(n == scan.pixel_count() && "set_pose takes the stored scan");
+  set_pose(edit, id, scan.T_world_scan, acquisition::world_bounds(scan));
+}
+
+void Project::set_pose(Edit& edit, std::int64_t id, const Eigen::Isometry3d& T_world_scan,
+                       const std::optional<Eigen::AlignedBox3d>& bbox_world) {
+  check_edit(edit);
+  assert(T_world_scan.matrix().allFinite() && "set_pose takes a finite pose");
   // The scanner moves with its scan: its position in the scan frame stays.
-  const StoredScanSummary before = current_summary(id);
-  const Eigen::Vector3d scanner_world = scan.T_world_scan * before.summary.T_world_scan.inverse() *
-                                        before.summary.scanner.position_world;
-  insert_pose(db(), file_name(), id, edit.command_id(), scan.T_world_scan, scanner_world,
-              acquisition::world_bounds(scan));
+  const StoredScanSummary before = current_summary(id);  // throws when there is none
+  const Eigen::Vector3d scanner_world =
+      T_world_scan * before.summary.T_world_scan.inverse() * before.summary.scanner.position_world;
+  insert_pose(db(), file_name(), id, edit.command_id(), T_world_scan, scanner_world, bbox_world);
 }
 
 StoredScanSummary Project::current_summary(std::int64_t id) const {

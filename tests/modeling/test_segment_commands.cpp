@@ -12,6 +12,7 @@
 #include "core/errors.hpp"
 #include "modeling/carried_objects.hpp"
 #include "modeling/node_tree.hpp"
+#include "modeling/scan_cache.hpp"
 #include "modeling/selection_commands.hpp"
 #include "modeling/selection_tools.hpp"
 #include "modeling/store/typed_layers.hpp"
@@ -295,9 +296,12 @@ TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
 
   // A registration swaps them: the second scan moves away, the later one comes.
   core::Progress quiet;
-  const LoadedScans loaded = load_scans(project, 1, "register", quiet);
-  ASSERT_EQ(loaded.ids, (std::vector<std::int64_t>{first, second, later}));
-  const CarriedAgain again = carry_objects_again(project, loaded, {here, away, here}, quiet);
+  const std::vector<store::StoredScanSummary> scans = project.scans();
+  std::vector<std::int64_t> ids;
+  for (const store::StoredScanSummary& scan : scans) ids.push_back(scan.id);
+  ASSERT_EQ(ids, (std::vector<std::int64_t>{first, second, later}));
+  CachedScans stream(project, ids, std::uint64_t{1} << 40, 1, "register", quiet);
+  const CarriedAgain again = carry_objects_again(project, scans, stream, {here, away, here}, quiet);
   EXPECT_EQ(again.released, in_second);
   EXPECT_EQ(again.carried_points, in_second);
   EXPECT_EQ(again.memberships.count(first), 0u);  // drawn there: unchanged
@@ -311,8 +315,10 @@ TEST(SegmentCommands, CarriedPointsFollowTheScansNewPoses) {
   EXPECT_EQ(static_cast<std::size_t>(std::count(carried.begin(), carried.end(), 1)), in_second);
   // Nothing moved: nothing changes.
   std::vector<Eigen::Isometry3d> where_they_are;
-  for (const acquisition::Scan& scan : loaded.scans) where_they_are.push_back(scan.T_world_scan);
-  EXPECT_TRUE(carry_objects_again(project, loaded, where_they_are, quiet).memberships.empty());
+  for (const store::StoredScanSummary& scan : scans)
+    where_they_are.push_back(scan.summary.T_world_scan);
+  EXPECT_TRUE(
+      carry_objects_again(project, scans, stream, where_they_are, quiet).memberships.empty());
 }
 
 // A review's rejected proposals go in one command, its accepted ones move

@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "modeling/merge_command.hpp"
+#include "modeling/register_command.hpp"
 #include "modeling/scan_cache.hpp"
 #include "modeling/scan_overlaps.hpp"
 #include "modeling/store/typed_layers.hpp"
@@ -40,9 +41,9 @@ TEST(OverlappingPairs, PairsTheBoxesThatReachEachOtherWithinTheMargin) {
   EXPECT_EQ(overlapping_pairs(scans, 11.0), (std::vector<ScanPair>{{0, 2}, {1, 3}, {2, 3}}));
 }
 
-// Four rooms a few centimetres apart (they share every surface) and one a
+// Four rooms a few centimetres and degrees apart (they share every surface) and one a
 // kilometre away (it shares none), with their geometry.
-class StreamedMergeTest : public ::testing::Test {
+class StreamedStagesTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const test::RoomScan& room = test::shared_room();
@@ -61,20 +62,30 @@ class StreamedMergeTest : public ::testing::Test {
     edit.commit("{}");
   }
 
-  // The keep masks of the merge of every scan in memory.
-  std::vector<std::vector<std::uint8_t>> merged_in_memory() const {
+  // Every scan of the project in memory, prepared.
+  struct InMemory {
     std::vector<acquisition::Scan> scans;
     std::vector<acquisition::ScanGeometry> geometry;
     std::vector<Eigen::Isometry3d> poses;
-    for (const std::int64_t id : ids_) {
-      scans.push_back(project_.load_scan(id));
-      geometry.push_back(*store::load_geometry(project_, id));
-      poses.push_back(scans.back().T_world_scan);
-    }
     std::vector<registration::PreparedScan> prepared;
-    for (std::size_t k = 0; k < scans.size(); ++k)
-      prepared.push_back(registration::prepare_scan(scans[k], geometry[k], 1));
-    registration::MergeResult result = registration::merge_by_sampling_rate(prepared, poses, {});
+  };
+  std::unique_ptr<InMemory> in_memory() const {
+    auto all = std::make_unique<InMemory>();
+    for (const std::int64_t id : ids_) {
+      all->scans.push_back(project_.load_scan(id));
+      all->geometry.push_back(*store::load_geometry(project_, id));
+      all->poses.push_back(all->scans.back().T_world_scan);
+    }
+    for (std::size_t k = 0; k < ids_.size(); ++k)
+      all->prepared.push_back(registration::prepare_scan(all->scans[k], all->geometry[k], 1));
+    return all;
+  }
+
+  // The keep masks of the merge of every scan in memory.
+  std::vector<std::vector<std::uint8_t>> merged_in_memory() const {
+    const std::unique_ptr<InMemory> all = in_memory();
+    registration::MergeResult result =
+        registration::merge_by_sampling_rate(all->prepared, all->poses, {});
     std::vector<std::vector<std::uint8_t>> keep;
     for (registration::MergeScanResult& scan : result.scans) keep.push_back(std::move(scan.keep));
     return keep;
@@ -88,7 +99,8 @@ class StreamedMergeTest : public ::testing::Test {
   // The memory one loaded room takes [bytes].
   std::uint64_t room_bytes() const {
     core::Progress progress;
-    ScanCache cache(project_, {ids_[0]}, std::uint64_t{1} << 40, 1, "test", progress);
+    ScanCache cache(project_, std::uint64_t{1} << 40, 1, "test", progress);
+    cache.plan({ids_[0]});
     return cache.get(ids_[0])->bytes;
   }
 
@@ -97,21 +109,23 @@ class StreamedMergeTest : public ::testing::Test {
   std::vector<std::int64_t> ids_;
 };
 
-TEST_F(StreamedMergeTest, TheCacheKeepsWhatThePlanNeedsAndDropsTheRest) {
+TEST_F(StreamedStagesTest, TheCacheKeepsWhatThePlanNeedsAndDropsTheRest) {
   core::Progress progress;
   const std::vector<std::int64_t> plan{ids_[0], ids_[1], ids_[0], ids_[2], ids_[0], ids_[1]};
-  ScanCache cache(project_, plan, std::uint64_t{1} << 40, 1, "test", progress);
+  ScanCache cache(project_, std::uint64_t{1} << 40, 1, "test", progress);
+  cache.plan(plan);
   for (const std::int64_t id : plan) EXPECT_EQ(cache.get(id)->id, id);
   EXPECT_EQ(cache.loads(), 3u);  // everything fits: each scan once
   // Room for two: the third scan pushes out the one needed last (scan 1,
   // not scan 0), which is loaded again at its turn.
-  ScanCache tight(project_, plan, room_bytes() * 5 / 2, 1, "test", progress);
+  ScanCache tight(project_, room_bytes() * 5 / 2, 1, "test", progress);
+  tight.plan(plan);
   for (const std::int64_t id : plan) EXPECT_EQ(tight.get(id)->id, id);
   EXPECT_EQ(tight.loads(), 4u);
   EXPECT_LE(tight.peak_bytes(), room_bytes() * 5 / 2);
 }
 
-TEST_F(StreamedMergeTest, DecidesAsTheMergeOfEveryScanInMemoryWhateverItsLimit) {
+TEST_F(StreamedStagesTest, DecidesAsTheMergeOfEveryScanInMemoryWhateverItsLimit) {
   const std::vector<std::vector<std::uint8_t>> expected = merged_in_memory();
   std::size_t redundant = 0;
   for (const auto& keep : expected) redundant += std::count(keep.begin(), keep.end(), 0);
@@ -132,7 +146,32 @@ TEST_F(StreamedMergeTest, DecidesAsTheMergeOfEveryScanInMemoryWhateverItsLimit) 
   }
 }
 
-TEST_F(StreamedMergeTest, ALimitTooSmallForTwoScansIsRefusedAndChangesNothing) {
+TEST_F(StreamedStagesTest, RegistrationWithTwoScansInHandEqualsTheOneInMemory) {
+  RegisterCommandSettings settings;
+  settings.registration.coarse = registration::CoarseMethod::kNone;
+  settings.registration.icp.threads = 1;
+  const std::unique_ptr<InMemory> all = in_memory();
+  const registration::RegistrationResult expected =
+      registration::register_scans(all->prepared, all->poses, settings.registration);
+  core::Progress progress;
+  const RegisterCommandResult out =
+      register_project(project_, settings, progress, room_bytes() * 5 / 2);
+  ASSERT_EQ(out.result.T_world_scan.size(), ids_.size());
+  for (std::size_t k = 0; k < ids_.size(); ++k) {
+    EXPECT_TRUE(out.result.T_world_scan[k].isApprox(expected.T_world_scan[k], 1e-12)) << k;
+    EXPECT_TRUE(project_.scans()[k].summary.T_world_scan.isApprox(expected.T_world_scan[k], 1e-12));
+  }
+  EXPECT_EQ(out.result.edges.size(), expected.edges.size());
+  EXPECT_EQ(out.result.rms_m, expected.rms_m);
+  // The chain's 4 pairs, and the 6 pairs among the rooms that share
+  // surfaces: the far room's bounds meet none (all pairs: 4 + 10).
+  EXPECT_EQ(out.result.pair_tests, 10u);
+  // The stored bounds are the scans' at their new poses.
+  const acquisition::Scan moved = project_.load_scan(ids_[1]);
+  EXPECT_TRUE(project_.scans()[1].summary.bbox_world->isApprox(*acquisition::world_bounds(moved)));
+}
+
+TEST_F(StreamedStagesTest, ALimitTooSmallForTwoScansIsRefusedAndChangesNothing) {
   const std::int64_t revision = project_.revision();
   core::Progress progress;
   try {
