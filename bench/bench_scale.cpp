@@ -23,13 +23,22 @@ namespace fs = std::filesystem;
 constexpr const char* kPoseErrorDeg = "3";
 constexpr const char* kPoseErrorM = "0.5";
 
-// A stage run in its own process; throws naming the stage and quoting its
-// error when it fails.
+// A stage past this is stopped and reported as timed out [s].
+constexpr double kStageTimeoutS = 1800.0;
+
+// A stage run in its own process.
 ChildRun run_stage(const std::string& stage, const std::vector<std::string>& arguments,
                    const fs::path& dir) {
   const fs::path beside = scanbench_beside_this();
-  const ChildRun run = run_process(beside.empty() ? this_executable() : beside, arguments,
-                                   dir / (stage + ".out"), dir / (stage + ".err"));
+  return run_process(beside.empty() ? this_executable() : beside, arguments, dir / (stage + ".out"),
+                     dir / (stage + ".err"), kStageTimeoutS);
+}
+
+// The same for a stage the campaign cannot do without: throws naming it
+// and quoting its error when it fails.
+ChildRun run_needed_stage(const std::string& stage, const std::vector<std::string>& arguments,
+                          const fs::path& dir) {
+  ChildRun run = run_stage(stage, arguments, dir);
   if (run.exit_code != 0) {
     throw std::runtime_error("bench scale: " + stage + " exited with " +
                              std::to_string(run.exit_code) + ": " + run.err);
@@ -87,7 +96,15 @@ std::size_t campaign_points(const fs::path& project) {
   return points;
 }
 
+// A stage's figures; for a stage that failed, how (its error, or that it
+// ran past kStageTimeoutS) instead of a throughput.
 nlohmann::json stage_json(const ChildRun& run, std::size_t points) {
+  if (run.exit_code != 0) {
+    return {{"seconds", run.seconds},
+            {"exit_code", run.exit_code},
+            {"timed_out", run.timed_out},
+            {"error", run.err.substr(0, 500)}};
+  }
   return {{"seconds", run.seconds},
           {"points_per_second", static_cast<double>(points) / run.seconds},
           {"peak_rss_bytes", run.peak_rss_bytes}};
@@ -108,7 +125,7 @@ nlohmann::json run_campaign(int scans, const BenchOptions& options, const fs::pa
   for (const std::string& file : simulated_scans(simulated.out)) import.push_back(file);
 
   nlohmann::json stages = nlohmann::json::object();
-  const ChildRun imported = run_stage("import", import, dir);
+  const ChildRun imported = run_needed_stage("import", import, dir);
   const std::size_t points = campaign_points(project);
   stages["import"] = stage_json(imported, points);
   stages["geometry"] = stage_json(run_stage("geometry", {"geometry", project}, dir), points);
@@ -124,12 +141,12 @@ nlohmann::json run_campaign(int scans, const BenchOptions& options, const fs::pa
       run_stage("export_las", {"export", project, "--format", "las", "-o", las, "--merged"}, dir),
       points);
 
-  const nlohmann::json report = nlohmann::json::parse(registered.out);
+  const nlohmann::json report = nlohmann::json::parse(registered.out, nullptr, false);
   const auto [rotation, translation] =
       registration_errors(project, true_poses(scan_dir / "truth.json"));
   return {{"scans", scans},
           {"points", points},
-          {"pair_tests", report.at("overall").at("pair_tests")},
+          {"pair_tests", report.is_object() ? report["overall"]["pair_tests"] : nlohmann::json()},
           {"max_rotation_error_deg", rotation},
           {"max_translation_error_m", translation},
           {"project_bytes", fs::file_size(project)},
@@ -146,7 +163,8 @@ nlohmann::json ratios(const nlohmann::json& campaigns, const char* field) {
   nlohmann::json out = nlohmann::json::object();
   if (four == nullptr || largest["scans"].get<int>() <= 4) return out;
   for (const auto& [stage, figures] : largest["stages"].items()) {
-    if (figures.is_null() || (*four)["stages"][stage].is_null()) continue;
+    const nlohmann::json& at_four = (*four)["stages"][stage];
+    if (!figures.contains(field) || !at_four.contains(field)) continue;
     out[stage] = figures[field].get<double>() / (*four)["stages"][stage][field].get<double>();
   }
   return out;

@@ -8,7 +8,9 @@
 // harmonize (null for one station: no colour pairs), export_las (--merged).
 // Per stage: "seconds" (wall, from spawn
 // to exit), "points_per_second" (the campaign's valid points / seconds) and
-// "peak_rss_bytes" (the kernel's maximum resident set of that process).
+// "peak_rss_bytes" (the kernel's maximum resident set of that process). A
+// stage that fails or runs past 30 minutes reports "exit_code",
+// "timed_out" and "error" instead, and the campaign goes on.
 //
 // Per campaign also: "scans", "points", "pair_tests" (pairs of scans the
 // registration tested), the registration's "max_rotation_error_deg" and

@@ -1,6 +1,7 @@
 #include "bench/child_process.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 
@@ -11,6 +12,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <string_view>
+#include <thread>
 
 #include "core/timing.hpp"
 
@@ -39,7 +41,7 @@ std::filesystem::path scanbench_beside_this() {
 
 ChildRun run_process(const std::filesystem::path& program,
                      const std::vector<std::string>& arguments, const std::filesystem::path& out,
-                     const std::filesystem::path& err) {
+                     const std::filesystem::path& err, double timeout_s) {
   std::vector<std::string> words{program.string()};
   words.insert(words.end(), arguments.begin(), arguments.end());
   std::vector<char*> argv;
@@ -66,11 +68,20 @@ ChildRun run_process(const std::filesystem::path& program,
   posix_spawn_file_actions_destroy(&files);
   if (spawned != 0)
     throw std::runtime_error("cannot start " + program.string() + ": " + std::strerror(spawned));
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
-  }
   ChildRun run;
+  int status = 0;
+  const int options = timeout_s > 0.0 ? WNOHANG : 0;
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, options);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR)
+      throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
+    if (done == 0 && core::seconds_since(start) > timeout_s && !run.timed_out) {
+      ::kill(pid, SIGKILL);
+      run.timed_out = true;
+    }
+    if (done == 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
   run.seconds = core::seconds_since(start);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (!peak_file.empty()) {

@@ -12,6 +12,7 @@ namespace scanbench::bench {
 
 struct ChildRun {
   int exit_code = 0;     // -1 when killed by a signal
+  bool timed_out = false;  // killed for running past its time
   double seconds = 0.0;  // from spawning to exit
   // The kernel's high-water mark of the program's resident memory (VmHWM),
   // as scanbench reports it through SCANBENCH_PEAK_RSS_FILE; 0 for other
@@ -32,10 +33,11 @@ std::filesystem::path scanbench_beside_this();
 
 // Runs `program` with `arguments` (argv[1..]), its standard output and
 // error written to the files `out` and `err` (read back into the result;
-// /dev/null reads back empty), and waits for it. Throws std::runtime_error
+// /dev/null reads back empty), and waits for it, at most `timeout_s`
+// seconds (0: as long as it runs), then kills it. Throws std::runtime_error
 // when the process cannot be started.
 ChildRun run_process(const std::filesystem::path& program,
                      const std::vector<std::string>& arguments, const std::filesystem::path& out,
-                     const std::filesystem::path& err);
+                     const std::filesystem::path& err, double timeout_s = 0.0);
 
 }  // namespace scanbench::bench
