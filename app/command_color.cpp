@@ -2,7 +2,8 @@
 //                           [--saturation S] [--reset] [--json]
 // scanbench recolor PROJECT --to ID (--clone SRC_ID | --clone-region SCAN:ROW0:COL0:ROW1:COL1 |
 //                           --paint-color '#RRGGBB') [--paint] [--json]
-// scanbench harmonize PROJECT [--model gain-offset|matrix] [--settings FILE] [--threads N] [--json]
+// scanbench harmonize PROJECT [--model gain-offset|matrix] [--settings FILE] [--threads N]
+//                             [--memory-limit SIZE] [--json]
 #include <fmt/core.h>
 
 #include <charconv>
@@ -146,6 +147,7 @@ struct HarmonizeOptions {
   std::string settings_file;
   int threads = 0;
   bool json = false;
+  std::uint64_t memory_limit = 0;
 };
 
 void run_harmonize(const HarmonizeOptions& options) {
@@ -156,8 +158,9 @@ void run_harmonize(const HarmonizeOptions& options) {
   settings.pairs.threads = settings.solve.threads = options.threads;
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::HarmonizeCommandResult out =
-      modeling::harmonize_project(project, settings, progress);
+  const modeling::HarmonizeCommandResult out = modeling::harmonize_project(
+      project, settings, progress,
+      options.memory_limit > 0 ? std::optional(options.memory_limit) : std::nullopt);
   if (options.json) {
     fmt::print("{}\n", modeling::result_json(out));
     return;
@@ -242,6 +245,7 @@ void add_harmonize_command(CLI::App& app) {
       ->default_str("gain-offset")
       ->excludes(settings);
   add_threads_option(command, options->threads);
+  add_memory_limit_option(command, options->memory_limit);
   command->add_flag("--json", options->json, "Print one JSON object");
   command->callback([options] { run_harmonize(*options); });
 }

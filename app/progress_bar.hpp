@@ -2,6 +2,8 @@
 // only when stderr is a terminal so that logs and pipes stay clean.
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <string>
 
 #include "core/progress.hpp"
@@ -13,12 +15,21 @@ class ProgressBar : public core::Progress {
   ProgressBar();
   ~ProgressBar() override;  // ends the line when anything was drawn
 
-  // Redraws as "stage [#####.....] done/total note"; total 0 draws no bar.
+  // Redraws as "stage [#####.....] done/total note, about 2 min 10 s left";
+  // total 0 draws no bar. The time left assumes the units still to come
+  // take as long as those done so far in this stage.
   void update(const core::ProgressStep& step) override;
 
  private:
   bool enabled_ = false;
   bool drawn_ = false;
+  std::string stage_;  // the stage being timed
+  std::size_t last_done_ = 0;
+  std::chrono::steady_clock::time_point started_;
 };
+
+// "about 45 s left", "about 3 min 05 s left", "about 1 h 02 min left";
+// empty below a second.
+std::string time_left_text(double seconds);
 
 }  // namespace scanbench::app

@@ -8,7 +8,8 @@
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
 #include "modeling/command_json.hpp"
-#include "modeling/loaded_scans.hpp"
+#include "modeling/scan_cache.hpp"
+#include "modeling/scan_overlaps.hpp"
 
 namespace scanbench::modeling {
 
@@ -40,7 +41,7 @@ namespace {
 // stored one kept for scans in no pair), its reference, and ΔE before and
 // after over all pairs and over each scan's own.
 HarmonizeCommandResult harmonize_outcome(
-    const LoadedScans& loaded, std::span<const registration::ColorPair> pairs,
+    std::span<const store::StoredScanSummary> scans, std::span<const registration::ColorPair> pairs,
     const registration::HarmonizeResult& solved,
     const std::map<std::int64_t, store::ScanColorCorrection>& stored) {
   HarmonizeCommandResult out;
@@ -48,12 +49,12 @@ HarmonizeCommandResult harmonize_outcome(
   out.iterations = solved.iterations;
   out.converged = solved.converged;
   std::vector<store::ScanColorCorrection> corrections;
-  for (std::size_t k = 0; k < loaded.ids.size(); ++k) {
+  for (std::size_t k = 0; k < scans.size(); ++k) {
     HarmonizeCommandScan scan;
-    scan.id = loaded.ids[k];
-    scan.name = loaded.scans[k].name;
+    scan.id = scans[k].id;
+    scan.name = scans[k].summary.name;
     if (solved.reference[k] >= 0) {
-      scan.reference = loaded.ids[static_cast<std::size_t>(solved.reference[k])];
+      scan.reference = scans[static_cast<std::size_t>(solved.reference[k])].id;
       scan.correction = solved.corrections[k];
     } else if (const auto kept = stored.find(scan.id); kept != stored.end()) {
       scan.correction = kept->second;
@@ -74,28 +75,69 @@ HarmonizeCommandResult harmonize_outcome(
   return out;
 }
 
+// The colour pairs of every two scans with colour whose bounds meet, in the
+// order find_color_pairs gives them (by the pair's first scan, then its
+// second), taking scan b and then each earlier scan a it pairs with from
+// the cache: scans are loaded a few at a time.
+std::vector<registration::ColorPair> streamed_color_pairs(
+    const store::Project& project, std::span<const store::StoredScanSummary> scans,
+    const registration::ColorPairSettings& settings, std::uint64_t memory_limit,
+    core::Progress& progress) {
+  std::vector<ScanPair> pairs = overlapping_pairs(scans);
+  std::erase_if(pairs, [&scans](const ScanPair& p) {
+    return !scans[static_cast<std::size_t>(p.first)].summary.has_color ||
+           !scans[static_cast<std::size_t>(p.second)].summary.has_color;
+  });
+  std::vector<std::int64_t> plan;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    if (k == 0 || pairs[k].second != pairs[k - 1].second)
+      plan.push_back(scans[static_cast<std::size_t>(pairs[k].second)].id);
+    plan.push_back(scans[static_cast<std::size_t>(pairs[k].first)].id);
+  }
+  ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress);
+  cache.plan(plan);
+  std::map<std::pair<int, int>, std::vector<registration::ColorPair>> found;
+  std::shared_ptr<const LoadedScan> b;
+  for (const ScanPair& pair : pairs) {
+    if (b == nullptr || b->id != scans[static_cast<std::size_t>(pair.second)].id) {
+      b.reset();
+      b = cache.get(scans[static_cast<std::size_t>(pair.second)].id);
+      progress.update({"harmonize", static_cast<std::size_t>(pair.second) + 1, scans.size(),
+                       "colour pairs of " + b->scan.name});
+    }
+    const std::shared_ptr<const LoadedScan> a =
+        cache.get(scans[static_cast<std::size_t>(pair.first)].id);
+    found[{pair.first, pair.second}] = registration::color_pairs_between(
+        a->prepared, b->prepared, static_cast<std::uint32_t>(pair.first),
+        static_cast<std::uint32_t>(pair.second), a->scan.T_world_scan, b->scan.T_world_scan,
+        settings);
+  }
+  std::vector<registration::ColorPair> out;
+  for (const auto& [which, list] : found) out.insert(out.end(), list.begin(), list.end());
+  return out;
+}
+
 }  // namespace
 
 HarmonizeCommandResult harmonize_project(store::Project& project,
                                          const HarmonizeCommandSettings& settings,
-                                         core::Progress& progress) {
+                                         core::Progress& progress,
+                                         std::optional<std::uint64_t> memory_limit) {
   constexpr const char* kStage = "harmonize";
   const auto start = std::chrono::steady_clock::now();
   const std::int64_t revision = project.revision();
-  const LoadedScans loaded = load_scans(project, settings.pairs.threads, kStage, progress);
-  std::vector<Eigen::Isometry3d> poses;
-  for (const acquisition::Scan& scan : loaded.scans) poses.push_back(scan.T_world_scan);
-  const std::vector<registration::ColorPair> pairs =
-      registration::find_color_pairs(loaded.prepared, poses, settings.pairs);
+  const std::vector<store::StoredScanSummary> scans = scans_with_geometry(project);
+  const std::vector<registration::ColorPair> pairs = streamed_color_pairs(
+      project, scans, settings.pairs, memory_limit_or_default(memory_limit), progress);
   if (pairs.empty()) {
     throw core::InputError(project.path().string(), {},
                            "no two scans with colour overlap: nothing to harmonise");
   }
   progress.throw_if_cancelled(kStage);
   const registration::HarmonizeResult solved =
-      registration::harmonize_colors(pairs, loaded.scans.size(), settings.solve);
+      registration::harmonize_colors(pairs, scans.size(), settings.solve);
   HarmonizeCommandResult out =
-      harmonize_outcome(loaded, pairs, solved, project.scan_color_corrections());
+      harmonize_outcome(scans, pairs, solved, project.scan_color_corrections());
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.throw_if_cancelled(kStage);
 

@@ -56,11 +56,15 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
 // group of overlapping scans fixed, stored as one command ("harmonize")
 // whose undo restores the earlier corrections. Scans that overlap no other
 // keep theirs.
+// Streams as merge_project does: colour pairs only between scans whose
+// bounds meet, a few scans loaded at a time under `memory_limit`.
 // Throws as merge_project (no scans, a scan without geometry, data it read
-// changed meanwhile, cancelled), and core::InputError when no two scans
-// with colour overlap. The project is then unchanged.
+// changed meanwhile, two scans beyond the memory limit, cancelled), and
+// core::InputError when no two scans with colour overlap. The project is
+// then unchanged.
 HarmonizeCommandResult harmonize_project(store::Project& project,
                                          const HarmonizeCommandSettings& settings,
-                                         core::Progress& progress);
+                                         core::Progress& progress,
+                                         std::optional<std::uint64_t> memory_limit = std::nullopt);
 
 }  // namespace scanbench::modeling

@@ -171,6 +171,24 @@ std::string_view color_model_name(ColorModel model) {
   return kModelNames[static_cast<std::size_t>(model)];
 }
 
+std::vector<ColorPair> color_pairs_between(const PreparedScan& a, const PreparedScan& b,
+                                           std::uint32_t ia, std::uint32_t ib,
+                                           const Eigen::Isometry3d& T_world_a,
+                                           const Eigen::Isometry3d& T_world_b,
+                                           const ColorPairSettings& settings) {
+  if (!a.scan->has_color() || !b.scan->has_color()) return {};
+  const Eigen::Isometry3f T_b_a = (T_world_b.inverse() * T_world_a).cast<float>();
+  std::vector<ColorPair> found = pairs_between(a, b, ia, ib, T_b_a, settings);
+  const std::size_t limit = settings.max_pairs_per_overlap;
+  if (limit > 0 && found.size() > limit) {
+    std::vector<ColorPair> thinned;
+    thinned.reserve(limit);
+    for (std::size_t k = 0; k < limit; ++k) thinned.push_back(found[k * found.size() / limit]);
+    found = std::move(thinned);
+  }
+  return found;
+}
+
 std::vector<ColorPair> find_color_pairs(std::span<const PreparedScan> scans,
                                         std::span<const Eigen::Isometry3d> T_world_scan,
                                         const ColorPairSettings& settings) {
@@ -178,18 +196,9 @@ std::vector<ColorPair> find_color_pairs(std::span<const PreparedScan> scans,
   std::vector<ColorPair> out;
   for (std::size_t a = 0; a < scans.size(); ++a) {
     for (std::size_t b = a + 1; b < scans.size(); ++b) {
-      if (!scans[a].scan->has_color() || !scans[b].scan->has_color()) continue;
-      const Eigen::Isometry3f T_b_a = (T_world_scan[b].inverse() * T_world_scan[a]).cast<float>();
-      std::vector<ColorPair> found =
-          pairs_between(scans[a], scans[b], static_cast<std::uint32_t>(a),
-                        static_cast<std::uint32_t>(b), T_b_a, settings);
-      const std::size_t limit = settings.max_pairs_per_overlap;
-      if (limit > 0 && found.size() > limit) {
-        std::vector<ColorPair> thinned;
-        thinned.reserve(limit);
-        for (std::size_t k = 0; k < limit; ++k) thinned.push_back(found[k * found.size() / limit]);
-        found = std::move(thinned);
-      }
+      const std::vector<ColorPair> found = color_pairs_between(
+          scans[a], scans[b], static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+          T_world_scan[a], T_world_scan[b], settings);
       out.insert(out.end(), found.begin(), found.end());
     }
   }

@@ -63,6 +63,16 @@ struct ColorPair {
   Eigen::Vector3f rgb_b = Eigen::Vector3f::Zero();
 };
 
+// The pairs of scans a and b (at positions ia < ib of the scan list, at
+// poses T_world_a and T_world_b): a's sampled points projected into b's
+// grid, thinned evenly to max_pairs_per_overlap. None when either scan has
+// no colour.
+std::vector<ColorPair> color_pairs_between(const PreparedScan& a, const PreparedScan& b,
+                                           std::uint32_t ia, std::uint32_t ib,
+                                           const Eigen::Isometry3d& T_world_a,
+                                           const Eigen::Isometry3d& T_world_b,
+                                           const ColorPairSettings& settings);
+
 // Pairs of every two scans, scan a < scan b, found by projecting a's
 // sampled points into b's grid (registration/prepared_scan.hpp's
 // association). Deterministic for any thread count. Scans without colour

@@ -7,11 +7,13 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "modeling/harmonize_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
 #include "modeling/scan_cache.hpp"
 #include "modeling/scan_overlaps.hpp"
 #include "modeling/store/typed_layers.hpp"
+#include "registration/color_harmonization.hpp"
 #include "registration/merge.hpp"
 #include "room_project.hpp"
 #include "support/test_support.hpp"
@@ -169,6 +171,24 @@ TEST_F(StreamedStagesTest, RegistrationWithTwoScansInHandEqualsTheOneInMemory) {
   // The stored bounds are the scans' at their new poses.
   const acquisition::Scan moved = project_.load_scan(ids_[1]);
   EXPECT_TRUE(project_.scans()[1].summary.bbox_world->isApprox(*acquisition::world_bounds(moved)));
+}
+
+TEST_F(StreamedStagesTest, HarmonizationWithTwoScansInHandFindsThePairsOfTheOneInMemory) {
+  const HarmonizeCommandSettings settings;
+  const std::unique_ptr<InMemory> all = in_memory();
+  const std::vector<registration::ColorPair> expected =
+      registration::find_color_pairs(all->prepared, all->poses, settings.pairs);
+  ASSERT_GT(expected.size(), 1000u);
+  core::Progress progress;
+  const HarmonizeCommandResult out =
+      harmonize_project(project_, settings, progress, room_bytes() * 5 / 2);
+  EXPECT_EQ(out.pairs, expected.size());
+  const registration::HarmonizeResult solved =
+      registration::harmonize_colors(expected, ids_.size(), settings.solve);
+  for (std::size_t k = 0; k < ids_.size(); ++k) {
+    EXPECT_TRUE(out.scans[k].correction.matrix.isApprox(solved.corrections[k].matrix)) << k;
+    EXPECT_EQ(out.scans[k].pairs == 0, k == ids_.size() - 1);  // the far room pairs with none
+  }
 }
 
 TEST_F(StreamedStagesTest, ALimitTooSmallForTwoScansIsRefusedAndChangesNothing) {
