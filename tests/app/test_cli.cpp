@@ -627,6 +627,12 @@ TEST(Cli, MergedExportWritesTheKeptPointsOnly) {
   EXPECT_EQ(early.exit_code, 2);
   EXPECT_NE(early.err.find("scanbench merge"), std::string::npos) << early.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "early.csv"));
+  // Not even one scan fits in a megabyte: refused as a runtime failure, and
+  // nothing stored.
+  const CliResult starved = run_cli(dir, {"merge", project.string(), "--memory-limit", "1MB"});
+  EXPECT_EQ(starved.exit_code, 1);
+  EXPECT_NE(starved.err.find("--memory-limit"), std::string::npos) << starved.err;
+  EXPECT_EQ(export_csv("early.csv", true).exit_code, 2);
 
   const CliResult merge = run_cli(dir, {"merge", project.string(), "--json"});
   ASSERT_EQ(merge.exit_code, 0) << merge.err;
