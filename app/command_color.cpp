@@ -159,8 +159,7 @@ void run_harmonize(const HarmonizeOptions& options) {
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
   const modeling::HarmonizeCommandResult out = modeling::harmonize_project(
-      project, settings, progress,
-      options.memory_limit > 0 ? std::optional(options.memory_limit) : std::nullopt);
+      project, settings, progress, memory_limit_of(options.memory_limit));
   if (options.json) {
     fmt::print("{}\n", modeling::result_json(out));
     return;

@@ -29,9 +29,8 @@ void run_merge(const MergeOptions& options) {
   }
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
-  const modeling::MergeCommandResult out = modeling::merge_project(
-      project, settings, progress,
-      options.memory_limit > 0 ? std::optional(options.memory_limit) : std::nullopt);
+  const modeling::MergeCommandResult out =
+      modeling::merge_project(project, settings, progress, memory_limit_of(options.memory_limit));
   if (options.json) {
     fmt::print("{}\n", modeling::result_json(out));
     return;

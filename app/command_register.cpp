@@ -79,8 +79,7 @@ void run_register(const RegisterOptions& options) {
   store::Project project = store::Project::open(options.project);
   ProgressBar progress;
   const modeling::RegisterCommandResult out = modeling::register_project(
-      project, settings, progress,
-      options.memory_limit > 0 ? std::optional(options.memory_limit) : std::nullopt);
+      project, settings, progress, memory_limit_of(options.memory_limit));
   if (options.json) {
     fmt::print("{}\n", modeling::result_json(out));
   } else {

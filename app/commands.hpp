@@ -66,6 +66,11 @@ inline void add_memory_limit_option(CLI::App* command, std::uint64_t& bytes) {
       ->transform(CLI::AsSizeValue(true));
 }
 
+// The limit add_memory_limit_option read: none (the default) for 0.
+inline std::optional<std::uint64_t> memory_limit_of(std::uint64_t bytes) {
+  return bytes > 0 ? std::optional(bytes) : std::nullopt;
+}
+
 // A choice among named values of `Enum`, any case: the option's text
 // becomes the value's number for CLI11 to read, and a text that names none
 // is a usage error that lists the names ("--format: xyz is not one of csv,

@@ -29,6 +29,7 @@ void ProgressBar::update(const core::ProgressStep& step) {
   if (step.stage != stage_ || step.done < last_done_ || stage_.empty()) {
     stage_ = std::string(step.stage);
     started_ = now;
+    done_at_start_ = step.done;
   }
   last_done_ = step.done;
   constexpr std::size_t kWidth = 30;
@@ -38,10 +39,11 @@ void ProgressBar::update(const core::ProgressStep& step) {
     const std::size_t filled = std::min(kWidth, step.done * kWidth / step.total);
     bar = fmt::format("[{}{}] {}/{}", std::string(filled, '#'), std::string(kWidth - filled, '.'),
                       step.done, step.total);
-    if (step.done > 0 && step.done < step.total) {
+    // The units done since the timing began, at the pace they took.
+    if (step.done > done_at_start_ && step.done < step.total) {
       const double elapsed = std::chrono::duration<double>(now - started_).count();
       left = time_left_text(elapsed * static_cast<double>(step.total - step.done) /
-                            static_cast<double>(step.done));
+                            static_cast<double>(step.done - done_at_start_));
     }
   }
   fmt::print(stderr, "\r\033[K{} {} {}{}{}", step.stage, bar, step.note, left.empty() ? "" : ", ",

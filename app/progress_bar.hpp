@@ -17,7 +17,7 @@ class ProgressBar : public core::Progress {
 
   // Redraws as "stage [#####.....] done/total note, about 2 min 10 s left";
   // total 0 draws no bar. The time left assumes the units still to come
-  // take as long as those done so far in this stage.
+  // take as long as those done since the stage's first update.
   void update(const core::ProgressStep& step) override;
 
  private:
@@ -25,6 +25,7 @@ class ProgressBar : public core::Progress {
   bool drawn_ = false;
   std::string stage_;  // the stage being timed
   std::size_t last_done_ = 0;
+  std::size_t done_at_start_ = 0;  // units done when the timing began
   std::chrono::steady_clock::time_point started_;
 };
 

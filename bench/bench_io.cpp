@@ -120,12 +120,18 @@ nlohmann::json compare_pcd_readers(const std::filesystem::path& pcd, double poin
 // Wall time from spawning `program arguments…` (output to /dev/null) to its
 // exit, in ms: the median of `runs`. What a user waits for a command that
 // does nothing: dynamic linking, static initialisers, parsing. NaN when a
-// run does not exit with `expected_exit` (a crash is no fast start).
+// run cannot start or does not exit with `expected_exit` (a crash is no
+// fast start).
 double median_run_ms(const std::filesystem::path& program,
                      const std::vector<std::string>& arguments, int expected_exit, int runs) {
   std::vector<double> ms;
   for (int r = 0; r < runs; ++r) {
-    const ChildRun run = run_process(program, arguments, "/dev/null", "/dev/null");
+    ChildRun run;
+    try {
+      run = run_process(program, arguments, "/dev/null", "/dev/null");
+    } catch (const std::runtime_error&) {
+      return std::numeric_limits<double>::quiet_NaN();  // could not start
+    }
     if (run.exit_code != expected_exit) return std::numeric_limits<double>::quiet_NaN();
     ms.push_back(1e3 * run.seconds);
   }

@@ -114,12 +114,12 @@ nlohmann::json run_campaign(int scans, const BenchOptions& options, const fs::pa
   fs::create_directories(dir);
   const fs::path scan_dir = dir / "scans";
   const ChildRun simulated =
-      run_stage("simulate",
-                {"simulate", "--site", options.site, "--out", scan_dir.string(), "--scans",
-                 std::to_string(scans), "--columns", std::to_string(options.columns), "--rows",
-                 std::to_string(options.rows), "--pose-error-deg", kPoseErrorDeg, "--pose-error-m",
-                 kPoseErrorM},
-                dir);
+      run_needed_stage("simulate",
+                       {"simulate", "--site", options.site, "--out", scan_dir.string(), "--scans",
+                        std::to_string(scans), "--columns", std::to_string(options.columns),
+                        "--rows", std::to_string(options.rows), "--pose-error-deg", kPoseErrorDeg,
+                        "--pose-error-m", kPoseErrorM},
+                       dir);
   const std::string project = (dir / "campaign.sbproj").string();
   std::vector<std::string> import{"import", project};
   for (const std::string& file : simulated_scans(simulated.out)) import.push_back(file);
@@ -156,10 +156,14 @@ nlohmann::json run_campaign(int scans, const BenchOptions& options, const fs::pa
 // Per stage, the largest campaign's figure over the 4-station one's.
 nlohmann::json ratios(const nlohmann::json& campaigns, const char* field) {
   const nlohmann::json* four = nullptr;
+  const nlohmann::json* largest_ptr = nullptr;
   for (const nlohmann::json& c : campaigns) {
     if (c["scans"] == 4) four = &c;
+    if (largest_ptr == nullptr || c["scans"].get<int>() > (*largest_ptr)["scans"].get<int>())
+      largest_ptr = &c;
   }
-  const nlohmann::json& largest = campaigns.back();
+  if (largest_ptr == nullptr) return nlohmann::json::object();
+  const nlohmann::json& largest = *largest_ptr;
   nlohmann::json out = nlohmann::json::object();
   if (four == nullptr || largest["scans"].get<int>() <= 4) return out;
   for (const auto& [stage, figures] : largest["stages"].items()) {

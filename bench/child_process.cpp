@@ -58,6 +58,8 @@ ChildRun run_process(const std::filesystem::path& program,
   std::vector<char*> envp;
   for (std::string& variable : environment) envp.push_back(variable.data());
   envp.push_back(nullptr);
+  std::error_code ignored;
+  if (!peak_file.empty()) std::filesystem::remove(peak_file, ignored);  // none from an earlier run
   posix_spawn_file_actions_t files;
   posix_spawn_file_actions_init(&files);
   posix_spawn_file_actions_addopen(&files, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -80,7 +82,7 @@ ChildRun run_process(const std::filesystem::path& program,
       ::kill(pid, SIGKILL);
       run.timed_out = true;
     }
-    if (done == 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (done == 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   run.seconds = core::seconds_since(start);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

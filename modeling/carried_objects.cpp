@@ -74,6 +74,67 @@ class Grids {
   std::vector<std::pair<acquisition::RangeNoise, segmentation::SegmentationGrid>> grids_;
 };
 
+// A target scan's object layers while objects are carried into it, and
+// which of its points are still free to take one.
+struct TargetLayers {
+  std::vector<std::uint32_t> membership;
+  std::vector<std::uint8_t> carried;
+  std::vector<std::uint8_t> open;
+};
+
+// Gives the carried points of a target back to the pool (deleted points
+// stay deleted); returns how many. Marks the free points open.
+std::size_t release_carried(TargetLayers& layers) {
+  std::size_t released = 0;
+  layers.open.assign(layers.membership.size(), 0);
+  for (std::size_t p = 0; p < layers.membership.size(); ++p) {
+    std::uint32_t& owner = layers.membership[p];
+    if (layers.carried[p] != 0 && owner != 0 && owner != store::kDeletedPoints) {
+      owner = 0;
+      ++released;
+    }
+    layers.carried[p] = 0;
+    layers.open[p] = owner == 0;
+  }
+  return released;
+}
+
+// A prepared scan at a pose.
+struct Posed {
+  const registration::PreparedScan* scan = nullptr;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+
+// Carries each object drawn in `source` into `target` as its commit grew
+// it, into the target's open points; returns how many points joined.
+std::size_t carry_drawn(const Posed& source, const DrawnPixels& drawn,
+                        const std::map<std::int64_t, CommitSettings>& commits, const Posed& target,
+                        Grids& grids, TargetLayers& layers) {
+  std::size_t joined = 0;
+  for (const auto& [object, drawn_at] : drawn) {
+    std::vector<std::uint32_t> labels(source.scan->in_model.size(), 0);
+    for (const std::uint32_t p : drawn_at) labels[p] = 1;
+    const CommitSettings& commit = commits.at(object);
+    CarrySettings settings;
+    settings.transfer.noise = commit.range_noise;
+    settings.grow = commit.grow;
+    // A scattered target has no grid to grow on: it takes the carried points.
+    const segmentation::SegmentationGrid* grid = settings.grow && !target.scan->scan->is_scattered()
+                                                     ? &grids.with(settings.transfer.noise)
+                                                     : nullptr;
+    const segmentation::PixelSet joins =
+        carry_object({source.scan, source.pose, labels},
+                     {target.scan, target.pose, grid, layers.open}, settings);
+    for (const std::uint32_t q : joins) {
+      layers.membership[q] = object;
+      layers.carried[q] = 1;
+      layers.open[q] = 0;
+    }
+    joined += joins.size();
+  }
+  return joined;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> load_carried(const store::Project& project, std::int64_t scan_id,
@@ -107,11 +168,18 @@ CarriedAgain carry_objects_again(const store::Project& project,
                      load_carried(project, id, pixels_of(k)), commits);
   }
   // Each target, then the scans whose drawn objects it may take.
-  for (int t = 0; t < n; ++t) {
-    order.push_back(t);
+  const auto sources_of = [&drawn, n](int t) {
+    std::vector<int> sources;
     for (int from = 0; from < n; ++from) {
-      if (from != t && !drawn[static_cast<std::size_t>(from)].empty()) order.push_back(from);
+      if (from != t && !drawn[static_cast<std::size_t>(from)].empty()) sources.push_back(from);
     }
+    return sources;
+  };
+  for (int t = 0; t < n; ++t) {
+    const std::vector<int> sources = sources_of(t);
+    if (sources.empty()) continue;  // its carried points go back without it
+    order.push_back(t);
+    order.insert(order.end(), sources.begin(), sources.end());
   }
   stream.plan(order);
   for (int t = 0; t < n; ++t) {
@@ -119,49 +187,26 @@ CarriedAgain carry_objects_again(const store::Project& project,
     progress.update(
         {"register", static_cast<std::size_t>(t), scans.size(), "carrying the objects again"});
     progress.throw_if_cancelled("register");
-    const std::shared_ptr<const registration::PreparedScan> target = stream.get(t);
     const std::size_t pixels = pixels_of(t);
-    std::vector<std::uint32_t> membership = load_membership(project, target_id, pixels);
-    std::vector<std::uint8_t> carried = load_carried(project, target_id, pixels);
-    const std::vector<std::uint32_t> before = membership;
-    std::vector<std::uint8_t> open(pixels);
-    for (std::size_t p = 0; p < pixels; ++p) {
-      if (carried[p] != 0 && membership[p] != 0 && membership[p] != store::kDeletedPoints) {
-        membership[p] = 0;
-        ++out.released;
-      }
-      carried[p] = 0;
-      open[p] = membership[p] == 0;
-    }
-    Grids grids(*target->scan, *target->geometry);
-    for (int from = 0; from < n; ++from) {
-      if (from == t || drawn[static_cast<std::size_t>(from)].empty()) continue;
-      const std::shared_ptr<const registration::PreparedScan> source = stream.get(from);
-      for (const auto& [object, drawn_at] : drawn[static_cast<std::size_t>(from)]) {
-        std::vector<std::uint32_t> labels(pixels_of(from), 0);
-        for (const std::uint32_t p : drawn_at) labels[p] = 1;
-        const CommitSettings& commit = commits.at(object);
-        CarrySettings settings;
-        settings.transfer.noise = commit.range_noise;
-        settings.grow = commit.grow;
-        // A scattered target has no grid to grow on: it takes the carried points.
-        const segmentation::SegmentationGrid* grid = settings.grow && !target->scan->is_scattered()
-                                                         ? &grids.with(settings.transfer.noise)
-                                                         : nullptr;
-        const segmentation::PixelSet joins =
-            carry_object({source.get(), poses[static_cast<std::size_t>(from)], labels},
-                         {target.get(), poses[static_cast<std::size_t>(t)], grid, open}, settings);
-        for (const std::uint32_t q : joins) {
-          membership[q] = object;
-          carried[q] = 1;
-          open[q] = 0;
-        }
-        out.carried_points += joins.size();
+    TargetLayers layers{
+        load_membership(project, target_id, pixels), load_carried(project, target_id, pixels), {}};
+    const std::vector<std::uint32_t> before = layers.membership;
+    out.released += release_carried(layers);
+    const std::vector<int> sources = sources_of(t);
+    if (!sources.empty()) {
+      const std::shared_ptr<const registration::PreparedScan> target = stream.get(t);
+      Grids grids(*target->scan, *target->geometry);
+      for (const int from : sources) {
+        const std::shared_ptr<const registration::PreparedScan> source = stream.get(from);
+        out.carried_points +=
+            carry_drawn({source.get(), poses[static_cast<std::size_t>(from)]},
+                        drawn[static_cast<std::size_t>(from)], commits,
+                        {target.get(), poses[static_cast<std::size_t>(t)]}, grids, layers);
       }
     }
-    if (membership != before) {
-      out.memberships.emplace(target_id, std::move(membership));
-      out.carried.emplace(target_id, std::move(carried));
+    if (layers.membership != before) {
+      out.memberships.emplace(target_id, std::move(layers.membership));
+      out.carried.emplace(target_id, std::move(layers.carried));
     }
   }
   return out;

@@ -89,11 +89,8 @@ std::vector<registration::ColorPair> streamed_color_pairs(
            !scans[static_cast<std::size_t>(p.second)].summary.has_color;
   });
   std::vector<std::int64_t> plan;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    if (k == 0 || pairs[k].second != pairs[k - 1].second)
-      plan.push_back(scans[static_cast<std::size_t>(pairs[k].second)].id);
-    plan.push_back(scans[static_cast<std::size_t>(pairs[k].first)].id);
-  }
+  for (const int k : pair_pass_order(pairs, static_cast<int>(scans.size()), false))
+    plan.push_back(scans[static_cast<std::size_t>(k)].id);
   ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress);
   cache.plan(plan);
   std::map<std::pair<int, int>, std::vector<registration::ColorPair>> found;

@@ -17,7 +17,8 @@ constexpr const char* kStage = "merge";
 // The streamed merge: scan b is compared with each earlier scan a whose
 // bounds reach it, both ways, while both are in hand; a scan's decision is
 // final after its last pair. Each scan is thus compared with the others in
-// list order, as merge_by_sampling_rate does, and results are the same.
+// list order, as merge_by_sampling_rate does: the keep masks and counts are
+// the same, but for decided_by_bound, which counts the pairs compared only.
 class StreamedMerge {
  public:
   StreamedMerge(const store::Project& project, const registration::MergeSettings& settings,
@@ -62,16 +63,13 @@ class StreamedMerge {
   // Scan b, then the earlier scans it pairs with, for every b; and for each
   // scan the b of its last pair (itself when it has none later).
   std::vector<std::int64_t> plan() {
+    for (int k = 0; k < static_cast<int>(scans_.size()); ++k)
+      last_pair_[static_cast<std::size_t>(k)] = k;
+    for (const ScanPair& pair : pairs_)
+      last_pair_[static_cast<std::size_t>(pair.first)] = pair.second;
     std::vector<std::int64_t> order;
-    auto pair = pairs_.begin();
-    for (int b = 0; b < static_cast<int>(scans_.size()); ++b) {
-      order.push_back(id(b));
-      last_pair_[static_cast<std::size_t>(b)] = b;
-      for (; pair != pairs_.end() && pair->second == b; ++pair) {
-        order.push_back(id(pair->first));
-        last_pair_[static_cast<std::size_t>(pair->first)] = b;
-      }
-    }
+    for (const int k : pair_pass_order(pairs_, static_cast<int>(scans_.size()), true))
+      order.push_back(id(k));
     return order;
   }
 

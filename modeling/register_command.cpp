@@ -68,17 +68,15 @@ void refuse_when_nothing_registered(const store::Project& project,
                              "no pair of scans registered, nothing stored (" + why + ")");
 }
 
-// Every scan's world bounds at its new pose, each scan taken from the
-// stream once more (those still in hand are not loaded again).
+// Every scan's world bounds at its new pose, from its channels alone (one
+// scan at a time, without its geometry or prepared view).
 std::vector<std::optional<Eigen::AlignedBox3d>> world_bounds_at(
-    registration::ScanStream& stream, const std::vector<Eigen::Isometry3d>& poses) {
-  std::vector<int> order(stream.size());
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
-  stream.plan(order);
+    const store::Project& project, const std::vector<std::int64_t>& ids,
+    const std::vector<Eigen::Isometry3d>& poses, core::Progress& progress) {
   std::vector<std::optional<Eigen::AlignedBox3d>> bounds;
-  for (const int k : order) {
-    bounds.push_back(
-        acquisition::world_bounds(*stream.get(k)->scan, poses[static_cast<std::size_t>(k)]));
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    progress.throw_if_cancelled("register");
+    bounds.push_back(acquisition::world_bounds(project.load_scan(ids[k]), poses[k]));
   }
   return bounds;
 }
@@ -117,7 +115,7 @@ RegisterCommandResult register_project(store::Project& project,
   const std::vector<store::ObjectNode> refigured =
       node_figures_after_moving(project, moved, carried.memberships);
   const std::vector<std::optional<Eigen::AlignedBox3d>> bounds =
-      world_bounds_at(stream, out.result.T_world_scan);
+      world_bounds_at(project, out.ids, out.result.T_world_scan, progress);
   progress.throw_if_cancelled(kStage);
 
   store::Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);

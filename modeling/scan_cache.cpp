@@ -137,22 +137,29 @@ void ScanCache::make_room(std::uint64_t bytes) {
   }
 }
 
+// Throws core::MemoryShortage when `bytes` (the scans in hand with scan
+// `id`) exceed the limit.
+void ScanCache::refuse_beyond_limit(std::uint64_t bytes, std::int64_t id) const {
+  if (bytes <= limit_) return;
+  throw core::MemoryShortage(project_.path().string(), {},
+                             stage_ + " needs about " + core::gigabytes(bytes) +
+                                 " for the scans it works on together (scan " + std::to_string(id) +
+                                 " and those in hand), more than its memory limit of " +
+                                 core::gigabytes(limit_) + " (--memory-limit)");
+}
+
 std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
+  // A scan the stage still holds from an earlier plan is not loaded twice.
+  for (const std::weak_ptr<const LoadedScan>& given : given_) {
+    if (std::shared_ptr<const LoadedScan> held = given.lock(); held && held->id == id) return held;
+  }
   const auto pixels = pixels_.find(id);
   if (pixels == pixels_.end())
     throw core::InputError(project_.path().string(), {}, "no scan with id " + std::to_string(id));
   const auto estimate =
       static_cast<std::uint64_t>(bytes_per_pixel_ * static_cast<double>(pixels->second));
   make_room(estimate);
-  const std::uint64_t in_hand = bytes_in_hand();
-  if (in_hand + estimate > limit_) {
-    throw core::MemoryShortage(project_.path().string(), {},
-                               stage_ + " needs about " + core::gigabytes(in_hand + estimate) +
-                                   " for the scans it works on " + "together (scan " +
-                                   std::to_string(id) +
-                                   " and those in hand), more than its memory " + "limit of " +
-                                   core::gigabytes(limit_) + " (--memory-limit)");
-  }
+  refuse_beyond_limit(bytes_in_hand() + estimate, id);
   auto loaded = std::make_shared<LoadedScan>();
   loaded->id = id;
   std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project_, id);
@@ -171,7 +178,12 @@ std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
   }
   ++loads_;
   given_.emplace_back(loaded);
-  peak_bytes_ = std::max(peak_bytes_, bytes_in_hand());
+  // The estimate may have been short (the first one, a kd-tree): the limit
+  // holds for what was really loaded.
+  make_room(0);
+  const std::uint64_t in_hand = bytes_in_hand();
+  refuse_beyond_limit(in_hand, id);
+  peak_bytes_ = std::max(peak_bytes_, in_hand);
   return loaded;
 }
 

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,8 @@
 namespace scanbench::modeling {
 
 // One scan as a stage works on it. Neither copied nor moved: `prepared`
-// points into `scan` and `geometry`.
+// points into `scan` and `geometry`. Given out as a shared_ptr: the cache
+// must know which scans the stage still holds.
 struct LoadedScan {
   std::int64_t id = 0;
   acquisition::Scan scan;
@@ -81,6 +83,7 @@ class ScanCache {
   };
 
   std::uint64_t bytes_in_hand() const;
+  void refuse_beyond_limit(std::uint64_t bytes, std::int64_t id) const;
   void make_room(std::uint64_t bytes);
   std::shared_ptr<const LoadedScan> load(std::int64_t id);
 

@@ -33,4 +33,15 @@ std::vector<ScanPair> overlapping_pairs(std::span<const store::StoredScanSummary
   return pairs;
 }
 
+std::vector<int> pair_pass_order(std::span<const ScanPair> pairs, int scan_count, bool every_scan) {
+  std::vector<int> order;
+  auto pair = pairs.begin();
+  for (int second = 0; second < scan_count; ++second) {
+    const bool paired = pair != pairs.end() && pair->second == second;
+    if (paired || every_scan) order.push_back(second);
+    for (; pair != pairs.end() && pair->second == second; ++pair) order.push_back(pair->first);
+  }
+  return order;
+}
+
 }  // namespace scanbench::modeling

@@ -25,8 +25,16 @@ struct ScanPair {
 
 // Every pair of `scans` whose world bounds, grown by `margin_m`, intersect,
 // ordered by second, then first. A scan without bounds (no valid point)
-// pairs with none. O(N log N + pairs): a sweep along x.
+// pairs with none. A sweep along x: O(N log N + pairs) where the scans
+// spread along x, up to N² box tests where they line up along y or z.
 std::vector<ScanPair> overlapping_pairs(std::span<const store::StoredScanSummary> scans,
                                         double margin_m = kSharedSurfaceMarginM);
+
+// The scans a pass over `pairs` (ordered as overlapping_pairs orders them)
+// takes, by position: each pair's second scan, then the first scan of each
+// of its pairs. With `every_scan` also the scans that are second in no
+// pair, in their place, so that the pass visits each of the `scan_count`
+// scans.
+std::vector<int> pair_pass_order(std::span<const ScanPair> pairs, int scan_count, bool every_scan);
 
 }  // namespace scanbench::modeling

@@ -73,7 +73,8 @@ float max_footprint_per_m(const PreparedScan& scan);
 // need not be in memory at once: start_merge keeps every in-model point of
 // s, each merge_with drops the kept points that scan o samples more finely,
 // finish_merge counts. Comparing s with every other scan in list order
-// gives merge_by_sampling_rate's result for s, counts included; a scan
+// gives merge_by_sampling_rate's result for s, counts included (leaving
+// out a scan leaves its tests out of decided_by_bound); a scan
 // that cannot share a surface with s (disjoint bounds) may be left out.
 MergeScanResult start_merge(const PreparedScan& scan);
 void merge_with(MergeScanResult& out, const MergeOperand& s, const MergeOperand& o,

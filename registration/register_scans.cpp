@@ -283,11 +283,13 @@ bool boxes_meet(const Eigen::AlignedBox3d& a, const Eigen::Isometry3d& T_b_a,
   return grown.intersects(moved);
 }
 
-// A source sample matches only within the ICP gate of a target sample's
-// surface, so pairs whose samples' bounds stay farther apart than this
-// cannot overlap [m] (the largest gate of ICP and of the global
-// refinement's first round, with room to spare).
-constexpr double kPairReachM = 2.0;
+// A source sample counts as overlapping only within the gate of the
+// overlap test (IcpSettings::min_gate_m, measure_alignment), so pairs whose
+// samples' bounds stay farther apart than that cannot overlap; one metre
+// more covers the samples' voxels (SampleSettings::voxel_m) and rounding.
+double pair_reach_m(const RegistrationSettings& settings) {
+  return settings.icp.min_gate_m + settings.icp_sample.voxel_m + 1.0;
+}
 
 // Every pair of registered scans that overlaps at the given poses: the
 // pairs whose samples' bounds meet are measured, target by target.
@@ -306,7 +308,7 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<Sam
       const auto ub = static_cast<std::size_t>(b);
       if (!registered[ua] || !registered[ub]) continue;
       if (boxes_meet(bounds[ua], T_first_scan[ub].inverse() * T_first_scan[ua], bounds[ub],
-                     kPairReachM)) {
+                     pair_reach_m(settings))) {
         candidates.push_back({a, b});
       }
     }
@@ -405,9 +407,9 @@ Chain register_chain(ScanStream& scans, std::span<const Eigen::Isometry3d> initi
   const bool with_features = settings.coarse == CoarseMethod::kFeatures;
   std::optional<FeatureCloud> previous_features;
   for (int k = 0; k < n; ++k) {
-    const Clock::time_point start = Clock::now();
     const auto uk = static_cast<std::size_t>(k);
     std::shared_ptr<const PreparedScan> source = scans.get(k);
+    const Clock::time_point start = Clock::now();
     chain.samples[uk] = sample_scan(*source, settings.icp_sample);
     std::optional<FeatureCloud> features;
     if (with_features)
