@@ -30,6 +30,11 @@ struct SimulateOptions {
 void run_campaign(SimulateOptions& options) {
   if (options.out_dir.empty())
     throw CLI::ValidationError("--out", "is required (the output folder)");
+  const int most = sim::max_scan_count(options.campaign.site);
+  if (options.campaign.scans > most) {
+    throw CLI::ValidationError(
+        "--scans", fmt::format("the {} site takes at most {} scans", options.campaign.site, most));
+  }
   options.campaign.scanner = sim::with_noise_profile(options.campaign.scanner, options.noise);
   ProgressBar progress;
   const sim::CampaignResult result =
@@ -69,8 +74,11 @@ void add_simulate_command(CLI::App& app) {
       ->required()
       ->check(CLI::IsMember(sim::site_names()));
   command->add_option("--out", options->out_dir, "Output folder for scans and truth");
-  command->add_option("--scans", campaign.scans, "Scan positions")
-      ->check(CLI::Range(1, 64))
+  command
+      ->add_option("--scans", campaign.scans,
+                   "Scan positions (campus and street: up to 64; path: up to 512, a street "
+                   "that grows with the campaign)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   command->add_option("--columns", campaign.scanner.columns, "Azimuth samples over 360°")
       ->check(CLI::Range(8, 36000))

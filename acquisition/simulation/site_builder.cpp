@@ -97,7 +97,7 @@ void SiteBuilder::add_ground(const GroundSpec& spec,
   };
   for (int tr = 0; tr < tile_rows; ++tr) {
     for (int tc = 0; tc < tile_cols; ++tc) {
-      const ObjectId tile = scene_.add_object(numbered("ground", tr, tc), site_, "ground");
+      const ObjectId tile = scene_.add_object(numbered(spec.name, tr, tc), site_, "ground");
       const Vector2d corner = spec.extent.min() + spec.tile_m * Vector2d(tc, tr);
       for (int r = 0; r < cells; ++r) {
         for (int c = 0; c < cells; ++c) {

@@ -87,7 +87,8 @@ struct TreeSpec {
 struct GroundSpec {
   Eigen::AlignedBox2d extent;  // world (x, y) [m]; multiple of tile_m on each side
   double cell_m = 1.0;         // triangle grid spacing; divides tile_m
-  double tile_m = 10.0;        // one "ground" object per tile
+  double tile_m = 10.0;        // one ground object per tile
+  std::string name = "ground";  // tiles are named NAME_<row>_<column>
 };
 
 // Footprint that scan positions keep clear of: a rectangle rotated by yaw,
@@ -180,9 +181,11 @@ std::vector<Eigen::Isometry3d> finish_site(const SiteBuilder& builder, Scene& sc
 // two scans from the given optical centres.
 double estimate_overlap(const Scene& scene, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 
-// The sites themselves (campus_site.cpp, street_site.cpp); make_site()
+// The sites themselves (campus_site.cpp, street_site.cpp, path_site.cpp); make_site()
 // dispatches to them.
 Site make_campus(std::uint64_t seed, int scan_count);
 Site make_street(std::uint64_t seed, int scan_count);
+Site make_path(std::uint64_t seed, int scan_count);
+int max_path_scans();
 
 }  // namespace scanbench::acquisition::sim::detail

@@ -149,8 +149,10 @@ std::vector<double> consecutive_overlaps(const Site& site, const char* label) {
 
 class SimSitesEachSite : public ::testing::TestWithParam<std::string> {};
 
-TEST(SimSites, NamesAreCampusAndStreet) {
-  EXPECT_EQ(site_names(), (std::vector<std::string>{"campus", "street"}));
+TEST(SimSites, NamesAreCampusStreetAndPath) {
+  EXPECT_EQ(site_names(), (std::vector<std::string>{"campus", "street", "path"}));
+  EXPECT_EQ(max_scan_count("campus"), 64);
+  EXPECT_EQ(max_scan_count("path"), 512);
 }
 
 TEST_P(SimSitesEachSite, SameSeedGivesIdenticalSite) {
@@ -238,6 +240,34 @@ TEST(SimSites, StreetHasAllRequiredParts) {
   expect_complete(site.scene, 16, 3);
 }
 
+TEST(SimSites, PathHasAllRequiredPartsOnEveryLeg) {
+  const Site site = make_site("path", 3, 12);  // three legs
+  expect_complete(site.scene, 24, 3);
+  EXPECT_EQ(children(site.scene, 1, "car").size(), 6u);
+}
+
+// The path's point: however long the campaign, a scan overlaps only the
+// scans of its own leg and the next ones, so the overlap graph is a band.
+TEST(SimSites, PathOverlapsStayWithinNeighbouringLegs) {
+  const Site site = make_site("path", 1, 40);  // seven legs
+  ASSERT_EQ(site.scan_poses.size(), 40u);
+  const std::size_t middle = 20;
+  int overlapping = 0;
+  for (std::size_t j = 0; j < site.scan_poses.size(); ++j) {
+    if (j == middle) continue;
+    const double shared = overlap(site, middle, j);
+    std::cout << "path overlap scan " << middle << "–" << j << ": " << shared << "\n";
+    overlapping += shared > 0.05;
+    if (j + 18 <= middle || j >= middle + 18) {
+      EXPECT_LT(shared, 0.01) << "scan " << j;
+    }
+    if (j + 1 == middle || j == middle + 1) {
+      EXPECT_GT(shared, 0.3) << "scan " << j;
+    }
+  }
+  EXPECT_LE(overlapping, 16);
+}
+
 // Each scanner stands 1.5–1.8 m above the ground, nearly level, clear of
 // walls, posts, trunks and cars (1.4 m around it up to 30° elevation), and
 // not inside anything.
@@ -277,7 +307,7 @@ TEST_P(SimSitesEachSite, LongerCampaignsExtendTheDefaultOne) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(SimSites, SimSitesEachSite, ::testing::Values("campus", "street"));
+INSTANTIATE_TEST_SUITE_P(SimSites, SimSitesEachSite, ::testing::Values("campus", "street", "path"));
 
 TEST(SimSites, CampusOverlapFallsToAboutAThird) {
   for (const std::uint64_t seed : {1u, 2u}) {
