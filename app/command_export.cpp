@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/progress_bar.hpp"
 #include "modeling/export_command.hpp"
 
 namespace scanbench::app {
@@ -23,7 +24,10 @@ void run_export(ExportOptions& options) {
   options.settings.scan_id = options.scan_id;
   options.settings.output = options.output;
   const store::Project project = store::Project::open_for_reading(options.project);
-  const modeling::ExportResult result = modeling::export_project(project, options.settings);
+  const modeling::ExportResult result = [&] {
+    ProgressBar progress;  // its line ends before the summary
+    return modeling::export_project(project, options.settings, &progress);
+  }();
   fmt::print("exported {} scan(s), {} {} points, to {}\n", result.scans, result.points,
              options.settings.merged ? "merged-model" : "valid", options.output);
   if (result.hidden + result.deleted > 0) {

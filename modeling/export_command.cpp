@@ -1,7 +1,10 @@
 #include "modeling/export_command.hpp"
 
+#include <algorithm>
+#include <array>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,56 +35,51 @@ std::vector<std::int64_t> exported_ids(const store::Project& project,
   return ids;
 }
 
-// With `merged`, the keep mask of every exported scan; none otherwise.
-std::vector<std::vector<std::uint8_t>> keep_masks(const store::Project& project,
-                                                  const ExportSettings& settings,
-                                                  const std::vector<std::int64_t>& ids) {
-  if (!settings.merged) return {};
+// With `merged`, refuses a grid format, and a scan without a keep mask
+// (never merged since its last registration), before anything is loaded.
+void check_merged(const store::Project& project, const ExportSettings& settings,
+                  const std::vector<std::int64_t>& ids) {
+  if (!settings.merged) return;
   const std::string file = project.path().string();
   if (settings.format == ExportFormat::kPtx || settings.format == ExportFormat::kTriplet) {
     throw core::InputError(file, {},
                            "--merged writes the merged model's points: use --format ply, csv, las "
                            "or e57");
   }
-  std::vector<std::vector<std::uint8_t>> masks;
   for (const std::int64_t id : ids) {
-    std::optional<std::vector<std::uint8_t>> mask = store::load_keep_mask(project, id);
-    if (!mask) {
+    const std::vector<std::string> layers = project.layer_names(id);
+    if (std::find(layers.begin(), layers.end(), store::layer::kKeep) == layers.end()) {
       throw core::InputError(
           file, {{}, {}, "scan " + std::to_string(id)},
           "no merged model for this scan: run `scanbench merge` after the last registration");
     }
-    masks.push_back(std::move(*mask));
   }
-  return masks;
 }
 
-void write_triplet(const store::Project& project, const std::vector<acquisition::Scan>& scans,
-                   const ExportSettings& settings) {
+// A triplet holds one spherical scan; a PTX holds grids, whose readers take
+// neighbouring cells for neighbouring points, which a scattered scan's are
+// not. Refused from the summaries, before anything is loaded or written.
+void check_grid_format(const store::Project& project, const ExportSettings& settings,
+                       const std::vector<const acquisition::ScanSummary*>& summaries) {
   const std::string file = project.path().string();
-  if (scans.size() != 1) {
-    throw core::InputError(file, {}, "a triplet holds one scan: choose it with --scan ID");
+  if (settings.format == ExportFormat::kTriplet) {
+    if (summaries.size() != 1) {
+      throw core::InputError(file, {}, "a triplet holds one scan: choose it with --scan ID");
+    }
+    if (!summaries.front()->spherical) {
+      throw core::InputError(file, {{}, {}, "scan \"" + summaries.front()->name + "\""},
+                             "a triplet needs the spherical angle model; this scan has per-pixel "
+                             "directions (export it as ptx, e57, ply, csv or las)");
+    }
   }
-  if (!scans.front().is_spherical()) {
-    throw core::InputError(file, {{}, {}, "scan \"" + scans.front().name + "\""},
-                           "a triplet needs the spherical angle model; this scan has per-pixel "
-                           "directions (export it as ptx, e57, ply, csv or las)");
-  }
-  acquisition::write_triplet(scans.front(), settings.output);
-}
-
-// A PTX holds grids: its readers take neighbouring cells for neighbouring
-// points, which a scattered scan's are not.
-void write_ptx(const store::Project& project, const std::vector<acquisition::Scan>& scans,
-               const ExportSettings& settings) {
-  for (const acquisition::Scan& scan : scans) {
-    if (scan.is_scattered()) {
-      throw core::InputError(project.path().string(), {{}, {}, "scan \"" + scan.name + "\""},
+  if (settings.format == ExportFormat::kPtx) {
+    for (const acquisition::ScanSummary* summary : summaries) {
+      if (!summary->scattered) continue;
+      throw core::InputError(file, {{}, {}, "scan \"" + summary->name + "\""},
                              "is an unstructured cloud, and a PTX holds scan grids (export it as "
                              "e57, ply, las or csv)");
     }
   }
-  acquisition::write_ptx(settings.output, scans);
 }
 
 // The coordinate reference system the exported scans' files named: the
@@ -126,92 +124,113 @@ std::string derived_guid(const store::Project& project, std::int64_t id,
 }
 
 // The scans as E57 data3D entries with their guids (kept from an E57
-// import, else derived_guid) and images; the images tied to no scan go with a whole-project
-// export only.
-void write_e57(const store::Project& project, const std::vector<std::int64_t>& ids,
-               const std::vector<acquisition::Scan>& scans,
-               const std::vector<const std::vector<std::uint8_t>*>& keep,
-               const ExportSettings& settings) {
-  const std::map<std::int64_t, acquisition::ScanSource> sources = project.scan_sources();
-  std::vector<store::StoredImage> images = project.images(true);
-  std::vector<acquisition::E57ScanOutput> outputs(scans.size());
-  for (std::size_t s = 0; s < scans.size(); ++s) {
-    outputs[s].scan = &scans[s];
-    const auto source = sources.find(ids[s]);
-    const acquisition::ScanSource* from = source != sources.end() ? &source->second : nullptr;
-    outputs[s].guid =
-        from && !from->guid.empty() ? from->guid : derived_guid(project, ids[s], from);
-    if (!keep.empty()) outputs[s].keep = keep[s];
-    for (store::StoredImage& stored : images) {
-      if (stored.scan_id == ids[s]) outputs[s].images.push_back(std::move(stored.image));
-    }
-  }
-  std::vector<acquisition::ScanImage> loose;
-  if (!settings.scan_id) {
-    for (store::StoredImage& stored : images) {
-      if (!stored.scan_id) loose.push_back(std::move(stored.image));
-    }
-  }
-  acquisition::write_e57(settings.output, outputs, loose,
-                         common_coordinate_metadata(project, ids, sources));
-}
+// import, else derived_guid) and images, one scan at a time; the images tied
+// to no scan go with a whole-project export only.
+class E57Export {
+ public:
+  E57Export(const store::Project& project, const std::vector<std::int64_t>& ids,
+            const ExportSettings& settings)
+      : project_(project),
+        sources_(project.scan_sources()),
+        images_(project.images(true)),
+        writer_(settings.output, common_coordinate_metadata(project, ids, sources_)),
+        whole_project_(!settings.scan_id) {}
 
-// The scans as the model shows them, unless the settings ask otherwise:
-// colours through the scan's correction and the owner's edit, and the
-// points of hidden objects and deleted ones left out. A grid format (PTX,
-// a triplet) marks them invalid; the others take them out of `keep`, made
-// from the valid points where there was none.
-void show_as_the_model_does(const store::Project& project, const std::vector<std::int64_t>& ids,
-                            const ExportSettings& settings, std::vector<acquisition::Scan>& scans,
-                            std::vector<std::vector<std::uint8_t>>& keep, ExportResult& result) {
-  const bool recolour = settings.colors == ExportColors::kShown;
-  if (!recolour && settings.all_points) return;
-  const std::vector<store::ObjectNode> tree = project.object_nodes();
-  const std::map<std::int64_t, bool> shown = shown_nodes(tree);
-  const ColorPipeline colors(project.scan_color_corrections(), resolve_color_edits(tree));
-  const bool grid_format =
-      settings.format == ExportFormat::kPtx || settings.format == ExportFormat::kTriplet;
-  const auto leave_out = [&](std::size_t s, std::size_t i) {
-    if (grid_format) {
-      scans[s].valid[i] = 0;
-      return;
+  void add(std::int64_t id, const acquisition::Scan& scan, const std::vector<std::uint8_t>* keep) {
+    acquisition::E57ScanOutput output;
+    output.scan = &scan;
+    const auto source = sources_.find(id);
+    const acquisition::ScanSource* from = source != sources_.end() ? &source->second : nullptr;
+    output.guid = from && !from->guid.empty() ? from->guid : derived_guid(project_, id, from);
+    output.keep = keep;
+    for (store::StoredImage& stored : images_) {
+      if (stored.scan_id == id) output.images.push_back(std::move(stored.image));
     }
-    if (keep.empty()) {
-      for (const acquisition::Scan& scan : scans) keep.push_back(scan.valid);
+    writer_.add(output);
+  }
+
+  void commit() {
+    std::vector<acquisition::ScanImage> loose;
+    if (whole_project_) {
+      for (store::StoredImage& stored : images_) {
+        if (!stored.scan_id) loose.push_back(std::move(stored.image));
+      }
     }
-    keep[s][i] = 0;
-  };
-  for (std::size_t s = 0; s < scans.size(); ++s) {
-    acquisition::Scan& scan = scans[s];
-    const auto membership = project.load_layer<std::uint32_t>(ids[s], store::layer::kMembership,
-                                                              store::ElementType::kU32);
+    writer_.commit(loose);
+  }
+
+ private:
+  const store::Project& project_;
+  std::map<std::int64_t, acquisition::ScanSource> sources_;
+  std::vector<store::StoredImage> images_;
+  acquisition::E57Writer writer_;
+  bool whole_project_;
+};
+
+// A scan as the model shows it, unless the settings ask otherwise: colours
+// through the scan's correction and the owner's edit, and the points of
+// hidden objects and deleted ones left out. A grid format (PTX, a triplet)
+// marks them invalid; the others take them out of `keep`, made from the
+// valid points where there was none.
+class ModelView {
+ public:
+  ModelView(const store::Project& project, const ExportSettings& settings)
+      : project_(project),
+        settings_(settings),
+        tree_(project.object_nodes()),
+        shown_(shown_nodes(tree_)),
+        colors_(project.scan_color_corrections(), resolve_color_edits(tree_)) {}
+
+  void show(std::int64_t id, acquisition::Scan& scan,
+            std::optional<std::vector<std::uint8_t>>& keep, ExportResult& result) const {
+    const bool recolour = settings_.colors == ExportColors::kShown;
+    if (!recolour && settings_.all_points) return;
+    const bool grid_format =
+        settings_.format == ExportFormat::kPtx || settings_.format == ExportFormat::kTriplet;
+    const auto leave_out = [&](std::size_t i) {
+      if (grid_format) {
+        scan.valid[i] = 0;
+        return;
+      }
+      if (!keep) keep = scan.valid;
+      (*keep)[i] = 0;
+    };
+    const auto membership =
+        project_.load_layer<std::uint32_t>(id, store::layer::kMembership, store::ElementType::kU32);
     for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
-      if (!scan.valid[i] || (!keep.empty() && keep[s][i] == 0)) continue;
+      if (!scan.valid[i] || (keep && (*keep)[i] == 0)) continue;
       std::uint32_t owner = membership ? (*membership)[i] : 0;
       if (owner == store::kDeletedPoints) {
         owner = 0;
-        if (!settings.all_points) {
+        if (!settings_.all_points) {
           ++result.deleted;
-          leave_out(s, i);
+          leave_out(i);
           continue;
         }
       } else if (owner != 0) {
-        const auto found = shown.find(owner);
-        if (found == shown.end()) {
+        const auto found = shown_.find(owner);
+        if (found == shown_.end()) {
           owner = 0;  // a node no longer in the tree owns nothing
-        } else if (!found->second && !settings.all_points) {
+        } else if (!found->second && !settings_.all_points) {
           ++result.hidden;
-          leave_out(s, i);
+          leave_out(i);
           continue;
         }
       }
       if (!recolour || !scan.has_color()) continue;
       std::uint8_t* rgb = &scan.rgb[3 * i];
-      const std::array<std::uint8_t, 3> out = colors.shown(ids[s], owner, {rgb[0], rgb[1], rgb[2]});
+      const std::array<std::uint8_t, 3> out = colors_.shown(id, owner, {rgb[0], rgb[1], rgb[2]});
       std::copy(out.begin(), out.end(), rgb);
     }
   }
-}
+
+ private:
+  const store::Project& project_;
+  const ExportSettings& settings_;
+  std::vector<store::ObjectNode> tree_;
+  std::map<std::int64_t, bool> shown_;
+  ColorPipeline colors_;
+};
 
 // The coordinate system for a LAS file, which names it in OGC WKT only;
 // anything else the scans' files named becomes a note.
@@ -246,14 +265,12 @@ std::vector<std::uint16_t> point_source_ids(const store::Project& project,
   return out;
 }
 
-std::size_t count_points(const std::vector<acquisition::Scan>& scans,
-                         const std::vector<std::vector<std::uint8_t>>& keep) {
-  std::size_t points = 0;
-  for (std::size_t s = 0; s < scans.size(); ++s) {
-    const std::vector<std::uint8_t>& counted = keep.empty() ? scans[s].valid : keep[s];
-    for (const std::uint8_t flag : counted) points += flag != 0 ? 1 : 0;
-  }
-  return points;
+// The pixels a grid format writes as valid: the valid ones, or the kept.
+std::size_t count_points(const acquisition::Scan& scan,
+                         const std::optional<std::vector<std::uint8_t>>& keep) {
+  const std::vector<std::uint8_t>& counted = keep ? *keep : scan.valid;
+  return static_cast<std::size_t>(
+      std::count_if(counted.begin(), counted.end(), [](std::uint8_t flag) { return flag != 0; }));
 }
 
 // The files a scan imported before sources were recorded names: its path as
@@ -323,58 +340,119 @@ void refuse_to_replace_inputs(const store::Project& project,
   }
 }
 
-ExportResult export_project(const store::Project& project, const ExportSettings& settings) {
+namespace {
+
+bool is_point_list(ExportFormat format) {
+  return format == ExportFormat::kPly || format == ExportFormat::kCsv ||
+         format == ExportFormat::kLas;
+}
+
+// The channels every exported scan has, from the summaries and the layers'
+// names: a point list's columns are fixed before the first scan is loaded.
+acquisition::PointChannels common_channels(
+    const store::Project& project, const std::vector<std::int64_t>& ids,
+    const std::vector<const acquisition::ScanSummary*>& summaries) {
+  acquisition::PointChannels channels;
+  for (std::size_t s = 0; s < ids.size(); ++s) {
+    channels.intensity = channels.intensity && summaries[s]->has_intensity;
+    channels.color = channels.color && summaries[s]->has_color;
+    const std::vector<std::string> layers = project.layer_names(ids[s]);
+    channels.geometry = channels.geometry && std::find(layers.begin(), layers.end(),
+                                                       store::layer::kNormal) != layers.end();
+  }
+  return channels;
+}
+
+// LAS's settings: the scans' stored world bounds (their points at the
+// current poses) give the offset; the coordinate system as las_wkt.
+acquisition::PointListWriter::LasSettings las_settings(
+    const store::Project& project, const std::vector<std::int64_t>& ids,
+    const std::vector<const acquisition::ScanSummary*>& summaries, ExportResult& result) {
+  acquisition::PointListWriter::LasSettings las;
+  for (const acquisition::ScanSummary* summary : summaries) {
+    if (summary->bbox_world) las.bounds.extend(*summary->bbox_world);
+  }
+  las.wkt = las_wkt(common_coordinate_metadata(project, ids, project.scan_sources()), result);
+  return las;
+}
+
+}  // namespace
+
+ExportResult export_project(const store::Project& project, const ExportSettings& settings,
+                            core::Progress* progress) {
   // Masks, poses and channels from one state, whatever commits meanwhile.
   const store::Project::ReadSnapshot snapshot = project.read_snapshot();
   const std::vector<std::int64_t> ids = exported_ids(project, settings);
-  std::vector<std::vector<std::uint8_t>> keep = keep_masks(project, settings, ids);
-  std::vector<acquisition::Scan> scans;
-  std::vector<std::optional<acquisition::ScanGeometry>> geometry;
+  const std::vector<store::StoredScanSummary> stored = project.scans();
+  std::vector<const acquisition::ScanSummary*> summaries;
   for (const std::int64_t id : ids) {
-    scans.push_back(project.load_scan(id));
-    geometry.push_back(store::load_geometry(project, id));
+    const auto found = std::find_if(stored.begin(), stored.end(),
+                                    [id](const store::StoredScanSummary& s) { return s.id == id; });
+    summaries.push_back(&found->summary);
   }
+  check_merged(project, settings, ids);
+  check_grid_format(project, settings, summaries);
+  std::vector<std::uint16_t> source_ids;
+  if (settings.format == ExportFormat::kLas) source_ids = point_source_ids(project, ids);
+  // A triplet's files are named after its one scan.
+  std::optional<acquisition::Scan> triplet_scan;
+  if (settings.format == ExportFormat::kTriplet) triplet_scan = project.load_scan(ids.front());
   const std::vector<std::filesystem::path> outputs =
-      settings.format == ExportFormat::kTriplet && scans.size() == 1
-          ? acquisition::triplet_files(scans.front(), settings.output)
-          : std::vector<std::filesystem::path>{settings.output};
+      triplet_scan ? acquisition::triplet_files(*triplet_scan, settings.output)
+                   : std::vector<std::filesystem::path>{settings.output};
   refuse_to_replace_inputs(project, outputs, settings.replace_existing);
+
   ExportResult result;
-  result.scans = scans.size();
-  show_as_the_model_does(project, ids, settings, scans, keep, result);
-  std::vector<const acquisition::ScanGeometry*> geometry_of;
-  for (const auto& g : geometry) geometry_of.push_back(g ? &*g : nullptr);
-  std::vector<const std::vector<std::uint8_t>*> keep_of;
-  for (const auto& mask : keep) keep_of.push_back(&mask);
-  switch (settings.format) {
-    case ExportFormat::kPtx:
-      write_ptx(project, scans, settings);
-      break;
-    case ExportFormat::kPly:
-      acquisition::write_ply(settings.output, scans, geometry_of, keep_of);
-      break;
-    case ExportFormat::kCsv:
-      acquisition::write_csv(settings.output, scans, geometry_of, keep_of);
-      break;
-    case ExportFormat::kTriplet:
-      write_triplet(project, scans, settings);
-      break;
-    case ExportFormat::kLas:
-      acquisition::write_las(
-          settings.output, scans, point_source_ids(project, ids), geometry_of, keep_of,
-          las_wkt(common_coordinate_metadata(project, ids, project.scan_sources()), result));
-      break;
-    case ExportFormat::kE57:
-      write_e57(project, ids, scans, keep_of, settings);
-      break;
+  result.scans = ids.size();
+  const ModelView view(project, settings);
+  // One writer per format; every scan is loaded, shown and written in turn.
+  const bool point_list = is_point_list(settings.format);
+  std::optional<acquisition::PointListWriter> points;
+  std::optional<acquisition::PtxWriter> ptx;
+  std::optional<E57Export> e57;
+  if (point_list) {
+    const acquisition::PointListFormat format =
+        settings.format == ExportFormat::kPly   ? acquisition::PointListFormat::kPly
+        : settings.format == ExportFormat::kCsv ? acquisition::PointListFormat::kCsv
+                                                : acquisition::PointListFormat::kLas;
+    const acquisition::PointListWriter::LasSettings las =
+        settings.format == ExportFormat::kLas ? las_settings(project, ids, summaries, result)
+                                              : acquisition::PointListWriter::LasSettings{};
+    points.emplace(settings.output, format, common_channels(project, ids, summaries), las);
+  } else if (settings.format == ExportFormat::kPtx) {
+    ptx.emplace(settings.output);
+  } else if (settings.format == ExportFormat::kE57) {
+    e57.emplace(project, ids, settings);
   }
-  // The point formats leave mixed pixels out; the grid formats keep every
-  // pixel, the valid ones (or with `merged` the kept ones) counted.
-  const bool point_list = settings.format == ExportFormat::kPly ||
-                          settings.format == ExportFormat::kCsv ||
-                          settings.format == ExportFormat::kLas;
-  result.points = point_list ? acquisition::count_exported_points(scans, geometry_of, keep_of)
-                             : count_points(scans, keep);
+  for (std::size_t s = 0; s < ids.size(); ++s) {
+    const std::int64_t id = ids[s];
+    acquisition::Scan scan = triplet_scan ? std::move(*triplet_scan) : project.load_scan(id);
+    std::optional<std::vector<std::uint8_t>> keep;
+    if (settings.merged) keep = store::load_keep_mask(project, id);
+    view.show(id, scan, keep, result);
+    const std::vector<std::uint8_t>* keep_of = keep ? &*keep : nullptr;
+    if (points) {
+      const std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, id);
+      points->add(scan, geometry ? &*geometry : nullptr, keep_of,
+                  source_ids.empty() ? 0 : source_ids[s]);
+    } else {
+      result.points += count_points(scan, keep);
+      if (ptx) ptx->add(scan);
+      if (e57) e57->add(id, scan, keep_of);
+      if (settings.format == ExportFormat::kTriplet)
+        acquisition::write_triplet(scan, settings.output);
+    }
+    if (progress != nullptr) {
+      progress->update({"export", s + 1, ids.size(), scan.name});
+      progress->throw_if_cancelled("export");
+    }
+  }
+  if (points) {
+    result.points = points->points();
+    points->commit();
+  }
+  if (ptx) ptx->commit();
+  if (e57) e57->commit();
   return result;
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
@@ -58,7 +59,9 @@ struct ExportResult {
 };
 
 // Writes the project's scans as the settings say, all read from one state of
-// the project (Project::read_snapshot): what the model shows unless the
+// the project (Project::read_snapshot), one scan at a time: memory holds the
+// scan being written, whatever the number of scans (E57 holds the
+// project's images too). What the model shows unless the
 // settings ask for recorded colours or all points. Points left out are
 // marked invalid in the grid formats (PTX, triplet, E57's structured scans)
 // and not written in the others. Outputs are checked first
@@ -70,7 +73,10 @@ struct ExportResult {
 // a scan whose id does not fit a point source id (above 65535). Output
 // is all-or-nothing (acquisition/formats/output_file.hpp); write failures throw
 // std::runtime_error naming the file.
-ExportResult export_project(const store::Project& project, const ExportSettings& settings);
+// `progress`, when given, gets a unit per scan written and may cancel
+// (core::Cancelled, nothing written).
+ExportResult export_project(const store::Project& project, const ExportSettings& settings,
+                            core::Progress* progress = nullptr);
 
 // Refuses (core::InputError naming the output, nothing written) an output
 // that would replace an input of the project: the project itself or one of

@@ -20,11 +20,7 @@ namespace {
 
 static_assert(std::endian::native == std::endian::little, "PLY export writes native little-endian");
 
-struct Channels {
-  bool intensity = true;
-  bool color = true;
-  bool geometry = true;
-};
+using Channels = PointChannels;
 
 Channels common_channels(std::span<const Scan> scans,
                          std::span<const ScanGeometry* const> geometry) {
@@ -39,26 +35,35 @@ Channels common_channels(std::span<const Scan> scans,
   return channels;
 }
 
-// Calls visit(scan index, pixel index, world point) for every exported pixel
-// (valid, not a mixed pixel when geometry is exported, and kept when a keep
-// mask is given), scan after scan, row-major.
+// Calls visit(pixel index, world point) for every exported pixel of one
+// scan (valid, not a mixed pixel when geometry is exported, and kept when a
+// keep mask is given), row-major.
+template <typename Visit>
+void for_each_scan_point(const Scan& scan, const ScanGeometry* geometry,
+                         const std::vector<std::uint8_t>* keep, bool with_geometry, Visit&& visit) {
+  assert((keep == nullptr || keep->size() == scan.pixel_count()) && "a byte per pixel");
+  assert((!with_geometry || geometry != nullptr) && "geometry to leave mixed pixels out");
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const std::size_t i = scan.index(row, col);
+      if (with_geometry ? !in_model(scan, *geometry, i) : !scan.valid[i]) continue;
+      if (keep != nullptr && (*keep)[i] == 0) continue;
+      visit(i, point_in_world(scan, row, col));
+    }
+  }
+}
+
+// for_each_scan_point over every scan, with visit(scan index, pixel index,
+// world point).
 template <typename Visit>
 void for_each_point(std::span<const Scan> scans, std::span<const ScanGeometry* const> geometry,
                     std::span<const std::vector<std::uint8_t>* const> keep, Channels channels,
                     Visit&& visit) {
   assert((keep.empty() || keep.size() == scans.size()) && "one keep entry per scan");
   for (std::size_t s = 0; s < scans.size(); ++s) {
-    const Scan& scan = scans[s];
-    const std::vector<std::uint8_t>* mask = keep.empty() ? nullptr : keep[s];
-    assert((mask == nullptr || mask->size() == scan.pixel_count()) && "a byte per pixel");
-    for (int row = 0; row < scan.rows; ++row) {
-      for (int col = 0; col < scan.columns; ++col) {
-        const std::size_t i = scan.index(row, col);
-        if (channels.geometry ? !in_model(scan, *geometry[s], i) : !scan.valid[i]) continue;
-        if (mask != nullptr && (*mask)[i] == 0) continue;
-        visit(s, i, point_in_world(scan, row, col));
-      }
-    }
+    for_each_scan_point(scans[s], channels.geometry ? geometry[s] : nullptr,
+                        keep.empty() ? nullptr : keep[s], channels.geometry,
+                        [&](std::size_t i, const Eigen::Vector3d& p) { visit(s, i, p); });
   }
 }
 
@@ -78,9 +83,23 @@ void append_geometry(std::string& out, const Scan& scan, const ScanGeometry& geo
   append_binary(out, geometry.footprint_m[i]);
 }
 
+// The vertex count is known only when every scan is written: the header
+// keeps it in a block of fixed size (the count, then a comment of spaces
+// that pads it), rewritten at the end.
+constexpr std::size_t kPlyCountWidth = 20;  // the digits of 2⁶⁴
+
+std::string ply_vertex_count(std::size_t vertices) {
+  const std::string digits = std::to_string(vertices);
+  return "element vertex " + digits + "\ncomment" +
+         std::string(kPlyCountWidth - digits.size(), ' ') + "\n";
+}
+
+constexpr std::string_view kPlyStart =
+    "ply\nformat binary_little_endian 1.0\ncomment written by scanbench\n";
+
 std::string ply_header(std::size_t vertices, Channels channels) {
-  std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by scanbench\n";
-  header += "element vertex " + std::to_string(vertices) + "\n";
+  std::string header(kPlyStart);
+  header += ply_vertex_count(vertices);
   header += "property double x\nproperty double y\nproperty double z\n";
   if (channels.intensity) header += "property float intensity\n";
   if (channels.color) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -190,6 +209,185 @@ std::uint16_t to_u16(double unit) {
 
 }  // namespace
 
+struct PointListWriter::State {
+  State(const std::filesystem::path& target, PointListFormat f, Channels c)
+      : path(target), file(target), format(f), channels(c) {}
+
+  std::filesystem::path path;
+  OutputFile file;
+  PointListFormat format;
+  Channels channels;
+  std::size_t points = 0;
+  // LAS: the offset, the VLRs, and the quantised extent of what was written.
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  std::string vlrs;
+  std::uint32_t vlr_count = 0;
+  Eigen::Array3<std::int64_t> min_q =
+      Eigen::Array3<std::int64_t>::Constant(std::numeric_limits<std::int64_t>::max());
+  Eigen::Array3<std::int64_t> max_q =
+      Eigen::Array3<std::int64_t>::Constant(std::numeric_limits<std::int64_t>::min());
+
+  void write_ply_point(const Scan& scan, const ScanGeometry* geometry, std::size_t i,
+                       const Eigen::Vector3d& p);
+  void write_csv_point(const Scan& scan, std::size_t i, const Eigen::Vector3d& p);
+  void write_las_point(const Scan& scan, const ScanGeometry* geometry, std::size_t i,
+                       const Eigen::Vector3d& p, std::uint16_t source_id);
+  std::string las_header_now() const;
+};
+
+void PointListWriter::State::write_ply_point(const Scan& scan, const ScanGeometry* geometry,
+                                             std::size_t i, const Eigen::Vector3d& p) {
+  std::string& out = file.buffer();
+  for (int axis = 0; axis < 3; ++axis) append_binary(out, p[axis]);
+  if (channels.intensity) append_binary(out, scan.intensity[i]);
+  if (channels.color) out.append(reinterpret_cast<const char*>(&scan.rgb[3 * i]), 3);
+  if (channels.geometry) append_geometry(out, scan, *geometry, i);
+}
+
+void PointListWriter::State::write_csv_point(const Scan& scan, std::size_t i,
+                                             const Eigen::Vector3d& p) {
+  std::string& out = file.buffer();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (axis > 0) out += ',';
+    append_number(out, p[axis]);
+  }
+  if (channels.intensity) {
+    out += ',';
+    append_number(out, scan.intensity[i]);
+  }
+  for (int c = 0; channels.color && c < 3; ++c) {
+    out += ',';
+    out += std::to_string(scan.rgb[3 * i + c]);
+  }
+  out += '\n';
+}
+
+void PointListWriter::State::write_las_point(const Scan& scan, const ScanGeometry* geometry,
+                                             std::size_t i, const Eigen::Vector3d& p,
+                                             std::uint16_t source_id) {
+  std::string& out = file.buffer();
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::int64_t q = std::llround((p[axis] - offset[axis]) / kLasScale);
+    if (q < std::numeric_limits<std::int32_t>::min() ||
+        q > std::numeric_limits<std::int32_t>::max()) {
+      throw core::InputError(path.string(), {{}, {}, "scan \"" + scan.name + "\""},
+                             "a point lies " + std::to_string(std::abs(q) * kLasScale) +
+                                 " m from the offset of the coordinates, beyond the scans' stored "
+                                 "bounds and more than LAS can hold at 0.1 mm");
+    }
+    min_q[axis] = std::min(min_q[axis], q);
+    max_q[axis] = std::max(max_q[axis], q);
+    append_binary(out, static_cast<std::int32_t>(q));
+  }
+  append_binary(out, channels.intensity ? to_u16(scan.intensity[i]) : std::uint16_t{0});
+  out += '\x11';                        // return 1 of 1
+  out += '\0';                          // classification flags, channel, direction, edge
+  out += '\0';                          // classification: never classified
+  out += '\0';                          // user data
+  append_binary(out, std::int16_t{0});  // scan angle
+  append_binary(out, source_id);
+  append_binary(out, 0.0);  // GPS time
+  for (int c = 0; c < 3; ++c) {
+    const std::uint16_t v =
+        channels.color ? static_cast<std::uint16_t>(scan.rgb[3 * i + c] * 257) : 0;
+    append_binary(out, v);
+  }
+  if (channels.geometry) append_geometry(out, scan, *geometry, i);
+}
+
+// The header's bounds are those of the quantised coordinates written.
+std::string PointListWriter::State::las_header_now() const {
+  LasExtent extent;
+  extent.points = points;
+  if (points > 0) {
+    extent.min = offset + min_q.cast<double>().matrix() * kLasScale;
+    extent.max = offset + max_q.cast<double>().matrix() * kLasScale;
+  }
+  return las_header(extent, vlrs, vlr_count, channels.geometry, offset);
+}
+
+PointListWriter::PointListWriter(const std::filesystem::path& path, PointListFormat format,
+                                 PointChannels channels, const LasSettings& las) {
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  if (format == PointListFormat::kLas) {
+    if (!las.bounds.isEmpty()) {
+      offset = las.bounds.min();
+      // The largest quantised coordinate must fit a signed 32-bit integer.
+      const double span = (las.bounds.max() - offset).maxCoeff();
+      if (span / kLasScale > static_cast<double>(std::numeric_limits<std::int32_t>::max())) {
+        throw core::InputError(path.string(), {},
+                               "the points span " + std::to_string(span) +
+                                   " m on an axis: more than LAS can hold at 0.1 mm");
+      }
+    }
+    assert(las.wkt.size() <= kMaxLasWktBytes && "a VLR holds 65535 bytes");
+  }
+  state_ = std::make_unique<State>(path, format, channels);
+  State& s = *state_;
+  switch (format) {
+    case PointListFormat::kPly:
+      s.file.write(ply_header(0, channels));
+      break;
+    case PointListFormat::kCsv:
+      s.file.write(std::string("x,y,z") + (channels.intensity ? ",intensity" : "") +
+                   (channels.color ? ",r,g,b" : "") + "\n");
+      break;
+    case PointListFormat::kLas:
+      s.offset = offset;
+      s.vlrs = channels.geometry ? extra_bytes_vlr() : std::string();
+      if (!las.wkt.empty()) s.vlrs += wkt_vlr(las.wkt);
+      s.vlr_count = (channels.geometry ? 1u : 0u) + (las.wkt.empty() ? 0u : 1u);
+      s.file.write(s.las_header_now());
+      s.file.write(s.vlrs);
+      break;
+  }
+}
+
+PointListWriter::~PointListWriter() = default;
+
+void PointListWriter::add(const Scan& scan, const ScanGeometry* geometry,
+                          const std::vector<std::uint8_t>* keep, std::uint16_t source_id) {
+  State& s = *state_;
+  const auto refuse = [&](const char* what) {
+    throw core::InputError(
+        s.path.string(), {{}, {}, "scan \"" + scan.name + "\""},
+        std::string("has no ") + what + ", which the other scans of the file have");
+  };
+  if (s.channels.intensity && !scan.has_intensity()) refuse("intensity");
+  if (s.channels.color && !scan.has_color()) refuse("colour");
+  if (s.channels.geometry && geometry == nullptr) refuse("geometry");
+  for_each_scan_point(scan, geometry, keep, s.channels.geometry,
+                      [&](std::size_t i, const Eigen::Vector3d& p) {
+                        switch (s.format) {
+                          case PointListFormat::kPly:
+                            s.write_ply_point(scan, geometry, i, p);
+                            break;
+                          case PointListFormat::kCsv:
+                            s.write_csv_point(scan, i, p);
+                            break;
+                          case PointListFormat::kLas:
+                            s.write_las_point(scan, geometry, i, p, source_id);
+                            break;
+                        }
+                        ++s.points;
+                        s.file.flush_if_full();
+                      });
+}
+
+std::size_t PointListWriter::points() const {
+  return state_->points;
+}
+
+void PointListWriter::commit() {
+  State& s = *state_;
+  if (s.format == PointListFormat::kPly) {
+    s.file.rewrite(kPlyStart.size(), ply_vertex_count(s.points));
+  } else if (s.format == PointListFormat::kLas) {
+    s.file.rewrite(0, s.las_header_now());
+  }
+  s.file.commit();
+}
+
 std::size_t count_exported_points(std::span<const Scan> scans,
                                   std::span<const ScanGeometry* const> geometry,
                                   std::span<const std::vector<std::uint8_t>* const> keep) {
@@ -199,53 +397,35 @@ std::size_t count_exported_points(std::span<const Scan> scans,
   return points;
 }
 
+namespace {
+
+void write_point_list(const std::filesystem::path& path, PointListFormat format,
+                      std::span<const Scan> scans, std::span<const ScanGeometry* const> geometry,
+                      std::span<const std::vector<std::uint8_t>* const> keep,
+                      std::span<const std::uint16_t> source_ids,
+                      const PointListWriter::LasSettings& las) {
+  assert((keep.empty() || keep.size() == scans.size()) && "one keep entry per scan");
+  const Channels channels = common_channels(scans, geometry);
+  PointListWriter writer(path, format, channels, las);
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    writer.add(scans[s], channels.geometry ? geometry[s] : nullptr,
+               keep.empty() ? nullptr : keep[s], source_ids.empty() ? 0 : source_ids[s]);
+  }
+  writer.commit();
+}
+
+}  // namespace
+
 void write_ply(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const ScanGeometry* const> geometry,
                std::span<const std::vector<std::uint8_t>* const> keep) {
-  const Channels channels = common_channels(scans, geometry);
-  OutputFile file(path);
-  file.write(ply_header(count_exported_points(scans, geometry, keep), channels));
-  for_each_point(scans, geometry, keep, channels,
-                 [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
-                   const Scan& scan = scans[s];
-                   std::string& out = file.buffer();
-                   for (int axis = 0; axis < 3; ++axis) append_binary(out, p[axis]);
-                   if (channels.intensity) append_binary(out, scan.intensity[i]);
-                   if (channels.color)
-                     out.append(reinterpret_cast<const char*>(&scan.rgb[3 * i]), 3);
-                   if (channels.geometry) append_geometry(out, scan, *geometry[s], i);
-                   file.flush_if_full();
-                 });
-  file.commit();
+  write_point_list(path, PointListFormat::kPly, scans, geometry, keep, {}, {});
 }
 
 void write_csv(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const ScanGeometry* const> geometry,
                std::span<const std::vector<std::uint8_t>* const> keep) {
-  const Channels channels = common_channels(scans, geometry);
-  OutputFile file(path);
-  file.write(std::string("x,y,z") + (channels.intensity ? ",intensity" : "") +
-             (channels.color ? ",r,g,b" : "") + "\n");
-  for_each_point(scans, geometry, keep, channels,
-                 [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
-                   const Scan& scan = scans[s];
-                   std::string& out = file.buffer();
-                   for (int axis = 0; axis < 3; ++axis) {
-                     if (axis > 0) out += ',';
-                     append_number(out, p[axis]);
-                   }
-                   if (channels.intensity) {
-                     out += ',';
-                     append_number(out, scan.intensity[i]);
-                   }
-                   for (int c = 0; channels.color && c < 3; ++c) {
-                     out += ',';
-                     out += std::to_string(scan.rgb[3 * i + c]);
-                   }
-                   out += '\n';
-                   file.flush_if_full();
-                 });
-  file.commit();
+  write_point_list(path, PointListFormat::kCsv, scans, geometry, keep, {}, {});
 }
 
 void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
@@ -253,60 +433,11 @@ void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const ScanGeometry* const> geometry,
                std::span<const std::vector<std::uint8_t>* const> keep, std::string_view wkt) {
   assert(source_ids.size() == scans.size() && "a point source id per scan");
-  const Channels channels = common_channels(scans, geometry);
-  LasExtent extent;
-  extent.min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  extent.max = -extent.min;
-  for_each_point(scans, geometry, keep, channels,
-                 [&](std::size_t, std::size_t, const Eigen::Vector3d& p) {
-                   ++extent.points;
-                   extent.min = extent.min.cwiseMin(p);
-                   extent.max = extent.max.cwiseMax(p);
-                 });
-  if (extent.points == 0) extent.min = extent.max = Eigen::Vector3d::Zero();
-  const Eigen::Vector3d offset = extent.min;
-  // The largest quantised coordinate must fit a signed 32-bit integer.
-  const Eigen::Vector3d span = (extent.max - offset) / kLasScale;
-  if (span.maxCoeff() > static_cast<double>(std::numeric_limits<std::int32_t>::max())) {
-    throw core::InputError(path.string(), {},
-                           "the points span " + std::to_string(span.maxCoeff() * kLasScale) +
-                               " m on an axis: more than LAS can hold at 0.1 mm");
-  }
-  // The header's bounds are those of the quantised coordinates.
-  for (int axis = 0; axis < 3; ++axis)
-    extent.max[axis] = offset[axis] + std::round(span[axis]) * kLasScale;
-  assert(wkt.size() <= kMaxLasWktBytes && "a VLR holds 65535 bytes");
-  std::string vlrs = channels.geometry ? extra_bytes_vlr() : std::string();
-  if (!wkt.empty()) vlrs += wkt_vlr(wkt);
-  const std::uint32_t vlr_count = (channels.geometry ? 1u : 0u) + (wkt.empty() ? 0u : 1u);
-  OutputFile file(path);
-  file.write(las_header(extent, vlrs, vlr_count, channels.geometry, offset));
-  file.write(vlrs);
-  for_each_point(
-      scans, geometry, keep, channels, [&](std::size_t s, std::size_t i, const Eigen::Vector3d& p) {
-        const Scan& scan = scans[s];
-        std::string& out = file.buffer();
-        for (int axis = 0; axis < 3; ++axis) {
-          append_binary(
-              out, static_cast<std::int32_t>(std::lround((p[axis] - offset[axis]) / kLasScale)));
-        }
-        append_binary(out, channels.intensity ? to_u16(scan.intensity[i]) : std::uint16_t{0});
-        out += '\x11';                        // return 1 of 1
-        out += '\0';                          // classification flags, channel, direction, edge
-        out += '\0';                          // classification: never classified
-        out += '\0';                          // user data
-        append_binary(out, std::int16_t{0});  // scan angle
-        append_binary(out, source_ids[s]);
-        append_binary(out, 0.0);  // GPS time
-        for (int c = 0; c < 3; ++c) {
-          const std::uint16_t v =
-              channels.color ? static_cast<std::uint16_t>(scan.rgb[3 * i + c] * 257) : 0;
-          append_binary(out, v);
-        }
-        if (channels.geometry) append_geometry(out, scan, *geometry[s], i);
-        file.flush_if_full();
-      });
-  file.commit();
+  PointListWriter::LasSettings las;
+  las.wkt = std::string(wkt);
+  for_each_point(scans, geometry, keep, common_channels(scans, geometry),
+                 [&](std::size_t, std::size_t, const Eigen::Vector3d& p) { las.bounds.extend(p); });
+  write_point_list(path, PointListFormat::kLas, scans, geometry, keep, source_ids, las);
 }
 
 bool looks_like_wkt(std::string_view text) {

@@ -3,9 +3,12 @@
 // double precision: georeferenced sites sit at 10^5–10^6 m.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -63,6 +66,54 @@ void write_las(const std::filesystem::path& path, std::span<const Scan> scans,
                std::span<const ScanGeometry* const> geometry = {},
                std::span<const std::vector<std::uint8_t>* const> keep = {},
                std::string_view wkt = {});
+
+// The optional fields of a point-list export, the same for every point.
+struct PointChannels {
+  bool intensity = true;
+  bool color = true;
+  // Normals and footprints (PLY, LAS); mixed pixels are left out.
+  bool geometry = true;
+};
+
+enum class PointListFormat { kPly, kCsv, kLas };
+
+// A PLY, CSV or LAS file written one scan at a time, so that an export holds
+// one scan in memory whatever the size of the campaign: the files are those
+// of write_ply, write_csv and write_las. The channels are fixed up front (a
+// project knows them from its scans' summaries); the counts, and LAS's
+// bounds, go into the header at commit().
+class PointListWriter {
+ public:
+  struct LasSettings {
+    // A box that holds every point to be written (the scans' world
+    // bounds): its minimum is the offset of the quantised coordinates.
+    Eigen::AlignedBox3d bounds;
+    std::string wkt;  // as write_las
+  };
+  // Throws core::InputError naming `path` when LAS `bounds` span more than
+  // 0.1 mm × 2³¹ on an axis (nothing written), and as OutputFile.
+  PointListWriter(const std::filesystem::path& path, PointListFormat format, PointChannels channels,
+                  const LasSettings& las = {});
+  ~PointListWriter();
+  PointListWriter(const PointListWriter&) = delete;
+  PointListWriter& operator=(const PointListWriter&) = delete;
+
+  // Writes the scan's exported pixels (valid, kept, not mixed when the
+  // channels have geometry), row-major. `geometry` is needed when the
+  // channels have geometry, `source_id` is LAS's point source id. Throws
+  // core::InputError naming the file and the scan when the scan lacks a
+  // channel the file has, or a LAS point falls outside `bounds` by more than
+  // its integers hold; as OutputFile on write errors.
+  void add(const Scan& scan, const ScanGeometry* geometry,
+           const std::vector<std::uint8_t>* keep = nullptr, std::uint16_t source_id = 0);
+  std::size_t points() const;
+  // Completes the header and replaces the target (all-or-nothing).
+  void commit();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // A VLR's length is 16 bits; the WKT is written with its terminating null.
 inline constexpr std::size_t kMaxLasWktBytes = 65534;

@@ -3,7 +3,6 @@
 #include <cassert>
 
 #include "acquisition/formats/number_format.hpp"
-#include "acquisition/formats/output_file.hpp"
 
 namespace scanbench::acquisition {
 namespace {
@@ -56,19 +55,21 @@ void append_point(std::string& out, const Scan& scan, int row, int col) {
 
 }  // namespace
 
-void write_ptx(const std::filesystem::path& path, std::span<const Scan> scans) {
-  OutputFile file(path);
-  for (const Scan& scan : scans) {
-    assert(check_consistency(scan).empty() && "write_ptx needs a consistent scan");
-    write_header(file.buffer(), scan);
-    for (int col = 0; col < scan.columns; ++col) {
-      for (int row = 0; row < scan.rows; ++row) {
-        append_point(file.buffer(), scan, row, col);
-        file.flush_if_full();
-      }
+void PtxWriter::add(const Scan& scan) {
+  assert(check_consistency(scan).empty() && "write_ptx needs a consistent scan");
+  write_header(file_.buffer(), scan);
+  for (int col = 0; col < scan.columns; ++col) {
+    for (int row = 0; row < scan.rows; ++row) {
+      append_point(file_.buffer(), scan, row, col);
+      file_.flush_if_full();
     }
   }
-  file.commit();
+}
+
+void write_ptx(const std::filesystem::path& path, std::span<const Scan> scans) {
+  PtxWriter writer(path);
+  for (const Scan& scan : scans) writer.add(scan);
+  writer.commit();
 }
 
 }  // namespace scanbench::acquisition

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <span>
 
+#include "acquisition/formats/output_file.hpp"
 #include "acquisition/scan.hpp"
 
 namespace scanbench::acquisition {
@@ -17,5 +18,17 @@ namespace scanbench::acquisition {
 // all-or-nothing (output_file.hpp); throws std::runtime_error naming `path` on
 // write errors. Asserts every scan passes check_consistency().
 void write_ptx(const std::filesystem::path& path, std::span<const Scan> scans);
+
+// The same file written one scan at a time, so that an export holds one
+// scan in memory.
+class PtxWriter {
+ public:
+  explicit PtxWriter(const std::filesystem::path& path) : file_(path) {}
+  void add(const Scan& scan);
+  void commit() { file_.commit(); }
+
+ private:
+  OutputFile file_;
+};
 
 }  // namespace scanbench::acquisition

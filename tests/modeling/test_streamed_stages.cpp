@@ -6,7 +6,9 @@
 #include <memory>
 #include <vector>
 
+#include "acquisition/formats/point_export.hpp"
 #include "core/errors.hpp"
+#include "modeling/export_command.hpp"
 #include "modeling/harmonize_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
@@ -188,6 +190,50 @@ TEST_F(StreamedStagesTest, HarmonizationWithTwoScansInHandFindsThePairsOfTheOneI
   for (std::size_t k = 0; k < ids_.size(); ++k) {
     EXPECT_TRUE(out.scans[k].correction.matrix.isApprox(solved.corrections[k].matrix)) << k;
     EXPECT_EQ(out.scans[k].pairs == 0, k == ids_.size() - 1);  // the far room pairs with none
+  }
+}
+
+// Cancels the stage at its second unit.
+class CancelAtSecond : public core::Progress {
+ public:
+  void update(const core::ProgressStep& step) override {
+    if (step.done == 2) request_cancel();
+    ++updates;
+  }
+  int updates = 0;
+};
+
+TEST_F(StreamedStagesTest, ExportWritesScanByScanTheFileOfEveryScanInMemory) {
+  core::Progress quiet;
+  merge_project(project_, {}, quiet, std::uint64_t{1} << 40);
+  const std::unique_ptr<InMemory> all = in_memory();
+  std::vector<std::vector<std::uint8_t>> keep;
+  std::vector<const std::vector<std::uint8_t>*> keep_of;
+  std::vector<const acquisition::ScanGeometry*> geometry_of;
+  for (std::size_t k = 0; k < ids_.size(); ++k) keep.push_back(stored_keep(ids_[k]));
+  for (std::size_t k = 0; k < ids_.size(); ++k) {
+    keep_of.push_back(&keep[k]);
+    geometry_of.push_back(&all->geometry[k]);
+  }
+  acquisition::write_ply(dir_ / "in_memory.ply", all->scans, geometry_of, keep_of);
+  ExportSettings settings;
+  settings.format = ExportFormat::kPly;
+  settings.merged = true;
+  settings.output = dir_ / "streamed.ply";
+  const ExportResult result = export_project(project_, settings);
+  EXPECT_EQ(result.points, acquisition::count_exported_points(all->scans, geometry_of, keep_of));
+  EXPECT_EQ(test::read_file_bytes(dir_ / "streamed.ply"),
+            test::read_file_bytes(dir_ / "in_memory.ply"));
+
+  // Cancelled after the second scan: no file, not even a partial one.
+  settings.output = dir_ / "cancelled.las";
+  settings.format = ExportFormat::kLas;
+  CancelAtSecond cancel;
+  EXPECT_THROW(export_project(project_, settings, &cancel), core::Cancelled);
+  EXPECT_EQ(cancel.updates, 2);
+  for (const auto& entry : std::filesystem::directory_iterator(dir_.path())) {
+    EXPECT_EQ(entry.path().filename().string().find("cancelled"), std::string::npos)
+        << entry.path();
   }
 }
 

@@ -215,33 +215,49 @@ std::string e57_guid_from(std::string_view identity) {
                      a & 0xFFF, 0x8000 | ((b >> 48) & 0x3FFF), b & 0xFFFFFFFFFFFF);
 }
 
-void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
-               std::span<const ScanImage> loose_images, const std::string& coordinate_metadata) {
-  OutputFile out(path);
-  E57PageWriter file(out);
-  const std::vector<std::byte> header_space(48, std::byte{0});
-  file.write(header_space);  // the header, written last
-  E57Document document;
-  document.guid = new_e57_guid();
-  document.coordinate_metadata = coordinate_metadata;
-  std::set<std::string> guids;  // a guid names one scan of the file
-  for (const E57ScanOutput& output : scans) {
-    std::string guid = output.guid;
-    if (guid.empty() || !guids.insert(guid).second) {
-      guid = new_e57_guid();
-      guids.insert(guid);
-    }
-    E57ScanEntry entry = scan_entry(file, output, guid, path.string());
-    for (const ScanImage& image : output.images) {
-      document.images.push_back(image_entry(file, image, entry.guid));
-    }
-    document.scans.push_back(std::move(entry));
+struct E57Writer::State {
+  State(const std::filesystem::path& target, std::string coordinate_metadata)
+      : path(target), out(target), file(out) {
+    const std::vector<std::byte> header_space(48, std::byte{0});
+    file.write(header_space);  // the header, written last
+    document.guid = new_e57_guid();
+    document.coordinate_metadata = std::move(coordinate_metadata);
   }
+
+  std::filesystem::path path;
+  OutputFile out;
+  E57PageWriter file;
+  E57Document document;
+  std::set<std::string> guids;  // a guid names one scan of the file
+};
+
+E57Writer::E57Writer(const std::filesystem::path& path, std::string coordinate_metadata)
+    : state_(std::make_unique<State>(path, std::move(coordinate_metadata))) {}
+
+E57Writer::~E57Writer() = default;
+
+void E57Writer::add(const E57ScanOutput& output) {
+  State& s = *state_;
+  std::string guid = output.guid;
+  if (guid.empty() || !s.guids.insert(guid).second) {
+    guid = new_e57_guid();
+    s.guids.insert(guid);
+  }
+  E57ScanEntry entry = scan_entry(s.file, output, guid, s.path.string());
+  for (const ScanImage& image : output.images) {
+    s.document.images.push_back(image_entry(s.file, image, entry.guid));
+  }
+  s.document.scans.push_back(std::move(entry));
+}
+
+void E57Writer::commit(std::span<const ScanImage> loose_images) {
+  State& s = *state_;
+  E57PageWriter& file = s.file;
   for (const ScanImage& image : loose_images)
-    document.images.push_back(image_entry(file, image, ""));
+    s.document.images.push_back(image_entry(file, image, ""));
   file.pad_to(4);
   const std::uint64_t xml_offset = file.physical_position();
-  std::string xml = write_e57_xml(document);
+  std::string xml = write_e57_xml(s.document);
   xml.append((4 - xml.size() % 4) % 4, ' ');
   file.write(std::as_bytes(std::span(xml)));
   std::byte header[48] = {};
@@ -260,7 +276,14 @@ void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput>
   std::memcpy(header + 40, &page_size, 8);
   [[maybe_unused]] const std::uint64_t written = file.finish(0, header);
   assert(written == physical_length);
-  out.commit();
+  s.out.commit();
+}
+
+void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
+               std::span<const ScanImage> loose_images, const std::string& coordinate_metadata) {
+  E57Writer writer(path, coordinate_metadata);
+  for (const E57ScanOutput& output : scans) writer.add(output);
+  writer.commit(loose_images);
 }
 
 }  // namespace scanbench::acquisition

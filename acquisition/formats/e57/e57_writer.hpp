@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -37,6 +38,29 @@ struct E57ScanOutput {
 void write_e57(const std::filesystem::path& path, std::span<const E57ScanOutput> scans,
                std::span<const ScanImage> loose_images,
                const std::string& coordinate_metadata = "");
+
+// The same file as write_e57, written one scan at a time so that an export
+// holds one scan in memory: only the scans' entries in the XML section
+// accumulate until commit().
+class E57Writer {
+ public:
+  // Starts the file (an OutputFile: nothing replaces `path` before commit).
+  E57Writer(const std::filesystem::path& path, std::string coordinate_metadata);
+  ~E57Writer();
+  E57Writer(const E57Writer&) = delete;
+  E57Writer& operator=(const E57Writer&) = delete;
+
+  // Writes the scan's points and images; the scan may be let go after.
+  // Throws as write_e57.
+  void add(const E57ScanOutput& scan);
+  // Writes the images tied to no scan, the XML section and the header, and
+  // replaces the target.
+  void commit(std::span<const ScanImage> loose_images);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // A new random GUID in the braced form E57 files use.
 std::string new_e57_guid();
