@@ -40,7 +40,11 @@ Campaign scan_campaign(const sim::ScannerModel& scanner, int scan_count, SiteLig
   c.site = simulate_site("campus", scanner, scan_count, lighting);
   for (std::size_t k = 0; k < c.site.scans.size(); ++k)
     c.prepared.push_back(registration::prepare_scan(c.site.scans[k], c.site.geometry[k], 0));
+  // As many pairs per pair of scans as `scanbench harmonize` takes: round
+  // the campus every scan overlaps every other.
   registration::ColorPairSettings fit;
+  const std::size_t partners = c.site.scans.size() - 1;
+  fit.max_pairs_per_overlap = registration::link_pair_budget(fit, partners, partners);
   c.fit = registration::find_color_pairs(c.prepared, c.site.true_poses, fit);
   registration::ColorPairSettings held_out = fit;
   held_out.phase = 1;

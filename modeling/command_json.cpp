@@ -113,7 +113,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MergeSettings, noise, range_sigm
                                                 bound_coarser_scans)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ColorPairSettings, stride, phase, max_distance_m,
                                                 max_normal_angle_deg, dark, bright, max_local_step,
-                                                max_pairs_per_overlap)
+                                                max_pairs_per_overlap, max_pairs_per_scan)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(HarmonizeSettings, model, loss_scale, prior_weight,
                                                 max_gain_ratio, max_cross_talk, max_offset,
                                                 max_iterations)
@@ -385,6 +385,7 @@ void check(const HarmonizeCommandSettings& s, const Bounds& b) {
   b.in(s.pairs.bright, s.pairs.dark + 1, 255, "bright");
   b.in(s.pairs.max_local_step, 0, 1e4, "max_local_step");
   b.in(s.pairs.max_pairs_per_overlap, 1, kMaxCount, "max_pairs_per_overlap");
+  b.in(s.pairs.max_pairs_per_scan, 0, kMaxCount, "max_pairs_per_scan");
   b.positive(s.solve.loss_scale, kMaxRatio, "loss_scale");
   b.in(s.solve.prior_weight, 0, 1e6, "prior_weight");
   b.in(s.solve.max_gain_ratio, 1, kMaxRatio, "max_gain_ratio");

@@ -93,6 +93,13 @@ std::vector<registration::ColorPair> streamed_color_pairs(
     plan.push_back(scans[static_cast<std::size_t>(k)].id);
   ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress);
   cache.plan(plan);
+  // The pairs each scan may take part in, shared among the scans it may
+  // overlap: the solve grows with the scans, not with their overlaps.
+  std::vector<std::size_t> partners(scans.size(), 0);
+  for (const ScanPair& pair : pairs) {
+    ++partners[static_cast<std::size_t>(pair.first)];
+    ++partners[static_cast<std::size_t>(pair.second)];
+  }
   std::map<std::pair<int, int>, std::vector<registration::ColorPair>> found;
   std::shared_ptr<const LoadedScan> b;
   for (const ScanPair& pair : pairs) {
@@ -104,10 +111,13 @@ std::vector<registration::ColorPair> streamed_color_pairs(
     }
     const std::shared_ptr<const LoadedScan> a =
         cache.get(scans[static_cast<std::size_t>(pair.first)].id);
+    registration::ColorPairSettings link = settings;
+    link.max_pairs_per_overlap =
+        registration::link_pair_budget(settings, partners[static_cast<std::size_t>(pair.first)],
+                                       partners[static_cast<std::size_t>(pair.second)]);
     found[{pair.first, pair.second}] = registration::color_pairs_between(
         a->prepared, b->prepared, static_cast<std::uint32_t>(pair.first),
-        static_cast<std::uint32_t>(pair.second), a->scan.T_world_scan, b->scan.T_world_scan,
-        settings);
+        static_cast<std::uint32_t>(pair.second), a->scan.T_world_scan, b->scan.T_world_scan, link);
   }
   std::vector<registration::ColorPair> out;
   for (const auto& [which, list] : found) out.insert(out.end(), list.begin(), list.end());

@@ -171,6 +171,17 @@ std::string_view color_model_name(ColorModel model) {
   return kModelNames[static_cast<std::size_t>(model)];
 }
 
+std::size_t link_pair_budget(const ColorPairSettings& settings, std::size_t partners_a,
+                             std::size_t partners_b) {
+  std::size_t budget = settings.max_pairs_per_overlap;  // 0: all
+  if (settings.max_pairs_per_scan > 0) {
+    const std::size_t busier = std::max<std::size_t>({partners_a, partners_b, 1});
+    const std::size_t share = std::max<std::size_t>(settings.max_pairs_per_scan / busier, 1);
+    budget = budget == 0 ? share : std::min(budget, share);
+  }
+  return budget;
+}
+
 std::vector<ColorPair> color_pairs_between(const PreparedScan& a, const PreparedScan& b,
                                            std::uint32_t ia, std::uint32_t ib,
                                            const Eigen::Isometry3d& T_world_a,

@@ -50,8 +50,22 @@ struct ColorPairSettings {
   // At most this many pairs per pair of scans, spread evenly over the
   // candidates (0: all).
   std::size_t max_pairs_per_overlap = 40000;
+  // At most this many pairs of one scan with all the others (0: no bound),
+  // split evenly among the scans it may overlap (link_pair_budget): six to
+  // twelve parameters per scan need thousands of pairs, not hundreds of
+  // thousands, and with the bound the solve grows with the number of scans,
+  // not with the number of overlapping pairs. harmonize_project applies it;
+  // find_color_pairs does not (it knows no overlap graph).
+  std::size_t max_pairs_per_scan = 24000;
   int threads = 0;  // 0 = all cores; results do not depend on it
 };
+
+// The pairs to keep between two scans that may overlap `partners_a` and
+// `partners_b` scans (each counting the other): the least of
+// max_pairs_per_overlap and max_pairs_per_scan shared among the partners
+// of the busier scan, at least 1; 0 (all) when neither bounds it.
+std::size_t link_pair_budget(const ColorPairSettings& settings, std::size_t partners_a,
+                             std::size_t partners_b);
 
 // One corresponding point: its colour in two scans, linear RGB.
 struct ColorPair {

@@ -178,8 +178,13 @@ TEST_F(StreamedStagesTest, RegistrationWithTwoScansInHandEqualsTheOneInMemory) {
 TEST_F(StreamedStagesTest, HarmonizationWithTwoScansInHandFindsThePairsOfTheOneInMemory) {
   const HarmonizeCommandSettings settings;
   const std::unique_ptr<InMemory> all = in_memory();
+  // Each near room may overlap the three others: the command shares each
+  // scan's pairs among them.
+  registration::ColorPairSettings per_link = settings.pairs;
+  per_link.max_pairs_per_overlap = registration::link_pair_budget(settings.pairs, 3, 3);
+  ASSERT_EQ(per_link.max_pairs_per_overlap, settings.pairs.max_pairs_per_scan / 3);
   const std::vector<registration::ColorPair> expected =
-      registration::find_color_pairs(all->prepared, all->poses, settings.pairs);
+      registration::find_color_pairs(all->prepared, all->poses, per_link);
   ASSERT_GT(expected.size(), 1000u);
   core::Progress progress;
   const HarmonizeCommandResult out =
