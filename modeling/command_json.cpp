@@ -107,7 +107,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PickedPairs, source, target, pai
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegistrationSettings, coarse, picks, features,
                                                 icp_sample, icp, global, refine_globally,
                                                 min_overlap, max_free_space_violation,
-                                                min_global_overlap, estimate_samples)
+                                                min_global_overlap, max_overlap_tests_per_scan,
+                                                estimate_samples)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MergeSettings, noise, range_sigmas,
                                                 max_normal_angle_deg, tie_tolerance,
                                                 bound_coarser_scans)
@@ -361,6 +362,7 @@ void check(const registration::RegistrationSettings& s, const Bounds& b) {
   b.in(s.min_overlap, 0, 1, "registration.min_overlap");
   b.in(s.max_free_space_violation, 0, 1, "registration.max_free_space_violation");
   b.in(s.min_global_overlap, 0, 1, "registration.min_global_overlap");
+  b.in(s.max_overlap_tests_per_scan, 0, kMaxCount, "registration.max_overlap_tests_per_scan");
   b.in(s.estimate_samples, 1, kMaxCount, "registration.estimate_samples");
 }
 

@@ -1,15 +1,20 @@
 // Joint point-to-plane refinement of all poses (a multi-view ICP in the
-// spirit of Pulli 1999), solved in one Ceres problem per association round.
+// spirit of Pulli 1999) on the pose graph of the measured pairs: each round
+// associates every edge and reduces its correspondences to a quadratic in
+// the edge's relative pose (Lu and Milios 1997), then solves the graph.
 #include "registration/global_refinement.hpp"
 
+#include <ceres/autodiff_cost_function.h>
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
 
 #include "core/parallel.hpp"
 #include "core/timing.hpp"
@@ -21,11 +26,70 @@
 namespace scanbench::registration {
 namespace {
 
-// The correspondences of one edge, and the poses they tie together.
-struct EdgeMatches {
-  std::vector<PlaneCorrespondence> matches;
-  PoseParameters* source = nullptr;
-  PoseParameters* target = nullptr;
+// An edge's robust point-to-plane cost for fixed correspondences, as the
+// Gauss-Newton quadratic in a small motion ξ = (ω, v) of the relative pose,
+// T_target_source = exp(ξ) · T0 (rotation first, in the target's frame):
+// with each match's robust residual ρ_i and its derivative J_i by ξ,
+//   Σ (ρ_i + J_iᵀ ξ)² = (ξ − ξ*)ᵀ H (ξ − ξ*) + const,  H = Σ J_i J_iᵀ,
+// ξ* = −H⁻¹ Σ ρ_i J_i. The sum of the edges' quadratics is the Gauss-Newton
+// model of the joint problem over all correspondences, so a round solves
+// the same problem while memory holds 6 × 6 numbers per edge instead of
+// every correspondence.
+struct EdgeQuadratic {
+  Eigen::Isometry3d T0 = Eigen::Isometry3d::Identity();  // target ← source at linearisation
+  Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Zero();  // Lᵀ
+  Eigen::Matrix<double, 6, 1> step = Eigen::Matrix<double, 6, 1>::Zero();              // ξ*
+  std::size_t correspondences = 0;
+};
+
+EdgeQuadratic edge_quadratic(std::span<const PlaneCorrespondence> matches,
+                             const Eigen::Isometry3d& T0, double loss_scale_m) {
+  EdgeQuadratic edge;
+  edge.T0 = T0;
+  edge.correspondences = matches.size();
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  for (const PlaneCorrespondence& m : matches) {
+    const Eigen::Vector3d moved = T0 * m.sample;
+    const RobustResidual robust = cauchy_residual(m.normal.dot(moved - m.point), loss_scale_m);
+    Eigen::Matrix<double, 6, 1> J;
+    J << moved.cross(m.normal), m.normal;
+    J *= robust.slope;
+    H.noalias() += J * J.transpose();
+    g += robust.value * J;
+  }
+  // A tiny ridge keeps the factorisation defined along directions the
+  // matches leave free (a single plane); it moves nothing the matches fix.
+  H.diagonal().array() += 1e-12 * std::max(H.trace(), 1.0);
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(H);
+  edge.step = -llt.solve(g);
+  edge.sqrt_information = llt.matrixU();
+  return edge;
+}
+
+// Lᵀ (ξ − ξ*), ξ the motion of the edge's relative pose from T0 at the
+// poses T_a, T_b (first-order logarithm: the motions are small).
+struct EdgeCost {
+  EdgeQuadratic edge;
+
+  template <typename T>
+  bool operator()(const T* q_a, const T* t_a, const T* q_b, const T* t_b, T* residual) const {
+    using Vector3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Eigen::Quaternion<T>> R_a(q_a);
+    const Eigen::Map<const Eigen::Quaternion<T>> R_b(q_b);
+    const Eigen::Map<const Vector3> ta(t_a);
+    const Eigen::Map<const Vector3> tb(t_b);
+    const Eigen::Quaternion<T> R_ba = R_b.conjugate() * R_a;
+    const Vector3 t_ba = R_b.conjugate() * (ta - tb);
+    const Eigen::Matrix<T, 3, 3> D =
+        R_ba.toRotationMatrix() * edge.T0.linear().transpose().template cast<T>();
+    Eigen::Matrix<T, 6, 1> xi;
+    xi << T(0.5) * (D(2, 1) - D(1, 2)), T(0.5) * (D(0, 2) - D(2, 0)), T(0.5) * (D(1, 0) - D(0, 1)),
+        t_ba - D * edge.T0.translation().template cast<T>();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(residual);
+    r = edge.sqrt_information.template cast<T>() * (xi - edge.step.template cast<T>());
+    return true;
+  }
 };
 
 ceres::Solver::Options solver_options(const GlobalSettings& settings) {
@@ -37,38 +101,36 @@ ceres::Solver::Options solver_options(const GlobalSettings& settings) {
   return options;
 }
 
-// One round: associate every edge at the current poses, then solve jointly.
-// Edges are associated target by target (each target scan taken from the
-// stream once), and enter the problem in their own order. Returns the
-// number of correspondences used.
+// One round: associate every edge at the current poses and reduce it to
+// its quadratic, then solve the pose graph. Edges are associated target by
+// target (each target scan taken from the stream once), and enter the
+// problem in their own order. Returns the number of correspondences used.
 std::size_t solve_round(std::span<const SampleCloud> samples, ScanStream& scans,
                         std::span<const ScanEdge> edges, std::vector<PoseParameters>& poses,
                         double gate_m, const GlobalSettings& settings) {
   const double min_cos = std::cos(settings.icp.max_normal_angle_deg * std::numbers::pi / 180.0);
-  std::vector<std::vector<PlaneCorrespondence>> matches(edges.size());
+  std::vector<std::optional<EdgeQuadratic>> quadratics(edges.size());
   for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
     const auto a = static_cast<std::size_t>(edges[e].source);
     const auto b = static_cast<std::size_t>(edges[e].target);
     const Eigen::Isometry3d T_target_source = poses[b].isometry().inverse() * poses[a].isometry();
-    matches[e] = plane_correspondences(samples[a], target,
-                                       associate_samples(samples[a], target, T_target_source,
-                                                         {gate_m, min_cos}, settings.icp.threads));
+    const std::vector<PlaneCorrespondence> matches =
+        plane_correspondences(samples[a], target,
+                              associate_samples(samples[a], target, T_target_source,
+                                                {gate_m, min_cos}, settings.icp.threads));
+    if (matches.size() < settings.icp.min_correspondences) return;
+    quadratics[e] = edge_quadratic(matches, T_target_source, settings.icp.loss_scale_m);
   });
-  std::vector<EdgeMatches> associated;
-  for (std::size_t e = 0; e < edges.size(); ++e) {
-    if (matches[e].size() < settings.icp.min_correspondences) continue;
-    associated.push_back({std::move(matches[e]), &poses[static_cast<std::size_t>(edges[e].source)],
-                          &poses[static_cast<std::size_t>(edges[e].target)]});
-  }
   ceres::Problem problem;
   std::size_t total = 0;
-  for (const EdgeMatches& edge : associated) {
-    for (std::span<const PlaneCorrespondence> block : correspondence_blocks(edge.matches)) {
-      problem.AddResidualBlock(new PairPointToPlaneCost(block, settings.icp.loss_scale_m), nullptr,
-                               edge.source->rotation, edge.source->translation,
-                               edge.target->rotation, edge.target->translation);
-    }
-    total += edge.matches.size();
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    if (!quadratics[e]) continue;
+    PoseParameters& source = poses[static_cast<std::size_t>(edges[e].source)];
+    PoseParameters& target = poses[static_cast<std::size_t>(edges[e].target)];
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<EdgeCost, 6, 4, 3, 4, 3>(new EdgeCost{*quadratics[e]}),
+        nullptr, source.rotation, source.translation, target.rotation, target.translation);
+    total += quadratics[e]->correspondences;
   }
   for (PoseParameters& pose : poses) {
     if (!problem.HasParameterBlock(pose.rotation)) continue;

@@ -4,7 +4,9 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "core/timing.hpp"
 #include "registration/pose_parameters.hpp"
@@ -291,35 +293,102 @@ double pair_reach_m(const RegistrationSettings& settings) {
   return settings.icp.min_gate_m + settings.icp_sample.voxel_m + 1.0;
 }
 
-// Every pair of registered scans that overlaps at the given poses: the
-// pairs whose samples' bounds meet are measured, target by target.
+// The cells of edge cell_m (in the first scan's frame) that a sample cloud
+// at pose T_first_cloud occupies, as packed keys.
+std::uint64_t cell_key(const Eigen::Vector3d& p, double cell_m) {
+  std::uint64_t key = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto index = static_cast<std::int64_t>(std::floor(p[axis] / cell_m)) + (1 << 20);
+    key = (key << 21) |
+          (static_cast<std::uint64_t>(std::clamp<std::int64_t>(index, 0, (1 << 21) - 1)));
+  }
+  return key;
+}
+
+std::vector<std::uint64_t> occupied_cells(const SampleCloud& cloud,
+                                          const Eigen::Isometry3d& T_first_cloud, double cell_m) {
+  std::vector<std::uint64_t> cells;
+  cells.reserve(cloud.size());
+  for (const Eigen::Vector3f& p : cloud.points)
+    cells.push_back(cell_key(T_first_cloud * p.cast<double>(), cell_m));
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  return cells;
+}
+
+// The share of `cloud`'s points (at T_first_cloud) with an occupied cell of
+// `cells` within one cell of their own: an upper bound of the share with a
+// correspondence closer than cell_m, computed from the samples alone.
+double reachable_share(const SampleCloud& cloud, const Eigen::Isometry3d& T_first_cloud,
+                       const std::vector<std::uint64_t>& cells, double cell_m) {
+  if (cloud.points.empty() || cells.empty()) return 0.0;
+  std::size_t reachable = 0;
+  for (const Eigen::Vector3f& point : cloud.points) {
+    const Eigen::Vector3d p = T_first_cloud * point.cast<double>();
+    bool found = false;
+    for (int dx = -1; dx <= 1 && !found; ++dx) {
+      for (int dy = -1; dy <= 1 && !found; ++dy) {
+        for (int dz = -1; dz <= 1 && !found; ++dz) {
+          const std::uint64_t key = cell_key(p + cell_m * Eigen::Vector3d(dx, dy, dz), cell_m);
+          found = std::binary_search(cells.begin(), cells.end(), key);
+        }
+      }
+    }
+    reachable += found;
+  }
+  return static_cast<double>(reachable) / static_cast<double>(cloud.size());
+}
+
+// The pairs of registered scans that overlap at the given poses. Of the
+// earlier scans whose samples' bounds meet a scan's, and that enough of its
+// thinned samples come within a cell (the reach) of, the ones reached most
+// (max_overlap_tests_per_scan) are measured on the target scan, target by
+// target: the pair tests grow with the scans, not with the scans in sight.
 std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
                                         const std::vector<Eigen::Isometry3d>& T_first_scan,
                                         const std::vector<bool>& registered,
                                         const RegistrationSettings& settings,
                                         std::size_t& pair_tests) {
   const int n = static_cast<int>(scans.size());
+  const double reach = pair_reach_m(settings);
   std::vector<Eigen::AlignedBox3d> bounds;
-  for (const SampleCloud& cloud : samples) bounds.push_back(bounds_of(cloud));
-  std::vector<ScanEdge> candidates;  // in (source, target) order
-  for (int a = 1; a < n; ++a) {
-    for (int b = 0; b < a; ++b) {
-      const auto ua = static_cast<std::size_t>(a);
-      const auto ub = static_cast<std::size_t>(b);
-      if (!registered[ua] || !registered[ub]) continue;
-      if (boxes_meet(bounds[ua], T_first_scan[ub].inverse() * T_first_scan[ua], bounds[ub],
-                     pair_reach_m(settings))) {
-        candidates.push_back({a, b});
-      }
-    }
+  std::vector<std::vector<std::uint64_t>> cells;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    bounds.push_back(bounds_of(samples[k]));
+    cells.push_back(occupied_cells(samples[k], T_first_scan[k], reach));
   }
   // A decision on a share: a thinned sample will do.
   std::vector<SampleCloud> estimates(samples.size());
+  std::vector<ScanEdge> candidates;  // in (source, target) order
+  for (int a = 1; a < n; ++a) {
+    const auto ua = static_cast<std::size_t>(a);
+    std::vector<std::pair<double, int>> reached;  // (share, target)
+    for (int b = 0; b < a; ++b) {
+      const auto ub = static_cast<std::size_t>(b);
+      if (!registered[ua] || !registered[ub]) continue;
+      if (!boxes_meet(bounds[ua], T_first_scan[ub].inverse() * T_first_scan[ua], bounds[ub],
+                      reach)) {
+        continue;
+      }
+      if (estimates[ua].points.empty())
+        estimates[ua] = thin(samples[ua], settings.estimate_samples);
+      const double share = reachable_share(estimates[ua], T_first_scan[ua], cells[ub], reach);
+      if (share >= settings.min_global_overlap) reached.emplace_back(share, b);
+    }
+    // The most reached first (ties: the earlier scan), then in scan order.
+    std::stable_sort(reached.begin(), reached.end(),
+                     [](const auto& x, const auto& y) { return x.first > y.first; });
+    if (reached.size() > settings.max_overlap_tests_per_scan)
+      reached.resize(settings.max_overlap_tests_per_scan);
+    std::vector<int> targets;
+    for (const auto& [share, b] : reached) targets.push_back(b);
+    std::sort(targets.begin(), targets.end());
+    for (const int b : targets) candidates.push_back({a, b});
+  }
   std::vector<bool> overlapping(candidates.size(), false);
   for_each_target(scans, candidates, [&](const PreparedScan& target, std::size_t e) {
     const auto a = static_cast<std::size_t>(candidates[e].source);
     const auto b = static_cast<std::size_t>(candidates[e].target);
-    if (estimates[a].points.empty()) estimates[a] = thin(samples[a], settings.estimate_samples);
     const AlignmentQuality quality = measure_alignment(
         estimates[a], target, T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
     ++pair_tests;

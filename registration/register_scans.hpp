@@ -68,6 +68,12 @@ struct RegistrationSettings {
   // Pairs matched at least this share at the registered poses join the
   // global refinement (loop closures included).
   double min_global_overlap = 0.05;
+  // Of the earlier scans whose samples reach a scan's (the share of its
+  // thinned samples within a reach of theirs, at least min_global_overlap),
+  // the overlap tests take at most this many, those reached most: the pose
+  // graph keeps its strong links, and the tests grow with the number of
+  // scans, not with how many see each other down a long street.
+  std::size_t max_overlap_tests_per_scan = 6;
   // Samples per scan (thinned evenly) for the overlap and free-space shares
   // that only decide: a coarse pose's tests, and which pairs join the
   // global refinement. Reported figures use every sample.

@@ -3,6 +3,7 @@
 // decides as the merge of every scan in memory does.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -173,6 +174,24 @@ TEST_F(StreamedStagesTest, RegistrationWithTwoScansInHandEqualsTheOneInMemory) {
   // The stored bounds are the scans' at their new poses.
   const acquisition::Scan moved = project_.load_scan(ids_[1]);
   EXPECT_TRUE(project_.scans()[1].summary.bbox_world->isApprox(*acquisition::world_bounds(moved)));
+}
+
+// The global refinement tests at most max_overlap_tests_per_scan earlier
+// scans per scan: with 2, the third and fourth rooms are tested against two
+// of the three rooms before them.
+TEST_F(StreamedStagesTest, RegistrationTestsAtMostTheSetNumberOfEarlierScansPerScan) {
+  RegisterCommandSettings settings;
+  settings.registration.coarse = registration::CoarseMethod::kNone;
+  settings.registration.max_overlap_tests_per_scan = 2;
+  core::Progress progress;
+  const RegisterCommandResult out = register_project(project_, settings, progress, std::nullopt);
+  EXPECT_EQ(out.result.pair_tests, 4u + 1u + 2u + 2u);  // the chain, then 1 + 2 + 2
+  std::map<int, int> tested;
+  for (const registration::EdgeReport& edge : out.result.edges) ++tested[edge.source];
+  EXPECT_EQ(out.result.edges.size(), 5u);
+  for (const auto& [source, count] : tested) EXPECT_LE(count, 2) << "scan " << source;
+  for (const Eigen::Isometry3d& pose : out.result.T_world_scan)
+    EXPECT_TRUE(pose.matrix().allFinite());
 }
 
 TEST_F(StreamedStagesTest, HarmonizationWithTwoScansInHandFindsThePairsOfTheOneInMemory) {
