@@ -44,4 +44,12 @@ std::vector<int> pair_pass_order(std::span<const ScanPair> pairs, int scan_count
   return order;
 }
 
+bool bounds_reach(const store::StoredScanSummary& scan, const Eigen::AlignedBox3d& box,
+                  double margin_m) {
+  if (!scan.summary.bbox_world || box.isEmpty()) return false;
+  const Eigen::AlignedBox3d grown(scan.summary.bbox_world->min().array() - margin_m,
+                                  scan.summary.bbox_world->max().array() + margin_m);
+  return grown.intersects(box);
+}
+
 }  // namespace scanbench::modeling

@@ -16,6 +16,12 @@ namespace scanbench::modeling {
 // noise plus a footprint) of the other's points only when it is much closer.
 inline constexpr double kSharedSurfaceMarginM = 5.0;
 
+// Whether `scan`'s world bounds, grown by `margin_m`, meet `box`: whether
+// the scan may hold points of a surface within `box`. False for a scan
+// without bounds.
+bool bounds_reach(const store::StoredScanSummary& scan, const Eigen::AlignedBox3d& box,
+                  double margin_m = kSharedSurfaceMarginM);
+
 // A pair of positions in the scan list, first < second.
 struct ScanPair {
   int first = 0;

@@ -10,6 +10,7 @@
 #include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/object_carry.hpp"
+#include "modeling/scan_overlaps.hpp"
 #include "modeling/store/typed_layers.hpp"
 #include "registration/prepared_scan.hpp"
 #include "segmentation/pixel_set.hpp"
@@ -314,7 +315,8 @@ std::int64_t keep_selections(store::Project& project,
 // with its points that sample the surface of object `node` (its pixels in
 // `membership` of scan `drawn`), and with `grow` those it grows to there,
 // added where they were still to be segmented (object_carry.hpp); scans
-// gaining none are left out. One other scan is decoded at a time.
+// gaining none are left out. One other scan is decoded at a time, and only
+// the scans whose stored bounds reach the object's are.
 CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_t drawn,
                                       const std::vector<std::uint32_t>& membership,
                                       std::uint32_t node,
@@ -333,8 +335,14 @@ CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_
   settings.transfer.noise = noise;
   settings.grow = grow;
   const DrawnObject object{&source, drawn_scan.T_world_scan, labels};
+  // Only scans whose bounds reach the object's can take any of it.
+  Eigen::AlignedBox3d object_bounds;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    if (labels[i] && source.in_model[i])
+      object_bounds.extend(drawn_scan.T_world_scan * source.points[i].cast<double>());
+  }
   for (const store::StoredScanSummary& stored : project.scans()) {
-    if (stored.id == drawn) continue;
+    if (stored.id == drawn || !bounds_reach(stored, object_bounds)) continue;
     const std::optional<acquisition::ScanGeometry> geometry =
         store::load_geometry(project, stored.id);
     if (!geometry) continue;
