@@ -1,6 +1,12 @@
 #include "modeling/import_command.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -11,6 +17,72 @@
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::modeling {
+
+// An unnamed file in the temporary folder (O_TMPFILE: it has no name, and
+// goes when it is closed or the process dies) holding the blobs the check
+// keeps until they are stored.
+class LayerSpill {
+ public:
+  LayerSpill() {
+    const std::filesystem::path folder = std::filesystem::temp_directory_path();
+    fd_ = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd_ < 0) fail(folder, "cannot make a temporary file for the checked scans");
+    where_ = folder;
+  }
+  ~LayerSpill() { ::close(fd_); }
+  LayerSpill(const LayerSpill&) = delete;
+  LayerSpill& operator=(const LayerSpill&) = delete;
+
+  // Moves every layer's blob of `scan` to the file; returns where each went.
+  std::vector<CheckedImport::Scan::Place> put(store::EncodedScan& scan) {
+    std::vector<CheckedImport::Scan::Place> places;
+    for (store::EncodedLayer& layer : scan.layers) {
+      places.push_back({end_, layer.blob.size()});
+      write_all(layer.blob.data(), layer.blob.size());
+      layer.blob.clear();
+      layer.blob.shrink_to_fit();
+    }
+    return places;
+  }
+
+  // `scan` with its layers' blobs read back.
+  store::EncodedScan get(const store::EncodedScan& scan,
+                         const std::vector<CheckedImport::Scan::Place>& places) const {
+    store::EncodedScan whole = scan;
+    for (std::size_t k = 0; k < whole.layers.size(); ++k) {
+      std::vector<std::uint8_t>& blob = whole.layers[k].blob;
+      blob.resize(places[k].size);
+      std::size_t done = 0;
+      while (done < blob.size()) {
+        const ssize_t got = ::pread(fd_, blob.data() + done, blob.size() - done,
+                                    static_cast<off_t>(places[k].offset + done));
+        if (got <= 0) fail(where_, "cannot read back the checked scans' temporary file");
+        done += static_cast<std::size_t>(got);
+      }
+    }
+    return whole;
+  }
+
+ private:
+  void write_all(const std::uint8_t* data, std::size_t size) {
+    std::size_t done = 0;
+    while (done < size) {
+      const ssize_t put = ::pwrite(fd_, data + done, size - done, static_cast<off_t>(end_ + done));
+      if (put <= 0) fail(where_, "cannot write the checked scans' temporary file (disk full?)");
+      done += static_cast<std::size_t>(put);
+    }
+    end_ += size;
+  }
+
+  [[noreturn]] static void fail(const std::filesystem::path& folder, const std::string& what) {
+    throw core::RuntimeFailure(folder.string(), {}, what + ": " + std::strerror(errno));
+  }
+
+  int fd_ = -1;
+  std::filesystem::path where_;
+  std::uint64_t end_ = 0;
+};
+
 namespace {
 
 constexpr const char* kStage = "import";
@@ -44,16 +116,10 @@ store::EncodedScan encode_imported(const acquisition::ImportedScan& imported) {
   return encoded;
 }
 
-// Encoded scans the check may keep in memory [bytes]: a quarter of what is
+// Images the check may keep in memory [bytes]: a quarter of what is
 // available, 1 GiB where that cannot be told.
 std::uint64_t keep_budget_bytes() {
   return core::available_memory_bytes().value_or(std::uint64_t{4} << 30) / 4;
-}
-
-std::uint64_t encoded_bytes(const store::EncodedScan& scan) {
-  std::uint64_t bytes = 0;
-  for (const store::EncodedLayer& layer : scan.layers) bytes += layer.blob.size();
-  return bytes;
 }
 
 std::uint64_t image_bytes(const std::vector<acquisition::ScanImage>& images) {
@@ -67,8 +133,9 @@ std::uint64_t image_bytes(const std::vector<acquisition::ScanImage>& images) {
 std::uint64_t release(CheckedImport::File& file) {
   std::uint64_t bytes = image_bytes(file.loose_images);
   for (CheckedImport::Scan& scan : file.scans) {
-    if (scan.encoded) bytes += encoded_bytes(*scan.encoded) + image_bytes(scan.images);
+    bytes += image_bytes(scan.images);
     scan.encoded.reset();
+    scan.spilled.clear();
     scan.images.clear();
   }
   file.loose_images.clear();
@@ -141,6 +208,7 @@ void store_read_again(store::Project& project, store::Project::LongCommand& comm
 CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
                                const ImportSettings& settings, core::Progress& progress) {
   CheckedImport checked;
+  checked.spill = std::make_shared<LayerSpill>();
   std::uint64_t budget = keep_budget_bytes();
   std::set<std::int64_t> digests;  // of the scans of this import
   for (std::size_t f = 0; f < files.size(); ++f) {
@@ -159,7 +227,8 @@ CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
       if (!file.kept) return;
       scan.encoded = encode_imported(imported);
       scan.images = std::move(imported.images);
-      keep_within(file, encoded_bytes(*scan.encoded) + image_bytes(scan.images), budget);
+      scan.spilled = checked.spill->put(*scan.encoded);
+      keep_within(file, image_bytes(scan.images), budget);
     };
     const auto on_loose_image = [&](acquisition::ScanImage&& image) {
       if (!file.kept) return;
@@ -196,8 +265,9 @@ ImportResult store_checked_scans(store::Project& project, const CheckedImport& c
     const CheckedImport::File& file = checked.files[f];
     if (file.kept) {
       for (const CheckedImport::Scan& scan : file.scans) {
-        result.scan_ids.push_back(
-            store_scan(project, command, *scan.encoded, scan.source, scan.images));
+        result.scan_ids.push_back(store_scan(project, command,
+                                             checked.spill->get(*scan.encoded, scan.spilled),
+                                             scan.source, scan.images));
         result.images += scan.images.size();
       }
       for (const acquisition::ScanImage& image : file.loose_images)

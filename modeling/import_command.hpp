@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -44,13 +45,25 @@ struct ImportResult {
 
 // The files of an import, each read whole and checked by its reader, and
 // the scans' digests (duplicates), before the project is opened for
-// writing: a refused file never writes to the project. The scans the check
-// read are kept encoded while they fit a quarter of the available memory,
-// and stored from there; the files beyond are read again when stored.
+// writing: a refused file never writes to the project. The compressed
+// channels of the scans the check read are kept in an unnamed temporary
+// file (LayerSpill), not in memory, and stored from there, so the check
+// holds one scan at a time however many files it reads. The images are
+// kept in memory while they fit a quarter of the available memory; the
+// files beyond are read again when stored.
+class LayerSpill;
+
 struct CheckedImport {
   struct Scan {
     std::string name;
-    std::optional<store::EncodedScan> encoded;  // none when the file is read again
+    // The scan's metadata, its layers' blobs in `spill` (at spilled[k] for
+    // layer k); none when the file is read again.
+    std::optional<store::EncodedScan> encoded;
+    struct Place {
+      std::uint64_t offset = 0;
+      std::uint64_t size = 0;
+    };
+    std::vector<Place> spilled;
     std::int64_t digest = 0;                    // EncodedScan::content_digest
     acquisition::ScanSource source;
     std::vector<acquisition::ScanImage> images;  // kept ones only
@@ -62,6 +75,7 @@ struct CheckedImport {
     std::vector<acquisition::ScanImage> loose_images;
   };
   std::vector<File> files;
+  std::shared_ptr<LayerSpill> spill;
 };
 
 // Reads and checks every file (one unit of `progress` per file, of two per

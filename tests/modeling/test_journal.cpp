@@ -63,6 +63,37 @@ TEST(Journal, EveryStageIsOneCommandWithItsSettingsAndResult) {
   EXPECT_FALSE(history[1].created_at.empty());
 }
 
+// The check keeps the scans' compressed channels in its temporary file, not
+// in memory, and the stored scans are the scans of the file.
+TEST(Journal, TheImportCheckSpillsTheChannelsItKeepsAndStoresThemWhole) {
+  core::Progress quiet;
+  const CheckedImport checked = check_scan_files(kTwoScans, {}, quiet);
+  ASSERT_EQ(checked.files.size(), 1u);
+  ASSERT_EQ(checked.files[0].scans.size(), 2u);
+  for (const CheckedImport::Scan& scan : checked.files[0].scans) {
+    ASSERT_TRUE(scan.encoded.has_value());
+    ASSERT_EQ(scan.spilled.size(), scan.encoded->layers.size());
+    for (std::size_t k = 0; k < scan.spilled.size(); ++k) {
+      EXPECT_TRUE(scan.encoded->layers[k].blob.empty());
+      EXPECT_GT(scan.spilled[k].size, 0u);
+    }
+  }
+  const ScratchDir dir;
+  store::Project spilled = store::Project::create(dir / "spilled.sbproj");
+  store::Project direct = store::Project::create(dir / "direct.sbproj");
+  store_checked_scans(spilled, checked, {}, quiet);
+  import_scans(direct, kTwoScans, {}, quiet);
+  ASSERT_EQ(spilled.scans().size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const acquisition::Scan a = spilled.load_scan(spilled.scans()[k].id);
+    const acquisition::Scan b = direct.load_scan(direct.scans()[k].id);
+    EXPECT_EQ(a.range_m, b.range_m);
+    EXPECT_EQ(a.valid, b.valid);
+    EXPECT_EQ(a.intensity, b.intensity);
+    EXPECT_TRUE(a.T_world_scan.isApprox(b.T_world_scan, 0.0));
+  }
+}
+
 TEST(Journal, UndoAndRedoWorkAcrossConnectionsAndRestoreTheStateExactly) {
   const ScratchDir dir;
   const auto file = dir / "p.sbproj";
