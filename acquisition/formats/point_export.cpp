@@ -267,14 +267,14 @@ void PointListWriter::State::write_las_point(const Scan& scan, const ScanGeometr
                                              std::uint16_t source_id) {
   std::string& out = file.buffer();
   for (int axis = 0; axis < 3; ++axis) {
-    const std::int64_t q = std::llround((p[axis] - offset[axis]) / kLasScale);
-    if (q < std::numeric_limits<std::int32_t>::min() ||
-        q > std::numeric_limits<std::int32_t>::max()) {
+    const double scaled = (p[axis] - offset[axis]) / kLasScale;
+    if (!(std::abs(scaled) < static_cast<double>(std::numeric_limits<std::int32_t>::max()))) {
       throw core::InputError(path.string(), {{}, {}, "scan \"" + scan.name + "\""},
-                             "a point lies " + std::to_string(std::abs(q) * kLasScale) +
+                             "a point lies " + std::to_string(std::abs(p[axis] - offset[axis])) +
                                  " m from the offset of the coordinates, beyond the scans' stored "
                                  "bounds and more than LAS can hold at 0.1 mm");
     }
+    const std::int64_t q = std::llround(scaled);
     min_q[axis] = std::min(min_q[axis], q);
     max_q[axis] = std::max(max_q[axis], q);
     append_binary(out, static_cast<std::int32_t>(q));

@@ -198,5 +198,29 @@ TEST(LasExport, WithoutGeometryThereAreNoExtraBytesAndTooWideASiteIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir / "far.las"));
 }
 
+// Written scan by scan, a LAS takes its offset from bounds given up front
+// (a project's stored ones); a point far outside them, beyond what the
+// integers hold, is refused naming the scan, and no file is left.
+TEST(LasExport, APointBeyondTheGivenBoundsIsRefusedNamingTheScan) {
+  const ScratchDir dir;
+  PointListWriter::LasSettings las;
+  las.bounds = Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-5.0), Eigen::Vector3d::Constant(5.0));
+  PointChannels channels;
+  channels.geometry = false;
+  {
+    PointListWriter writer(dir / "stale.las", PointListFormat::kLas, channels, las);
+    writer.add(wall_scan({0.0, 0.0, 0.0}), nullptr);
+    Scan far = wall_scan({300000.0, 0.0, 0.0});
+    far.name = "far station";
+    try {
+      writer.add(far, nullptr);
+      ADD_FAILURE() << "a point 300 km off the bounds was written";
+    } catch (const core::InputError& error) {
+      EXPECT_THAT(error.what(), ::testing::HasSubstr("far station"));
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "stale.las"));
+}
+
 }  // namespace
 }  // namespace scanbench::acquisition
