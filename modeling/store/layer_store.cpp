@@ -206,7 +206,9 @@ std::vector<std::string> Project::layer_names(std::int64_t id) const {
   const std::string sql = sql_of({R"sql(
 SELECT )sql",
                                   kLayerColumns, R"sql( FROM (
-  SELECT l.*, row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
+  SELECT )sql",
+                                  kLayerColumns, R"sql(,
+    row_number() OVER (PARTITION BY l.name ORDER BY c.seq DESC) AS newest
   FROM scan_layers l JOIN commands c ON c.id = l.command_id
   WHERE l.scan_id = ?1 AND c.state = 'done') l
 WHERE newest = 1
