@@ -362,7 +362,7 @@ void check(const registration::RegistrationSettings& s, const Bounds& b) {
   b.in(s.min_overlap, 0, 1, "registration.min_overlap");
   b.in(s.max_free_space_violation, 0, 1, "registration.max_free_space_violation");
   b.in(s.min_global_overlap, 0, 1, "registration.min_global_overlap");
-  b.in(s.max_overlap_tests_per_scan, 0, kMaxCount, "registration.max_overlap_tests_per_scan");
+  b.in(s.max_overlap_tests_per_scan, 1, kMaxCount, "registration.max_overlap_tests_per_scan");
   b.in(s.estimate_samples, 1, kMaxCount, "registration.estimate_samples");
 }
 

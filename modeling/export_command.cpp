@@ -439,13 +439,15 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
       result.points += count_points(scan, keep);
       if (ptx) ptx->add(scan);
       if (e57) e57->add(id, scan, keep_of);
-      if (settings.format == ExportFormat::kTriplet)
-        acquisition::write_triplet(scan, settings.output);
     }
     if (progress != nullptr) {
       progress->update({"export", s + 1, ids.size(), scan.name});
       progress->throw_if_cancelled("export");
     }
+    // A triplet's files are complete once written: written after the last
+    // chance to cancel, as the other formats commit.
+    if (settings.format == ExportFormat::kTriplet)
+      acquisition::write_triplet(scan, settings.output);
   }
   if (points) {
     result.points = points->points();

@@ -18,31 +18,55 @@
 
 namespace scanbench::modeling {
 
-// An unnamed file in the temporary folder (O_TMPFILE: it has no name, and
-// goes when it is closed or the process dies) holding the blobs the check
-// keeps until they are stored.
+// An unnamed file in the temporary folder holding the blobs the check keeps
+// until they are stored: O_TMPFILE (it has no name, and goes when it is
+// closed or the process dies), else tmpfile() (named and unlinked at once).
+// Best effort: where no such file can be made, or once a write to it fails
+// (a full disk), the blobs stay in memory as the check kept them before.
 class LayerSpill {
  public:
   LayerSpill() {
-    const std::filesystem::path folder = std::filesystem::temp_directory_path();
-    fd_ = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-    if (fd_ < 0) fail(folder, "cannot make a temporary file for the checked scans");
+    std::error_code error;
+    const std::filesystem::path folder = std::filesystem::temp_directory_path(error);
+    if (!error) fd_ = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd_ < 0) {
+      fallback_ = std::tmpfile();
+      if (fallback_ != nullptr) fd_ = ::fileno(fallback_);
+    }
     where_ = folder;
   }
-  ~LayerSpill() { ::close(fd_); }
+  ~LayerSpill() {
+    if (fallback_ != nullptr) {
+      std::fclose(fallback_);
+    } else if (fd_ >= 0) {
+      ::close(fd_);
+    }
+  }
   LayerSpill(const LayerSpill&) = delete;
   LayerSpill& operator=(const LayerSpill&) = delete;
 
-  // Moves every layer's blob of `scan` to the file; returns where each went.
-  std::vector<CheckedImport::Scan::Place> put(store::EncodedScan& scan) {
-    std::vector<CheckedImport::Scan::Place> places;
+  // Moves every layer's blob of `scan` to the file and says where each went
+  // in `places`; false (the blobs left in `scan`) when the file cannot take
+  // them.
+  bool put(store::EncodedScan& scan, std::vector<CheckedImport::Scan::Place>& places) {
+    if (fd_ < 0 || failed_) return false;
+    std::vector<CheckedImport::Scan::Place> written;
+    std::uint64_t end = end_;
+    for (const store::EncodedLayer& layer : scan.layers) {
+      if (!write_all(layer.blob.data(), layer.blob.size(), end)) {
+        failed_ = true;
+        return false;
+      }
+      written.push_back({end, layer.blob.size()});
+      end += layer.blob.size();
+    }
+    end_ = end;
     for (store::EncodedLayer& layer : scan.layers) {
-      places.push_back({end_, layer.blob.size()});
-      write_all(layer.blob.data(), layer.blob.size());
       layer.blob.clear();
       layer.blob.shrink_to_fit();
     }
-    return places;
+    places = std::move(written);
+    return true;
   }
 
   // `scan` with its layers' blobs read back.
@@ -56,7 +80,11 @@ class LayerSpill {
       while (done < blob.size()) {
         const ssize_t got = ::pread(fd_, blob.data() + done, blob.size() - done,
                                     static_cast<off_t>(places[k].offset + done));
-        if (got <= 0) fail(where_, "cannot read back the checked scans' temporary file");
+        if (got < 0) {
+          fail(where_, std::string("cannot read back the checked scans' temporary file: ") +
+                           std::strerror(errno));
+        }
+        if (got == 0) fail(where_, "the checked scans' temporary file ends early");
         done += static_cast<std::size_t>(got);
       }
     }
@@ -64,23 +92,25 @@ class LayerSpill {
   }
 
  private:
-  void write_all(const std::uint8_t* data, std::size_t size) {
+  bool write_all(const std::uint8_t* data, std::size_t size, std::uint64_t at) const {
     std::size_t done = 0;
     while (done < size) {
-      const ssize_t put = ::pwrite(fd_, data + done, size - done, static_cast<off_t>(end_ + done));
-      if (put <= 0) fail(where_, "cannot write the checked scans' temporary file (disk full?)");
+      const ssize_t put = ::pwrite(fd_, data + done, size - done, static_cast<off_t>(at + done));
+      if (put <= 0) return false;
       done += static_cast<std::size_t>(put);
     }
-    end_ += size;
+    return true;
   }
 
   [[noreturn]] static void fail(const std::filesystem::path& folder, const std::string& what) {
-    throw core::RuntimeFailure(folder.string(), {}, what + ": " + std::strerror(errno));
+    throw core::RuntimeFailure(folder.string(), {}, what);
   }
 
   int fd_ = -1;
+  std::FILE* fallback_ = nullptr;
   std::filesystem::path where_;
   std::uint64_t end_ = 0;
+  bool failed_ = false;
 };
 
 namespace {
@@ -116,10 +146,17 @@ store::EncodedScan encode_imported(const acquisition::ImportedScan& imported) {
   return encoded;
 }
 
-// Images the check may keep in memory [bytes]: a quarter of what is
-// available, 1 GiB where that cannot be told.
+// What the check may keep in memory [bytes] (images, and the channels the
+// temporary file could not take): a quarter of what is available, 1 GiB
+// where that cannot be told.
 std::uint64_t keep_budget_bytes() {
   return core::available_memory_bytes().value_or(std::uint64_t{4} << 30) / 4;
+}
+
+std::uint64_t encoded_bytes(const store::EncodedScan& scan) {
+  std::uint64_t bytes = 0;
+  for (const store::EncodedLayer& layer : scan.layers) bytes += layer.blob.size();
+  return bytes;
 }
 
 std::uint64_t image_bytes(const std::vector<acquisition::ScanImage>& images) {
@@ -134,6 +171,7 @@ std::uint64_t release(CheckedImport::File& file) {
   std::uint64_t bytes = image_bytes(file.loose_images);
   for (CheckedImport::Scan& scan : file.scans) {
     bytes += image_bytes(scan.images);
+    if (scan.encoded) bytes += encoded_bytes(*scan.encoded);  // 0 when spilled
     scan.encoded.reset();
     scan.spilled.clear();
     scan.images.clear();
@@ -227,8 +265,9 @@ CheckedImport check_scan_files(std::span<const std::filesystem::path> files,
       if (!file.kept) return;
       scan.encoded = encode_imported(imported);
       scan.images = std::move(imported.images);
-      scan.spilled = checked.spill->put(*scan.encoded);
-      keep_within(file, image_bytes(scan.images), budget);
+      std::uint64_t held = image_bytes(scan.images);
+      if (!checked.spill->put(*scan.encoded, scan.spilled)) held += encoded_bytes(*scan.encoded);
+      keep_within(file, held, budget);
     };
     const auto on_loose_image = [&](acquisition::ScanImage&& image) {
       if (!file.kept) return;
@@ -265,9 +304,10 @@ ImportResult store_checked_scans(store::Project& project, const CheckedImport& c
     const CheckedImport::File& file = checked.files[f];
     if (file.kept) {
       for (const CheckedImport::Scan& scan : file.scans) {
-        result.scan_ids.push_back(store_scan(project, command,
-                                             checked.spill->get(*scan.encoded, scan.spilled),
-                                             scan.source, scan.images));
+        std::optional<store::EncodedScan> read_back;
+        if (!scan.spilled.empty()) read_back = checked.spill->get(*scan.encoded, scan.spilled);
+        result.scan_ids.push_back(store_scan(
+            project, command, read_back ? *read_back : *scan.encoded, scan.source, scan.images));
         result.images += scan.images.size();
       }
       for (const acquisition::ScanImage& image : file.loose_images)

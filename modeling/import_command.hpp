@@ -43,16 +43,19 @@ struct ImportResult {
   double seconds = 0.0;
 };
 
+class LayerSpill;  // import_command.cpp
+
 // The files of an import, each read whole and checked by its reader, and
 // the scans' digests (duplicates), before the project is opened for
 // writing: a refused file never writes to the project. The compressed
-// channels of the scans the check read are kept in an unnamed temporary
-// file (LayerSpill), not in memory, and stored from there, so the check
-// holds one scan at a time however many files it reads. The images are
-// kept in memory while they fit a quarter of the available memory; the
-// files beyond are read again when stored.
-class LayerSpill;
-
+// channels of the scans the check read are kept in an unnamed file in the
+// temporary folder (on the disk unless TMPDIR names a memory file system),
+// not in memory (where that file cannot be made or fills up, in memory as
+// below), and stored from there, so the check holds one scan at a time
+// however many files it reads. The images are kept in memory while
+// they fit a quarter of the available memory; the files beyond are read
+// again when stored (what such a file spilled stays in the temporary file
+// until the import ends).
 struct CheckedImport {
   struct Scan {
     std::string name;
@@ -75,6 +78,7 @@ struct CheckedImport {
     std::vector<acquisition::ScanImage> loose_images;
   };
   std::vector<File> files;
+  // Shared: CheckedImport is moved around where LayerSpill is incomplete.
   std::shared_ptr<LayerSpill> spill;
 };
 

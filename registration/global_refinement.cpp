@@ -32,9 +32,10 @@ namespace {
 // with each match's robust residual ρ_i and its derivative J_i by ξ,
 //   Σ (ρ_i + J_iᵀ ξ)² = (ξ − ξ*)ᵀ H (ξ − ξ*) + const,  H = Σ J_i J_iᵀ,
 // ξ* = −H⁻¹ Σ ρ_i J_i. The sum of the edges' quadratics is the Gauss-Newton
-// model of the joint problem over all correspondences, so a round solves
-// the same problem while memory holds 6 × 6 numbers per edge instead of
-// every correspondence.
+// model of the joint problem over all correspondences (Jacobians and robust
+// weights frozen at the round's poses), so memory holds 6 × 6 numbers per
+// edge instead of every correspondence; the rounds re-associate and
+// re-linearise.
 struct EdgeQuadratic {
   Eigen::Isometry3d T0 = Eigen::Isometry3d::Identity();  // target ← source at linearisation
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Zero();  // Lᵀ

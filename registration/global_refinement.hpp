@@ -1,6 +1,7 @@
-// Global refinement: all scan poses adjusted together over every overlapping
-// pair, first scan held fixed, so that registration errors spread over a loop
-// instead of accumulating along a chain of pairwise alignments.
+// Global refinement: all scan poses adjusted together over the pose graph of
+// the measured pairs (the edges the registration chose), first scan held
+// fixed, so that registration errors spread over a loop instead of
+// accumulating along a chain of pairwise alignments.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -21,7 +22,8 @@ struct ScanEdge {
 
 struct GlobalSettings {
   // Association is redone this many times at most; each round solves the
-  // joint problem for fixed correspondences.
+  // pose graph of the edges' Gauss-Newton quadratics, built at the round's
+  // correspondences and poses (robust weights frozen for the round).
   int max_rounds = 10;
   // Levenberg-Marquardt steps of Ceres per round.
   int solver_iterations = 5;

@@ -85,44 +85,4 @@ bool PointToPlaneCost::Evaluate(double const* const* parameters, double* residua
   return true;
 }
 
-PairPointToPlaneCost::PairPointToPlaneCost(std::span<const PlaneCorrespondence> matches,
-                                           double loss_scale_m)
-    : matches_(matches), loss_scale_m_(loss_scale_m) {
-  assert(!matches.empty() && matches.size() <= kCorrespondencesPerBlock && loss_scale_m > 0.0);
-  set_num_residuals(static_cast<int>(matches.size()));
-  mutable_parameter_block_sizes()->assign({4, 3, 4, 3});
-}
-
-bool PairPointToPlaneCost::Evaluate(double const* const* parameters, double* residuals,
-                                    double** jacobians) const {
-  const Eigen::Map<const Eigen::Quaterniond> q_a(parameters[0]);
-  const Eigen::Map<const Eigen::Vector3d> t_a(parameters[1]);
-  const Eigen::Map<const Eigen::Quaterniond> q_b(parameters[2]);
-  const Eigen::Map<const Eigen::Vector3d> t_b(parameters[3]);
-  const Eigen::Matrix3d R_a = q_a.toRotationMatrix();
-  const Eigen::Matrix3d R_b = q_b.toRotationMatrix();
-  // R_bᵀ as the polynomial of the conjugate quaternion (−v, w).
-  const Eigen::Quaterniond q_b_conjugate = q_b.conjugate();
-  const Eigen::Matrix3d R_b_inverse = q_b_conjugate.toRotationMatrix();
-  const bool derivatives = jacobians != nullptr;
-  for (std::size_t i = 0; i < matches_.size(); ++i) {
-    const PlaneCorrespondence& m = matches_[i];
-    const Eigen::Vector3d y =
-        R_a * m.sample + t_a - t_b;  // sample in the first scan's frame, less t_b
-    const RobustResidual robust =
-        cauchy_residual(m.normal.dot(R_b_inverse * y - m.point), loss_scale_m_);
-    residuals[i] = robust.value;
-    if (!derivatives) continue;
-    const Eigen::Vector3d world_normal = R_b * m.normal;
-    write_row(jacobians[0], jacobians[1], i,
-              robust.slope * rotated_projection_gradient(q_a, m.sample, world_normal),
-              robust.slope * world_normal);
-    // Through the conjugate: ∂/∂v_b = −∂/∂v', ∂/∂w_b = ∂/∂w' with q' = (−v_b, w_b).
-    Eigen::Vector4d d_q_b = rotated_projection_gradient(q_b_conjugate, y, m.normal);
-    d_q_b.head<3>() = -d_q_b.head<3>();
-    write_row(jacobians[2], jacobians[3], i, robust.slope * d_q_b, -robust.slope * world_normal);
-  }
-  return true;
-}
-
 }  // namespace scanbench::registration

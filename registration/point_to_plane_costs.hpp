@@ -9,11 +9,8 @@
 // the signed distance of the moved sample from the target's tangent plane.
 // Minimising Σ ρ(r²) lets the surfaces slide along each other, which is why
 // point-to-plane ICP converges in few iterations on the planar scenes of
-// outdoor scans (Chen and Medioni 1992). For the global refinement both
-// poses are unknown, T_a and T_b mapping the two scans into the first scan's
-// frame:
-//
-//   r = (R_b n)ᵀ ((R_a s + t_a) − (R_b p + t_b)) = nᵀ (R_bᵀ (R_a s + t_a − t_b) − p)
+// outdoor scans (Chen and Medioni 1992). The global refinement reduces the
+// same residuals to a quadratic per pair of scans (global_refinement.cpp).
 //
 // Rotations are unit quaternions in Eigen's (x, y, z, w) order, on
 // ceres::EigenQuaternionManifold, so updates stay on SO(3) and no Euler-angle
@@ -63,19 +60,6 @@ class PointToPlaneCost final : public ceres::CostFunction {
  public:
   // `matches` must outlive the cost; at most kCorrespondencesPerBlock of them.
   PointToPlaneCost(std::span<const PlaneCorrespondence> matches, double loss_scale_m);
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override;
-
- private:
-  std::span<const PlaneCorrespondence> matches_;
-  double loss_scale_m_;
-};
-
-// Global refinement: parameter blocks (rotation 4, translation 3) of the
-// source scan's pose T_a, then those of the target scan's pose T_b.
-class PairPointToPlaneCost final : public ceres::CostFunction {
- public:
-  PairPointToPlaneCost(std::span<const PlaneCorrespondence> matches, double loss_scale_m);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 

@@ -293,44 +293,54 @@ double pair_reach_m(const RegistrationSettings& settings) {
   return settings.icp.min_gate_m + settings.icp_sample.voxel_m + 1.0;
 }
 
-// The cells of edge cell_m (in the first scan's frame) that a sample cloud
-// at pose T_first_cloud occupies, as packed keys.
-std::uint64_t cell_key(const Eigen::Vector3d& p, double cell_m) {
+// Cells of edge cell_m in the first scan's frame: integer indices per
+// axis, packed 21 bits each (±1 048 576 cells, over a thousand kilometres
+// at the reach), clamped at the edges.
+using CellIndex = Eigen::Array<std::int64_t, 3, 1>;
+
+CellIndex cell_of(const Eigen::Vector3d& p, double cell_m) {
+  constexpr double kLimit = (1 << 20) - 2;  // a neighbour of an edge cell still fits
+  CellIndex cell;
+  for (int axis = 0; axis < 3; ++axis)
+    cell[axis] =
+        static_cast<std::int64_t>(std::clamp(std::floor(p[axis] / cell_m), -kLimit, kLimit));
+  return cell;
+}
+
+std::uint64_t cell_key(const CellIndex& cell) {
   std::uint64_t key = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto index = static_cast<std::int64_t>(std::floor(p[axis] / cell_m)) + (1 << 20);
-    key = (key << 21) |
-          (static_cast<std::uint64_t>(std::clamp<std::int64_t>(index, 0, (1 << 21) - 1)));
-  }
+  for (int axis = 0; axis < 3; ++axis)
+    key = (key << 21) | static_cast<std::uint64_t>((cell[axis] + (1 << 20)) & ((1 << 21) - 1));
   return key;
 }
 
+// The cells that a sample cloud at pose T_first_cloud occupies, sorted.
 std::vector<std::uint64_t> occupied_cells(const SampleCloud& cloud,
                                           const Eigen::Isometry3d& T_first_cloud, double cell_m) {
   std::vector<std::uint64_t> cells;
   cells.reserve(cloud.size());
   for (const Eigen::Vector3f& p : cloud.points)
-    cells.push_back(cell_key(T_first_cloud * p.cast<double>(), cell_m));
+    cells.push_back(cell_key(cell_of(T_first_cloud * p.cast<double>(), cell_m)));
   std::sort(cells.begin(), cells.end());
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
   return cells;
 }
 
-// The share of `cloud`'s points (at T_first_cloud) with an occupied cell of
-// `cells` within one cell of their own: an upper bound of the share with a
+// The share of `cloud`'s points (at T_first_cloud) whose cell or one of its
+// 26 neighbours is among `cells`: an upper bound of the share with a
 // correspondence closer than cell_m, computed from the samples alone.
 double reachable_share(const SampleCloud& cloud, const Eigen::Isometry3d& T_first_cloud,
                        const std::vector<std::uint64_t>& cells, double cell_m) {
   if (cloud.points.empty() || cells.empty()) return 0.0;
   std::size_t reachable = 0;
   for (const Eigen::Vector3f& point : cloud.points) {
-    const Eigen::Vector3d p = T_first_cloud * point.cast<double>();
+    const CellIndex cell = cell_of(T_first_cloud * point.cast<double>(), cell_m);
     bool found = false;
     for (int dx = -1; dx <= 1 && !found; ++dx) {
       for (int dy = -1; dy <= 1 && !found; ++dy) {
         for (int dz = -1; dz <= 1 && !found; ++dz) {
-          const std::uint64_t key = cell_key(p + cell_m * Eigen::Vector3d(dx, dy, dz), cell_m);
-          found = std::binary_search(cells.begin(), cells.end(), key);
+          found = std::binary_search(cells.begin(), cells.end(),
+                                     cell_key(cell + CellIndex(dx, dy, dz)));
         }
       }
     }

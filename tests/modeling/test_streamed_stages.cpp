@@ -177,8 +177,8 @@ TEST_F(StreamedStagesTest, RegistrationWithTwoScansInHandEqualsTheOneInMemory) {
 }
 
 // The global refinement tests at most max_overlap_tests_per_scan earlier
-// scans per scan: with 2, the third and fourth rooms are tested against two
-// of the three rooms before them.
+// scans per scan: with 2, the fourth room is tested against two of the
+// three rooms before it.
 TEST_F(StreamedStagesTest, RegistrationTestsAtMostTheSetNumberOfEarlierScansPerScan) {
   RegisterCommandSettings settings;
   settings.registration.coarse = registration::CoarseMethod::kNone;

@@ -114,37 +114,6 @@ TEST(PointToPlaneCosts, PairwiseJacobiansMatchNumericDifferentiation) {
   }
 }
 
-TEST(PointToPlaneCosts, GlobalJacobiansMatchNumericDifferentiation) {
-  std::mt19937 random(11);
-  const std::vector<PlaneCorrespondence> matches = random_matches(40, random);
-  const PairPointToPlaneCost cost(matches, 0.05);
-  ceres::EigenQuaternionManifold quaternion;
-  for (int trial = 0; trial < 5; ++trial) {
-    const Eigen::Quaterniond q_a = random_rotation(random);
-    const Eigen::Quaterniond q_b = random_rotation(random);
-    const Eigen::Vector3d t_a(1.0, 0.5 * trial, -3.0);
-    const Eigen::Vector3d t_b(-2.0, 4.0, 0.1 * trial);
-    expect_gradients_match(cost, {&quaternion, nullptr, &quaternion, nullptr},
-                           {q_a.coeffs().data(), t_a.data(), q_b.coeffs().data(), t_b.data()});
-  }
-}
-
-// With the target scan at the identity, the global cost is the pairwise one.
-TEST(PointToPlaneCosts, GlobalResidualsEqualPairwiseOnesForAnIdentityTarget) {
-  std::mt19937 random(3);
-  const std::vector<PlaneCorrespondence> matches = random_matches(25, random);
-  const Eigen::Quaterniond q = random_rotation(random);
-  const Eigen::Vector3d t(0.5, -0.25, 1.0);
-  const Eigen::Quaterniond identity = Eigen::Quaterniond::Identity();
-  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
-  std::vector<double> pairwise(matches.size()), global(matches.size());
-  const double* pose[] = {q.coeffs().data(), t.data()};
-  const double* poses[] = {q.coeffs().data(), t.data(), identity.coeffs().data(), zero.data()};
-  ASSERT_TRUE(PointToPlaneCost(matches, 0.1).Evaluate(pose, pairwise.data(), nullptr));
-  ASSERT_TRUE(PairPointToPlaneCost(matches, 0.1).Evaluate(poses, global.data(), nullptr));
-  for (std::size_t i = 0; i < matches.size(); ++i) EXPECT_NEAR(pairwise[i], global[i], 1e-12);
-}
-
 TEST(PointToPlaneCosts, BlocksCoverEveryCorrespondenceOnce) {
   std::mt19937 random(5);
   const std::vector<PlaneCorrespondence> matches =
