@@ -63,6 +63,21 @@ Eigen::Vector3d direction_precise(const Scan& scan, int row, int col) {
   return norm > 0.0 ? Eigen::Vector3d(d / norm) : Eigen::Vector3d::Zero();
 }
 
+// Angles as direction_precise computes them, so that the products agree.
+SphericalDirections::SphericalDirections(const Scan& scan) {
+  const auto& model = std::get<SphericalAngles>(scan.angles);
+  rows_.reserve(static_cast<std::size_t>(scan.rows));
+  for (int row = 0; row < scan.rows; ++row) {
+    const double el = model.elevation_start_rad + row * model.elevation_step_rad;
+    rows_.emplace_back(std::cos(el), std::sin(el));
+  }
+  columns_.reserve(static_cast<std::size_t>(scan.columns));
+  for (int col = 0; col < scan.columns; ++col) {
+    const double az = model.azimuth_start_rad + col * model.azimuth_step_rad;
+    columns_.emplace_back(std::cos(az), std::sin(az));
+  }
+}
+
 Eigen::Vector3f direction(const Scan& scan, int row, int col) {
   if (scan.is_spherical()) return direction_precise(scan, row, col).cast<float>();
   return std::get<PerPixelDirections>(scan.angles).directions[scan.index(row, col)];

@@ -138,7 +138,9 @@ nlohmann::json to_report(const HarmonizeCommandResult& out) {
           {"delta_e_after", out.delta_e_after},
           {"iterations", out.iterations},
           {"converged", out.converged},
-          {"seconds", out.seconds}};
+          {"seconds", out.seconds},
+          {"pair_search_seconds", out.pair_search_seconds},
+          {"solve_seconds", out.solve_seconds}};
 }
 
 }  // namespace

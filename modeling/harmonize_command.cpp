@@ -7,6 +7,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/scan_cache.hpp"
 #include "modeling/scan_overlaps.hpp"
@@ -91,7 +92,11 @@ std::vector<registration::ColorPair> streamed_color_pairs(
   std::vector<std::int64_t> plan;
   for (const int k : pair_pass_order(pairs, static_cast<int>(scans.size()), false))
     plan.push_back(scans[static_cast<std::size_t>(k)].id);
-  ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress);
+  // Scans parked in a temporary file when first loaded, and two kept in
+  // memory beyond the pair in hand: a scan the plan brings back is read
+  // from the file.
+  ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress,
+                  {ScanForm::kWhole, true, 2});
   cache.plan(plan);
   // The pairs each scan may take part in, shared among the scans it may
   // overlap: the solve grows with the scans, not with their overlaps.
@@ -141,11 +146,16 @@ HarmonizeCommandResult harmonize_project(store::Project& project,
                            "no two scans with colour overlap: nothing to harmonise");
   }
   progress.throw_if_cancelled(kStage);
+  const double search_seconds = core::seconds_since(start);
+  const auto solve_start = std::chrono::steady_clock::now();
   const registration::HarmonizeResult solved =
       registration::harmonize_colors(pairs, scans.size(), settings.solve);
+  const double solve_seconds = core::seconds_since(solve_start);
   HarmonizeCommandResult out =
       harmonize_outcome(scans, pairs, solved, project.scan_color_corrections());
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.seconds = core::seconds_since(start);
+  out.pair_search_seconds = search_seconds;
+  out.solve_seconds = solve_seconds;
   progress.throw_if_cancelled(kStage);
 
   store::Project::Edit edit = project.begin_command(kStage, settings_to_json(settings), revision);

@@ -43,6 +43,8 @@ struct HarmonizeCommandResult {
   int iterations = 0;
   bool converged = false;
   double seconds = 0.0;
+  double pair_search_seconds = 0.0;  // of seconds: finding the colour pairs
+  double solve_seconds = 0.0;        // of seconds: the corrections' solve
 };
 
 // Mean CIE76 ΔE between the two colours of each pair, each corrected by its

@@ -1,12 +1,6 @@
 #include "modeling/import_command.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <chrono>
-#include <cstdio>
-#include <cstring>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -18,49 +12,23 @@
 
 namespace scanbench::modeling {
 
-// An unnamed file in the temporary folder holding the blobs the check keeps
-// until they are stored: O_TMPFILE (it has no name, and goes when it is
-// closed or the process dies), else tmpfile() (named and unlinked at once).
-// Best effort: where no such file can be made, or once a write to it fails
-// (a full disk), the blobs stay in memory as the check kept them before.
+// The blobs the check keeps until they are stored, parked in a
+// core::SpillFile. Best effort: where the file cannot take them (none can
+// be made, a full disk), the blobs stay in memory as the check kept them
+// before.
 class LayerSpill {
  public:
-  LayerSpill() {
-    std::error_code error;
-    const std::filesystem::path folder = std::filesystem::temp_directory_path(error);
-    if (!error) fd_ = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-    if (fd_ < 0) {
-      fallback_ = std::tmpfile();
-      if (fallback_ != nullptr) fd_ = ::fileno(fallback_);
-    }
-    where_ = folder;
-  }
-  ~LayerSpill() {
-    if (fallback_ != nullptr) {
-      std::fclose(fallback_);
-    } else if (fd_ >= 0) {
-      ::close(fd_);
-    }
-  }
-  LayerSpill(const LayerSpill&) = delete;
-  LayerSpill& operator=(const LayerSpill&) = delete;
-
   // Moves every layer's blob of `scan` to the file and says where each went
   // in `places`; false (the blobs left in `scan`) when the file cannot take
   // them.
   bool put(store::EncodedScan& scan, std::vector<CheckedImport::Scan::Place>& places) {
-    if (fd_ < 0 || failed_) return false;
     std::vector<CheckedImport::Scan::Place> written;
-    std::uint64_t end = end_;
     for (const store::EncodedLayer& layer : scan.layers) {
-      if (!write_all(layer.blob.data(), layer.blob.size(), end)) {
-        failed_ = true;
-        return false;
-      }
-      written.push_back({end, layer.blob.size()});
-      end += layer.blob.size();
+      const std::optional<core::SpillFile::Extent> extent =
+          file_.put(layer.blob.data(), layer.blob.size());
+      if (!extent) return false;
+      written.push_back(*extent);
     }
-    end_ = end;
     for (store::EncodedLayer& layer : scan.layers) {
       layer.blob.clear();
       layer.blob.shrink_to_fit();
@@ -75,42 +43,14 @@ class LayerSpill {
     store::EncodedScan whole = scan;
     for (std::size_t k = 0; k < whole.layers.size(); ++k) {
       std::vector<std::uint8_t>& blob = whole.layers[k].blob;
-      blob.resize(places[k].size);
-      std::size_t done = 0;
-      while (done < blob.size()) {
-        const ssize_t got = ::pread(fd_, blob.data() + done, blob.size() - done,
-                                    static_cast<off_t>(places[k].offset + done));
-        if (got < 0) {
-          fail(where_, std::string("cannot read back the checked scans' temporary file: ") +
-                           std::strerror(errno));
-        }
-        if (got == 0) fail(where_, "the checked scans' temporary file ends early");
-        done += static_cast<std::size_t>(got);
-      }
+      blob.resize(places[k].bytes);
+      file_.get(places[k], blob.data());
     }
     return whole;
   }
 
  private:
-  bool write_all(const std::uint8_t* data, std::size_t size, std::uint64_t at) const {
-    std::size_t done = 0;
-    while (done < size) {
-      const ssize_t put = ::pwrite(fd_, data + done, size - done, static_cast<off_t>(at + done));
-      if (put <= 0) return false;
-      done += static_cast<std::size_t>(put);
-    }
-    return true;
-  }
-
-  [[noreturn]] static void fail(const std::filesystem::path& folder, const std::string& what) {
-    throw core::RuntimeFailure(folder.string(), {}, what);
-  }
-
-  int fd_ = -1;
-  std::FILE* fallback_ = nullptr;
-  std::filesystem::path where_;
-  std::uint64_t end_ = 0;
-  bool failed_ = false;
+  core::SpillFile file_;
 };
 
 namespace {

@@ -12,6 +12,7 @@
 
 #include "acquisition/formats/scan_files.hpp"
 #include "core/progress.hpp"
+#include "core/spill_file.hpp"
 #include "modeling/store/project.hpp"
 
 namespace scanbench::modeling {
@@ -62,10 +63,7 @@ struct CheckedImport {
     // The scan's metadata, its layers' blobs in `spill` (at spilled[k] for
     // layer k); none when the file is read again.
     std::optional<store::EncodedScan> encoded;
-    struct Place {
-      std::uint64_t offset = 0;
-      std::uint64_t size = 0;
-    };
+    using Place = core::SpillFile::Extent;
     std::vector<Place> spilled;
     std::int64_t digest = 0;                    // EncodedScan::content_digest
     acquisition::ScanSource source;

@@ -14,6 +14,11 @@ namespace {
 
 constexpr const char* kStage = "merge";
 
+// The merge's scans: what it compares only, parked in a temporary file when
+// first loaded, and two kept in memory beyond the pair in hand; a scan the
+// plan brings back again is read from the file.
+const ScanCacheSettings kMergeCache{ScanForm::kMerge, true, 2};
+
 // The streamed merge: scan b is compared with each earlier scan a whose
 // bounds reach it, both ways, while both are in hand; a scan's decision is
 // final after its last pair. Each scan is thus compared with the others in
@@ -27,7 +32,7 @@ class StreamedMerge {
         pairs_(overlapping_pairs(scans_)),
         settings_(settings),
         last_pair_(scans_.size()),
-        cache_(project, memory_limit, settings.threads, kStage, progress),
+        cache_(project, memory_limit, settings.threads, kStage, progress, kMergeCache),
         progress_(progress) {
     cache_.plan(plan());
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <limits>
+#include <type_traits>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -16,30 +17,74 @@ constexpr std::size_t kNever = std::numeric_limits<std::size_t>::max();
 
 // Before the first load: a scan with colour, intensity, geometry and its
 // prepared view takes about this much per pixel; later loads use the most
-// measured.
+// measured (before a stage's form trims it).
 constexpr double kFirstBytesPerPixel = 64.0;
 // A point index (kd-tree of a grid without a spherical model) per point.
 constexpr std::size_t kIndexBytesPerPoint = 32;
 
-template <typename T>
-std::size_t heap_bytes(const std::vector<T>& v) {
-  return v.capacity() * sizeof(T);
+// Calls visit(v) for every per-pixel array of `loaded` (a LoadedScan,
+// const or not), always in the same order (the spill's).
+template <typename Loaded, typename Visit>
+void visit_arrays(Loaded& loaded, Visit&& visit) {
+  auto& s = loaded.scan;
+  visit(s.range_m);
+  visit(s.valid);
+  visit(s.intensity);
+  visit(s.rgb);
+  if (auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&s.angles))
+    visit(per_pixel->directions);
+  auto& g = loaded.geometry;
+  visit(g.footprint_m);
+  visit(g.normal);
+  visit(g.confidence);
+  visit(g.flags);
+  auto& p = loaded.prepared;
+  visit(p.points);
+  visit(p.in_model);
+  visit(p.usable);
+  visit(p.sample_area_m2);
 }
 
 std::size_t heap_bytes_of(const LoadedScan& loaded) {
-  const acquisition::Scan& s = loaded.scan;
-  std::size_t bytes =
-      heap_bytes(s.range_m) + heap_bytes(s.valid) + heap_bytes(s.intensity) + heap_bytes(s.rgb);
-  if (const auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&s.angles))
-    bytes += heap_bytes(per_pixel->directions);
-  const acquisition::ScanGeometry& g = loaded.geometry;
-  bytes += heap_bytes(g.footprint_m) + heap_bytes(g.normal) + heap_bytes(g.confidence) +
-           heap_bytes(g.flags);
-  const registration::PreparedScan& p = loaded.prepared;
-  bytes += heap_bytes(p.points) + heap_bytes(p.in_model) + heap_bytes(p.usable) +
-           heap_bytes(p.sample_area_m2);
-  if (p.tree) bytes += kIndexBytesPerPoint * p.points.size();
+  std::size_t bytes = 0;
+  visit_arrays(loaded, [&bytes](auto& v) { bytes += v.capacity() * sizeof(v[0]); });
+  if (loaded.prepared.tree) bytes += kIndexBytesPerPoint * loaded.prepared.points.size();
   return bytes;
+}
+
+template <typename T>
+void release(std::vector<T>& v) {
+  v.clear();
+  v.shrink_to_fit();
+}
+
+// Drops what a stage of `form` does not read.
+void trim_to(ScanForm form, LoadedScan& loaded) {
+  if (form == ScanForm::kWhole) return;
+  release(loaded.scan.valid);
+  release(loaded.scan.intensity);
+  release(loaded.scan.rgb);
+  release(loaded.geometry.confidence);
+  release(loaded.geometry.flags);
+  if (loaded.prepared.grid) release(loaded.prepared.points);
+}
+
+// The scan without its arrays (which must be empty, or set aside): its
+// name, grid, angle model, pose and scanner.
+acquisition::Scan scan_without_arrays(const acquisition::Scan& scan) {
+  acquisition::Scan out;
+  out.name = scan.name;
+  out.rows = scan.rows;
+  out.columns = scan.columns;
+  if (const auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&scan.angles)) {
+    out.angles = acquisition::PerPixelDirections{{}, per_pixel->scattered};
+  } else {
+    out.angles = scan.angles;
+  }
+  out.T_world_scan = scan.T_world_scan;
+  out.scanner = scan.scanner;
+  out.import_round_trip_m = scan.import_round_trip_m;
+  return out;
 }
 
 }  // namespace
@@ -67,13 +112,15 @@ std::vector<store::StoredScanSummary> scans_with_geometry(const store::Project& 
 }
 
 ScanCache::ScanCache(const store::Project& project, std::uint64_t memory_limit_bytes, int threads,
-                     std::string stage, core::Progress& progress)
+                     std::string stage, core::Progress& progress, ScanCacheSettings settings)
     : project_(project),
       limit_(memory_limit_bytes),
       threads_(threads),
       stage_(std::move(stage)),
       progress_(progress),
+      settings_(settings),
       bytes_per_pixel_(kFirstBytesPerPixel) {
+  if (settings_.spill) spill_ = std::make_unique<core::SpillFile>();
   for (const store::StoredScanSummary& stored : project_.scans()) {
     pixels_[stored.id] = static_cast<std::size_t>(stored.summary.rows) *
                          static_cast<std::size_t>(stored.summary.columns);
@@ -133,7 +180,29 @@ void ScanCache::make_room(std::uint64_t bytes) {
       if (farthest == kept_.end() || it->second.next_use > farthest->second.next_use) farthest = it;
     }
     if (farthest == kept_.end()) return;
-    kept_.erase(farthest);
+    drop(farthest);
+  }
+}
+
+// Lets a kept scan go, parking it first when the plan brings it back.
+void ScanCache::drop(std::map<std::int64_t, Entry>::iterator kept) {
+  if (kept->second.next_use != kNever) park(*kept->second.scan);
+  kept_.erase(kept);
+}
+
+// Drops kept scans the stage does not hold, farthest next use first, until
+// at most `count` are left.
+void ScanCache::keep_at_most(std::size_t count) {
+  while (true) {
+    std::size_t unheld = 0;
+    auto farthest = kept_.end();
+    for (auto it = kept_.begin(); it != kept_.end(); ++it) {
+      if (it->second.scan.use_count() > 1) continue;
+      ++unheld;
+      if (farthest == kept_.end() || it->second.next_use > farthest->second.next_use) farthest = it;
+    }
+    if (unheld <= count) return;
+    drop(farthest);
   }
 }
 
@@ -148,18 +217,7 @@ void ScanCache::refuse_beyond_limit(std::uint64_t bytes, std::int64_t id) const 
                                  core::gigabytes(limit_) + " (--memory-limit)");
 }
 
-std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
-  // A scan the stage still holds from an earlier plan is not loaded twice.
-  for (const std::weak_ptr<const LoadedScan>& given : given_) {
-    if (std::shared_ptr<const LoadedScan> held = given.lock(); held && held->id == id) return held;
-  }
-  const auto pixels = pixels_.find(id);
-  if (pixels == pixels_.end())
-    throw core::InputError(project_.path().string(), {}, "no scan with id " + std::to_string(id));
-  const auto estimate =
-      static_cast<std::uint64_t>(bytes_per_pixel_ * static_cast<double>(pixels->second));
-  make_room(estimate);
-  refuse_beyond_limit(bytes_in_hand() + estimate, id);
+std::shared_ptr<LoadedScan> ScanCache::load_from_project(std::int64_t id) const {
   auto loaded = std::make_shared<LoadedScan>();
   loaded->id = id;
   std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project_, id);
@@ -171,12 +229,84 @@ std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
   loaded->geometry = std::move(*geometry);
   loaded->scan = project_.load_scan(id);
   loaded->prepared = registration::prepare_scan(loaded->scan, loaded->geometry, threads_);
-  loaded->bytes = heap_bytes_of(*loaded);
-  if (pixels->second > 0) {
-    bytes_per_pixel_ = std::max(
-        bytes_per_pixel_, static_cast<double>(loaded->bytes) / static_cast<double>(pixels->second));
+  return loaded;
+}
+
+// Writes the arrays of `loaded` to the spill, unless they are there
+// already or it cannot take them all.
+void ScanCache::park(const LoadedScan& loaded) {
+  if (spill_ == nullptr || !spill_->usable() || parked_.contains(loaded.id)) return;
+  Parked parked{scan_without_arrays(loaded.scan), loaded.geometry.range_noise, {}};
+  visit_arrays(loaded, [&](auto& v) {
+    if (const std::optional<core::SpillFile::Extent> extent =
+            spill_->put(v.data(), v.size() * sizeof(v[0]))) {
+      parked.arrays.push_back(*extent);
+    }
+  });
+  if (spill_->usable()) parked_.emplace(loaded.id, std::move(parked));
+}
+
+// The scan `parked` describes, its arrays read back from the spill; the
+// same as when it was parked.
+std::shared_ptr<LoadedScan> ScanCache::read_back(const Parked& parked, std::int64_t id) const {
+  auto loaded = std::make_shared<LoadedScan>();
+  loaded->id = id;
+  loaded->scan = parked.scan;
+  loaded->geometry.range_noise = parked.range_noise;
+  std::size_t k = 0;
+  visit_arrays(*loaded, [&](auto& v) {
+    const core::SpillFile::Extent& extent = parked.arrays[k++];
+    using T = typename std::remove_reference_t<decltype(v)>::value_type;
+    core::reserve_mapped(v, extent.bytes / sizeof(T));
+    v.resize(extent.bytes / sizeof(T));
+    spill_->get(extent, v.data());
+  });
+  registration::PreparedScan& prepared = loaded->prepared;
+  prepared.scan = &loaded->scan;
+  prepared.geometry = &loaded->geometry;
+  if (loaded->scan.is_spherical()) {
+    prepared.grid.emplace(loaded->scan);
+  } else {
+    prepared.tree = std::make_unique<registration::PointIndex>(prepared.points, prepared.usable);
   }
-  ++loads_;
+  return loaded;
+}
+
+std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
+  // A scan the stage still holds from an earlier plan is not loaded twice.
+  for (const std::weak_ptr<const LoadedScan>& given : given_) {
+    if (std::shared_ptr<const LoadedScan> held = given.lock(); held && held->id == id) return held;
+  }
+  const auto pixels = pixels_.find(id);
+  if (pixels == pixels_.end())
+    throw core::InputError(project_.path().string(), {}, "no scan with id " + std::to_string(id));
+  keep_at_most(settings_.max_kept);  // scans let go since the last get
+  // A scan read back takes what was parked (and its index); one loaded
+  // from the project takes its whole form until it is trimmed.
+  const auto parked = parked_.find(id);
+  std::uint64_t estimate = 0;
+  if (parked != parked_.end()) {
+    for (const core::SpillFile::Extent& extent : parked->second.arrays) estimate += extent.bytes;
+  } else {
+    estimate = static_cast<std::uint64_t>(bytes_per_pixel_ * static_cast<double>(pixels->second));
+  }
+  make_room(estimate);
+  refuse_beyond_limit(bytes_in_hand() + estimate, id);
+  std::shared_ptr<LoadedScan> loaded;
+  if (parked != parked_.end()) {
+    loaded = read_back(parked->second, id);
+    ++spill_reads_;
+  } else {
+    loaded = load_from_project(id);
+    const std::size_t whole = heap_bytes_of(*loaded);
+    if (pixels->second > 0) {
+      bytes_per_pixel_ = std::max(bytes_per_pixel_,
+                                  static_cast<double>(whole) / static_cast<double>(pixels->second));
+    }
+    trim_to(settings_.form, *loaded);
+    ++loads_;
+  }
+  loaded->bytes = heap_bytes_of(*loaded);
   given_.emplace_back(loaded);
   // The estimate may have been short (the first one, a kd-tree): the limit
   // holds for what was really loaded.
@@ -202,6 +332,7 @@ std::shared_ptr<const LoadedScan> ScanCache::get(std::int64_t id) {
   } else {
     kept_[id] = {scan, next};
   }
+  keep_at_most(settings_.max_kept);
   return scan;
 }
 

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/scan.hpp"
 #include "core/progress.hpp"
+#include "core/spill_file.hpp"
 #include "modeling/store/project.hpp"
 #include "registration/prepared_scan.hpp"
 #include "registration/scan_stream.hpp"
@@ -40,6 +42,34 @@ struct LoadedScan {
   LoadedScan& operator=(const LoadedScan&) = delete;
 };
 
+// What of a scan a stage reads.
+enum class ScanForm {
+  kWhole,
+  // What the merge compares (registration/merge.hpp): ranges, footprints,
+  // normals and the prepared in_model, usable and sample areas, about 26
+  // bytes a pixel instead of about 51. The scan's valid, intensity and
+  // colour, the geometry's confidence and flags are dropped, and so are
+  // the prepared points of a spherical grid (registration::
+  // point_of recomputes them).
+  kMerge,
+};
+
+// How a stage's cache holds its scans, within the memory limit.
+struct ScanCacheSettings {
+  ScanForm form = ScanForm::kWhole;
+  // Park a scan's arrays in a temporary file (core::SpillFile) when it is
+  // let go before the plan is done with it, and read them back from there
+  // when the plan brings it back, rather than load it from the project
+  // again: a read instead of decompressing and preparing. Where the file
+  // cannot take them, from the project.
+  bool spill = false;
+  // Scans kept for a later use of the plan, beyond those the stage holds,
+  // at most (Belady's rule picks them). With a spill, a few suffice: peak
+  // memory is then that of the scans a stage needs together and these,
+  // however many scans come back.
+  std::size_t max_kept = std::numeric_limits<std::size_t>::max();
+};
+
 // The memory a stage may fill with loaded scans [bytes]: `requested` when
 // given, else three quarters of what the process can still be given
 // (core::available_memory_bytes), else 4 GB when that cannot be told.
@@ -56,7 +86,7 @@ class ScanCache {
   // Scans of `project` (which must outlive the cache) prepared on `threads`
   // workers; each get checks `progress` for cancellation of `stage`.
   ScanCache(const store::Project& project, std::uint64_t memory_limit_bytes, int threads,
-            std::string stage, core::Progress& progress);
+            std::string stage, core::Progress& progress, ScanCacheSettings settings = {});
 
   // The scan ids in the order the following get() calls will ask for them
   // (an id may repeat). Replaces the previous plan: scans in hand that it
@@ -72,7 +102,9 @@ class ScanCache {
   // core::Cancelled when cancelled.
   std::shared_ptr<const LoadedScan> get(std::int64_t id);
 
+  // Scans loaded from the project, and read back from the spill.
   std::size_t loads() const { return loads_; }
+  std::size_t spill_reads() const { return spill_reads_; }
   // The most memory the scans in hand (held or kept) took at once [bytes].
   std::uint64_t peak_bytes() const { return peak_bytes_; }
 
@@ -81,11 +113,23 @@ class ScanCache {
     std::shared_ptr<const LoadedScan> scan;
     std::size_t next_use = 0;  // position in the plan; kNever when none
   };
+  // A scan in the spill: what its arrays leave of it, and where each array
+  // went (in the order of visit_arrays in scan_cache.cpp).
+  struct Parked {
+    acquisition::Scan scan;
+    acquisition::RangeNoise range_noise;
+    std::vector<core::SpillFile::Extent> arrays;
+  };
 
   std::uint64_t bytes_in_hand() const;
   void refuse_beyond_limit(std::uint64_t bytes, std::int64_t id) const;
   void make_room(std::uint64_t bytes);
+  void keep_at_most(std::size_t count);
   std::shared_ptr<const LoadedScan> load(std::int64_t id);
+  std::shared_ptr<LoadedScan> load_from_project(std::int64_t id) const;
+  std::shared_ptr<LoadedScan> read_back(const Parked& parked, std::int64_t id) const;
+  void park(const LoadedScan& loaded);
+  void drop(std::map<std::int64_t, Entry>::iterator kept);
 
   const store::Project& project_;
   std::vector<std::int64_t> plan_;
@@ -95,6 +139,9 @@ class ScanCache {
   int threads_;
   std::string stage_;
   core::Progress& progress_;
+  ScanCacheSettings settings_;
+  std::unique_ptr<core::SpillFile> spill_;  // with settings_.spill only
+  std::map<std::int64_t, Parked> parked_;
   std::map<std::int64_t, Entry> kept_;
   // Scans given out, kept or not: memory is theirs until the last holder
   // lets go.
@@ -102,6 +149,7 @@ class ScanCache {
   std::map<std::int64_t, std::size_t> pixels_;  // per scan, from the summaries
   double bytes_per_pixel_ = 0.0;                // the most seen so far
   std::size_t loads_ = 0;
+  std::size_t spill_reads_ = 0;
   std::uint64_t peak_bytes_ = 0;
 };
 

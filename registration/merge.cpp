@@ -101,16 +101,21 @@ bool finer_elsewhere(const PreparedScan& s, int s_index, std::size_t i, const Ei
 
 // Decides row `row` of scan s against one other scan o, for the points no
 // earlier comparison dropped; returns how many (point, o) tests the area
-// bound decided.
+// bound decided. `directions` recomputes s's points where they were dropped
+// (a spherical grid's; none where s has its points).
 std::size_t merge_row(const PreparedScan& s, int s_index, const OtherScan& o, const Thresholds& t,
-                      int row, MergeScanResult& out) {
+                      const acquisition::SphericalDirections* directions, int row,
+                      MergeScanResult& out) {
   const int columns = s.scan->columns;
   std::size_t bounded = 0;
   for (int col = 0; col < columns; ++col) {
     const std::size_t i = s.scan->index(row, col);
     if (!out.keep[i]) continue;
     const float sigma_s = t.range_sigma(s, s.scan->range_m[i]);
-    const Eigen::Vector3f p = o.R_o_s * s.points[i] + o.t_o_s;
+    // As prepare_scan computes the point.
+    const Eigen::Vector3f point_s =
+        directions != nullptr ? s.scan->range_m[i] * (*directions)(row, col) : s.points[i];
+    const Eigen::Vector3f p = o.R_o_s * point_s + o.t_o_s;
     const float range = p.norm();
     const float sigma_p = t.range_sigma(*o.scan, range);  // what o measures there
     if (coarser_by_bound(p, range, sigma_p, sigma_s, s.sample_area_m2[i], o, t)) {
@@ -165,10 +170,16 @@ void merge_with(MergeScanResult& out, const MergeOperand& s, const MergeOperand&
   assert(out.keep.size() == s.scan->in_model.size() && "start_merge(s) made `out`");
   const Thresholds thresholds = thresholds_of(settings);
   const OtherScan other = other_scan(s, o, settings.bound_coarser_scans);
+  std::optional<acquisition::SphericalDirections> directions;
+  if (s.scan->points.empty()) directions.emplace(*s.scan->scan);
+  const acquisition::SphericalDirections* recompute = directions ? &*directions : nullptr;
   std::atomic<std::size_t> bounded{0};
   core::parallel_for_index(
       s.scan->scan->rows, settings.threads,
-      [&](int row) { bounded += merge_row(*s.scan, s.index, other, thresholds, row, out); }, 4);
+      [&](int row) {
+        bounded += merge_row(*s.scan, s.index, other, thresholds, recompute, row, out);
+      },
+      4);
   out.decided_by_bound += bounded;
 }
 

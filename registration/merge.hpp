@@ -55,7 +55,10 @@ struct MergeResult {
   double seconds = 0.0;
 };
 
-// A scan as one side of a comparison: the prepared scan, its position in
+// A scan as one side of a comparison: the prepared scan (a spherical
+// grid's without its points will do: they are recomputed as prepare_scan
+// computes them, from the ranges, so the scan takes half the memory; its
+// valid, intensity, colour, confidence and flags are not read), its position in
 // the scan list (ties go to the scan listed first), its pose, and
 // max_footprint_per_m of it (0 when settings.bound_coarser_scans is off).
 struct MergeOperand {

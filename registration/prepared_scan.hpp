@@ -23,6 +23,8 @@ struct PreparedScan {
   const acquisition::Scan* scan = nullptr;
   const acquisition::ScanGeometry* geometry = nullptr;
   // Point in the scan frame [m]; zero where the pixel is not in the model.
+  // A spherical grid's may be dropped (empty) where only the merge uses the
+  // scan: it recomputes them from the ranges (registration/merge.hpp).
   std::vector<Eigen::Vector3f> points;
   // 1 = the point belongs in a model: valid and not a mixed pixel.
   std::vector<std::uint8_t> in_model;

@@ -75,7 +75,7 @@ TEST(Journal, TheImportCheckSpillsTheChannelsItKeepsAndStoresThemWhole) {
     ASSERT_EQ(scan.spilled.size(), scan.encoded->layers.size());
     for (std::size_t k = 0; k < scan.spilled.size(); ++k) {
       EXPECT_TRUE(scan.encoded->layers[k].blob.empty());
-      EXPECT_GT(scan.spilled[k].size, 0u);
+      EXPECT_GT(scan.spilled[k].bytes, 0u);
     }
   }
   const ScratchDir dir;

@@ -1,0 +1,65 @@
+#include "core/spill_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <string>
+
+#include "core/errors.hpp"
+
+namespace scanbench::core {
+
+SpillFile::SpillFile() {
+  std::error_code error;
+  folder_ = std::filesystem::temp_directory_path(error);
+  if (!error) fd_ = ::open(folder_.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+  if (fd_ < 0) {
+    fallback_ = std::tmpfile();
+    if (fallback_ != nullptr) fd_ = ::fileno(fallback_);
+  }
+}
+
+SpillFile::~SpillFile() {
+  if (fallback_ != nullptr) {
+    std::fclose(fallback_);
+  } else if (fd_ >= 0) {
+    ::close(fd_);
+  }
+}
+
+std::optional<SpillFile::Extent> SpillFile::put(const void* data, std::size_t bytes) {
+  if (!usable()) return std::nullopt;
+  const auto* from = static_cast<const std::uint8_t*>(data);
+  std::size_t done = 0;
+  while (done < bytes) {
+    const ssize_t wrote = ::pwrite(fd_, from + done, bytes - done, static_cast<off_t>(end_ + done));
+    if (wrote <= 0) {
+      failed_ = true;
+      return std::nullopt;
+    }
+    done += static_cast<std::size_t>(wrote);
+  }
+  const Extent extent{end_, bytes};
+  end_ += bytes;
+  return extent;
+}
+
+void SpillFile::get(const Extent& extent, void* data) const {
+  auto* to = static_cast<std::uint8_t*>(data);
+  std::size_t done = 0;
+  while (done < extent.bytes) {
+    const ssize_t got =
+        ::pread(fd_, to + done, extent.bytes - done, static_cast<off_t>(extent.offset + done));
+    if (got < 0) {
+      throw RuntimeFailure(
+          folder_.string(), {},
+          std::string("cannot read back a temporary file: ") + std::strerror(errno));
+    }
+    if (got == 0) throw RuntimeFailure(folder_.string(), {}, "a temporary file ends early");
+    done += static_cast<std::size_t>(got);
+  }
+}
+
+}  // namespace scanbench::core

@@ -1,0 +1,53 @@
+// An unnamed file in the temporary folder where a stage parks data it will
+// read again, instead of holding it in memory: the kernel's page cache
+// keeps what fits, and none of it counts against the process. O_TMPFILE
+// where the file system has it (the file has no name and goes when it is
+// closed or the process dies), else tmpfile() (named and unlinked at once).
+// Best effort: where no such file can be made, or once a write fails (a
+// full disk), put() says so and the caller keeps the data another way.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+namespace scanbench::core {
+
+class SpillFile {
+ public:
+  // Where in the file a put() went.
+  struct Extent {
+    std::uint64_t offset = 0;
+    std::uint64_t bytes = 0;
+  };
+
+  SpillFile();
+  ~SpillFile();
+  SpillFile(const SpillFile&) = delete;
+  SpillFile& operator=(const SpillFile&) = delete;
+
+  // False once the file cannot be made or has failed a write.
+  bool usable() const { return fd_ >= 0 && !failed_; }
+
+  // Appends `bytes` bytes at `data`; none when the file cannot take them
+  // (the file is then unusable from here on; what it took stays readable).
+  std::optional<Extent> put(const void* data, std::size_t bytes);
+
+  // Reads `extent` back into `data` (extent.bytes long). Throws
+  // core::RuntimeFailure naming the temporary folder when it cannot.
+  void get(const Extent& extent, void* data) const;
+
+  // The bytes put so far.
+  std::uint64_t size() const { return end_; }
+
+ private:
+  int fd_ = -1;
+  std::FILE* fallback_ = nullptr;
+  std::filesystem::path folder_;
+  std::uint64_t end_ = 0;
+  bool failed_ = false;
+};
+
+}  // namespace scanbench::core

@@ -1,0 +1,47 @@
+// core::SpillFile gives back what it was given, wherever it was put, and
+// says when it cannot take more rather than losing it.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "core/spill_file.hpp"
+
+namespace scanbench::core {
+namespace {
+
+TEST(SpillFile, GivesBackEachPutWhereverItWent) {
+  SpillFile file;
+  ASSERT_TRUE(file.usable());
+  std::vector<std::uint8_t> first(3 << 20);
+  std::iota(first.begin(), first.end(), std::uint8_t{7});
+  const std::vector<float> second{1.5f, -2.0f, 3.25f};
+  const std::optional<SpillFile::Extent> a = file.put(first.data(), first.size());
+  const std::optional<SpillFile::Extent> b = file.put(second.data(), sizeof(float) * 3);
+  const std::optional<SpillFile::Extent> empty = file.put(nullptr, 0);
+  ASSERT_TRUE(a && b && empty);
+  EXPECT_EQ(b->offset, first.size());
+  EXPECT_EQ(file.size(), first.size() + sizeof(float) * 3);
+
+  std::vector<float> second_back(3);
+  file.get(*b, second_back.data());
+  EXPECT_EQ(second_back, second);
+  std::vector<std::uint8_t> first_back(first.size());
+  file.get(*a, first_back.data());
+  EXPECT_EQ(first_back, first);
+  file.get(*empty, nullptr);
+}
+
+TEST(SpillFile, AReadBeyondWhatWasPutIsARuntimeFailure) {
+  SpillFile file;
+  ASSERT_TRUE(file.usable());
+  const std::uint32_t value = 42;
+  ASSERT_TRUE(file.put(&value, sizeof value));
+  std::vector<std::uint8_t> back(64);
+  EXPECT_THROW(file.get({0, back.size()}, back.data()), RuntimeFailure);
+}
+
+}  // namespace
+}  // namespace scanbench::core
