@@ -3,6 +3,14 @@
 #include <algorithm>
 
 namespace scanbench::modeling {
+namespace {
+
+// `box` grown by `margin_m` on every side.
+Eigen::AlignedBox3d grown_by(const Eigen::AlignedBox3d& box, double margin_m) {
+  return {box.min().array() - margin_m, box.max().array() + margin_m};
+}
+
+}  // namespace
 
 std::vector<ScanPair> overlapping_pairs(std::span<const store::StoredScanSummary> scans,
                                         double margin_m) {
@@ -17,8 +25,7 @@ std::vector<ScanPair> overlapping_pairs(std::span<const store::StoredScanSummary
             [&box](int a, int b) { return box(a).min().x() < box(b).min().x(); });
   std::vector<ScanPair> pairs;
   for (std::size_t i = 0; i < by_x.size(); ++i) {
-    const Eigen::AlignedBox3d grown(box(by_x[i]).min().array() - margin_m,
-                                    box(by_x[i]).max().array() + margin_m);
+    const Eigen::AlignedBox3d grown = grown_by(box(by_x[i]), margin_m);
     for (std::size_t j = i + 1; j < by_x.size(); ++j) {
       const Eigen::AlignedBox3d& other = box(by_x[j]);
       if (other.min().x() > grown.max().x()) break;
@@ -47,9 +54,7 @@ std::vector<int> pair_pass_order(std::span<const ScanPair> pairs, int scan_count
 bool bounds_reach(const store::StoredScanSummary& scan, const Eigen::AlignedBox3d& box,
                   double margin_m) {
   if (!scan.summary.bbox_world || box.isEmpty()) return false;
-  const Eigen::AlignedBox3d grown(scan.summary.bbox_world->min().array() - margin_m,
-                                  scan.summary.bbox_world->max().array() + margin_m);
-  return grown.intersects(box);
+  return grown_by(*scan.summary.bbox_world, margin_m).intersects(box);
 }
 
 }  // namespace scanbench::modeling
