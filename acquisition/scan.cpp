@@ -37,6 +37,22 @@ std::size_t scattered_pixel_count(std::size_t points) {
   return rows * columns;
 }
 
+Scan without_arrays(const Scan& scan) {
+  Scan out;
+  out.name = scan.name;
+  out.rows = scan.rows;
+  out.columns = scan.columns;
+  if (const auto* per_pixel = std::get_if<PerPixelDirections>(&scan.angles)) {
+    out.angles = PerPixelDirections{{}, per_pixel->scattered};
+  } else {
+    out.angles = scan.angles;
+  }
+  out.T_world_scan = scan.T_world_scan;
+  out.scanner = scan.scanner;
+  out.import_round_trip_m = scan.import_round_trip_m;
+  return out;
+}
+
 Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_color) {
   const auto [rows, columns] = scattered_grid(points);
   assert(rows < (1u << 31) && columns < (1u << 31) && "a scattered scan of at most 2^62 points");

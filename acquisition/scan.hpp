@@ -114,6 +114,13 @@ struct RecordedGeometry {
   bool empty() const { return normal.empty() && footprint_m.empty(); }
 };
 
+// `scan` without its per-pixel arrays (channels, per-pixel directions),
+// which are left empty: its name, grid size, angle model, pose, scanner
+// and round-trip error. For code that keeps a scan's arrays elsewhere (a
+// spill file) and its description in memory; a field added to Scan is
+// copied here.
+Scan without_arrays(const Scan& scan);
+
 // Allocates every channel of a rows × columns scan: range 0, all pixels
 // invalid, intensity / rgb only when requested. Asserts rows, columns ≥ 0.
 Scan make_empty_scan(int rows, int columns, bool with_intensity, bool with_color);

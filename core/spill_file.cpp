@@ -46,6 +46,14 @@ std::optional<SpillFile::Extent> SpillFile::put(const void* data, std::size_t by
   return extent;
 }
 
+void SpillFile::release(const Extent& extent) {
+  if (fd_ < 0 || extent.bytes == 0) return;
+  // Best effort: a file system without holes keeps the space until the
+  // file is closed.
+  (void)::fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE,
+                    static_cast<off_t>(extent.offset), static_cast<off_t>(extent.bytes));
+}
+
 void SpillFile::get(const Extent& extent, void* data) const {
   auto* to = static_cast<std::uint8_t*>(data);
   std::size_t done = 0;

@@ -39,6 +39,12 @@ class SpillFile {
   // core::RuntimeFailure naming the temporary folder when it cannot.
   void get(const Extent& extent, void* data) const;
 
+  // Gives the disk space of `extent`, which will not be read again, back to
+  // the file system (a hole in the file) where it can; the file's size and
+  // the other extents stay. So a file that many puts go through takes only
+  // what is still to be read.
+  void release(const Extent& extent);
+
   // The bytes put so far.
   std::uint64_t size() const { return end_; }
 

@@ -92,11 +92,13 @@ std::vector<registration::ColorPair> streamed_color_pairs(
   std::vector<std::int64_t> plan;
   for (const int k : pair_pass_order(pairs, static_cast<int>(scans.size()), false))
     plan.push_back(scans[static_cast<std::size_t>(k)].id);
-  // Scans parked in a temporary file when first loaded, and two kept in
-  // memory beyond the pair in hand: a scan the plan brings back is read
-  // from the file.
+  // One scan kept in memory beyond the pair in hand, the others parked in
+  // a temporary file until the plan brings them back. Whole scans: one
+  // more kept would be as many megabytes as loading the next scan from the
+  // project takes on top (16 path stations: 0.77 GB against 0.61 GB, in
+  // the same time).
   ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress,
-                  {ScanForm::kWhole, true, 2});
+                  {ScanForm::kWhole, true, 1});
   cache.plan(plan);
   // The pairs each scan may take part in, shared among the scans it may
   // overlap: the solve grows with the scans, not with their overlaps.

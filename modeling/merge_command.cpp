@@ -14,9 +14,9 @@ namespace {
 
 constexpr const char* kStage = "merge";
 
-// The merge's scans: what it compares only, parked in a temporary file when
-// first loaded, and two kept in memory beyond the pair in hand; a scan the
-// plan brings back again is read from the file.
+// The merge's scans: what it compares only, two kept in memory beyond the
+// pair in hand, the others parked in a temporary file until the plan
+// brings them back.
 const ScanCacheSettings kMergeCache{ScanForm::kMerge, true, 2};
 
 // The streamed merge: scan b is compared with each earlier scan a whose

@@ -69,24 +69,6 @@ void trim_to(ScanForm form, LoadedScan& loaded) {
   if (loaded.prepared.grid) release(loaded.prepared.points);
 }
 
-// The scan without its arrays (which must be empty, or set aside): its
-// name, grid, angle model, pose and scanner.
-acquisition::Scan scan_without_arrays(const acquisition::Scan& scan) {
-  acquisition::Scan out;
-  out.name = scan.name;
-  out.rows = scan.rows;
-  out.columns = scan.columns;
-  if (const auto* per_pixel = std::get_if<acquisition::PerPixelDirections>(&scan.angles)) {
-    out.angles = acquisition::PerPixelDirections{{}, per_pixel->scattered};
-  } else {
-    out.angles = scan.angles;
-  }
-  out.T_world_scan = scan.T_world_scan;
-  out.scanner = scan.scanner;
-  out.import_round_trip_m = scan.import_round_trip_m;
-  return out;
-}
-
 }  // namespace
 
 std::uint64_t memory_limit_or_default(std::optional<std::uint64_t> requested) {
@@ -236,7 +218,7 @@ std::shared_ptr<LoadedScan> ScanCache::load_from_project(std::int64_t id) const 
 // already or it cannot take them all.
 void ScanCache::park(const LoadedScan& loaded) {
   if (spill_ == nullptr || !spill_->usable() || parked_.contains(loaded.id)) return;
-  Parked parked{scan_without_arrays(loaded.scan), loaded.geometry.range_noise, {}};
+  Parked parked{acquisition::without_arrays(loaded.scan), loaded.geometry.range_noise, {}};
   visit_arrays(loaded, [&](auto& v) {
     if (const std::optional<core::SpillFile::Extent> extent =
             spill_->put(v.data(), v.size() * sizeof(v[0]))) {
@@ -244,6 +226,14 @@ void ScanCache::park(const LoadedScan& loaded) {
     }
   });
   if (spill_->usable()) parked_.emplace(loaded.id, std::move(parked));
+}
+
+// Gives the spill's space of scan `id` back: the plan is done with it.
+void ScanCache::unpark(std::int64_t id) {
+  const auto parked = parked_.find(id);
+  if (parked == parked_.end()) return;
+  for (const core::SpillFile::Extent& extent : parked->second.arrays) spill_->release(extent);
+  parked_.erase(parked);
 }
 
 // The scan `parked` describes, its arrays read back from the spill; the
@@ -329,6 +319,7 @@ std::shared_ptr<const LoadedScan> ScanCache::get(std::int64_t id) {
   }
   if (next == kNever) {
     kept_.erase(id);  // the stage is its last holder
+    unpark(id);
   } else {
     kept_[id] = {scan, next};
   }

@@ -61,7 +61,10 @@ struct ScanCacheSettings {
   // let go before the plan is done with it, and read them back from there
   // when the plan brings it back, rather than load it from the project
   // again: a read instead of decompressing and preparing. Where the file
-  // cannot take them, from the project.
+  // cannot take them, from the project. The file gives a scan's space
+  // back once the plan is done with it, so it holds only the scans whose
+  // uses are not over (down a street, a band of neighbours, not the
+  // campaign).
   bool spill = false;
   // Scans kept for a later use of the plan, beyond those the stage holds,
   // at most (Belady's rule picks them). With a spill, a few suffice: peak
@@ -129,6 +132,7 @@ class ScanCache {
   std::shared_ptr<LoadedScan> load_from_project(std::int64_t id) const;
   std::shared_ptr<LoadedScan> read_back(const Parked& parked, std::int64_t id) const;
   void park(const LoadedScan& loaded);
+  void unpark(std::int64_t id);
   void drop(std::map<std::int64_t, Entry>::iterator kept);
 
   const store::Project& project_;

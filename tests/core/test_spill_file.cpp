@@ -32,6 +32,15 @@ TEST(SpillFile, GivesBackEachPutWhereverItWent) {
   file.get(*a, first_back.data());
   EXPECT_EQ(first_back, first);
   file.get(*empty, nullptr);
+
+  // Giving the first one's space back leaves the second, and room for more.
+  file.release(*a);
+  std::fill(second_back.begin(), second_back.end(), 0.0f);
+  file.get(*b, second_back.data());
+  EXPECT_EQ(second_back, second);
+  const std::optional<SpillFile::Extent> third = file.put(first.data(), 16);
+  ASSERT_TRUE(third);
+  EXPECT_EQ(third->offset, first.size() + sizeof(float) * 3);
 }
 
 TEST(SpillFile, AReadBeyondWhatWasPutIsARuntimeFailure) {
