@@ -1,26 +1,14 @@
 #!/usr/bin/env bash
-# The test command, as CI runs it: installs what is missing, builds, runs the
-# whole test suite on a Release build, then every fuzz target for a short
-# while (scripts/fuzz.sh; FUZZ_SECONDS, default 10, per target) under
-# AddressSanitizer and UndefinedBehaviorSanitizer.
-#   --fast      the Release pass only
-#   --sanitize  between the two, the whole suite again on a build under
-#               AddressSanitizer and UndefinedBehaviorSanitizer at -O1,
-#               without the benches and the tests labelled release_only (the
-#               simulator's own tests, the bench smoke runs). It takes about
-#               half an hour on two cores, beyond CI's budget of a quarter
-#               of an hour: run it before landing changes to code that
-#               manages memory (docs/CONTRIBUTING.md).
+# The test command: installs what is missing, builds, and runs the whole test
+# suite twice, as CI does: a Release build, then a build under AddressSanitizer
+# and UndefinedBehaviorSanitizer at -O1, without the benches and the tests
+# labelled release_only (the simulator's own tests, the bench smoke runs),
+# then every fuzz target for a short while (scripts/fuzz.sh; FUZZ_SECONDS,
+# default 10, per target). `--fast` runs the Release pass only.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 fast=0
-sanitize=0
-case "${1:-}" in
-  --fast) fast=1 ;;
-  --sanitize) sanitize=1 ;;
-  "") ;;
-  *) echo "usage: scripts/test.sh [--fast | --sanitize]" >&2; exit 2 ;;
-esac
+[ "${1:-}" = "--fast" ] && fast=1
 
 run_pass() {
   local name=$1 dir=$2 ctest_args=$3
@@ -36,13 +24,11 @@ run_pass() {
 
 "$root/scripts/install-deps.sh" --tests
 run_pass release "$root/build" "" -DSCANBENCH_SANITIZE=OFF
-if [ $sanitize -eq 1 ]; then
+if [ $fast -eq 0 ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   BUILD_TYPE=RelWithDebInfo run_pass "asan+ubsan" "$root/build-asan" "-LE release_only" \
     -DSCANBENCH_SANITIZE=ON -DSCANBENCH_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1"
-fi
-if [ $fast -eq 0 ]; then
   echo "== fuzz =="
   start=$SECONDS
   "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-10}"
