@@ -68,8 +68,8 @@ Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_colo
 Eigen::Vector3d direction_precise(const Scan& scan, int row, int col) {
   assert(row >= 0 && row < scan.rows && col >= 0 && col < scan.columns);
   if (const auto* spherical = std::get_if<SphericalAngles>(&scan.angles)) {
-    const double az = spherical->azimuth_start_rad + col * spherical->azimuth_step_rad;
-    const double el = spherical->elevation_start_rad + row * spherical->elevation_step_rad;
+    const double az = spherical->azimuth(col);
+    const double el = spherical->elevation(row);
     const double cos_el = std::cos(el);
     return {cos_el * std::cos(az), cos_el * std::sin(az), std::sin(el)};
   }
@@ -79,17 +79,16 @@ Eigen::Vector3d direction_precise(const Scan& scan, int row, int col) {
   return norm > 0.0 ? Eigen::Vector3d(d / norm) : Eigen::Vector3d::Zero();
 }
 
-// Angles as direction_precise computes them, so that the products agree.
 SphericalDirections::SphericalDirections(const Scan& scan) {
   const auto& model = std::get<SphericalAngles>(scan.angles);
   rows_.reserve(static_cast<std::size_t>(scan.rows));
   for (int row = 0; row < scan.rows; ++row) {
-    const double el = model.elevation_start_rad + row * model.elevation_step_rad;
+    const double el = model.elevation(row);
     rows_.emplace_back(std::cos(el), std::sin(el));
   }
   columns_.reserve(static_cast<std::size_t>(scan.columns));
   for (int col = 0; col < scan.columns; ++col) {
-    const double az = model.azimuth_start_rad + col * model.azimuth_step_rad;
+    const double az = model.azimuth(col);
     columns_.emplace_back(std::cos(az), std::sin(az));
   }
 }

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -31,6 +32,11 @@ struct SphericalAngles {
   double azimuth_step_rad = 0.0;
   double elevation_start_rad = 0.0;
   double elevation_step_rad = 0.0;
+
+  // Of column `col` and row `row` [rad]: every direction is computed from
+  // these, so that directions computed apart agree bit for bit.
+  double azimuth(int col) const { return azimuth_start_rad + col * azimuth_step_rad; }
+  double elevation(int row) const { return elevation_start_rad + row * elevation_step_rad; }
 
   friend bool operator==(const SphericalAngles&, const SphericalAngles&) = default;
 };
@@ -145,7 +151,8 @@ inline constexpr double kMaxCoordinateM = 1e8;
 // accessor below asserts 0 ≤ row < rows and 0 ≤ col < columns.
 Eigen::Vector3f direction(const Scan& scan, int row, int col);
 
-// direction() of every pixel of a spherical grid (asserted), from each
+// direction() of every pixel of a spherical grid (std::get: the scan must
+// have one), from each
 // row's and column's sines and cosines computed once: the same vectors, bit
 // for bit, at the cost of a few multiplications, for loops that need the
 // directions of a scan's pixels again and again.
@@ -153,6 +160,8 @@ class SphericalDirections {
  public:
   explicit SphericalDirections(const Scan& scan);
   Eigen::Vector3f operator()(int row, int col) const {
+    assert(row >= 0 && static_cast<std::size_t>(row) < rows_.size() && col >= 0 &&
+           static_cast<std::size_t>(col) < columns_.size());
     const Eigen::Vector2d& el = rows_[static_cast<std::size_t>(row)];
     const Eigen::Vector2d& az = columns_[static_cast<std::size_t>(col)];
     return Eigen::Vector3d(el.x() * az.x(), el.x() * az.y(), el.y()).cast<float>();

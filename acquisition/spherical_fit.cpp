@@ -71,8 +71,8 @@ struct LineFit {
 };
 
 Eigen::Vector3d model_direction(const SphericalAngles& a, int row, int col) {
-  const double az = a.azimuth_start_rad + col * a.azimuth_step_rad;
-  const double el = a.elevation_start_rad + row * a.elevation_step_rad;
+  const double az = a.azimuth(col);
+  const double el = a.elevation(row);
   return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
 }
 
@@ -137,12 +137,10 @@ SphericalFitResult fit_spherical_angles_to_angles(int rows, int columns,
   for_each_valid(rows, columns, valid, [&](int row, int col, std::size_t i) {
     if (row != cos_row) {
       cos_row = row;
-      model_el = angles.elevation_start_rad + row * angles.elevation_step_rad;
+      model_el = angles.elevation(row);
       cos_el = std::cos(model_el);
     }
-    const double d_az =
-        cos_el *
-        wrap_angle(azimuth[i] - (angles.azimuth_start_rad + col * angles.azimuth_step_rad));
+    const double d_az = cos_el * wrap_angle(azimuth[i] - angles.azimuth(col));
     const double d_el = elevation[i] - model_el;
     const double r = range[i];
     squared = std::max(squared, r * r * (d_az * d_az + d_el * d_el));

@@ -1,6 +1,8 @@
 #include "core/spill_file.hpp"
 
 #include <fcntl.h>
+#include <linux/magic.h>
+#include <sys/vfs.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -11,22 +13,38 @@
 
 namespace scanbench::core {
 
-SpillFile::SpillFile() {
+namespace {
+
+// True when `folder` is on a file system in memory.
+bool in_memory(const std::filesystem::path& folder) {
+  struct statfs info {};
+  return ::statfs(folder.c_str(), &info) == 0 && info.f_type == TMPFS_MAGIC;
+}
+
+// The temporary folder, or /var/tmp where that one is in memory and
+// /var/tmp is not.
+std::filesystem::path spill_folder() {
   std::error_code error;
-  folder_ = std::filesystem::temp_directory_path(error);
-  if (!error) fd_ = ::open(folder_.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-  if (fd_ < 0) {
-    fallback_ = std::tmpfile();
-    if (fallback_ != nullptr) fd_ = ::fileno(fallback_);
-  }
+  std::filesystem::path folder = std::filesystem::temp_directory_path(error);
+  if (error) folder = "/tmp";
+  const std::filesystem::path var_tmp = "/var/tmp";
+  if (in_memory(folder) && std::filesystem::is_directory(var_tmp, error) && !in_memory(var_tmp))
+    return var_tmp;
+  return folder;
+}
+
+}  // namespace
+
+SpillFile::SpillFile() : folder_(spill_folder()) {
+  fd_ = ::open(folder_.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+  if (fd_ >= 0) return;
+  std::string name = (folder_ / "scanbench-spill-XXXXXX").string();
+  fd_ = ::mkostemp(name.data(), O_CLOEXEC);
+  if (fd_ >= 0) ::unlink(name.c_str());
 }
 
 SpillFile::~SpillFile() {
-  if (fallback_ != nullptr) {
-    std::fclose(fallback_);
-  } else if (fd_ >= 0) {
-    ::close(fd_);
-  }
+  if (fd_ >= 0) ::close(fd_);
 }
 
 std::optional<SpillFile::Extent> SpillFile::put(const void* data, std::size_t bytes) {
@@ -63,9 +81,13 @@ void SpillFile::get(const Extent& extent, void* data) const {
     if (got < 0) {
       throw RuntimeFailure(
           folder_.string(), {},
-          std::string("cannot read back a temporary file: ") + std::strerror(errno));
+          std::string("cannot read back the data parked in a temporary file here: ") +
+              std::strerror(errno));
     }
-    if (got == 0) throw RuntimeFailure(folder_.string(), {}, "a temporary file ends early");
+    if (got == 0) {
+      throw RuntimeFailure(folder_.string(), {},
+                           "a temporary file here holding parked data ends early");
+    }
     done += static_cast<std::size_t>(got);
   }
 }

@@ -1,15 +1,17 @@
-// An unnamed file in the temporary folder where a stage parks data it will
-// read again, instead of holding it in memory: the kernel's page cache
-// keeps what fits, and none of it counts against the process. O_TMPFILE
-// where the file system has it (the file has no name and goes when it is
-// closed or the process dies), else tmpfile() (named and unlinked at once).
-// Best effort: where no such file can be made, or once a write fails (a
-// full disk), put() says so and the caller keeps the data another way.
+// An unnamed file on disk where a stage parks data it will read again,
+// instead of holding it in memory: the kernel's page cache keeps what
+// fits, and the rest waits on the disk. In the temporary folder (TMPDIR,
+// else /tmp), or in /var/tmp where that folder is in memory (tmpfs, as
+// Debian 13's /tmp: parked data would then take memory after all).
+// O_TMPFILE where the file system has it (the file has no name and goes
+// when it is closed or the process dies), else a file made by mkstemp and
+// unlinked at once. Best effort: where no such file can be made, or once a
+// write fails (a full disk), put() says so and the caller keeps the data
+// another way.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -23,6 +25,7 @@ class SpillFile {
     std::uint64_t bytes = 0;
   };
 
+  // Opens the file; usable() says whether that worked.
   SpillFile();
   ~SpillFile();
   SpillFile(const SpillFile&) = delete;
@@ -36,7 +39,7 @@ class SpillFile {
   std::optional<Extent> put(const void* data, std::size_t bytes);
 
   // Reads `extent` back into `data` (extent.bytes long). Throws
-  // core::RuntimeFailure naming the temporary folder when it cannot.
+  // core::RuntimeFailure naming the file's folder when it cannot.
   void get(const Extent& extent, void* data) const;
 
   // Gives the disk space of `extent`, which will not be read again, back to
@@ -47,10 +50,11 @@ class SpillFile {
 
   // The bytes put so far.
   std::uint64_t size() const { return end_; }
+  // The folder the file is in (empty when there is none).
+  const std::filesystem::path& folder() const { return folder_; }
 
  private:
   int fd_ = -1;
-  std::FILE* fallback_ = nullptr;
   std::filesystem::path folder_;
   std::uint64_t end_ = 0;
   bool failed_ = false;

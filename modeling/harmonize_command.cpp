@@ -98,7 +98,7 @@ std::vector<registration::ColorPair> streamed_color_pairs(
   // project takes on top (16 path stations: 0.77 GB against 0.61 GB, in
   // the same time).
   ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress,
-                  {ScanForm::kWhole, true, 1});
+                  {.form = ScanForm::kWhole, .spill = true, .max_kept = 1});
   cache.plan(plan);
   // The pairs each scan may take part in, shared among the scans it may
   // overlap: the solve grows with the scans, not with their overlaps.

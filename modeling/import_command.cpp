@@ -26,7 +26,10 @@ class LayerSpill {
     for (const store::EncodedLayer& layer : scan.layers) {
       const std::optional<core::SpillFile::Extent> extent =
           file_.put(layer.blob.data(), layer.blob.size());
-      if (!extent) return false;
+      if (!extent) {
+        for (const CheckedImport::Scan::Place& place : written) file_.release(place);
+        return false;
+      }
       written.push_back(*extent);
     }
     for (store::EncodedLayer& layer : scan.layers) {

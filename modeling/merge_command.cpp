@@ -17,7 +17,7 @@ constexpr const char* kStage = "merge";
 // The merge's scans: what it compares only, two kept in memory beyond the
 // pair in hand, the others parked in a temporary file until the plan
 // brings them back.
-const ScanCacheSettings kMergeCache{ScanForm::kMerge, true, 2};
+const ScanCacheSettings kMergeCache{.form = ScanForm::kMerge, .spill = true, .max_kept = 2};
 
 // The streamed merge: scan b is compared with each earlier scan a whose
 // bounds reach it, both ways, while both are in hand; a scan's decision is

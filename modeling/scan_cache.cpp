@@ -128,6 +128,10 @@ void ScanCache::plan(std::vector<std::int64_t> order) {
       ++it;
     }
   }
+  std::vector<std::int64_t> unnamed;
+  for (const auto& [id, parked] : parked_)
+    if (!later.contains(id)) unnamed.push_back(id);
+  for (const std::int64_t id : unnamed) unpark(id);
 }
 
 void CachedScans::plan(std::vector<int> order) {
@@ -225,7 +229,13 @@ void ScanCache::park(const LoadedScan& loaded) {
       parked.arrays.push_back(*extent);
     }
   });
-  if (spill_->usable()) parked_.emplace(loaded.id, std::move(parked));
+  if (spill_->usable()) {
+    parked_.emplace(loaded.id, std::move(parked));
+  } else {
+    // The file failed a write (a full disk): what it took of this scan is
+    // given back, and the scan will be loaded from the project again.
+    for (const core::SpillFile::Extent& extent : parked.arrays) spill_->release(extent);
+  }
 }
 
 // Gives the spill's space of scan `id` back: the plan is done with it.
@@ -277,6 +287,7 @@ std::shared_ptr<const LoadedScan> ScanCache::load(std::int64_t id) {
   std::uint64_t estimate = 0;
   if (parked != parked_.end()) {
     for (const core::SpillFile::Extent& extent : parked->second.arrays) estimate += extent.bytes;
+    if (!parked->second.scan.is_spherical()) estimate += kIndexBytesPerPoint * pixels->second;
   } else {
     estimate = static_cast<std::uint64_t>(bytes_per_pixel_ * static_cast<double>(pixels->second));
   }

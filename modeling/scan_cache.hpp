@@ -49,8 +49,8 @@ enum class ScanForm {
   // normals and the prepared in_model, usable and sample areas, about 26
   // bytes a pixel instead of about 51. The scan's valid, intensity and
   // colour, the geometry's confidence and flags are dropped, and so are
-  // the prepared points of a spherical grid (registration::
-  // point_of recomputes them).
+  // the prepared points of a spherical grid (the merge recomputes them
+  // from the ranges, registration/merge.hpp).
   kMerge,
 };
 

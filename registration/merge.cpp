@@ -171,7 +171,10 @@ void merge_with(MergeScanResult& out, const MergeOperand& s, const MergeOperand&
   const Thresholds thresholds = thresholds_of(settings);
   const OtherScan other = other_scan(s, o, settings.bound_coarser_scans);
   std::optional<acquisition::SphericalDirections> directions;
-  if (s.scan->points.empty()) directions.emplace(*s.scan->scan);
+  if (s.scan->points.size() != s.scan->in_model.size()) {
+    assert(s.scan->grid && "only a spherical grid's points may be dropped");
+    directions.emplace(*s.scan->scan);
+  }
   const acquisition::SphericalDirections* recompute = directions ? &*directions : nullptr;
   std::atomic<std::size_t> bounded{0};
   core::parallel_for_index(

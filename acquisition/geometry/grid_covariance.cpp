@@ -16,12 +16,12 @@ GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
   }
   const auto& a = std::get<SphericalAngles>(scan.angles);
   for (int col = 0; col < scan.columns; ++col) {
-    const double az = a.azimuth_start_rad + col * a.azimuth_step_rad;
+    const double az = a.azimuth(col);
     cos_az.push_back(static_cast<float>(std::cos(az)));
     sin_az.push_back(static_cast<float>(std::sin(az)));
   }
   for (int row = 0; row < scan.rows; ++row) {
-    const double el = a.elevation_start_rad + row * a.elevation_step_rad;
+    const double el = a.elevation(row);
     cos_el.push_back(static_cast<float>(std::cos(el)));
     sin_el.push_back(static_cast<float>(std::sin(el)));
   }

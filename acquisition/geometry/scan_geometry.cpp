@@ -214,7 +214,7 @@ struct RowFactors {
     const auto* a = std::get_if<SphericalAngles>(&scan.angles);
     if (a == nullptr) return;
     for (int row = 0; row < scan.rows; ++row) {
-      const double cos_el = std::cos(a->elevation_start_rad + row * a->elevation_step_rad);
+      const double cos_el = std::cos(a->elevation(row));
       azimuth_gradient.push_back(
           static_cast<float>(1.0 / a->azimuth_step_rad / std::max(cos_el, 1e-3)));
       const double az = std::abs(a->azimuth_step_rad) * cos_el, el = a->elevation_step_rad;

@@ -158,7 +158,7 @@ TEST_F(StreamedStagesTest, AScanLetGoBeforeThePlanIsDoneComesBackFromTheSpillAsI
 
   // Nothing kept beyond the scan in hand: every return is a read.
   ScanCache spilled(project_, std::uint64_t{1} << 40, 1, "test", progress,
-                    {ScanForm::kWhole, true, 0});
+                    {.form = ScanForm::kWhole, .spill = true, .max_kept = 0});
   spilled.plan(plan);
   for (const std::int64_t id : plan) expect_same_arrays(*spilled.get(id), *whole.at(id));
   EXPECT_EQ(spilled.loads(), 3u);
@@ -167,7 +167,7 @@ TEST_F(StreamedStagesTest, AScanLetGoBeforeThePlanIsDoneComesBackFromTheSpillAsI
 
   // The merge's form: what the merge reads, the same; the rest dropped.
   ScanCache merge(project_, std::uint64_t{1} << 40, 1, "test", progress,
-                  {ScanForm::kMerge, true, 0});
+                  {.form = ScanForm::kMerge, .spill = true, .max_kept = 0});
   merge.plan(plan);
   for (const std::int64_t id : plan) {
     const std::shared_ptr<const LoadedScan> got = merge.get(id);
@@ -184,6 +184,55 @@ TEST_F(StreamedStagesTest, AScanLetGoBeforeThePlanIsDoneComesBackFromTheSpillAsI
     EXPECT_LT(got->bytes, expected.bytes * 6 / 10);
   }
   EXPECT_EQ(merge.spill_reads(), 3u);
+}
+
+// A grid of per-pixel directions comes back with its directions and its
+// points, and a point index built again.
+TEST(ScanCacheSpill, AScanWithPerPixelDirectionsComesBackWhole) {
+  const test::RoomScan& room = test::shared_room();
+  acquisition::Scan scan = room.scan;
+  std::vector<Eigen::Vector3f> directions(scan.pixel_count());
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col)
+      directions[scan.index(row, col)] = acquisition::direction(room.scan, row, col);
+  }
+  scan.angles = acquisition::PerPixelDirections{std::move(directions), false};
+  ScratchDir dir;
+  store::Project project = store::Project::create(dir / "grids.sbproj");
+  std::vector<std::int64_t> ids;
+  for (int k = 0; k < 2; ++k) ids.push_back(test::insert_committed(project, scan));
+  store::Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const std::int64_t id : ids) {
+    for (const store::EncodedLayer& layer : store::encode_geometry(room.geometry))
+      project.put_layer(edit, id, layer);
+  }
+  edit.commit("{}");
+
+  core::Progress progress;
+  ScanCache reference(project, std::uint64_t{1} << 40, 1, "test", progress);
+  reference.plan({ids[0]});
+  const std::shared_ptr<const LoadedScan> whole = reference.get(ids[0]);
+  ScanCache spilled(project, std::uint64_t{1} << 40, 1, "test", progress,
+                    {.form = ScanForm::kMerge, .spill = true, .max_kept = 0});
+  spilled.plan({ids[0], ids[1], ids[0]});
+  spilled.get(ids[0]);
+  spilled.get(ids[1]);
+  const std::shared_ptr<const LoadedScan> back = spilled.get(ids[0]);
+  EXPECT_EQ(spilled.spill_reads(), 1u);
+  EXPECT_EQ(std::get<acquisition::PerPixelDirections>(back->scan.angles),
+            std::get<acquisition::PerPixelDirections>(whole->scan.angles));
+  EXPECT_EQ(back->prepared.points, whole->prepared.points);  // kept: no grid to recompute them
+  EXPECT_EQ(back->prepared.sample_area_m2, whole->prepared.sample_area_m2);
+  ASSERT_NE(back->prepared.tree, nullptr);
+  std::size_t compared = 0;
+  for (std::size_t i = 0; i < scan.pixel_count(); i += 97) {
+    if (!whole->prepared.usable[i]) continue;
+    const Eigen::Vector3f near = whole->prepared.points[i] + Eigen::Vector3f(0.003f, 0, 0);
+    ASSERT_EQ(registration::associate(back->prepared, near),
+              registration::associate(whole->prepared, near));
+    ++compared;
+  }
+  EXPECT_GT(compared, 100u);
 }
 
 // The points a merge recomputes where its form dropped them are those
@@ -329,14 +378,14 @@ TEST_F(StreamedStagesTest, ExportWritesScanByScanTheFileOfEveryScanInMemory) {
   }
 }
 
-TEST_F(StreamedStagesTest, ALimitTooSmallForTwoScansIsRefusedAndChangesNothing) {
+TEST_F(StreamedStagesTest, ALimitTooSmallToLoadAScanIsRefusedAndChangesNothing) {
   const std::int64_t revision = project_.revision();
   core::Progress progress;
   try {
     // The merge's form of a room takes half of it, but loading one takes
     // it whole.
     merge_project(project_, {}, progress, room_bytes() * 3 / 4);
-    FAIL() << "a pair of rooms does not fit";
+    FAIL() << "a room being loaded does not fit";
   } catch (const core::MemoryShortage& e) {
     EXPECT_NE(std::string(e.what()).find("--memory-limit"), std::string::npos) << e.what();
   }

@@ -71,9 +71,8 @@ std::vector<E57Field> scan_fields(const Scan& scan, double max_range_m) {
 bool pixel_angles(const Scan& scan, int row, int col, double& azimuth, double& elevation) {
   if (const auto* angles = std::get_if<SphericalAngles>(&scan.angles)) {
     // Within [−π, π], as the field's bounds say.
-    azimuth = std::remainder(angles->azimuth_start_rad + col * angles->azimuth_step_rad,
-                             2.0 * std::numbers::pi);
-    elevation = angles->elevation_start_rad + row * angles->elevation_step_rad;
+    azimuth = std::remainder(angles->azimuth(col), 2.0 * std::numbers::pi);
+    elevation = angles->elevation(row);
     return true;
   }
   const Eigen::Vector3d d = direction_precise(scan, row, col);
