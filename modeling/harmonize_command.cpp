@@ -7,6 +7,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
+#include "core/spill_file.hpp"
 #include "core/timing.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/scan_cache.hpp"
@@ -14,14 +15,12 @@
 
 namespace scanbench::modeling {
 
-double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
-                         std::span<const store::ScanColorCorrection> corrections) {
-  if (pairs.empty()) return 0.0;
-  assert((corrections.empty() || std::all_of(pairs.begin(), pairs.end(),
-                                             [&](const auto& p) {
-                                               return std::max(p.scan_a, p.scan_b) <
-                                                      corrections.size();
-                                             })) &&
+namespace {
+
+// ΔE of one pair, each colour under its scan's correction when given.
+double pair_delta_e(const registration::ColorPair& p,
+                    std::span<const store::ScanColorCorrection> corrections) {
+  assert((corrections.empty() || std::max(p.scan_a, p.scan_b) < corrections.size()) &&
          "a correction for every scan of the pairs");
   const auto lab = [&](std::uint32_t scan, const Eigen::Vector3f& rgb) {
     Eigen::Vector3d linear = rgb.cast<double>();
@@ -30,9 +29,16 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
     }
     return acquisition::linear_rgb_to_lab(linear);
   };
+  return acquisition::delta_e(lab(p.scan_a, p.rgb_a), lab(p.scan_b, p.rgb_b));
+}
+
+}  // namespace
+
+double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
+                         std::span<const store::ScanColorCorrection> corrections) {
+  if (pairs.empty()) return 0.0;
   double sum = 0.0;
-  for (const registration::ColorPair& p : pairs)
-    sum += acquisition::delta_e(lab(p.scan_a, p.rgb_a), lab(p.scan_b, p.rgb_b));
+  for (const registration::ColorPair& p : pairs) sum += pair_delta_e(p, corrections);
   return sum / static_cast<double>(pairs.size());
 }
 
@@ -63,23 +69,104 @@ HarmonizeCommandResult harmonize_outcome(
     corrections.push_back(scan.correction);
     out.scans.push_back(std::move(scan));
   }
-  out.delta_e_before = mean_pair_delta_e(pairs, {});
-  out.delta_e_after = mean_pair_delta_e(pairs, corrections);
+  // Sums of ΔE over all pairs and over each scan's, in the pairs' order.
+  struct Sums {
+    std::size_t pairs = 0;
+    double before = 0.0;
+    double after = 0.0;
+  };
+  Sums all;
+  std::vector<Sums> own(out.scans.size());
+  for (const registration::ColorPair& p : pairs) {
+    const double before = pair_delta_e(p, {});
+    const double after = pair_delta_e(p, corrections);
+    for (Sums* sums : {&all, &own[p.scan_a], &own[p.scan_b]}) {
+      ++sums->pairs;
+      sums->before += before;
+      sums->after += after;
+    }
+  }
+  const auto mean = [](double sum, std::size_t count) {
+    return count == 0 ? 0.0 : sum / static_cast<double>(count);
+  };
+  out.delta_e_before = mean(all.before, all.pairs);
+  out.delta_e_after = mean(all.after, all.pairs);
   for (std::size_t k = 0; k < out.scans.size(); ++k) {
-    std::vector<registration::ColorPair> own;
-    for (const registration::ColorPair& p : pairs)
-      if (p.scan_a == k || p.scan_b == k) own.push_back(p);
-    out.scans[k].pairs = own.size();
-    out.scans[k].delta_e_before = mean_pair_delta_e(own, {});
-    out.scans[k].delta_e_after = mean_pair_delta_e(own, corrections);
+    out.scans[k].pairs = own[k].pairs;
+    out.scans[k].delta_e_before = mean(own[k].before, own[k].pairs);
+    out.scans[k].delta_e_after = mean(own[k].after, own[k].pairs);
   }
   return out;
 }
 
+// The colour samples of the scans still to be paired as a pair's first
+// scan, parked in a temporary file (core::SpillFile) while they wait, or
+// kept in memory where the file cannot take them.
+class ParkedSamples {
+ public:
+  void put(int scan, registration::ColorSamples samples) {
+    Parked parked;
+    if (spill_.usable()) {
+      const auto put_array = [&](const auto& v) {
+        const auto extent = spill_.put(v.data(), v.size() * sizeof(v[0]));
+        if (extent) parked.extents.push_back(*extent);
+        return extent.has_value();
+      };
+      if (put_array(samples.pixels) && put_array(samples.points) && put_array(samples.normals) &&
+          put_array(samples.rgb)) {
+        parked.count = samples.size();
+        parked_[scan] = std::move(parked);
+        return;
+      }
+      for (const core::SpillFile::Extent& extent : parked.extents) spill_.release(extent);
+      parked.extents.clear();
+    }
+    parked.count = samples.size();
+    parked.in_memory = std::move(samples);
+    parked_[scan] = std::move(parked);
+  }
+
+  // The samples of `scan`, which were put and not released (asserted).
+  registration::ColorSamples get(int scan) const {
+    const auto found = parked_.find(scan);
+    assert(found != parked_.end() && "the samples were put");
+    const Parked& parked = found->second;
+    if (parked.extents.empty()) return parked.in_memory;
+    registration::ColorSamples out;
+    out.pixels.resize(parked.count);
+    out.points.resize(parked.count);
+    out.normals.resize(parked.count);
+    out.rgb.resize(parked.count);
+    spill_.get(parked.extents[0], out.pixels.data());
+    spill_.get(parked.extents[1], out.points.data());
+    spill_.get(parked.extents[2], out.normals.data());
+    spill_.get(parked.extents[3], out.rgb.data());
+    return out;
+  }
+
+  void release(int scan) {
+    const auto found = parked_.find(scan);
+    if (found == parked_.end()) return;
+    for (const core::SpillFile::Extent& extent : found->second.extents) spill_.release(extent);
+    parked_.erase(found);
+  }
+
+ private:
+  struct Parked {
+    std::size_t count = 0;
+    std::vector<core::SpillFile::Extent> extents;  // pixels, points, normals, rgb; or none
+    registration::ColorSamples in_memory;          // where the file could not take them
+  };
+  core::SpillFile spill_;
+  std::map<int, Parked> parked_;
+};
+
 // The colour pairs of every two scans with colour whose bounds meet, in the
 // order find_color_pairs gives them (by the pair's first scan, then its
-// second), taking scan b and then each earlier scan a it pairs with from
-// the cache: scans are loaded a few at a time.
+// second). One pass over the scans in the project's order, each loaded once:
+// scan b is paired with the samples of every earlier scan a it may overlap,
+// then its own samples are parked until its last pair as a first scan. In
+// memory at once: one scan, and the samples of one or two.
 std::vector<registration::ColorPair> streamed_color_pairs(
     const store::Project& project, std::span<const store::StoredScanSummary> scans,
     const registration::ColorPairSettings& settings, std::uint64_t memory_limit,
@@ -89,42 +176,48 @@ std::vector<registration::ColorPair> streamed_color_pairs(
     return !scans[static_cast<std::size_t>(p.first)].summary.has_color ||
            !scans[static_cast<std::size_t>(p.second)].summary.has_color;
   });
-  std::vector<std::int64_t> plan;
-  for (const int k : pair_pass_order(pairs, static_cast<int>(scans.size()), false))
-    plan.push_back(scans[static_cast<std::size_t>(k)].id);
-  // One scan kept in memory beyond the pair in hand, the others parked in
-  // a temporary file until the plan brings them back. Whole scans: one
-  // more kept would be as many megabytes as loading the next scan from the
-  // project takes on top (16 path stations: 0.77 GB against 0.61 GB, in
-  // the same time).
-  ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress,
-                  {.form = ScanForm::kWhole, .spill = true, .max_kept = 1});
-  cache.plan(plan);
   // The pairs each scan may take part in, shared among the scans it may
-  // overlap: the solve grows with the scans, not with their overlaps.
+  // overlap: the solve grows with the scans, not with their overlaps. And
+  // each scan's last pair as a first scan, after which its samples go.
   std::vector<std::size_t> partners(scans.size(), 0);
+  std::vector<int> last_second(scans.size(), -1);
   for (const ScanPair& pair : pairs) {
     ++partners[static_cast<std::size_t>(pair.first)];
     ++partners[static_cast<std::size_t>(pair.second)];
+    int& last = last_second[static_cast<std::size_t>(pair.first)];
+    last = std::max(last, pair.second);
   }
+  std::vector<int> visit;
+  std::vector<std::int64_t> plan;
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    if (partners[k] == 0) continue;
+    visit.push_back(static_cast<int>(k));
+    plan.push_back(scans[k].id);
+  }
+  ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress,
+                  {.form = ScanForm::kWhole, .spill = false, .max_kept = 0});
+  cache.plan(plan);
+  ParkedSamples samples;
   std::map<std::pair<int, int>, std::vector<registration::ColorPair>> found;
-  std::shared_ptr<const LoadedScan> b;
-  for (const ScanPair& pair : pairs) {
-    if (b == nullptr || b->id != scans[static_cast<std::size_t>(pair.second)].id) {
-      b.reset();
-      b = cache.get(scans[static_cast<std::size_t>(pair.second)].id);
-      progress.update({"harmonize", static_cast<std::size_t>(pair.second) + 1, scans.size(),
-                       "colour pairs of " + b->scan.name});
+  auto next_pair = pairs.begin();  // ordered by second, then first
+  for (std::size_t v = 0; v < visit.size(); ++v) {
+    const int k = visit[v];
+    const auto& summary = scans[static_cast<std::size_t>(k)];
+    const std::shared_ptr<const LoadedScan> b = cache.get(summary.id);
+    progress.update({"harmonize", v + 1, visit.size(), "colour pairs of " + summary.summary.name});
+    for (; next_pair != pairs.end() && next_pair->second == k; ++next_pair) {
+      const int a = next_pair->first;
+      const auto& summary_a = scans[static_cast<std::size_t>(a)];
+      registration::ColorPairSettings link = settings;
+      link.max_pairs_per_overlap = registration::link_pair_budget(
+          settings, partners[static_cast<std::size_t>(a)], partners[static_cast<std::size_t>(k)]);
+      found[{a, k}] = registration::color_pairs_between(
+          samples.get(a), b->prepared, static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(k),
+          summary_a.summary.T_world_scan, summary.summary.T_world_scan, link);
+      if (last_second[static_cast<std::size_t>(a)] == k) samples.release(a);
     }
-    const std::shared_ptr<const LoadedScan> a =
-        cache.get(scans[static_cast<std::size_t>(pair.first)].id);
-    registration::ColorPairSettings link = settings;
-    link.max_pairs_per_overlap =
-        registration::link_pair_budget(settings, partners[static_cast<std::size_t>(pair.first)],
-                                       partners[static_cast<std::size_t>(pair.second)]);
-    found[{pair.first, pair.second}] = registration::color_pairs_between(
-        a->prepared, b->prepared, static_cast<std::uint32_t>(pair.first),
-        static_cast<std::uint32_t>(pair.second), a->scan.T_world_scan, b->scan.T_world_scan, link);
+    if (last_second[static_cast<std::size_t>(k)] > k)
+      samples.put(k, registration::color_samples(b->prepared, settings));
   }
   std::vector<registration::ColorPair> out;
   for (const auto& [which, list] : found) out.insert(out.end(), list.begin(), list.end());

@@ -58,10 +58,12 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
 // group of overlapping scans fixed, stored as one command ("harmonize")
 // whose undo restores the earlier corrections. Scans that overlap no other
 // keep theirs.
-// Streams as merge_project does: colour pairs only between scans whose
-// bounds meet, a few scans loaded at a time under `memory_limit`.
+// Streams: colour pairs only between scans whose bounds meet, each scan
+// loaded once, one at a time under `memory_limit`, paired with the colour
+// samples (registration::ColorSamples) of the earlier scans it may overlap,
+// which wait in a temporary file.
 // Throws as merge_project (no scans, a scan without geometry, data it read
-// changed meanwhile, two scans beyond the memory limit, cancelled), and
+// changed meanwhile, a scan beyond the memory limit, cancelled), and
 // core::InputError when no two scans with colour overlap. The project is
 // then unchanged.
 HarmonizeCommandResult harmonize_project(store::Project& project,

@@ -157,14 +157,24 @@ std::uint64_t ScanCache::bytes_in_hand() const {
 
 // Drops kept scans, farthest next use first, until `bytes` more fit under
 // the limit or only held scans are left.
+// The kept scan the stage does not hold whose next use is farthest away
+// (kept_.end() when it holds them all), and how many it does not hold.
+std::pair<std::map<std::int64_t, ScanCache::Entry>::iterator, std::size_t>
+ScanCache::farthest_unheld() {
+  std::size_t unheld = 0;
+  auto farthest = kept_.end();
+  for (auto it = kept_.begin(); it != kept_.end(); ++it) {
+    if (it->second.scan.use_count() > 1) continue;  // held by the stage
+    ++unheld;
+    if (farthest == kept_.end() || it->second.next_use > farthest->second.next_use) farthest = it;
+  }
+  return {farthest, unheld};
+}
+
 void ScanCache::make_room(std::uint64_t bytes) {
   std::erase_if(given_, [](const auto& given) { return given.expired(); });
   while (bytes_in_hand() + bytes > limit_) {
-    auto farthest = kept_.end();
-    for (auto it = kept_.begin(); it != kept_.end(); ++it) {
-      if (it->second.scan.use_count() > 1) continue;  // held by the stage
-      if (farthest == kept_.end() || it->second.next_use > farthest->second.next_use) farthest = it;
-    }
+    const auto farthest = farthest_unheld().first;
     if (farthest == kept_.end()) return;
     drop(farthest);
   }
@@ -180,13 +190,7 @@ void ScanCache::drop(std::map<std::int64_t, Entry>::iterator kept) {
 // at most `count` are left.
 void ScanCache::keep_at_most(std::size_t count) {
   while (true) {
-    std::size_t unheld = 0;
-    auto farthest = kept_.end();
-    for (auto it = kept_.begin(); it != kept_.end(); ++it) {
-      if (it->second.scan.use_count() > 1) continue;
-      ++unheld;
-      if (farthest == kept_.end() || it->second.next_use > farthest->second.next_use) farthest = it;
-    }
+    const auto [farthest, unheld] = farthest_unheld();
     if (unheld <= count) return;
     drop(farthest);
   }

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "acquisition/geometry/scan_geometry.hpp"
@@ -126,6 +127,7 @@ class ScanCache {
 
   std::uint64_t bytes_in_hand() const;
   void refuse_beyond_limit(std::uint64_t bytes, std::int64_t id) const;
+  std::pair<std::map<std::int64_t, Entry>::iterator, std::size_t> farthest_unheld();
   void make_room(std::uint64_t bytes);
   void keep_at_most(std::size_t count);
   std::shared_ptr<const LoadedScan> load(std::int64_t id);

@@ -52,25 +52,21 @@ Eigen::Vector3f linear_color(const acquisition::Scan& scan, std::size_t i) {
           acquisition::srgb_to_linear(scan.rgb[3 * i + 2])};
 }
 
-// Pairs from a's sampled pixels into b, in a's row order.
-std::vector<ColorPair> pairs_between(const PreparedScan& a, const PreparedScan& b, std::uint32_t ia,
+// Pairs from a's samples into b, in a's row order: chunks of samples on
+// the workers, joined in order.
+std::vector<ColorPair> pairs_between(const ColorSamples& a, const PreparedScan& b, std::uint32_t ia,
                                      std::uint32_t ib, const Eigen::Isometry3f& T_b_a,
                                      const ColorPairSettings& s) {
-  const acquisition::Scan& scan_a = *a.scan;
   const acquisition::Scan& scan_b = *b.scan;
   const double min_cos = std::cos(s.max_normal_angle_deg * 3.14159265358979323846 / 180.0);
-  const int stride = std::max(1, s.stride);
-  const int phase = std::clamp(s.phase, 0, stride - 1);
-  const int sampled_rows = std::max(0, (scan_a.rows - phase + stride - 1) / stride);
-  std::vector<std::vector<ColorPair>> by_row(static_cast<std::size_t>(sampled_rows));
-  core::parallel_for_index(sampled_rows, s.threads, [&](int k) {
-    const int row = phase + k * stride;
-    for (int col = phase; col < scan_a.columns; col += stride) {
-      const std::size_t i = scan_a.index(row, col);
-      if (!a.in_model[i] || !usable_color(scan_a, i, s) ||
-          !locally_uniform(scan_a, i, s.max_local_step))
-        continue;
-      const Eigen::Vector3f p = T_b_a * a.points[i];
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t chunks = (a.size() + kChunk - 1) / kChunk;
+  std::vector<std::vector<ColorPair>> by_chunk(chunks);
+  core::parallel_for_index(static_cast<int>(chunks), s.threads, [&](int c) {
+    const std::size_t begin = static_cast<std::size_t>(c) * kChunk;
+    const std::size_t end = std::min(a.size(), begin + kChunk);
+    for (std::size_t k = begin; k < end; ++k) {
+      const Eigen::Vector3f p = T_b_a * a.points[k];
       const std::int64_t found = associate(b, p);
       if (found < 0) continue;
       const auto j = static_cast<std::size_t>(found);
@@ -79,18 +75,18 @@ std::vector<ColorPair> pairs_between(const PreparedScan& a, const PreparedScan& 
         continue;
       const double reach = s.max_distance_m + 2.0 * b.geometry->footprint_m[j];
       if ((p - b.points[j]).norm() > reach) continue;
-      const Eigen::Vector3f& na = a.geometry->normal[i];
+      const Eigen::Vector3f& na = a.normals[k];
       const Eigen::Vector3f& nb = b.geometry->normal[j];
       if (na.squaredNorm() > 0.25f && nb.squaredNorm() > 0.25f &&
           (T_b_a.linear() * na).dot(nb) < min_cos)
         continue;
-      by_row[static_cast<std::size_t>(k)].push_back({ia, ib, static_cast<std::int64_t>(i), found,
-                                                     linear_color(scan_a, i),
-                                                     linear_color(scan_b, j)});
+      by_chunk[static_cast<std::size_t>(c)].push_back(
+          {ia, ib, a.pixels[k], found, a.rgb[k], linear_color(scan_b, j)});
     }
   });
   std::vector<ColorPair> out;
-  for (const std::vector<ColorPair>& row : by_row) out.insert(out.end(), row.begin(), row.end());
+  for (const std::vector<ColorPair>& chunk : by_chunk)
+    out.insert(out.end(), chunk.begin(), chunk.end());
   return out;
 }
 
@@ -182,12 +178,43 @@ std::size_t link_pair_budget(const ColorPairSettings& settings, std::size_t part
   return budget;
 }
 
-std::vector<ColorPair> color_pairs_between(const PreparedScan& a, const PreparedScan& b,
+ColorSamples color_samples(const PreparedScan& scan, const ColorPairSettings& settings) {
+  const acquisition::Scan& a = *scan.scan;
+  if (!a.has_color()) return {};
+  const int stride = std::max(1, settings.stride);
+  const int phase = std::clamp(settings.phase, 0, stride - 1);
+  const int sampled_rows = std::max(0, (a.rows - phase + stride - 1) / stride);
+  std::vector<std::vector<std::int64_t>> by_row(static_cast<std::size_t>(sampled_rows));
+  core::parallel_for_index(sampled_rows, settings.threads, [&](int k) {
+    const int row = phase + k * stride;
+    for (int col = phase; col < a.columns; col += stride) {
+      const std::size_t i = a.index(row, col);
+      if (scan.in_model[i] && usable_color(a, i, settings) &&
+          locally_uniform(a, i, settings.max_local_step))
+        by_row[static_cast<std::size_t>(k)].push_back(static_cast<std::int64_t>(i));
+    }
+  });
+  ColorSamples out;
+  for (const std::vector<std::int64_t>& row : by_row)
+    out.pixels.insert(out.pixels.end(), row.begin(), row.end());
+  out.points.reserve(out.size());
+  out.normals.reserve(out.size());
+  out.rgb.reserve(out.size());
+  for (const std::int64_t pixel : out.pixels) {
+    const auto i = static_cast<std::size_t>(pixel);
+    out.points.push_back(scan.points[i]);
+    out.normals.push_back(scan.geometry->normal[i]);
+    out.rgb.push_back(linear_color(a, i));
+  }
+  return out;
+}
+
+std::vector<ColorPair> color_pairs_between(const ColorSamples& a, const PreparedScan& b,
                                            std::uint32_t ia, std::uint32_t ib,
                                            const Eigen::Isometry3d& T_world_a,
                                            const Eigen::Isometry3d& T_world_b,
                                            const ColorPairSettings& settings) {
-  if (!a.scan->has_color() || !b.scan->has_color()) return {};
+  if (a.size() == 0 || !b.scan->has_color()) return {};
   const Eigen::Isometry3f T_b_a = (T_world_b.inverse() * T_world_a).cast<float>();
   std::vector<ColorPair> found = pairs_between(a, b, ia, ib, T_b_a, settings);
   const std::size_t limit = settings.max_pairs_per_overlap;
@@ -206,9 +233,10 @@ std::vector<ColorPair> find_color_pairs(std::span<const PreparedScan> scans,
   assert(scans.size() == T_world_scan.size() && "one pose per scan");
   std::vector<ColorPair> out;
   for (std::size_t a = 0; a < scans.size(); ++a) {
+    const ColorSamples samples = color_samples(scans[a], settings);
     for (std::size_t b = a + 1; b < scans.size(); ++b) {
       const std::vector<ColorPair> found = color_pairs_between(
-          scans[a], scans[b], static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+          samples, scans[b], static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
           T_world_scan[a], T_world_scan[b], settings);
       out.insert(out.end(), found.begin(), found.end());
     }

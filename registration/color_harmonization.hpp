@@ -77,11 +77,29 @@ struct ColorPair {
   Eigen::Vector3f rgb_b = Eigen::Vector3f::Zero();
 };
 
+// What of a scan the pair search takes as a pair's first scan: the pixels
+// its sampling (stride, phase) takes that are in the model, of a usable
+// colour and locally uniform, in row order, each with its point and normal
+// in the scan frame and its linear colour. A few percent of the scan's
+// bytes: a stage keeps these of the scans still to be paired, not the
+// scans. Empty for a scan without colour.
+struct ColorSamples {
+  std::vector<std::int64_t> pixels;  // row-major
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3f> normals;  // zero where the pixel has none
+  std::vector<Eigen::Vector3f> rgb;      // linear
+  std::size_t size() const { return pixels.size(); }
+};
+
+// The samples of `scan` under `settings` (stride, phase, dark, bright,
+// max_local_step, threads).
+ColorSamples color_samples(const PreparedScan& scan, const ColorPairSettings& settings);
+
 // The pairs of scans a and b (at positions ia < ib of the scan list, at
-// poses T_world_a and T_world_b): a's sampled points projected into b's
-// grid, thinned evenly to max_pairs_per_overlap. None when either scan has
-// no colour.
-std::vector<ColorPair> color_pairs_between(const PreparedScan& a, const PreparedScan& b,
+// poses T_world_a and T_world_b): a's samples projected into b's grid,
+// thinned evenly to max_pairs_per_overlap, in a's row order. None when
+// either scan has no colour.
+std::vector<ColorPair> color_pairs_between(const ColorSamples& a, const PreparedScan& b,
                                            std::uint32_t ia, std::uint32_t ib,
                                            const Eigen::Isometry3d& T_world_a,
                                            const Eigen::Isometry3d& T_world_b,

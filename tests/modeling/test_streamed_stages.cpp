@@ -311,7 +311,7 @@ TEST_F(StreamedStagesTest, RegistrationTestsAtMostTheSetNumberOfEarlierScansPerS
     EXPECT_TRUE(pose.matrix().allFinite());
 }
 
-TEST_F(StreamedStagesTest, HarmonizationWithTwoScansInHandFindsThePairsOfTheOneInMemory) {
+TEST_F(StreamedStagesTest, HarmonizationWithOneScanInHandFindsThePairsOfTheOneInMemory) {
   const HarmonizeCommandSettings settings;
   const std::unique_ptr<InMemory> all = in_memory();
   // Each near room may overlap the three others: the command shares each
@@ -324,12 +324,18 @@ TEST_F(StreamedStagesTest, HarmonizationWithTwoScansInHandFindsThePairsOfTheOneI
   ASSERT_GT(expected.size(), 1000u);
   core::Progress progress;
   const HarmonizeCommandResult out =
-      harmonize_project(project_, settings, progress, room_bytes() * 5 / 2);
+      harmonize_project(project_, settings, progress, room_bytes() * 3 / 2);
   EXPECT_EQ(out.pairs, expected.size());
+  std::vector<std::size_t> pairs_of(ids_.size(), 0);
+  for (const registration::ColorPair& pair : expected) {
+    ++pairs_of[pair.scan_a];
+    ++pairs_of[pair.scan_b];
+  }
   const registration::HarmonizeResult solved =
       registration::harmonize_colors(expected, ids_.size(), settings.solve);
   for (std::size_t k = 0; k < ids_.size(); ++k) {
     EXPECT_TRUE(out.scans[k].correction.matrix.isApprox(solved.corrections[k].matrix)) << k;
+    EXPECT_EQ(out.scans[k].pairs, pairs_of[k]) << k;
     EXPECT_EQ(out.scans[k].pairs == 0, k == ids_.size() - 1);  // the far room pairs with none
   }
 }

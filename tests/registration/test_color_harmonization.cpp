@@ -1,11 +1,12 @@
 // The colour harmonisation solver on synthetic pairs: known gains and
 // offsets come back with outliers among the pairs, the first scan of each
 // group of overlapping scans stays fixed, and a scan in no pair is left
-// alone.
+// alone. And the samples a scan gives the pair search, on a hand-made grid.
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "acquisition/color_space.hpp"
 #include "registration/color_harmonization.hpp"
 
 namespace scanbench::registration {
@@ -102,6 +103,69 @@ TEST(ColorHarmonization, EachGroupOfOverlappingScansHasItsOwnReference) {
   EXPECT_TRUE(out.corrections[1].matrix.isIdentity());
   EXPECT_NEAR(out.corrections[2].matrix(0, 0), 1.3, 0.005);
   EXPECT_NEAR(out.corrections[2].matrix(2, 2), 0.9, 0.005);
+}
+
+// An 8 × 8 spherical grid of a wall 5 m away, grey 100 but for a dark pixel
+// at (2, 2) and a bright one at (4, 4) that steps away from its neighbours.
+struct GreyWall {
+  acquisition::Scan scan = acquisition::make_empty_scan(8, 8, false, true);
+  acquisition::ScanGeometry geometry;
+  GreyWall() {
+    const double step = 0.01;
+    scan.angles = acquisition::SphericalAngles{0.04, -step, 0.04, -step};
+    const std::size_t n = scan.pixel_count();
+    geometry.footprint_m.assign(n, 0.05f);
+    geometry.normal.assign(n, Eigen::Vector3f(-1.0f, 0.0f, 0.0f));
+    geometry.confidence.assign(n, 1.0f);
+    geometry.flags.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      scan.valid[i] = 1;
+      scan.range_m[i] = 5.0f;
+      for (std::size_t c = 0; c < 3; ++c) scan.rgb[3 * i + c] = 100;
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      scan.rgb[3 * scan.index(2, 2) + c] = 2;
+      scan.rgb[3 * scan.index(4, 4) + c] = 200;
+    }
+  }
+};
+
+TEST(ColorSamples, TheSampledPixelsOfUsableUniformColourInRowOrder) {
+  const GreyWall wall;
+  const PreparedScan prepared = prepare_scan(wall.scan, wall.geometry, 1);
+  ColorPairSettings settings;  // stride 2
+  const ColorSamples even = color_samples(prepared, settings);
+  std::vector<std::int64_t> expected;
+  for (int row = 0; row < 8; row += 2)
+    for (int col = 0; col < 8; col += 2)
+      if (!(row == col && (row == 2 || row == 4)))  // dark; not uniform
+        expected.push_back(static_cast<std::int64_t>(wall.scan.index(row, col)));
+  EXPECT_EQ(even.pixels, expected);
+  ASSERT_EQ(even.points.size(), expected.size());
+  ASSERT_EQ(even.normals.size(), expected.size());
+  ASSERT_EQ(even.rgb.size(), expected.size());
+  const float grey = acquisition::srgb_to_linear(100);
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    const auto i = static_cast<std::size_t>(expected[k]);
+    EXPECT_EQ(even.points[k], prepared.points[i]);
+    EXPECT_EQ(even.normals[k], wall.geometry.normal[i]);
+    EXPECT_EQ(even.rgb[k], Eigen::Vector3f::Constant(grey));
+  }
+  // The odd pixels: none is dark, and the step at (4, 4) is not theirs.
+  settings.phase = 1;
+  EXPECT_EQ(color_samples(prepared, settings).size(), 16u);
+  // Every pixel: the dark and the bright one go, and so do their four
+  // neighbours each, which see their step.
+  settings.stride = 1;
+  settings.phase = 0;
+  EXPECT_EQ(color_samples(prepared, settings).size(), 64u - 2u * (1u + 4u));
+}
+
+TEST(ColorSamples, AScanWithoutColourHasNone) {
+  GreyWall wall;
+  wall.scan.rgb.clear();
+  const PreparedScan prepared = prepare_scan(wall.scan, wall.geometry, 1);
+  EXPECT_EQ(color_samples(prepared, {}).size(), 0u);
 }
 
 }  // namespace
