@@ -64,11 +64,13 @@ void add_trees(SiteBuilder& b, std::uint64_t seed) {
     TreeSpec spec;
     spec.trunk_radius_m = random.uniform(0.15, 0.3);
     spec.crown_base_m = random.uniform(2.6, 3.4);
-    spec.crown_radii_m = Vector2d(random.uniform(2.0, 3.2), random.uniform(2.2, 3.2));
+    const double crown_ry = random.uniform(2.2, 3.2);  // drawn first (random.hpp)
+    spec.crown_radii_m = Vector2d(random.uniform(2.0, 3.2), crown_ry);
     spec.leaf_count = random.integer(150, 400);
     char name[32];
     std::snprintf(name, sizeof name, "tree_%02d", ++index);
-    const Vector2d jitter(random.uniform(-1.0, 1.0), random.uniform(-1.0, 1.0));
+    const double jitter_y = random.uniform(-1.0, 1.0);  // drawn first (random.hpp)
+    const Vector2d jitter(random.uniform(-1.0, 1.0), jitter_y);
     b.add_tree(name, base + jitter, spec, random);
   }
 }
@@ -82,7 +84,8 @@ void add_street_furniture(SiteBuilder& b, Random& random) {
     std::snprintf(name, sizeof name, "lamp_post_%02d", ++index);
     b.add_lamp_post(name, base);
   }
-  b.add_car("car_01", Vector2d(8.0 + random.uniform(-2.0, 2.0), -31.0), random.uniform(-0.05, 0.05),
+  const double car_yaw = random.uniform(-0.05, 0.05);  // drawn first (random.hpp)
+  b.add_car("car_01", Vector2d(8.0 + random.uniform(-2.0, 2.0), -31.0), car_yaw,
             b.materials().paint_red);
   b.add_low_wall("low_wall_01", Vector2d(-28.0, -24.0),
                  Vector2d(-2.5, -24.0 + random.uniform(-0.5, 0.5)));

@@ -109,7 +109,8 @@ BuildingSpec house(const Leg& leg, std::string name, double t_mid, double across
   spec.windowed_sides = 1u << street_side;
   spec.window_spacing_m = random.uniform(2.3, 3.4);
   char sign[32];
-  std::snprintf(sign, sizeof sign, "%s %d", kTrades[random.integer(0, 24)], random.integer(1, 99));
+  const int number = random.integer(1, 99);  // drawn first (random.hpp)
+  std::snprintf(sign, sizeof sign, "%s %d", kTrades[random.integer(0, 24)], number);
   spec.sign_text = sign;
   return spec;
 }
@@ -171,17 +172,22 @@ void add_kerb_items(SiteBuilder& b, const Leg& leg, Random& random) {
     return slot;
   };
   const auto [tree_t, tree_side] = take_slot();
-  const TreeSpec tree{random.uniform(0.12, 0.22), random.uniform(3.0, 3.6),
-                      Vector2d(random.uniform(1.2, 1.6), random.uniform(1.6, 2.4)),
+  // A braced list takes its draws in order; a Vector2d's y comes first
+  // (random.hpp).
+  const double trunk_radius = random.uniform(0.12, 0.22);
+  const double crown_base = random.uniform(3.0, 3.6);
+  const double crown_ry = random.uniform(1.6, 2.4);
+  const TreeSpec tree{trunk_radius, crown_base, Vector2d(random.uniform(1.2, 1.6), crown_ry),
                       random.integer(150, 300)};
   b.add_tree(leg_name(leg, "tree"), leg.at(tree_t, tree_side * (kHalfCanyon - 1.2)), tree, random);
   const MaterialId paints[] = {b.materials().paint_red, b.materials().paint_blue,
                                b.materials().paint_grey};
   for (int i = 1; i <= 2; ++i) {
     const auto [t, side] = take_slot();
+    const MaterialId paint = paints[random.integer(0, 2)];  // drawn first (random.hpp)
     b.add_car(leg_name(leg, i == 1 ? "car_1" : "car_2"),
               leg.at(t, side * (kHalfCanyon - kSidewalk - 1.0)),
-              leg.yaw_rad + random.uniform(-0.03, 0.03), paints[random.integer(0, 2)]);
+              leg.yaw_rad + random.uniform(-0.03, 0.03), paint);
   }
 }
 

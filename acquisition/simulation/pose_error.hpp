@@ -23,7 +23,8 @@ inline Eigen::Isometry3d random_pose_error(double max_rotation_deg, double max_t
   const double angle_rad = random.uniform(0.0, max_rotation_deg) * std::numbers::pi / 180.0;
   Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
   error.linear() = Eigen::AngleAxisd(angle_rad, unit_vector()).toRotationMatrix();
-  error.translation() = random.uniform(0.0, max_translation_m) * unit_vector();
+  const Eigen::Vector3d direction = unit_vector();  // drawn first (random.hpp)
+  error.translation() = random.uniform(0.0, max_translation_m) * direction;
   return error;
 }
 

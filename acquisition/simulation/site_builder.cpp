@@ -133,7 +133,10 @@ void SiteBuilder::add_tree(const std::string& name, const Vector2d& base, const 
              trunk, materials_.bark);
   const double lobe_phase = random.uniform(0.0, 2.0 * std::numbers::pi);
   for (int i = 0; i < spec.leaf_count; ++i) {
-    Vector3d d(random.normal(), random.normal(), random.normal());
+    // z, then y, then x (random.hpp).
+    const double dz = random.normal();
+    const double dy = random.normal();
+    Vector3d d(random.normal(), dy, dz);
     d /= std::max(d.norm(), 1e-9);
     const double azimuth = std::atan2(d.y(), d.x());
     const double lobe = 1.0 + 0.15 * std::sin(3.0 * azimuth + lobe_phase) * std::cos(2.5 * d.z());

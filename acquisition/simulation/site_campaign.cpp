@@ -35,8 +35,8 @@ Vector2d clear_position(const SiteBuilder& builder, const CampaignSettings& sett
   const Vector2d side(-direction.y(), direction.x());
   for (int attempt = 0; attempt < 200; ++attempt) {
     const double spread = settings.jitter_m * (1.0 + attempt / 20.0);
-    const Vector2d p = nominal + direction * random.uniform(-spread, spread) +
-                       side * random.uniform(-0.5 * spread, 0.5 * spread);
+    const double across = random.uniform(-0.5 * spread, 0.5 * spread);  // first (random.hpp)
+    const Vector2d p = nominal + direction * random.uniform(-spread, spread) + side * across;
     if (builder.clearance(p) >= settings.min_clearance_m) return p;
   }
   assert(false && "no clear scan position near the campaign path");

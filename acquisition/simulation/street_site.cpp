@@ -82,8 +82,12 @@ void add_kerb_items(SiteBuilder& b, Random& random, double canyon_m) {
   shuffle(free_slots, random);
   for (int i = 0; i < 5; ++i) {
     const Vector2d slot = free_slots[static_cast<std::size_t>(i)];
-    TreeSpec spec{random.uniform(0.12, 0.22), random.uniform(3.0, 3.6),
-                  Vector2d(random.uniform(1.2, 1.6), random.uniform(1.6, 2.4)),
+    // A braced list takes its draws in order; a Vector2d's y comes first
+    // (random.hpp).
+    const double trunk_radius = random.uniform(0.12, 0.22);
+    const double crown_base = random.uniform(3.0, 3.6);
+    const double crown_ry = random.uniform(1.6, 2.4);
+    TreeSpec spec{trunk_radius, crown_base, Vector2d(random.uniform(1.2, 1.6), crown_ry),
                   random.integer(150, 300)};
     char name[32];
     std::snprintf(name, sizeof name, "tree_%02d", i + 1);
