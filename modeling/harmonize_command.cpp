@@ -7,6 +7,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 #include "core/spill_file.hpp"
 #include "core/timing.hpp"
 #include "modeling/command_json.hpp"
@@ -101,7 +102,8 @@ HarmonizeCommandResult harmonize_outcome(
 
 // The colour samples of the scans still to be paired as a pair's first
 // scan, parked in a temporary file (core::SpillFile) while they wait, or
-// kept in memory where the file cannot take them.
+// kept in memory where the file cannot take them (bytes_in_memory counts
+// those: the stage holds them against its memory limit).
 class ParkedSamples {
  public:
   void put(int scan, registration::ColorSamples samples) {
@@ -123,10 +125,14 @@ class ParkedSamples {
     }
     parked.count = samples.size();
     parked.in_memory = std::move(samples);
+    in_memory_bytes_ += bytes_of(parked.count);
     parked_[scan] = std::move(parked);
   }
 
+  std::uint64_t bytes_in_memory() const { return in_memory_bytes_; }
+
   // The samples of `scan`, which were put and not released (asserted).
+  // Throws core::RuntimeFailure when the file cannot be read.
   registration::ColorSamples get(int scan) const {
     const auto found = parked_.find(scan);
     assert(found != parked_.end() && "the samples were put");
@@ -148,6 +154,7 @@ class ParkedSamples {
     const auto found = parked_.find(scan);
     if (found == parked_.end()) return;
     for (const core::SpillFile::Extent& extent : found->second.extents) spill_.release(extent);
+    if (found->second.extents.empty()) in_memory_bytes_ -= bytes_of(found->second.count);
     parked_.erase(found);
   }
 
@@ -157,8 +164,12 @@ class ParkedSamples {
     std::vector<core::SpillFile::Extent> extents;  // pixels, points, normals, rgb; or none
     registration::ColorSamples in_memory;          // where the file could not take them
   };
+  static std::uint64_t bytes_of(std::size_t count) {
+    return count * (sizeof(std::int64_t) + 3 * sizeof(Eigen::Vector3f));
+  }
   core::SpillFile spill_;
   std::map<int, Parked> parked_;
+  std::uint64_t in_memory_bytes_ = 0;
 };
 
 // The colour pairs of every two scans with colour whose bounds meet, in the
@@ -166,7 +177,9 @@ class ParkedSamples {
 // second). One pass over the scans in the project's order, each loaded once:
 // scan b is paired with the samples of every earlier scan a it may overlap,
 // then its own samples are parked until its last pair as a first scan. In
-// memory at once: one scan, and the samples of one or two.
+// memory at once: one scan, and the samples of one or two, but where the
+// temporary file cannot take them: then the waiting samples too, within
+// the memory limit (core::MemoryShortage beyond it).
 std::vector<registration::ColorPair> streamed_color_pairs(
     const store::Project& project, std::span<const store::StoredScanSummary> scans,
     const registration::ColorPairSettings& settings, std::uint64_t memory_limit,
@@ -215,12 +228,26 @@ std::vector<registration::ColorPair> streamed_color_pairs(
           samples.get(a), b->prepared, static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(k),
           summary_a.summary.T_world_scan, summary.summary.T_world_scan, link);
       if (last_second[static_cast<std::size_t>(a)] == k) samples.release(a);
+      progress.throw_if_cancelled("harmonize");
     }
-    if (last_second[static_cast<std::size_t>(k)] > k)
+    if (last_second[static_cast<std::size_t>(k)] > k) {
       samples.put(k, registration::color_samples(b->prepared, settings));
+      if (samples.bytes_in_memory() + b->bytes > memory_limit) {
+        throw core::MemoryShortage(
+            project.path().string(), {},
+            "harmonize needs about " + core::gigabytes(samples.bytes_in_memory() + b->bytes) +
+                " for scan " + std::to_string(summary.id) +
+                " and the colour samples that a temporary file could not take (none could be "
+                "made, or the disk is full), more than its memory limit of " +
+                core::gigabytes(memory_limit) + " (--memory-limit)");
+      }
+    }
   }
   std::vector<registration::ColorPair> out;
-  for (const auto& [which, list] : found) out.insert(out.end(), list.begin(), list.end());
+  for (auto& [which, list] : found) {
+    out.insert(out.end(), list.begin(), list.end());
+    list = {};
+  }
   return out;
 }
 

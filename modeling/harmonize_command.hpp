@@ -61,9 +61,11 @@ double mean_pair_delta_e(std::span<const registration::ColorPair> pairs,
 // Streams: colour pairs only between scans whose bounds meet, each scan
 // loaded once, one at a time under `memory_limit`, paired with the colour
 // samples (registration::ColorSamples) of the earlier scans it may overlap,
-// which wait in a temporary file.
+// which wait in a temporary file (in memory, within the limit, where no
+// such file can take them).
 // Throws as merge_project (no scans, a scan without geometry, data it read
 // changed meanwhile, a scan beyond the memory limit, cancelled), and
+// core::RuntimeFailure when the temporary file cannot be read back, and
 // core::InputError when no two scans with colour overlap. The project is
 // then unchanged.
 HarmonizeCommandResult harmonize_project(store::Project& project,

@@ -155,8 +155,6 @@ std::uint64_t ScanCache::bytes_in_hand() const {
   return bytes;
 }
 
-// Drops kept scans, farthest next use first, until `bytes` more fit under
-// the limit or only held scans are left.
 // The kept scan the stage does not hold whose next use is farthest away
 // (kept_.end() when it holds them all), and how many it does not hold.
 std::pair<std::map<std::int64_t, ScanCache::Entry>::iterator, std::size_t>
@@ -171,6 +169,8 @@ ScanCache::farthest_unheld() {
   return {farthest, unheld};
 }
 
+// Drops kept scans, farthest next use first, until `bytes` more fit under
+// the limit or only held scans are left.
 void ScanCache::make_room(std::uint64_t bytes) {
   std::erase_if(given_, [](const auto& given) { return given.expired(); });
   while (bytes_in_hand() + bytes > limit_) {

@@ -84,21 +84,22 @@ struct ColorPair {
 // bytes: a stage keeps these of the scans still to be paired, not the
 // scans. Empty for a scan without colour.
 struct ColorSamples {
-  std::vector<std::int64_t> pixels;  // row-major
-  std::vector<Eigen::Vector3f> points;
-  std::vector<Eigen::Vector3f> normals;  // zero where the pixel has none
+  std::vector<std::int64_t> pixels;      // row-major
+  std::vector<Eigen::Vector3f> points;   // scan frame [m]
+  std::vector<Eigen::Vector3f> normals;  // scan frame, unit; zero where the pixel has none
   std::vector<Eigen::Vector3f> rgb;      // linear
   std::size_t size() const { return pixels.size(); }
 };
 
-// The samples of `scan` under `settings` (stride, phase, dark, bright,
-// max_local_step, threads).
+// The samples of `scan` (prepared with its geometry) under `settings`
+// (stride, phase, dark, bright, max_local_step, threads).
 ColorSamples color_samples(const PreparedScan& scan, const ColorPairSettings& settings);
 
 // The pairs of scans a and b (at positions ia < ib of the scan list, at
-// poses T_world_a and T_world_b): a's samples projected into b's grid,
-// thinned evenly to max_pairs_per_overlap, in a's row order. None when
-// either scan has no colour.
+// poses T_world_a and T_world_b): a's samples, taken by color_samples under
+// the same `settings`, projected into b's grid and tested there, thinned
+// evenly to max_pairs_per_overlap, in a's row order. None when a has no
+// samples or b no colour.
 std::vector<ColorPair> color_pairs_between(const ColorSamples& a, const PreparedScan& b,
                                            std::uint32_t ia, std::uint32_t ib,
                                            const Eigen::Isometry3d& T_world_a,

@@ -29,7 +29,7 @@ run_pass release "$root/build" "" -DSCANBENCH_SANITIZE=OFF
 if [ $fast -eq 0 ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  BUILD_TYPE=RelWithDebInfo run_pass "asan+ubsan" "$root/build-asan" "-LE release_only" \
+  BUILD_TYPE=RelWithDebInfo run_pass "asan+ubsan" "$root/build-asan-clang" "-LE release_only" \
     -DCMAKE_CXX_COMPILER=clang++ -DSCANBENCH_SANITIZE=ON -DSCANBENCH_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1"
   echo "== fuzz =="
   start=$SECONDS

@@ -326,6 +326,8 @@ TEST_F(StreamedStagesTest, HarmonizationWithOneScanInHandFindsThePairsOfTheOneIn
   const HarmonizeCommandResult out =
       harmonize_project(project_, settings, progress, room_bytes() * 3 / 2);
   EXPECT_EQ(out.pairs, expected.size());
+  // The same pairs in the same order: the same sum, to the last bit.
+  EXPECT_EQ(out.delta_e_before, mean_pair_delta_e(expected, {}));
   std::vector<std::size_t> pairs_of(ids_.size(), 0);
   for (const registration::ColorPair& pair : expected) {
     ++pairs_of[pair.scan_a];
