@@ -1,12 +1,12 @@
-// The costs of colour harmonisation (color_harmonization.hpp), templated
-// for Ceres' automatic derivatives.
+// The cost of one colour pair in colour harmonisation
+// (color_harmonization.hpp), with its derivatives.
 //
 // A scan's correction maps its linear RGB colour c to
 //   gain-offset  c' = g ∘ c + o            parameters (g₀ g₁ g₂ o₀ o₁ o₂)
 //   matrix       c' = M c + o              parameters (M row-major, o)
 // A colour pair (the same surface point in scans a and b) has, per channel,
 // the residual
-//   r = log(max(c'_a, 0) + ε) − log(max(c'_b, 0) + ε),   ε = 0.01.
+//   r = s(c'_a) − s(c'_b),   s(v) = log(max(v, 0) + ε),   ε = 0.01.
 // For c' ≫ ε this is log(c'_a / c'_b): a gain is a shift, so exposure and
 // white balance differences are constant residuals that the gains remove
 // exactly, and shrinking every colour of a scan towards one value (which
@@ -14,12 +14,17 @@
 // For c' ≲ ε it turns absolute (≈ (c'_a − c'_b) / ε), so dark noise does
 // not dominate as it would under a true logarithm. The solver puts a Cauchy
 // loss on it; its scale is a relative difference (0.05: about 5 %).
+//
+// Derivatives: s'(v) = 1 / (v + ε) for v > 0 and 0 below, and channel k of
+// c' depends on the gain or matrix row of channel k and on offset k:
+//   ∂r_k/∂g_k = s'(c'_k) c_k            (gain-offset, scan a; b: negated)
+//   ∂r_k/∂M_kj = s'(c'_k) c_j           (matrix)
+//   ∂r_k/∂o_k = s'(c'_k)
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
-#include <cstddef>
-#include <vector>
 
 #include "registration/color_harmonization.hpp"
 
@@ -30,48 +35,68 @@ inline constexpr double kSoftLogEpsilon = 0.01;
 template <ColorModel Model>
 inline constexpr int kColorParameters = Model == ColorModel::kGainOffset ? 6 : 12;
 
-// c' of `rgb` under the parameters p.
-template <ColorModel Model, typename T>
-void correct_color(const T* p, const Eigen::Vector3f& rgb, T* out) {
-  for (int c = 0; c < 3; ++c) {
-    if constexpr (Model == ColorModel::kGainOffset) {
-      out[c] = p[c] * T(rgb[c]) + p[3 + c];
-    } else {
-      out[c] =
-          p[3 * c] * T(rgb[0]) + p[3 * c + 1] * T(rgb[1]) + p[3 * c + 2] * T(rgb[2]) + p[9 + c];
-    }
+template <ColorModel Model>
+using PairJacobian = Eigen::Matrix<double, 3, kColorParameters<Model>>;
+
+// Channel k of c' for `rgb` under the parameters p.
+template <ColorModel Model>
+double corrected_channel(const double* p, const Eigen::Vector3f& rgb, int k) {
+  if constexpr (Model == ColorModel::kGainOffset) {
+    return p[k] * double{rgb[k]} + p[3 + k];
+  } else {
+    return p[3 * k] * double{rgb[0]} + p[3 * k + 1] * double{rgb[1]} +
+           p[3 * k + 2] * double{rgb[2]} + p[9 + k];
   }
 }
 
-// The residual of one colour pair (3 values) over both scans' parameters.
-template <ColorModel Model>
-struct ColorPairCost {
-  Eigen::Vector3f rgb_a;
-  Eigen::Vector3f rgb_b;
-  template <typename T>
-  bool operator()(const T* pa, const T* pb, T* residual) const {
-    using std::log;
-    T ca[3], cb[3];
-    correct_color<Model>(pa, rgb_a, ca);
-    correct_color<Model>(pb, rgb_b, cb);
-    const T zero(0.0), soft(kSoftLogEpsilon);
-    for (int c = 0; c < 3; ++c)
-      residual[c] = log((ca[c] < zero ? zero : ca[c]) + soft) - log((cb[c] < zero ? zero : cb[c]) + soft);
-    return true;
-  }
-};
+inline double soft_log(double v) {
+  return std::log(std::max(v, 0.0) + kSoftLogEpsilon);
+}
+inline double soft_log_slope(double v) {
+  return v > 0.0 ? 1.0 / (v + kSoftLogEpsilon) : 0.0;
+}
 
-// weight · (p − identity) for every parameter: a gentle tie of a scan's
-// correction to "no change" where its pairs constrain it poorly.
-struct IdentityPrior {
-  std::vector<double> identity;
-  double weight = 0.0;
-  template <typename T>
-  bool operator()(const T* const* parameters, T* residual) const {
-    for (std::size_t k = 0; k < identity.size(); ++k)
-      residual[k] = T(weight) * (parameters[0][k] - T(identity[k]));
-    return true;
+// Row k of a scan's Jacobian: `slope` × ∂c'_k/∂p.
+template <ColorModel Model>
+void set_jacobian_row(const Eigen::Vector3f& rgb, int k, double slope, PairJacobian<Model>& J) {
+  if constexpr (Model == ColorModel::kGainOffset) {
+    J(k, k) = slope * double{rgb[k]};
+    J(k, 3 + k) = slope;
+  } else {
+    for (int j = 0; j < 3; ++j) J(k, 3 * k + j) = slope * double{rgb[j]};
+    J(k, 9 + k) = slope;
   }
-};
+}
+
+// The residual of the pair (rgb_a in scan a at parameters pa, rgb_b in b
+// at pb), and where J_a and J_b are given, its Jacobians with respect to pa
+// and pb.
+template <ColorModel Model>
+Eigen::Vector3d pair_residual(const double* pa, const double* pb, const Eigen::Vector3f& rgb_a,
+                              const Eigen::Vector3f& rgb_b, PairJacobian<Model>* J_a = nullptr,
+                              PairJacobian<Model>* J_b = nullptr) {
+  Eigen::Vector3d r;
+  if (J_a != nullptr) J_a->setZero();
+  if (J_b != nullptr) J_b->setZero();
+  for (int k = 0; k < 3; ++k) {
+    const double ca = corrected_channel<Model>(pa, rgb_a, k);
+    const double cb = corrected_channel<Model>(pb, rgb_b, k);
+    r[k] = soft_log(ca) - soft_log(cb);
+    if (J_a != nullptr) set_jacobian_row<Model>(rgb_a, k, soft_log_slope(ca), *J_a);
+    if (J_b != nullptr) set_jacobian_row<Model>(rgb_b, k, -soft_log_slope(cb), *J_b);
+  }
+  return r;
+}
+
+// The Cauchy loss of a squared residual norm s at scale a:
+// ρ(s) = a² log(1 + s / a²), and its slope ρ'(s) = 1 / (1 + s / a²), the
+// weight of the pair's rows in the normal equations.
+inline double cauchy_loss(double s, double scale) {
+  const double b = scale * scale;
+  return b * std::log1p(s / b);
+}
+inline double cauchy_weight(double s, double scale) {
+  return 1.0 / (1.0 + s / (scale * scale));
+}
 
 }  // namespace scanbench::registration::costs

@@ -1,7 +1,5 @@
 #include "registration/color_harmonization.hpp"
 
-#include <ceres/ceres.h>
-
 #include <algorithm>
 #include <array>
 #include <cassert>
@@ -10,7 +8,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/parallel.hpp"
-#include "registration/color_costs.hpp"
+#include "registration/color_solver.hpp"
 
 namespace scanbench::registration {
 
@@ -90,13 +88,6 @@ std::vector<ColorPair> pairs_between(const ColorSamples& a, const PreparedScan& 
   return out;
 }
 
-template <ColorModel Model>
-ceres::CostFunction* pair_cost(const ColorPair& pair) {
-  constexpr int kParameters = costs::kColorParameters<Model>;
-  return new ceres::AutoDiffCostFunction<costs::ColorPairCost<Model>, 3, kParameters, kParameters>(
-      new costs::ColorPairCost<Model>{pair.rgb_a, pair.rgb_b});
-}
-
 // Per scan, the fixed scan of its group of scans linked by pairs (the one
 // with the lowest index), or -1 for a scan in no pair.
 std::vector<std::int32_t> group_references(std::span<const ColorPair> pairs, std::size_t count) {
@@ -117,32 +108,6 @@ std::vector<std::int32_t> group_references(std::span<const ColorPair> pairs, std
   for (std::size_t k = 0; k < count; ++k)
     if (paired[k]) out[k] = static_cast<std::int32_t>(find(k));
   return out;
-}
-
-// The identity correction's parameters.
-std::vector<double> identity_parameters(bool matrix) {
-  std::vector<double> p(matrix ? 12 : 6, 0.0);
-  for (std::size_t c = 0; c < 3; ++c) p[matrix ? 4 * c : c] = 1.0;
-  return p;
-}
-
-// Bounds of what exposure, white balance and flare can do: gains within
-// max_gain_ratio either way, channel cross-talk and offsets small.
-void bound_parameters(ceres::Problem& problem, double* p, bool matrix,
-                      const HarmonizeSettings& settings) {
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < (matrix ? 3 : 1); ++c) {
-      const int at = matrix ? 3 * r + c : r;
-      const bool diagonal = !matrix || r == c;
-      problem.SetParameterLowerBound(
-          p, at, diagonal ? 1.0 / settings.max_gain_ratio : -settings.max_cross_talk);
-      problem.SetParameterUpperBound(p, at,
-                                     diagonal ? settings.max_gain_ratio : settings.max_cross_talk);
-    }
-    const int offset = (matrix ? 9 : 3) + r;
-    problem.SetParameterLowerBound(p, offset, -settings.max_offset);
-    problem.SetParameterUpperBound(p, offset, settings.max_offset);
-  }
 }
 
 acquisition::ColorCorrection correction_of(const std::vector<double>& p, bool matrix) {
@@ -250,54 +215,26 @@ HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t s
   result.corrections.resize(scan_count);
   result.reference = group_references(pairs, scan_count);
   if (pairs.empty()) return result;
-  const bool matrix = settings.model == ColorModel::kMatrix;
-  const std::vector<double> identity = identity_parameters(matrix);
-  std::vector<std::vector<double>> parameters(scan_count, identity);
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  ceres::CauchyLoss loss(settings.loss_scale);
   std::vector<std::size_t> pairs_of(scan_count, 0);
   for (const ColorPair& pair : pairs) {
-    problem.AddResidualBlock(
-        matrix ? pair_cost<ColorModel::kMatrix>(pair) : pair_cost<ColorModel::kGainOffset>(pair),
-        &loss, parameters[pair.scan_a].data(), parameters[pair.scan_b].data());
     ++pairs_of[pair.scan_a];
     ++pairs_of[pair.scan_b];
   }
-  result.pairs = pairs.size();
+  std::vector<std::uint8_t> solved(scan_count, 0);
+  std::vector<double> prior_weight(scan_count, 0.0);
   for (std::size_t k = 0; k < scan_count; ++k) {
-    if (pairs_of[k] == 0) continue;
-    if (result.reference[k] == static_cast<std::int32_t>(k)) {
-      problem.SetParameterBlockConstant(parameters[k].data());
-      continue;
-    }
-    auto* prior =
-        new ceres::DynamicAutoDiffCostFunction<costs::IdentityPrior>(new costs::IdentityPrior{
-            identity, settings.prior_weight * std::sqrt(static_cast<double>(pairs_of[k]))});
-    prior->AddParameterBlock(static_cast<int>(identity.size()));
-    prior->SetNumResiduals(static_cast<int>(identity.size()));
-    problem.AddResidualBlock(prior, nullptr, parameters[k].data());
-    bound_parameters(problem, parameters[k].data(), matrix, settings);
+    solved[k] = result.reference[k] >= 0 && result.reference[k] != static_cast<std::int32_t>(k);
+    prior_weight[k] = settings.prior_weight * std::sqrt(static_cast<double>(pairs_of[k]));
   }
-  ceres::Solver::Options options;
-  // Sparse: a pair touches two scans, and a dense solver writes every
-  // pair's rows with a column for every scan's parameters, memory and time
-  // that grow with pairs × scans (3 × 32 × 12 doubles a pair, 3.5 GB for
-  // the 380 000 pairs of 32 stations).
-  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = settings.max_iterations;
-  options.num_threads = core::worker_count(settings.threads);
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  result.initial_cost = summary.initial_cost;
-  result.final_cost = summary.final_cost;
-  result.iterations = static_cast<int>(summary.iterations.size());
-  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  const ColorSolveOutcome solve = solve_color_parameters(pairs, solved, prior_weight, settings);
+  result.pairs = pairs.size();
+  result.initial_cost = solve.initial_cost;
+  result.final_cost = solve.final_cost;
+  result.iterations = solve.iterations;
+  result.converged = solve.converged;
+  const bool matrix = settings.model == ColorModel::kMatrix;
   for (std::size_t k = 0; k < scan_count; ++k) {
-    if (result.reference[k] >= 0 && result.reference[k] != static_cast<std::int32_t>(k))
-      result.corrections[k] = correction_of(parameters[k], matrix);
+    if (solved[k]) result.corrections[k] = correction_of(solve.parameters[k], matrix);
   }
   return result;
 }

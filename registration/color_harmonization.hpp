@@ -2,7 +2,7 @@
 // are taken over hours under other exposures and white balances, so one
 // wall gets another colour in each scan. Corresponding points in the
 // overlaps (the same surface sampled by two scans) give colour pairs; a
-// robust least-squares problem (Ceres) solves for each scan's correction in
+// robust least-squares problem (color_solver.hpp) solves for each scan's correction in
 // linear RGB, where exposure and white balance act as per-channel gains:
 //   gain-offset  rgb' = diag(g) · rgb + o   (6 parameters per scan)
 //   matrix       rgb' = M · rgb + o         (12: also cross-talk between channels)
@@ -149,7 +149,7 @@ struct HarmonizeResult {
 
 // Solves the corrections of `scan_count` scans from `pairs`: Levenberg–
 // Marquardt on the costs of color_costs.hpp under a Cauchy loss, within the
-// settings' bounds.
+// settings' bounds (color_solver.hpp). `iterations` counts the steps tried.
 HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t scan_count,
                                  const HarmonizeSettings& settings);
 

@@ -1,13 +1,17 @@
 // The colour harmonisation solver on synthetic pairs: known gains and
 // offsets come back with outliers among the pairs, the first scan of each
-// group of overlapping scans stays fixed, and a scan in no pair is left
-// alone. And the samples a scan gives the pair search, on a hand-made grid.
+// group of overlapping scans stays fixed, a scan in no pair is left alone,
+// the solve is deterministic and keeps its bounds, and the costs'
+// derivatives are right. And the samples a scan gives the pair search, on a hand-made grid.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "acquisition/color_space.hpp"
+#include "registration/color_costs.hpp"
 #include "registration/color_harmonization.hpp"
+#include "registration/color_solver.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -103,6 +107,88 @@ TEST(ColorHarmonization, EachGroupOfOverlappingScansHasItsOwnReference) {
   EXPECT_TRUE(out.corrections[1].matrix.isIdentity());
   EXPECT_NEAR(out.corrections[2].matrix(0, 0), 1.3, 0.005);
   EXPECT_NEAR(out.corrections[2].matrix(2, 2), 0.9, 0.005);
+}
+
+// The solve sums each link's pairs in their order and the links in scan
+// order: the same bits on one worker or two, and whatever the order of the
+// links among the pairs.
+TEST(ColorHarmonization, TheSolveIsTheSameForAnyThreadCountAndLinkOrder) {
+  std::vector<Truth> truth(4);
+  truth[1].matrix.diagonal() << 1.3, 0.85, 1.1;
+  truth[2].matrix.diagonal() << 0.7, 0.75, 0.9;
+  truth[3].offset << 0.003, 0.0, -0.001;
+  const std::vector<ColorPair> pairs = synthetic_pairs(truth, 0.2);
+  std::vector<ColorPair> by_link_backwards;
+  for (std::size_t end = pairs.size(); end > 0; end -= 3000)
+    by_link_backwards.insert(by_link_backwards.end(), pairs.begin() + static_cast<long>(end - 3000),
+                             pairs.begin() + static_cast<long>(end));
+  HarmonizeSettings one;
+  one.threads = 1;
+  HarmonizeSettings two;
+  two.threads = 2;
+  const HarmonizeResult first = harmonize_colors(pairs, 4, one);
+  for (const HarmonizeResult& other :
+       {harmonize_colors(pairs, 4, two), harmonize_colors(by_link_backwards, 4, two)}) {
+    EXPECT_EQ(other.final_cost, first.final_cost);
+    EXPECT_EQ(other.iterations, first.iterations);
+    for (std::size_t s = 0; s < 4; ++s) {
+      EXPECT_EQ(other.corrections[s].matrix, first.corrections[s].matrix) << s;
+      EXPECT_EQ(other.corrections[s].offset, first.corrections[s].offset) << s;
+    }
+  }
+}
+
+// A scan two and a half times too dark with gains bounded at 2: the solve
+// stops at the bound, where the bounded problem is stationary.
+TEST(ColorHarmonization, AGainBeyondItsBoundStopsAtTheBound) {
+  std::vector<Truth> truth(2);
+  truth[1].matrix.diagonal() << 2.5, 2.5, 1.5;
+  HarmonizeSettings settings;
+  settings.max_gain_ratio = 2.0;
+  const HarmonizeResult out = harmonize_colors(synthetic_pairs(truth, 0.0), 2, settings);
+  EXPECT_TRUE(out.converged);
+  EXPECT_EQ(out.corrections[1].matrix(0, 0), 2.0);
+  EXPECT_EQ(out.corrections[1].matrix(1, 1), 2.0);
+  EXPECT_LT(out.corrections[1].matrix(2, 2), 2.0);
+  EXPECT_LT(out.final_cost, out.initial_cost);
+}
+
+// The derivatives of color_costs.hpp against central differences, for both
+// models, at parameters away from the identity.
+template <ColorModel Model>
+void expect_jacobians_match_differences() {
+  constexpr int P = costs::kColorParameters<Model>;
+  std::vector<double> pa = identity_color_parameters(Model), pb = pa;
+  for (int i = 0; i < P; ++i) {
+    pa[static_cast<std::size_t>(i)] += 0.05 * std::sin(1.0 + i);
+    pb[static_cast<std::size_t>(i)] += 0.04 * std::cos(2.0 + i);
+  }
+  const Eigen::Vector3f rgb_a(0.2f, 0.45f, 0.08f), rgb_b(0.3f, 0.1f, 0.6f);
+  costs::PairJacobian<Model> Ja, Jb;
+  costs::pair_residual<Model>(pa.data(), pb.data(), rgb_a, rgb_b, &Ja, &Jb);
+  constexpr double h = 1e-6;
+  for (int i = 0; i < P; ++i) {
+    for (std::vector<double>* p : {&pa, &pb}) {
+      std::vector<double> up = *p, down = *p;
+      up[static_cast<std::size_t>(i)] += h;
+      down[static_cast<std::size_t>(i)] -= h;
+      const bool a = p == &pa;
+      const Eigen::Vector3d difference =
+          (costs::pair_residual<Model>(a ? up.data() : pa.data(), a ? pb.data() : up.data(), rgb_a,
+                                       rgb_b) -
+           costs::pair_residual<Model>(a ? down.data() : pa.data(), a ? pb.data() : down.data(),
+                                       rgb_a, rgb_b)) /
+          (2.0 * h);
+      const Eigen::Vector3d analytic = a ? Ja.col(i) : Jb.col(i);
+      EXPECT_LT((difference - analytic).cwiseAbs().maxCoeff(), 1e-6)
+          << (a ? "a" : "b") << " parameter " << i;
+    }
+  }
+}
+
+TEST(ColorHarmonization, TheCostsDerivativesMatchDifferences) {
+  expect_jacobians_match_differences<ColorModel::kGainOffset>();
+  expect_jacobians_match_differences<ColorModel::kMatrix>();
 }
 
 // An 8 × 8 spherical grid of a wall 5 m away, grey 100 but for a dark pixel
