@@ -318,12 +318,17 @@ Sample filtered(const Scene& scene, const Hit& hit, double footprint_m) {
 
 }  // namespace
 
+SurfaceAppearance surface_appearance(const Scene& scene, const Hit& hit, double footprint_m) {
+  const Sample s = filtered(scene, hit, footprint_m);
+  return {s.albedo.cwiseMax(0.0f).cwiseMin(1.0f), std::clamp(s.reflectance, 0.0f, 1.0f)};
+}
+
 Eigen::Vector3f surface_albedo(const Scene& scene, const Hit& hit, double footprint_m) {
-  return filtered(scene, hit, footprint_m).albedo.cwiseMax(0.0f).cwiseMin(1.0f);
+  return surface_appearance(scene, hit, footprint_m).albedo;
 }
 
 float surface_reflectance(const Scene& scene, const Hit& hit, double footprint_m) {
-  return std::clamp(filtered(scene, hit, footprint_m).reflectance, 0.0f, 1.0f);
+  return surface_appearance(scene, hit, footprint_m).reflectance;
 }
 
 }  // namespace scanbench::acquisition::sim

@@ -22,6 +22,14 @@ Eigen::Vector3f surface_albedo(const Scene& scene, const Hit& hit, double footpr
 // as colour.
 float surface_reflectance(const Scene& scene, const Hit& hit, double footprint_m = 0.0);
 
+// Both of the above at one hit, from one evaluation of the pattern (each
+// alone evaluates it over the footprint's disk: thirteen samples).
+struct SurfaceAppearance {
+  Eigen::Vector3f albedo;  // linear RGB in [0, 1]
+  float reflectance;       // in [0, 1]
+};
+SurfaceAppearance surface_appearance(const Scene& scene, const Hit& hit, double footprint_m = 0.0);
+
 // Renders `text` in large capitals (dark letters on a light panel, linear RGB)
 // into an image of the given physical size, with about `pixels_per_m` texels
 // per metre: a building's name sign or a shop front.

@@ -7,6 +7,7 @@
 
 #include "acquisition/formats/image_file.hpp"
 #include "acquisition/formats/output_file.hpp"
+#include "acquisition/simulation/textures.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 
@@ -45,7 +46,9 @@ TruthImage render_truth_view(const Scene& scene, const CameraView& view,
       const Eigen::Vector3d point = ray.origin + hit->distance_m * ray.direction;
       const double footprint =
           footprint_radius(hit->distance_m, 1.0 / focal, std::abs(hit->normal.dot(ray.direction)));
-      const auto rgb = expose(shade(scene, *hit, point, lighting, true, footprint), lighting);
+      const auto rgb =
+          expose(shade(scene, *hit, point, lighting, true, surface_albedo(scene, *hit, footprint)),
+                 lighting);
       for (int c = 0; c < 3; ++c) image.rgb[3 * i + c] = rgb[c];
     }
   };

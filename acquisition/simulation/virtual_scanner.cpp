@@ -38,11 +38,10 @@ Eigen::Vector3d direction_at(const SphericalAngles& a, double row, double col) {
   return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
 }
 
-float clean_intensity(const Scene& scene, const Hit& hit, double cos_incidence, double footprint_m,
+float clean_intensity(const Hit& hit, double reflectance, double cos_incidence,
                       const ScannerModel& model) {
   const double falloff = std::sqrt(model.intensity_reference_range_m /
                                    std::max(hit.distance_m, model.intensity_reference_range_m));
-  const double reflectance = surface_reflectance(scene, hit, footprint_m);
   return static_cast<float>(std::clamp(reflectance * cos_incidence * falloff, 0.0, 1.0));
 }
 
@@ -64,8 +63,9 @@ CleanSample cast_beam(const Scene& scene, const Eigen::Isometry3d& T_world_scan,
   const double pixel_angle =
       std::max(std::abs(angles.azimuth_step_rad), std::abs(angles.elevation_step_rad));
   const double footprint = footprint_radius(hit->distance_m, pixel_angle, cos_incidence);
-  sample.radiance = shade(scene, *hit, point, lighting, model.shadows, footprint);
-  sample.intensity = clean_intensity(scene, *hit, cos_incidence, footprint, model);
+  const SurfaceAppearance look = surface_appearance(scene, *hit, footprint);
+  sample.radiance = shade(scene, *hit, point, lighting, model.shadows, look.albedo);
+  sample.intensity = clean_intensity(*hit, look.reflectance, cos_incidence, model);
   return sample;
 }
 
@@ -193,7 +193,7 @@ double footprint_radius(double range_m, double pixel_angle_rad, double cos_incid
 }
 
 Eigen::Vector3f shade(const Scene& scene, const Hit& hit, const Eigen::Vector3d& point_world,
-                      const ScanLighting& lighting, bool shadows, double footprint_m) {
+                      const ScanLighting& lighting, bool shadows, const Eigen::Vector3f& albedo) {
   const double facing = hit.normal.dot(lighting.sun_direction_world);
   double sun = 0.0;
   if (facing > 0.0) {
@@ -201,8 +201,7 @@ Eigen::Vector3f shade(const Scene& scene, const Hit& hit, const Eigen::Vector3d&
     const bool lit = !shadows || !scene.intersect(to_sun, 0.0, 1e4).has_value();
     sun = lit ? lighting.sun_irradiance * facing : 0.0;
   }
-  return surface_albedo(scene, hit, footprint_m) *
-         static_cast<float>(lighting.sky_irradiance + sun);
+  return albedo * static_cast<float>(lighting.sky_irradiance + sun);
 }
 
 Eigen::Matrix<std::uint8_t, 3, 1> expose(const Eigen::Vector3f& radiance,

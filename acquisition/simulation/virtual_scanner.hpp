@@ -116,10 +116,10 @@ Eigen::Matrix<std::uint8_t, 3, 1> expose(const Eigen::Vector3f& radiance,
 
 // Linear radiance leaving the surface at `hit` towards the viewer under
 // `lighting`: albedo · (sky + sun · max(0, n·s) · visible), where `visible`
-// casts a shadow ray when `shadows` is set. The albedo is averaged over the
-// pixel's footprint on the surface, a disk of radius footprint_m [m].
+// casts a shadow ray when `shadows` is set. `albedo` is the surface's
+// (textures.hpp), averaged over the pixel's footprint.
 Eigen::Vector3f shade(const Scene& scene, const Hit& hit, const Eigen::Vector3d& point_world,
-                      const ScanLighting& lighting, bool shadows, double footprint_m);
+                      const ScanLighting& lighting, bool shadows, const Eigen::Vector3f& albedo);
 
 // Radius [m] of the disk a beam or pixel of angular size pixel_angle_rad
 // covers on a surface at `range_m` whose normal makes cos_incidence with the
