@@ -10,10 +10,13 @@
 // another way.
 #pragma once
 
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
+#include <vector>
 
 namespace scanbench::core {
 
@@ -47,6 +50,37 @@ class SpillFile {
   // the other extents stay. So a file that many puts go through takes only
   // what is still to be read.
   void release(const Extent& extent);
+
+  // Puts each vector's elements (trivially copyable) in turn: their
+  // extents, in order; none when the file cannot take them all (what it
+  // took of them is released).
+  template <typename... Vectors>
+  std::optional<std::vector<Extent>> put_vectors(const Vectors&... vectors) {
+    std::vector<Extent> extents;
+    const auto put_one = [&](const auto& v) {
+      const std::optional<Extent> extent = put(v.data(), v.size() * sizeof(v[0]));
+      if (extent) extents.push_back(*extent);
+      return extent.has_value();
+    };
+    if ((put_one(vectors) && ...)) return extents;
+    for (const Extent& extent : extents) release(extent);
+    return std::nullopt;
+  }
+
+  // Reads what put_vectors() put, at `extents`, back into `vectors` (of the
+  // same types, in the same order), each resized to its extent. Throws as
+  // get().
+  template <typename... Vectors>
+  void get_vectors(std::span<const Extent> extents, Vectors&... vectors) const {
+    assert(extents.size() == sizeof...(Vectors) && "one extent a vector");
+    std::size_t k = 0;
+    const auto get_one = [&](auto& v) {
+      const Extent& extent = extents[k++];
+      v.resize(extent.bytes / sizeof(v[0]));
+      get(extent, v.data());
+    };
+    (get_one(vectors), ...);
+  }
 
   // The bytes put so far.
   std::uint64_t size() const { return end_; }

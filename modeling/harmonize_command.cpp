@@ -108,22 +108,15 @@ class ParkedSamples {
  public:
   void put(int scan, registration::ColorSamples samples) {
     Parked parked;
+    parked.count = samples.size();
     if (spill_.usable()) {
-      const auto put_array = [&](const auto& v) {
-        const auto extent = spill_.put(v.data(), v.size() * sizeof(v[0]));
-        if (extent) parked.extents.push_back(*extent);
-        return extent.has_value();
-      };
-      if (put_array(samples.pixels) && put_array(samples.points) && put_array(samples.normals) &&
-          put_array(samples.rgb)) {
-        parked.count = samples.size();
+      if (auto extents =
+              spill_.put_vectors(samples.pixels, samples.points, samples.normals, samples.rgb)) {
+        parked.extents = std::move(*extents);
         parked_[scan] = std::move(parked);
         return;
       }
-      for (const core::SpillFile::Extent& extent : parked.extents) spill_.release(extent);
-      parked.extents.clear();
     }
-    parked.count = samples.size();
     parked.in_memory = std::move(samples);
     in_memory_bytes_ += bytes_of(parked.count);
     parked_[scan] = std::move(parked);
@@ -139,14 +132,7 @@ class ParkedSamples {
     const Parked& parked = found->second;
     if (parked.extents.empty()) return parked.in_memory;
     registration::ColorSamples out;
-    out.pixels.resize(parked.count);
-    out.points.resize(parked.count);
-    out.normals.resize(parked.count);
-    out.rgb.resize(parked.count);
-    spill_.get(parked.extents[0], out.pixels.data());
-    spill_.get(parked.extents[1], out.points.data());
-    spill_.get(parked.extents[2], out.normals.data());
-    spill_.get(parked.extents[3], out.rgb.data());
+    spill_.get_vectors(parked.extents, out.pixels, out.points, out.normals, out.rgb);
     return out;
   }
 

@@ -106,19 +106,20 @@ ceres::Solver::Options solver_options(const GlobalSettings& settings) {
 // its quadratic, then solve the pose graph. Edges are associated target by
 // target (each target scan taken from the stream once), and enter the
 // problem in their own order. Returns the number of correspondences used.
-std::size_t solve_round(std::span<const SampleCloud> samples, ScanStream& scans,
-                        std::span<const ScanEdge> edges, std::vector<PoseParameters>& poses,
-                        double gate_m, const GlobalSettings& settings) {
+std::size_t solve_round(SampleShelf& samples, ScanStream& scans, std::span<const ScanEdge> edges,
+                        std::vector<PoseParameters>& poses, double gate_m,
+                        const GlobalSettings& settings) {
   const double min_cos = std::cos(settings.icp.max_normal_angle_deg * std::numbers::pi / 180.0);
   std::vector<std::optional<EdgeQuadratic>> quadratics(edges.size());
   for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
     const auto a = static_cast<std::size_t>(edges[e].source);
     const auto b = static_cast<std::size_t>(edges[e].target);
     const Eigen::Isometry3d T_target_source = poses[b].isometry().inverse() * poses[a].isometry();
+    const std::shared_ptr<const SampleCloud> source = samples.get(a);
     const std::vector<PlaneCorrespondence> matches =
-        plane_correspondences(samples[a], target,
-                              associate_samples(samples[a], target, T_target_source,
-                                                {gate_m, min_cos}, settings.icp.threads));
+        plane_correspondences(*source, target,
+                              associate_samples(*source, target, T_target_source, {gate_m, min_cos},
+                                                settings.icp.threads));
     if (matches.size() < settings.icp.min_correspondences) return;
     quadratics[e] = edge_quadratic(matches, T_target_source, settings.icp.loss_scale_m);
   });
@@ -162,7 +163,7 @@ void for_each_target(ScanStream& scans, std::span<const ScanEdge> edges,
   }
 }
 
-GlobalResult refine_globally(std::span<const SampleCloud> samples, ScanStream& scans,
+GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans,
                              std::vector<Eigen::Isometry3d> T_first_scan,
                              std::span<const ScanEdge> edges, const GlobalSettings& settings) {
   assert(samples.size() == scans.size() && T_first_scan.size() == scans.size());
@@ -172,8 +173,9 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples, ScanStream& s
   GlobalResult result;
   std::vector<PoseParameters> poses;
   for (const Eigen::Isometry3d& T : T_first_scan) poses.push_back(PoseParameters::from(T));
-  std::vector<SampleCloud> thinned;
-  for (const SampleCloud& cloud : samples) thinned.push_back(thin(cloud, settings.max_samples));
+  SampleShelf thinned(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k)
+    thinned.put(k, thin(*samples.get(k), settings.max_samples));
   // Rounds run on the thinned samples until the poses stop moving (then the
   // refinement has converged); one more round on all samples polishes them:
   // the cheap rounds do the moving, the last one the last tenths of a
@@ -182,8 +184,8 @@ GlobalResult refine_globally(std::span<const SampleCloud> samples, ScanStream& s
   double gate = settings.initial_gate_m;
   for (int round = 0; round < settings.max_rounds; ++round) {
     result.rounds = round + 1;
-    result.correspondences = solve_round(full ? samples : std::span<const SampleCloud>(thinned),
-                                         scans, edges, poses, gate, settings);
+    result.correspondences =
+        solve_round(full ? samples : thinned, scans, edges, poses, gate, settings);
     double largest_rotation = 0.0;
     double largest_translation = 0.0;
     for (std::size_t i = 0; i < poses.size(); ++i) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "registration/icp.hpp"
+#include "registration/sample_shelf.hpp"
 #include "registration/scan_stream.hpp"
 
 namespace scanbench::registration {
@@ -54,11 +55,12 @@ void for_each_target(ScanStream& scans, std::span<const ScanEdge> edges,
                      const std::function<void(const PreparedScan&, std::size_t)>& visit);
 
 // Refines `T_first_scan` (poses of all scans in the first scan's frame;
-// [0] must be the identity, asserted) over `edges`. samples[i] and scan i of
-// `scans` belong to scan i; each round takes every target scan from the
-// stream once. Edges with too few correspondences in a round add nothing to
-// it.
-GlobalResult refine_globally(std::span<const SampleCloud> samples, ScanStream& scans,
+// [0] must be the identity, asserted) over `edges`. The cloud of slot i of
+// `samples` (every slot put) and scan i of `scans` belong to scan i; each
+// round takes every target scan from the stream once, and the samples of
+// its edges' sources from the shelf. Edges with too few correspondences in
+// a round add nothing to it.
+GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans,
                              std::vector<Eigen::Isometry3d> T_first_scan,
                              std::span<const ScanEdge> edges, const GlobalSettings& settings);
 

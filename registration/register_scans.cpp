@@ -11,6 +11,7 @@
 #include "core/timing.hpp"
 #include "registration/pose_parameters.hpp"
 #include "registration/sample_cloud.hpp"
+#include "registration/sample_shelf.hpp"
 
 namespace scanbench::registration {
 namespace {
@@ -354,7 +355,7 @@ double reachable_share(const SampleCloud& cloud, const Eigen::Isometry3d& T_firs
 // thinned samples come within a cell (the reach) of, the ones reached most
 // (max_overlap_tests_per_scan) are measured on the target scan, target by
 // target: the pair tests grow with the scans, not with the scans in sight.
-std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
+std::vector<ScanEdge> overlapping_edges(ScanStream& scans, SampleShelf& samples,
                                         const std::vector<Eigen::Isometry3d>& T_first_scan,
                                         const std::vector<bool>& registered,
                                         const RegistrationSettings& settings,
@@ -364,11 +365,12 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<Sam
   std::vector<Eigen::AlignedBox3d> bounds;
   std::vector<std::vector<std::uint64_t>> cells;
   for (std::size_t k = 0; k < samples.size(); ++k) {
-    bounds.push_back(bounds_of(samples[k]));
-    cells.push_back(occupied_cells(samples[k], T_first_scan[k], reach));
+    const std::shared_ptr<const SampleCloud> cloud = samples.get(k);
+    bounds.push_back(bounds_of(*cloud));
+    cells.push_back(occupied_cells(*cloud, T_first_scan[k], reach));
   }
   // A decision on a share: a thinned sample will do.
-  std::vector<SampleCloud> estimates(samples.size());
+  SampleShelf estimates(samples.size());
   std::vector<ScanEdge> candidates;  // in (source, target) order
   for (int a = 1; a < n; ++a) {
     const auto ua = static_cast<std::size_t>(a);
@@ -380,9 +382,8 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<Sam
                       reach)) {
         continue;
       }
-      if (estimates[ua].points.empty())
-        estimates[ua] = thin(samples[ua], settings.estimate_samples);
-      const double share = reachable_share(estimates[ua], T_first_scan[ua], cells[ub], reach);
+      if (!estimates.has(ua)) estimates.put(ua, thin(*samples.get(ua), settings.estimate_samples));
+      const double share = reachable_share(*estimates.get(ua), T_first_scan[ua], cells[ub], reach);
       if (share >= settings.min_global_overlap) reached.emplace_back(share, b);
     }
     // The most reached first (ties: the earlier scan), then in scan order.
@@ -400,7 +401,7 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<Sam
     const auto a = static_cast<std::size_t>(candidates[e].source);
     const auto b = static_cast<std::size_t>(candidates[e].target);
     const AlignmentQuality quality = measure_alignment(
-        estimates[a], target, T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
+        *estimates.get(a), target, T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
     ++pair_tests;
     overlapping[e] = quality.overlap >= settings.min_global_overlap;
   });
@@ -411,7 +412,7 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, const std::vector<Sam
   return edges;
 }
 
-void report_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
+void report_edges(ScanStream& scans, SampleShelf& samples,
                   const std::vector<Eigen::Isometry3d>& T_first_scan,
                   const std::vector<ScanEdge>& edges, const RegistrationSettings& settings,
                   RegistrationResult& result) {
@@ -419,7 +420,7 @@ void report_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
   for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
     const auto a = static_cast<std::size_t>(edges[e].source);
     const auto b = static_cast<std::size_t>(edges[e].target);
-    qualities[e] = measure_alignment(samples[a], target,
+    qualities[e] = measure_alignment(*samples.get(a), target,
                                      T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
   });
   double sum_squared = 0.0;
@@ -429,7 +430,7 @@ void report_edges(ScanStream& scans, const std::vector<SampleCloud>& samples,
     result.edges.push_back({edges[e].source, edges[e].target, quality});
     sum_squared += quality.rms_m * quality.rms_m * static_cast<double>(quality.correspondences);
     result.correspondences += quality.correspondences;
-    sample_count += samples[static_cast<std::size_t>(edges[e].source)].size();
+    sample_count += samples.count(static_cast<std::size_t>(edges[e].source));
   }
   if (result.correspondences > 0) result.rms_m = std::sqrt(sum_squared / result.correspondences);
   if (sample_count > 0) result.overlap = static_cast<double>(result.correspondences) / sample_count;
@@ -453,12 +454,11 @@ class StageProgress {
   std::size_t done_ = 0;
 };
 
-// Every scan's pose in the first scan's frame, whether it registered (with
-// the whole chain to the first scan), and its ICP samples.
+// Every scan's pose in the first scan's frame, and whether it registered
+// (with the whole chain to the first scan).
 struct Chain {
   std::vector<Eigen::Isometry3d> T_first_scan;
   std::vector<bool> registered;
-  std::vector<SampleCloud> samples;
 };
 
 // The target of each scan after the first: the previous scan, or the one
@@ -472,14 +472,14 @@ int target_of(int source, const RegistrationSettings& settings) {
 // Registers each scan after the first against its target, chaining the
 // poses, with two scans in hand at a time: each scan is sampled when it is
 // taken as a source (its features kept for the next pair, whose target it
-// is), and its target taken again. Adds each pair's report, iterations and
-// times to `result`.
+// is), and its target taken again; its ICP samples go on `samples`. Adds
+// each pair's report, iterations and times to `result`.
 Chain register_chain(ScanStream& scans, std::span<const Eigen::Isometry3d> initial_T_world_scan,
                      const RegistrationSettings& settings, StageProgress& steps,
-                     RegistrationResult& result) {
+                     SampleShelf& samples, RegistrationResult& result) {
   const int n = static_cast<int>(scans.size());
   Chain chain{std::vector<Eigen::Isometry3d>(scans.size(), Eigen::Isometry3d::Identity()),
-              std::vector<bool>(scans.size(), true), std::vector<SampleCloud>(scans.size())};
+              std::vector<bool>(scans.size(), true)};
   std::vector<int> order{0};
   for (int k = 1; k < n; ++k) order.insert(order.end(), {k, target_of(k, settings)});
   scans.plan(order);
@@ -489,7 +489,7 @@ Chain register_chain(ScanStream& scans, std::span<const Eigen::Isometry3d> initi
     const auto uk = static_cast<std::size_t>(k);
     std::shared_ptr<const PreparedScan> source = scans.get(k);
     const Clock::time_point start = Clock::now();
-    chain.samples[uk] = sample_scan(*source, settings.icp_sample);
+    samples.put(uk, sample_scan(*source, settings.icp_sample));
     std::optional<FeatureCloud> features;
     if (with_features)
       features.emplace(sample_scan(*source, settings.features.sample), settings.features);
@@ -511,9 +511,11 @@ Chain register_chain(ScanStream& scans, std::span<const Eigen::Isometry3d> initi
         initial_T_world_scan[0].inverse() * initial_T_world_scan[uk];
     const Eigen::Isometry3d initial = chain.T_first_scan[t].inverse() * initial_T_first_source;
     const std::shared_ptr<const PreparedScan> target_scan = scans.get(target);
+    const std::shared_ptr<const SampleCloud> source_samples = samples.get(uk);
+    const std::shared_ptr<const SampleCloud> target_samples = samples.get(t);
     PairReport pair = register_pair(
-        k, target, initial, {&chain.samples[uk], features ? &*features : nullptr}, *target_scan,
-        {&chain.samples[t], previous_features ? &*previous_features : nullptr}, settings);
+        k, target, initial, {source_samples.get(), features ? &*features : nullptr}, *target_scan,
+        {target_samples.get(), previous_features ? &*previous_features : nullptr}, settings);
     chain.T_first_scan[uk] =
         pair.registered ? chain.T_first_scan[t] * pair.icp.T_target_source : initial_T_first_source;
     chain.registered[uk] = pair.registered && chain.registered[t];
@@ -563,18 +565,18 @@ RegistrationResult register_scans(ScanStream& scans,
   const std::size_t n = scans.size();
   StageProgress steps(progress, 2 * n);  // scans made ready, pairs, the global refinement
   RegistrationResult result;
-  Chain chain = register_chain(scans, initial_T_world_scan, settings, steps, result);
+  SampleShelf samples(n);
+  Chain chain = register_chain(scans, initial_T_world_scan, settings, steps, samples, result);
 
   const std::vector<ScanEdge> edges = overlapping_edges(
-      scans, chain.samples, chain.T_first_scan, chain.registered, settings, result.pair_tests);
+      scans, samples, chain.T_first_scan, chain.registered, settings, result.pair_tests);
   if (settings.refine_globally && n > 1 && !edges.empty()) {
-    result.global =
-        refine_globally(chain.samples, scans, chain.T_first_scan, edges, settings.global);
+    result.global = refine_globally(samples, scans, chain.T_first_scan, edges, settings.global);
     chain.T_first_scan = result.global.T_first_scan;
     result.iterations += result.global.rounds;
     result.fine_seconds += result.global.seconds;
   }
-  report_edges(scans, chain.samples, chain.T_first_scan, edges, settings, result);
+  report_edges(scans, samples, chain.T_first_scan, edges, settings, result);
   steps.step("global refinement");
 
   for (std::size_t k = 0; k < n; ++k) {

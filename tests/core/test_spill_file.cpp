@@ -43,6 +43,25 @@ TEST(SpillFile, GivesBackEachPutWhereverItWent) {
   EXPECT_EQ(third->offset, first.size() + sizeof(float) * 3);
 }
 
+TEST(SpillFile, VectorsComeBackWithTheirSizes) {
+  SpillFile file;
+  ASSERT_TRUE(file.usable());
+  const std::vector<std::int64_t> pixels{5, 9, 1 << 30};
+  const std::vector<float> values{0.25f, -7.0f};
+  const std::vector<double> none;
+  const std::optional<std::vector<SpillFile::Extent>> extents =
+      file.put_vectors(pixels, values, none);
+  ASSERT_TRUE(extents);
+  ASSERT_EQ(extents->size(), 3U);
+  std::vector<std::int64_t> pixels_back{1};
+  std::vector<float> values_back;
+  std::vector<double> none_back{2.0, 3.0};
+  file.get_vectors(*extents, pixels_back, values_back, none_back);
+  EXPECT_EQ(pixels_back, pixels);
+  EXPECT_EQ(values_back, values);
+  EXPECT_TRUE(none_back.empty());
+}
+
 TEST(SpillFile, AReadBeyondWhatWasPutIsARuntimeFailure) {
   SpillFile file;
   ASSERT_TRUE(file.usable());
