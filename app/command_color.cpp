@@ -229,8 +229,8 @@ void add_harmonize_command(CLI::App& app) {
       "harmonize",
       "Make the same surface look the same from every scan: corresponding points in the "
       "overlaps of the registered scans give colour pairs, and a robust least-squares solve "
-      "(Ceres) gives each scan a colour correction in linear RGB, the first scan fixed. Stored as "
-      "one command, undoable; the scans' colours are never changed.");
+      "gives each scan a colour correction in linear RGB, the first scan fixed. Stored as one "
+      "command, undoable; the scans' colours are never changed.");
   command->add_option("project", options->project, "Project file (.sbproj)")
       ->required()
       ->check(CLI::ExistingFile);
