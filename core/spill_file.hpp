@@ -51,7 +51,7 @@ class SpillFile {
   // what is still to be read.
   void release(const Extent& extent);
 
-  // Puts each vector's elements (trivially copyable) in turn: their
+  // Puts each vector's elements (plain data, copied byte for byte) in turn: their
   // extents, in order; none when the file cannot take them all (what it
   // took of them is released).
   template <typename... Vectors>
@@ -76,6 +76,7 @@ class SpillFile {
     std::size_t k = 0;
     const auto get_one = [&](auto& v) {
       const Extent& extent = extents[k++];
+      assert(extent.bytes % sizeof(v[0]) == 0 && "the extent of a vector of this type");
       v.resize(extent.bytes / sizeof(v[0]));
       get(extent, v.data());
     };

@@ -2,8 +2,9 @@
 // are taken over hours under other exposures and white balances, so one
 // wall gets another colour in each scan. Corresponding points in the
 // overlaps (the same surface sampled by two scans) give colour pairs; a
-// robust least-squares problem (color_solver.hpp) solves for each scan's correction in
-// linear RGB, where exposure and white balance act as per-channel gains:
+// robust least-squares problem (color_solver.hpp) solves for each scan's
+// correction in linear RGB, where exposure and white balance act as
+// per-channel gains:
 //   gain-offset  rgb' = diag(g) · rgb + o   (6 parameters per scan)
 //   matrix       rgb' = M · rgb + o         (12: also cross-talk between channels)
 // In each group of scans linked by overlaps, the first scan (lowest index)

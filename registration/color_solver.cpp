@@ -1,3 +1,8 @@
+// Levenberg–Marquardt with the damping update of Nielsen (Madsen, Nielsen
+// and Tingleff, "Methods for non-linear least squares problems", 2004,
+// §3.2), as Ceres' trust-region strategy does it, and bounds by projected
+// Newton (Bertsekas 1982): a parameter at a bound that the gradient pushes
+// against is held for the step, the others move and are clamped.
 #include "registration/color_solver.hpp"
 
 #include <Eigen/Sparse>
@@ -5,7 +10,10 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <numeric>
+#include <utility>
 
 #include "core/parallel.hpp"
 #include "registration/color_costs.hpp"
@@ -14,17 +22,20 @@ namespace scanbench::registration {
 
 namespace {
 
-// Stopping and damping as Ceres' Levenberg–Marquardt defaults, which this
-// solve replaced: the relative cost change of an accepted step, the
-// projected gradient, the relative step, the first damping, the least
-// useful step, and the range of the damped diagonal.
+// Stopping and damping as the defaults of Ceres' Levenberg–Marquardt, which
+// this solve replaced (without its Jacobi scaling): the relative cost change
+// of an accepted step, the projected gradient, the relative step, the least
+// useful step, the range of the damped diagonal, and the damping at the
+// start and its range (the inverse of the trust region's radius: at most
+// 1e16, at least 1e-32, where the solve stops as converged).
 constexpr double kFunctionTolerance = 1e-6;
 constexpr double kGradientTolerance = 1e-10;
 constexpr double kParameterTolerance = 1e-8;
-constexpr double kInitialDamping = 1e-4;
 constexpr double kMinRelativeDecrease = 1e-3;
 constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;
+constexpr double kInitialDamping = 1e-4;
+constexpr double kMinDamping = 1e-16;
 constexpr double kMaxDamping = 1e32;
 
 // A pair of scans that share pairs: theirs are order[begin, end).
@@ -266,8 +277,12 @@ class LinkSolver {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> cholesky;
     cholesky.analyzePattern(system.H);
     double damping = kInitialDamping, growth = 2.0;
-    while (out.iterations < settings_.max_iterations && damping < kMaxDamping) {
-      if (projected_gradient(x, system.g) <= kGradientTolerance) {
+    const auto reject = [&] {
+      damping *= growth;
+      growth *= 2.0;
+    };
+    while (out.iterations < settings_.max_iterations) {
+      if (damping >= kMaxDamping || projected_gradient(x, system.g) <= kGradientTolerance) {
         out.converged = true;
         return;
       }
@@ -275,8 +290,7 @@ class LinkSolver {
       const std::vector<std::uint8_t> held = held_at_bounds(x, system.g);
       cholesky.factorize(damped_matrix(system.H, damping, held));
       if (cholesky.info() != Eigen::Success) {
-        damping *= growth;
-        growth *= 2.0;
+        reject();
         continue;
       }
       Eigen::VectorXd rhs = -system.g;
@@ -295,14 +309,14 @@ class LinkSolver {
       const double decrease = system.cost - next.cost;
       const double quality = predicted > 0.0 ? decrease / predicted : -1.0;
       if (quality < kMinRelativeDecrease) {
-        damping *= growth;
-        growth *= 2.0;
+        reject();
         continue;
       }
       const bool settled = decrease <= kFunctionTolerance * system.cost;
       x = candidate;
       system = std::move(next);
-      damping *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * quality - 1.0, 3));
+      damping = std::max(kMinDamping,
+                         damping * std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * quality - 1.0, 3)));
       growth = 2.0;
       if (settled) {
         out.converged = true;
@@ -335,6 +349,13 @@ ColorSolveOutcome solve_color_parameters(std::span<const ColorPair> pairs,
                                          std::span<const double> prior_weight,
                                          const HarmonizeSettings& settings) {
   assert(solved.size() == prior_weight.size() && "one flag and one prior weight a scan");
+  assert(settings.max_gain_ratio >= 1.0 && settings.max_offset >= 0.0 &&
+         settings.max_cross_talk >= 0.0 && "bounds that contain the identity");
+  assert(std::all_of(pairs.begin(), pairs.end(),
+                     [&](const ColorPair& p) {
+                       return p.scan_a < solved.size() && p.scan_b < solved.size();
+                     }) &&
+         "every pair's scans have a flag");
   if (settings.model == ColorModel::kMatrix)
     return LinkSolver<ColorModel::kMatrix>(pairs, solved, prior_weight, settings).run();
   return LinkSolver<ColorModel::kGainOffset>(pairs, solved, prior_weight, settings).run();

@@ -32,11 +32,13 @@ std::vector<double> identity_color_parameters(ColorModel model);
 // Solves the parameters of the scans whose `solved` flag is set; the others
 // stay at the identity (each group's fixed scan, scans in no pair).
 // `prior_weight[k]` weighs scan k's pull towards the identity. Every pair's
-// scans index `solved` and `prior_weight`, which have one entry a scan.
-// Within HarmonizeSettings' bounds; stops when a step changes the cost by
-// less than a millionth, the projected gradient vanishes, or after
-// settings.max_iterations steps (not converged). The same for any thread
-// count.
+// scans index `solved` and `prior_weight`, which have one entry a scan
+// (asserted), and the bounds contain the identity (asserted). Within
+// HarmonizeSettings' bounds. Converged when an accepted step changes the
+// cost by less than a millionth, the projected gradient vanishes, a step
+// moves the parameters by less than 1e-8 of their norm, or no step is
+// accepted even at the largest damping; not converged after
+// settings.max_iterations steps. The same for any thread count.
 ColorSolveOutcome solve_color_parameters(std::span<const ColorPair> pairs,
                                          std::span<const std::uint8_t> solved,
                                          std::span<const double> prior_weight,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/timing.hpp"
@@ -489,11 +490,12 @@ Chain register_chain(ScanStream& scans, std::span<const Eigen::Isometry3d> initi
     const auto uk = static_cast<std::size_t>(k);
     std::shared_ptr<const PreparedScan> source = scans.get(k);
     const Clock::time_point start = Clock::now();
-    samples.put(uk, sample_scan(*source, settings.icp_sample));
+    SampleCloud icp_samples = sample_scan(*source, settings.icp_sample);
     std::optional<FeatureCloud> features;
     if (with_features)
       features.emplace(sample_scan(*source, settings.features.sample), settings.features);
     result.coarse_seconds += core::seconds_since(start);
+    samples.put(uk, std::move(icp_samples));
     const std::string name = source->scan->name;
     steps.step("features of " + name);
     source.reset();

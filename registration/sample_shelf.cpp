@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <utility>
 
 namespace scanbench::registration {
 
@@ -26,8 +27,9 @@ std::shared_ptr<const SampleCloud> SampleShelf::get(std::size_t scan) {
     spill_.get_vectors(slot.extents, cloud->points, cloud->normals, cloud->pixels);
     slot.in_memory = std::move(cloud);
   }
-  if (!slot.extents.empty()) keep(scan);
-  return slot.in_memory;
+  std::shared_ptr<const SampleCloud> out = slot.in_memory;
+  if (!slot.extents.empty()) keep(scan);  // may let it go from the shelf, not from `out`
+  return out;
 }
 
 // Marks parked slot `scan` as used last, and lets the least recently used

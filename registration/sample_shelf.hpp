@@ -7,8 +7,8 @@
 // Not thread-safe: one stage's thread puts and gets.
 #pragma once
 
+#include <cassert>
 #include <cstddef>
-#include <cstdint>
 #include <list>
 #include <memory>
 #include <vector>
@@ -21,7 +21,7 @@ namespace scanbench::registration {
 class SampleShelf {
  public:
   // `scans` empty slots; besides the clouds handed out and still held, at
-  // most `kept` stay in memory (the ones used last).
+  // most `kept` stay in memory (the ones used last; 0: none).
   explicit SampleShelf(std::size_t scans, std::size_t kept = 16);
 
   std::size_t size() const { return slots_.size(); }
@@ -30,14 +30,20 @@ class SampleShelf {
   void put(std::size_t scan, SampleCloud cloud);
 
   // Whether scan `scan`'s cloud was put.
-  bool has(std::size_t scan) const { return slots_[scan].put; }
+  bool has(std::size_t scan) const {
+    assert(scan < slots_.size() && "a slot of the shelf");
+    return slots_[scan].put;
+  }
 
   // The cloud of scan `scan` (put before, asserted). Throws
   // core::RuntimeFailure when the file cannot be read back.
   std::shared_ptr<const SampleCloud> get(std::size_t scan);
 
   // Its number of samples, without reading it back.
-  std::size_t count(std::size_t scan) const { return slots_[scan].count; }
+  std::size_t count(std::size_t scan) const {
+    assert(scan < slots_.size() && "a slot of the shelf");
+    return slots_[scan].count;
+  }
 
  private:
   struct Slot {

@@ -25,8 +25,8 @@ float surface_reflectance(const Scene& scene, const Hit& hit, double footprint_m
 // Both of the above at one hit, from one evaluation of the pattern (each
 // alone evaluates it over the footprint's disk: thirteen samples).
 struct SurfaceAppearance {
-  Eigen::Vector3f albedo;  // linear RGB in [0, 1]
-  float reflectance;       // in [0, 1]
+  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // linear RGB in [0, 1]
+  float reflectance = 0.0f;                          // in [0, 1]
 };
 SurfaceAppearance surface_appearance(const Scene& scene, const Hit& hit, double footprint_m = 0.0);
 

@@ -39,6 +39,13 @@ TEST(SampleShelf, GivesBackEveryCloudAsItWasPut) {
   }
 }
 
+TEST(SampleShelf, AShelfThatKeepsNoneReadsEveryCloudBack) {
+  SampleShelf shelf(2, 0);
+  shelf.put(0, cloud_of(0, 20));
+  shelf.put(1, cloud_of(1, 30));
+  for (const std::size_t k : {1U, 0U, 1U}) expect_same(*shelf.get(k), cloud_of(k, shelf.count(k)));
+}
+
 TEST(SampleShelf, ACloudHandedOutOutlivesItsPlaceInMemory) {
   SampleShelf shelf(3, 1);
   shelf.put(0, cloud_of(0, 50));
