@@ -4,6 +4,7 @@
 // A scan's correction maps its linear RGB colour c to
 //   gain-offset  c' = g ∘ c + o            parameters (g₀ g₁ g₂ o₀ o₁ o₂)
 //   matrix       c' = M c + o              parameters (M row-major, o)
+// (matrix_parameter and offset_parameter below are that layout).
 // A colour pair (the same surface point in scans a and b) has, per channel,
 // the residual
 //   r = s(c'_a) − s(c'_b),   s(v) = log(max(v, 0) + ε),   ε = 0.01.
@@ -32,8 +33,23 @@ namespace scanbench::registration::costs {
 
 inline constexpr double kSoftLogEpsilon = 0.01;
 
+// The parameter layout, written here only: where M(row, col) and o(row)
+// sit in a scan's parameter vector p.
+constexpr int color_parameter_count(ColorModel model) {
+  return model == ColorModel::kGainOffset ? 6 : 12;
+}
+// Index of M(row, col) in p; −1 where the model holds it at the identity's
+// value (the gain-offset model's cross-talk).
+constexpr int matrix_parameter(ColorModel model, int row, int col) {
+  if (model == ColorModel::kGainOffset) return row == col ? row : -1;
+  return 3 * row + col;
+}
+constexpr int offset_parameter(ColorModel model, int row) {
+  return color_parameter_count(model) - 3 + row;
+}
+
 template <ColorModel Model>
-inline constexpr int kColorParameters = Model == ColorModel::kGainOffset ? 6 : 12;
+inline constexpr int kColorParameters = color_parameter_count(Model);
 
 template <ColorModel Model>
 using PairJacobian = Eigen::Matrix<double, 3, kColorParameters<Model>>;
@@ -41,12 +57,12 @@ using PairJacobian = Eigen::Matrix<double, 3, kColorParameters<Model>>;
 // Channel k of c' for `rgb` under the parameters p.
 template <ColorModel Model>
 double corrected_channel(const double* p, const Eigen::Vector3f& rgb, int k) {
-  if constexpr (Model == ColorModel::kGainOffset) {
-    return p[k] * double{rgb[k]} + p[3 + k];
-  } else {
-    return p[3 * k] * double{rgb[0]} + p[3 * k + 1] * double{rgb[1]} +
-           p[3 * k + 2] * double{rgb[2]} + p[9 + k];
+  double sum = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    const int i = matrix_parameter(Model, k, j);
+    if (i >= 0) sum += p[i] * double{rgb[j]};
   }
+  return sum + p[offset_parameter(Model, k)];
 }
 
 inline double soft_log(double v) {
@@ -59,13 +75,11 @@ inline double soft_log_slope(double v) {
 // Row k of a scan's Jacobian: `slope` × ∂c'_k/∂p.
 template <ColorModel Model>
 void set_jacobian_row(const Eigen::Vector3f& rgb, int k, double slope, PairJacobian<Model>& J) {
-  if constexpr (Model == ColorModel::kGainOffset) {
-    J(k, k) = slope * double{rgb[k]};
-    J(k, 3 + k) = slope;
-  } else {
-    for (int j = 0; j < 3; ++j) J(k, 3 * k + j) = slope * double{rgb[j]};
-    J(k, 9 + k) = slope;
+  for (int j = 0; j < 3; ++j) {
+    const int i = matrix_parameter(Model, k, j);
+    if (i >= 0) J(k, i) = slope * double{rgb[j]};
   }
+  J(k, offset_parameter(Model, k)) = slope;
 }
 
 // The residual of the pair (rgb_a in scan a at parameters pa, rgb_b in b

@@ -8,6 +8,7 @@
 
 #include "acquisition/color_space.hpp"
 #include "core/parallel.hpp"
+#include "registration/color_costs.hpp"
 #include "registration/color_solver.hpp"
 
 namespace scanbench::registration {
@@ -110,18 +111,14 @@ std::vector<std::int32_t> group_references(std::span<const ColorPair> pairs, std
   return out;
 }
 
-acquisition::ColorCorrection correction_of(const std::vector<double>& p, bool matrix) {
+acquisition::ColorCorrection correction_of(const std::vector<double>& p, ColorModel model) {
   acquisition::ColorCorrection c;
-  for (int r = 0; r < 3; ++r) {
-    const auto ur = static_cast<std::size_t>(r);
-    if (matrix) {
-      for (int col = 0; col < 3; ++col)
-        c.matrix(r, col) = p[3 * ur + static_cast<std::size_t>(col)];
-      c.offset[r] = p[9 + ur];
-    } else {
-      c.matrix(r, r) = p[ur];
-      c.offset[r] = p[3 + ur];
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      const int i = costs::matrix_parameter(model, row, col);
+      if (i >= 0) c.matrix(row, col) = p[static_cast<std::size_t>(i)];
     }
+    c.offset[row] = p[static_cast<std::size_t>(costs::offset_parameter(model, row))];
   }
   return c;
 }
@@ -232,9 +229,8 @@ HarmonizeResult harmonize_colors(std::span<const ColorPair> pairs, std::size_t s
   result.final_cost = solve.final_cost;
   result.iterations = solve.iterations;
   result.converged = solve.converged;
-  const bool matrix = settings.model == ColorModel::kMatrix;
   for (std::size_t k = 0; k < scan_count; ++k) {
-    if (solved[k]) result.corrections[k] = correction_of(solve.parameters[k], matrix);
+    if (solved[k]) result.corrections[k] = correction_of(solve.parameters[k], settings.model);
   }
   return result;
 }

@@ -72,15 +72,22 @@ LinkOrder links_of(std::span<const ColorPair> pairs) {
 // either way, channel cross-talk and offsets small.
 std::pair<std::vector<double>, std::vector<double>> parameter_bounds(
     ColorModel model, const HarmonizeSettings& settings) {
-  const bool matrix = model == ColorModel::kMatrix;
-  const std::size_t count = matrix ? 12 : 6;
+  const auto count = static_cast<std::size_t>(costs::color_parameter_count(model));
   std::vector<double> lower(count), upper(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const bool offset = i >= (matrix ? 9U : 3U);
-    const bool gain = !offset && (!matrix || i % 4 == 0);
-    upper[i] =
-        offset ? settings.max_offset : (gain ? settings.max_gain_ratio : settings.max_cross_talk);
-    lower[i] = gain ? 1.0 / settings.max_gain_ratio : -upper[i];
+  const auto bound = [&](int i, double low, double high) {
+    lower[static_cast<std::size_t>(i)] = low;
+    upper[static_cast<std::size_t>(i)] = high;
+  };
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      const int i = costs::matrix_parameter(model, row, col);
+      if (i < 0) continue;
+      if (row == col)
+        bound(i, 1.0 / settings.max_gain_ratio, settings.max_gain_ratio);
+      else
+        bound(i, -settings.max_cross_talk, settings.max_cross_talk);
+    }
+    bound(costs::offset_parameter(model, row), -settings.max_offset, settings.max_offset);
   }
   return {lower, upper};
 }
@@ -338,9 +345,9 @@ class LinkSolver {
 }  // namespace
 
 std::vector<double> identity_color_parameters(ColorModel model) {
-  const bool matrix = model == ColorModel::kMatrix;
-  std::vector<double> p(matrix ? 12 : 6, 0.0);
-  for (std::size_t c = 0; c < 3; ++c) p[matrix ? 4 * c : c] = 1.0;
+  std::vector<double> p(static_cast<std::size_t>(costs::color_parameter_count(model)), 0.0);
+  for (int c = 0; c < 3; ++c)
+    p[static_cast<std::size_t>(costs::matrix_parameter(model, c, c))] = 1.0;
   return p;
 }
 
