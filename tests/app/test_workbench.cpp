@@ -49,19 +49,28 @@ json read_json(const std::filesystem::path& file) {
 
 // The campus's first scan at a quarter of the resolution (0.4° steps) with
 // its geometry: Keller Hall's west wall faces the scanner at column 654, row
-// 116, its south wall at column 617, row 82.
+// 116, its south wall at column 617, row 82. Simulated, imported and
+// measured once per test process; each test gets a copy of the project and
+// the simulator's output (sim/) in its own folder.
 std::filesystem::path campus_project(const ScratchDir& dir) {
-  const std::filesystem::path project = dir / "campus.sbproj";
-  const std::vector<std::vector<std::string>> steps = {
-      {"simulate", "--site", "campus", "--scans", "1", "--columns", "900", "--rows", "225", "--out",
-       (dir / "sim").string()},
-      {"import", project.string(), (dir / "sim" / "campus_scan_01.json").string()},
-      {"geometry", project.string()}};
-  for (const std::vector<std::string>& step : steps) {
-    const CliResult result = run_cli(dir, step);
-    EXPECT_EQ(result.exit_code, 0) << step.front() << ": " << result.err;
-  }
-  return project;
+  static const ScratchDir built;
+  static const bool made = [] {
+    const std::filesystem::path project = built / "campus.sbproj";
+    const std::vector<std::vector<std::string>> steps = {
+        {"simulate", "--site", "campus", "--scans", "1", "--columns", "900", "--rows", "225",
+         "--out", (built / "sim").string()},
+        {"import", project.string(), (built / "sim" / "campus_scan_01.json").string()},
+        {"geometry", project.string()}};
+    for (const std::vector<std::string>& step : steps) {
+      const CliResult result = run_cli(built, step);
+      EXPECT_EQ(result.exit_code, 0) << step.front() << ": " << result.err;
+      if (result.exit_code != 0) return false;
+    }
+    return true;
+  }();
+  EXPECT_TRUE(made) << "the campus project could not be made";
+  std::filesystem::copy(built.path(), dir.path(), std::filesystem::copy_options::recursive);
+  return dir / "campus.sbproj";
 }
 
 // A replay's events file.
