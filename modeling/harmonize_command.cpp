@@ -8,7 +8,7 @@
 #include "acquisition/color_space.hpp"
 #include "core/errors.hpp"
 #include "core/memory.hpp"
-#include "core/spill_file.hpp"
+#include "core/spill_shelf.hpp"
 #include "core/timing.hpp"
 #include "modeling/command_json.hpp"
 #include "modeling/scan_cache.hpp"
@@ -100,64 +100,6 @@ HarmonizeCommandResult harmonize_outcome(
   return out;
 }
 
-// The colour samples of the scans still to be paired as a pair's first
-// scan, parked in a temporary file (core::SpillFile) while they wait, or
-// kept in memory where the file cannot take them (bytes_in_memory counts
-// those: the stage holds them against its memory limit).
-class ParkedSamples {
- public:
-  void put(int scan, registration::ColorSamples samples) {
-    Parked parked;
-    parked.count = samples.size();
-    if (spill_.usable()) {
-      if (auto extents =
-              spill_.put_vectors(samples.pixels, samples.points, samples.normals, samples.rgb)) {
-        parked.extents = std::move(*extents);
-        parked_[scan] = std::move(parked);
-        return;
-      }
-    }
-    parked.in_memory = std::move(samples);
-    in_memory_bytes_ += bytes_of(parked.count);
-    parked_[scan] = std::move(parked);
-  }
-
-  std::uint64_t bytes_in_memory() const { return in_memory_bytes_; }
-
-  // The samples of `scan`, which were put and not released (asserted).
-  // Throws core::RuntimeFailure when the file cannot be read.
-  registration::ColorSamples get(int scan) const {
-    const auto found = parked_.find(scan);
-    assert(found != parked_.end() && "the samples were put");
-    const Parked& parked = found->second;
-    if (parked.extents.empty()) return parked.in_memory;
-    registration::ColorSamples out;
-    spill_.get_vectors(parked.extents, out.pixels, out.points, out.normals, out.rgb);
-    return out;
-  }
-
-  void release(int scan) {
-    const auto found = parked_.find(scan);
-    if (found == parked_.end()) return;
-    for (const core::SpillFile::Extent& extent : found->second.extents) spill_.release(extent);
-    if (found->second.extents.empty()) in_memory_bytes_ -= bytes_of(found->second.count);
-    parked_.erase(found);
-  }
-
- private:
-  struct Parked {
-    std::size_t count = 0;
-    std::vector<core::SpillFile::Extent> extents;  // pixels, points, normals, rgb; or none
-    registration::ColorSamples in_memory;          // where the file could not take them
-  };
-  static std::uint64_t bytes_of(std::size_t count) {
-    return count * (sizeof(std::int64_t) + 3 * sizeof(Eigen::Vector3f));
-  }
-  core::SpillFile spill_;
-  std::map<int, Parked> parked_;
-  std::uint64_t in_memory_bytes_ = 0;
-};
-
 // The colour pairs of every two scans with colour whose bounds meet, in the
 // order find_color_pairs gives them (by the pair's first scan, then its
 // second). One pass over the scans in the project's order, each loaded once:
@@ -196,7 +138,9 @@ std::vector<registration::ColorPair> streamed_color_pairs(
   ScanCache cache(project, memory_limit, settings.threads, "harmonize", progress,
                   {.form = ScanForm::kWhole, .spill = false, .max_kept = 0});
   cache.plan(plan);
-  ParkedSamples samples;
+  // The colour samples of the scans still to be paired as a pair's first
+  // scan wait in a temporary file, or in memory where it cannot take them.
+  core::SpillShelf<registration::ColorSamples> samples(scans.size(), 0);
   std::map<std::pair<int, int>, std::vector<registration::ColorPair>> found;
   auto next_pair = pairs.begin();  // ordered by second, then first
   for (std::size_t v = 0; v < visit.size(); ++v) {
@@ -211,13 +155,15 @@ std::vector<registration::ColorPair> streamed_color_pairs(
       link.max_pairs_per_overlap = registration::link_pair_budget(
           settings, partners[static_cast<std::size_t>(a)], partners[static_cast<std::size_t>(k)]);
       found[{a, k}] = registration::color_pairs_between(
-          samples.get(a), b->prepared, static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(k),
-          summary_a.summary.T_world_scan, summary.summary.T_world_scan, link);
-      if (last_second[static_cast<std::size_t>(a)] == k) samples.release(a);
+          *samples.get(static_cast<std::size_t>(a)), b->prepared, static_cast<std::uint32_t>(a),
+          static_cast<std::uint32_t>(k), summary_a.summary.T_world_scan,
+          summary.summary.T_world_scan, link);
+      if (last_second[static_cast<std::size_t>(a)] == k)
+        samples.release(static_cast<std::size_t>(a));
       progress.throw_if_cancelled("harmonize");
     }
     if (last_second[static_cast<std::size_t>(k)] > k) {
-      samples.put(k, registration::color_samples(b->prepared, settings));
+      samples.put(static_cast<std::size_t>(k), registration::color_samples(b->prepared, settings));
       if (samples.bytes_in_memory() + b->bytes > memory_limit) {
         throw core::MemoryShortage(
             project.path().string(), {},

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "acquisition/color_space.hpp"
@@ -90,6 +91,9 @@ struct ColorSamples {
   std::vector<Eigen::Vector3f> normals;  // scan frame, unit; zero where the pixel has none
   std::vector<Eigen::Vector3f> rgb;      // linear
   std::size_t size() const { return pixels.size(); }
+  // Its arrays, for core::SpillShelf.
+  auto vectors() { return std::tie(pixels, points, normals, rgb); }
+  auto vectors() const { return std::tie(pixels, points, normals, rgb); }
 };
 
 // The samples of `scan` (prepared with its geometry) under `settings`

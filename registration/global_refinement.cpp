@@ -173,7 +173,7 @@ GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans,
   GlobalResult result;
   std::vector<PoseParameters> poses;
   for (const Eigen::Isometry3d& T : T_first_scan) poses.push_back(PoseParameters::from(T));
-  SampleShelf thinned(samples.size());
+  SampleShelf thinned(samples.size(), kSamplesKept);
   for (std::size_t k = 0; k < samples.size(); ++k)
     thinned.put(k, thin(*samples.get(k), settings.max_samples));
   // Rounds run on the thinned samples until the poses stop moving (then the

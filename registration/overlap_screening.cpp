@@ -117,7 +117,7 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, SampleShelf& samples,
     cells.push_back(occupied_cells(*cloud, T_first_scan[k], reach));
   }
   // A decision on a share: a thinned sample will do.
-  SampleShelf estimates(samples.size());
+  SampleShelf estimates(samples.size(), kSamplesKept);
   std::vector<ScanEdge> candidates;  // in (source, target) order
   for (int a = 1; a < n; ++a) {
     const auto ua = static_cast<std::size_t>(a);

@@ -397,7 +397,7 @@ RegistrationResult register_scans(ScanStream& scans,
   const std::size_t n = scans.size();
   StageProgress steps(progress, 2 * n);  // scans made ready, pairs, the global refinement
   RegistrationResult result;
-  SampleShelf samples(n);
+  SampleShelf samples(n, kSamplesKept);
   Chain chain = register_chain(scans, initial_T_world_scan, settings, steps, samples, result);
 
   const std::vector<ScanEdge> edges = overlapping_edges(

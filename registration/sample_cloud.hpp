@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include "registration/prepared_scan.hpp"
@@ -19,6 +20,9 @@ struct SampleCloud {
   std::vector<Eigen::Vector3f> normals;  // unit, pointing to the scanner
   std::vector<std::int64_t> pixels;      // row-major pixel of the scan
   std::size_t size() const { return points.size(); }
+  // Its arrays, for core::SpillShelf.
+  auto vectors() { return std::tie(points, normals, pixels); }
+  auto vectors() const { return std::tie(points, normals, pixels); }
 };
 
 struct SampleSettings {

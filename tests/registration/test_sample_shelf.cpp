@@ -1,6 +1,7 @@
-// registration::SampleShelf gives back every cloud as it was put, whether
-// it stayed in memory or was read back from its file, and a cloud handed
-// out stays whole after the shelf lets it go.
+// registration::SampleShelf (core::SpillShelf of sample clouds) gives back
+// every cloud as it was put, whether it stayed in memory or was read back
+// from its file; a cloud handed out stays whole after the shelf lets it go,
+// and a released one is gone.
 #include <gtest/gtest.h>
 
 #include "registration/sample_shelf.hpp"
@@ -54,6 +55,18 @@ TEST(SampleShelf, ACloudHandedOutOutlivesItsPlaceInMemory) {
   shelf.put(2, cloud_of(2, 50));
   expect_same(*held, cloud_of(0, 50));
   expect_same(*shelf.get(0), cloud_of(0, 50));
+}
+
+TEST(SampleShelf, AReleasedCloudIsGoneAndTheOthersStay) {
+  SampleShelf shelf(3, 1);
+  for (std::size_t k = 0; k < 3; ++k) shelf.put(k, cloud_of(k, 40));
+  const std::shared_ptr<const SampleCloud> held = shelf.get(1);
+  shelf.release(1);
+  shelf.release(1);  // nothing more to let go
+  EXPECT_FALSE(shelf.has(1));
+  expect_same(*held, cloud_of(1, 40));
+  for (const std::size_t k : {2U, 0U, 2U}) expect_same(*shelf.get(k), cloud_of(k, 40));
+  EXPECT_EQ(shelf.bytes_in_memory(), 0U);  // the file took every cloud
 }
 
 }  // namespace
