@@ -209,27 +209,30 @@ class LinkSolver {
     return system;
   }
 
+  // Calls f(at, column, i) for parameter i of every solved scan: `at` its
+  // place in x, `column` its place in the system.
+  template <typename F>
+  void for_each_solved(F&& f) const {
+    for (std::size_t k = 0; k < column_.size(); ++k) {
+      if (column_[k] < 0) continue;
+      for (int i = 0; i < P; ++i)
+        f(k * P + static_cast<std::size_t>(i), column_[k] + i, static_cast<std::size_t>(i));
+    }
+  }
+
   // The solved parameters of x moved by `step` and held within bounds.
   std::vector<double> moved(const std::vector<double>& x, const Eigen::VectorXd& step) const {
     std::vector<double> out = x;
-    for (std::size_t k = 0; k < column_.size(); ++k) {
-      if (column_[k] < 0) continue;
-      for (int i = 0; i < P; ++i) {
-        double& v = out[k * P + static_cast<std::size_t>(i)];
-        v = std::clamp(v + step[column_[k] + i], bounds_.first[static_cast<std::size_t>(i)],
-                       bounds_.second[static_cast<std::size_t>(i)]);
-      }
-    }
+    for_each_solved([&](std::size_t at, int column, std::size_t i) {
+      out[at] = std::clamp(out[at] + step[column], bounds_.first[i], bounds_.second[i]);
+    });
     return out;
   }
 
   // The solved columns of b − a.
   Eigen::VectorXd difference(const std::vector<double>& a, const std::vector<double>& b) const {
     Eigen::VectorXd d(static_cast<Eigen::Index>(unknowns_ * P));
-    for (std::size_t k = 0; k < column_.size(); ++k) {
-      if (column_[k] < 0) continue;
-      for (int i = 0; i < P; ++i) d[column_[k] + i] = b[k * P + i] - a[k * P + i];
-    }
+    for_each_solved([&](std::size_t at, int column, std::size_t) { d[column] = b[at] - a[at]; });
     return d;
   }
 
@@ -245,15 +248,11 @@ class LinkSolver {
   std::vector<std::uint8_t> held_at_bounds(const std::vector<double>& x,
                                            const Eigen::VectorXd& g) const {
     std::vector<std::uint8_t> held(static_cast<std::size_t>(g.size()), 0);
-    for (std::size_t k = 0; k < column_.size(); ++k) {
-      if (column_[k] < 0) continue;
-      for (int i = 0; i < P; ++i) {
-        const auto at = static_cast<std::size_t>(i);
-        const double v = x[k * P + at], slope = g[column_[k] + i];
-        held[static_cast<std::size_t>(column_[k] + i)] =
-            (v <= bounds_.first[at] && slope > 0.0) || (v >= bounds_.second[at] && slope < 0.0);
-      }
-    }
+    for_each_solved([&](std::size_t at, int column, std::size_t i) {
+      const double slope = g[column];
+      held[static_cast<std::size_t>(column)] =
+          (x[at] <= bounds_.first[i] && slope > 0.0) || (x[at] >= bounds_.second[i] && slope < 0.0);
+    });
     return held;
   }
 
