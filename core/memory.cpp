@@ -125,6 +125,15 @@ void check_memory(std::uint64_t bytes, const std::string& file) {
   }
 }
 
+void check_memory_limit(std::uint64_t bytes, std::uint64_t limit, const std::string& file,
+                        const std::string& stage, const std::string& what) {
+  if (bytes <= limit) return;
+  throw MemoryShortage(file, {},
+                       stage + " needs about " + gigabytes(bytes) + " for " + what +
+                           ", more than its memory limit of " + gigabytes(limit) +
+                           " (--memory-limit)");
+}
+
 void map_now(const void* data, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
   constexpr std::size_t kWorthIt = std::size_t{1} << 20;  // below, a few faults

@@ -33,6 +33,12 @@ std::optional<std::uint64_t> peak_resident_bytes();
 // Nothing happens where the available memory cannot be told.
 void check_memory(std::uint64_t bytes, const std::string& file);
 
+// Throws MemoryShortage naming `file` when `bytes`, what `stage` needs for
+// `what`, exceed its memory limit `limit`: "STAGE needs about N GB for
+// WHAT, more than its memory limit of L GB (--memory-limit)".
+void check_memory_limit(std::uint64_t bytes, std::uint64_t limit, const std::string& file,
+                        const std::string& stage, const std::string& what);
+
 // Backs the pages of [data, data + bytes) with memory now, in one system
 // call and in 2 MB pages where the kernel allows them (Linux: transparent
 // huge pages on madvise, MADV_POPULATE_WRITE from 5.14), instead of one page

@@ -164,15 +164,11 @@ std::vector<registration::ColorPair> streamed_color_pairs(
     }
     if (last_second[static_cast<std::size_t>(k)] > k) {
       samples.put(static_cast<std::size_t>(k), registration::color_samples(b->prepared, settings));
-      if (samples.bytes_in_memory() + b->bytes > memory_limit) {
-        throw core::MemoryShortage(
-            project.path().string(), {},
-            "harmonize needs about " + core::gigabytes(samples.bytes_in_memory() + b->bytes) +
-                " for scan " + std::to_string(summary.id) +
-                " and the colour samples that a temporary file could not take (none could be "
-                "made, or the disk is full), more than its memory limit of " +
-                core::gigabytes(memory_limit) + " (--memory-limit)");
-      }
+      core::check_memory_limit(samples.bytes_in_memory() + b->bytes, memory_limit,
+                               project.path().string(), "harmonize",
+                               "scan " + std::to_string(summary.id) +
+                                   " and the colour samples that a temporary file could not take "
+                                   "(none could be made, or the disk is full)");
     }
   }
   std::vector<registration::ColorPair> out;

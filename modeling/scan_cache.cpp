@@ -199,12 +199,9 @@ void ScanCache::keep_at_most(std::size_t count) {
 // Throws core::MemoryShortage when `bytes` (the scans in hand with scan
 // `id`) exceed the limit.
 void ScanCache::refuse_beyond_limit(std::uint64_t bytes, std::int64_t id) const {
-  if (bytes <= limit_) return;
-  throw core::MemoryShortage(project_.path().string(), {},
-                             stage_ + " needs about " + core::gigabytes(bytes) +
-                                 " for the scans it works on together (scan " + std::to_string(id) +
-                                 " and those in hand), more than its memory limit of " +
-                                 core::gigabytes(limit_) + " (--memory-limit)");
+  core::check_memory_limit(
+      bytes, limit_, project_.path().string(), stage_,
+      "the scans it works on together (scan " + std::to_string(id) + " and those in hand)");
 }
 
 std::shared_ptr<LoadedScan> ScanCache::load_from_project(std::int64_t id) const {

@@ -388,15 +388,6 @@ void PointListWriter::commit() {
   s.file.commit();
 }
 
-std::size_t count_exported_points(std::span<const Scan> scans,
-                                  std::span<const ScanGeometry* const> geometry,
-                                  std::span<const std::vector<std::uint8_t>* const> keep) {
-  std::size_t points = 0;
-  for_each_point(scans, geometry, keep, common_channels(scans, geometry),
-                 [&](std::size_t, std::size_t, const Eigen::Vector3d&) { ++points; });
-  return points;
-}
-
 namespace {
 
 void write_point_list(const std::filesystem::path& path, PointListFormat format,

@@ -26,13 +26,6 @@ namespace scanbench::acquisition {
 // pixel (1 = write the point; the merged model of `scanbench merge`), or
 // nullptr to write every point of that scan.
 
-// The number of points write_ply, write_csv and write_las write for these
-// arguments: valid, kept, and not mixed pixels when every scan has
-// geometry.
-std::size_t count_exported_points(std::span<const Scan> scans,
-                                  std::span<const ScanGeometry* const> geometry = {},
-                                  std::span<const std::vector<std::uint8_t>* const> keep = {});
-
 // Binary little-endian PLY: double x y z, then float intensity when every scan
 // has intensity, then uchar red green blue when every scan has colour, then
 // float nx ny nz (unit, world frame; 0 0 0 where invalid) and float radius
