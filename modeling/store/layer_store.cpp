@@ -38,11 +38,16 @@ const TypeInfo& info(ElementType type) {
 }
 
 // The current version of layer (scan, name): the row of the newest done
-// command, in journal order.
+// command, in journal order. The newest is picked from the index alone, and
+// then its row read by key: sorting the rows themselves would copy each
+// version's data through a temporary b-tree (a temporary file for a layer
+// of megabytes) on every read.
 const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data
-FROM scan_layers l JOIN commands c ON c.id = l.command_id
-WHERE l.scan_id = ?1 AND l.name = ?2 AND c.state = 'done'
-ORDER BY c.seq DESC LIMIT 1)sql"});
+FROM scan_layers l
+WHERE l.scan_id = ?1 AND l.name = ?2 AND l.command_id = (
+  SELECT k.command_id FROM scan_layers k JOIN commands c ON c.id = k.command_id
+  WHERE k.scan_id = ?1 AND k.name = ?2 AND c.state = 'done'
+  ORDER BY c.seq DESC LIMIT 1))sql"});
 
 // The layers whose name fixes their type (layer_store.hpp).
 struct KnownLayer {
