@@ -103,6 +103,9 @@ void add_simulate_command(CLI::App& app) {
                    "(σ = 0.6 mm + 2e-5 r + 2e-6 r², 0.6–120 m) or structured-light (σ = 1.5e-3 "
                    "r², 0.5–8 m)")
       ->transform(one_of(profiles));
+  command->add_flag("--one-sun", campaign.one_sun,
+                    "Light every scan by one sun: the scans' colours then differ by exposure "
+                    "and white balance only (truth.json has each scan's)");
   add_threads_option(command, campaign.simulation.threads);
   command
       ->add_option("--pose-error-deg", campaign.pose_error_deg,

@@ -14,13 +14,8 @@ acquisition::sim::ScanLighting scan_lighting(SiteLighting lighting, int k) {
   switch (lighting) {
     case SiteLighting::kReference:
       return sim::reference_lighting();
-    case SiteLighting::kExposureOnly: {
-      sim::ScanLighting out = sim::reference_lighting();
-      const sim::ScanLighting own = sim::random_lighting(scan_seed(k));
-      out.exposure = own.exposure;
-      out.white_balance = own.white_balance;
-      return out;
-    }
+    case SiteLighting::kExposureOnly:
+      return sim::one_sun_lighting(scan_seed(k));
     case SiteLighting::kPerScan:
       break;
   }

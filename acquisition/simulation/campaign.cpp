@@ -132,7 +132,8 @@ CampaignResult simulate_campaign(const CampaignSettings& settings, const fs::pat
   for (int k = 0; k < static_cast<int>(site.scan_poses.size()); ++k) {
     progress.throw_if_cancelled("simulate");
     const std::uint64_t scan_seed = hash_combine(settings.seed, static_cast<std::uint64_t>(k) + 1);
-    const ScanLighting lighting = random_lighting(scan_seed);
+    const ScanLighting lighting =
+        settings.one_sun ? one_sun_lighting(scan_seed) : random_lighting(scan_seed);
     const auto cast_start = std::chrono::steady_clock::now();
     SimulatedScan sim = simulate_scan(site.scene, site.scan_poses[k], settings.scanner, lighting,
                                       scan_seed, settings.simulation);

@@ -39,6 +39,10 @@ struct CampaignSettings {
   // poses): up to this rotation [deg] and translation [m], seeded. 0 = exact.
   double pose_error_deg = 0.0;
   double pose_error_m = 0.0;
+  // Every scan under one sun (one_sun_lighting: the scans' colours differ
+  // by their exposure and white balance only) instead of each its own
+  // (random_lighting).
+  bool one_sun = false;
 };
 
 struct CampaignResult {

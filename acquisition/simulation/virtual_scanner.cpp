@@ -188,6 +188,14 @@ ScanLighting random_lighting(std::uint64_t seed) {
   return lighting;
 }
 
+ScanLighting one_sun_lighting(std::uint64_t seed) {
+  ScanLighting out = reference_lighting();
+  const ScanLighting own = random_lighting(seed);
+  out.exposure = own.exposure;
+  out.white_balance = own.white_balance;
+  return out;
+}
+
 double footprint_radius(double range_m, double pixel_angle_rad, double cos_incidence) {
   return 0.5 * range_m * pixel_angle_rad / std::max(cos_incidence, 0.1);
 }

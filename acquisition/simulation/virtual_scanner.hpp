@@ -80,6 +80,10 @@ ScanLighting reference_lighting();
 // 0.45–0.8, white balance gains within ±12 %.
 ScanLighting random_lighting(std::uint64_t seed);
 
+// The reference sun and sky with random_lighting(seed)'s exposure and white
+// balance: scans of one campaign lit so differ by per-channel gains only.
+ScanLighting one_sun_lighting(std::uint64_t seed);
+
 // Per-pixel truth, rows × columns, row-major like the scan.
 struct ScanTruth {
   std::vector<ObjectId> object_id;  // object under the beam centre; 0 = no return

@@ -562,6 +562,37 @@ TEST(Cli, SimulateThenImportThenInfoOnTheCampusSite) {
   EXPECT_EQ(info["scans"][1]["T_world_scan"], truth["scans"][1]["T_world_scan"]);
 }
 
+// --one-sun: every scan under the same sun and sky, each with its own
+// exposure and white balance (what a harmonisation should undo exactly).
+TEST(Cli, SimulateUnderOneSunVariesOnlyExposureAndWhiteBalance) {
+  ScratchDir dir;
+  const auto lighting = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {
+        "simulate",  "--site", "path",   "--out", (dir / "sim").string(), "--scans", "3",
+        "--columns", "72",     "--rows", "18"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CliResult sim = run_cli(dir, args);
+    EXPECT_EQ(sim.exit_code, 0) << sim.err;
+    const nlohmann::json truth =
+        nlohmann::json::parse(test::read_file_bytes(dir / "sim/truth.json"));
+    std::vector<nlohmann::json> out;
+    for (const nlohmann::json& scan : truth["scans"]) out.push_back(scan["lighting"]);
+    return out;
+  };
+  const std::vector<nlohmann::json> own = lighting({});
+  const std::vector<nlohmann::json> one = lighting({"--one-sun"});
+  ASSERT_EQ(own.size(), 3u);
+  ASSERT_EQ(one.size(), 3u);
+  EXPECT_NE(own[0]["sun_direction_world"], own[1]["sun_direction_world"]);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(one[k]["sun_direction_world"], one[0]["sun_direction_world"]);
+    EXPECT_EQ(one[k]["sky_irradiance"], one[0]["sky_irradiance"]);
+    EXPECT_EQ(one[k]["exposure"], own[k]["exposure"]);
+    EXPECT_EQ(one[k]["white_balance"], own[k]["white_balance"]);
+  }
+  EXPECT_NE(one[1]["exposure"], one[0]["exposure"]);
+}
+
 TEST(Cli, GeometryThenPlyExportCarriesNormalsAndLeavesMixedPixelsOut) {
   ScratchDir dir;
   ASSERT_EQ(run_cli(dir, {"simulate", "--site", "campus", "--out", (dir / "sim").string(),
