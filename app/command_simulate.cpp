@@ -1,5 +1,6 @@
 // scanbench simulate: the virtual scanner on a procedural site.
 //   simulate --site S --out DIR [--scans N] [--columns C --rows R] [--seed K] [--format F]
+//            [--noise P] [--pose-error-deg D --pose-error-m M] [--one-sun]
 //   simulate --site S [--seed K] --render-view VIEW.json -o truth.png
 #include <fmt/core.h>
 

@@ -35,6 +35,7 @@ inline constexpr double kSoftLogEpsilon = 0.01;
 
 // The parameter layout, written here only: where M(row, col) and o(row)
 // sit in a scan's parameter vector p.
+// The parameters of one scan's correction: 6 (gain-offset) or 12 (matrix).
 constexpr int color_parameter_count(ColorModel model) {
   return model == ColorModel::kGainOffset ? 6 : 12;
 }
@@ -44,6 +45,7 @@ constexpr int matrix_parameter(ColorModel model, int row, int col) {
   if (model == ColorModel::kGainOffset) return row == col ? row : -1;
   return 3 * row + col;
 }
+// Index of o(row) in p: the last three parameters.
 constexpr int offset_parameter(ColorModel model, int row) {
   return color_parameter_count(model) - 3 + row;
 }

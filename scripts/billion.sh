@@ -9,7 +9,11 @@
 # 45 GB of disk for 48 stations (scan files 6.7 GB, project 26 GB, merged
 # LAS) and /usr/bin/time (Debian package `time`).
 set -u
-B=$1; D=$2; N=$3; FROM=${4:-simulate}; TO=${5:-export}
+stages="simulate import geometry register merge export"
+B=$(realpath "$1"); D=$(realpath -m "$2"); N=$3; FROM=${4:-simulate}; TO=${5:-export}
+for s in "$FROM" "$TO"; do
+  case " $stages " in *" $s "*) ;; *) echo "billion.sh: no stage \"$s\" ($stages)" >&2; exit 2 ;; esac
+done
 mkdir -p "$D"; cd "$D" || exit 1
 stage() {  # name, command...
   local name=$1; shift
@@ -20,8 +24,8 @@ stage() {  # name, command...
   [ $rc -eq 0 ] || exit $rc
 }
 go=0
-for s in simulate import geometry register merge export; do
-  [ $s = "$FROM" ] && go=1
+for s in $stages; do
+  [ "$s" = "$FROM" ] && go=1
   [ $go = 1 ] || continue
   case $s in
     simulate) stage simulate "$B" simulate --site path --scans "$N" --columns 10000 --rows 2500 \
@@ -34,6 +38,6 @@ for s in simulate import geometry register merge export; do
     export) stage export "$B" export "$D/b.sbproj" --format las --merged -o "$D/merged.las" ;;
   esac
   du -sb "$D"/b.sbproj* "$D/sim" 2>/dev/null >> stages.log
-  [ $s = "$TO" ] && break
+  [ "$s" = "$TO" ] && break
 done
 echo "== done $(date +%T)" >> stages.log

@@ -38,10 +38,10 @@ const TypeInfo& info(ElementType type) {
 }
 
 // The current version of layer (scan, name): the row of the newest done
-// command, in journal order. The newest is picked from the index alone, and
-// then its row read by key: sorting the rows themselves would copy each
-// version's data through a temporary b-tree (a temporary file for a layer
-// of megabytes) on every read.
+// command, in journal order. The newest is picked without the data column,
+// and then its row read by key: sorting the rows with their data would copy
+// each version's data through a temporary b-tree (a temporary file for a
+// layer of megabytes) on every read.
 const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data
 FROM scan_layers l
 WHERE l.scan_id = ?1 AND l.name = ?2 AND l.command_id = (

@@ -4,6 +4,7 @@
 // and a released one is gone.
 #include <gtest/gtest.h>
 
+#include "core/spill_file.hpp"
 #include "registration/sample_shelf.hpp"
 
 namespace scanbench::registration {
@@ -66,7 +67,9 @@ TEST(SampleShelf, AReleasedCloudIsGoneAndTheOthersStay) {
   EXPECT_FALSE(shelf.has(1));
   expect_same(*held, cloud_of(1, 40));
   for (const std::size_t k : {2U, 0U, 2U}) expect_same(*shelf.get(k), cloud_of(k, 40));
-  EXPECT_EQ(shelf.bytes_in_memory(), 0U);  // the file took every cloud
+  if (core::SpillFile().usable()) {
+    EXPECT_EQ(shelf.bytes_in_memory(), 0U);  // the file took every cloud
+  }
 }
 
 }  // namespace
