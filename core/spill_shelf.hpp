@@ -36,18 +36,14 @@ class SpillShelf {
   // Puts the value of slot `slot` (< size(); each slot once, asserted).
   void put(std::size_t slot, T value) {
     assert(slot < slots_.size() && !slots_[slot].put && "each slot is put once");
-    Slot& s = slots_[slot];
-    s.put = true;
-    s.count = value.size();
-    if (auto extents = std::apply([this](const auto&... v) { return spill_.put_vectors(v...); },
-                                  value.vectors())) {
-      s.extents = std::move(*extents);
-    } else {
-      s.pinned_bytes = bytes_of(value);
-      pinned_bytes_ += s.pinned_bytes;
-    }
-    s.in_memory = std::make_shared<const T>(std::move(value));
-    if (!s.extents.empty()) keep(slot);
+    fill(slot, std::move(value));
+  }
+
+  // Puts `value` in a new slot at the end, and returns that slot.
+  std::size_t add(T value) {
+    slots_.emplace_back();
+    fill(slots_.size() - 1, std::move(value));
+    return slots_.size() - 1;
   }
 
   // Whether slot `slot` holds a value (put and not released).
@@ -103,6 +99,23 @@ class SpillShelf {
     std::uint64_t pinned_bytes = 0;
     std::shared_ptr<const T> in_memory;
   };
+
+  // Parks `value` in empty slot `slot`, or pins it in memory where the file
+  // cannot take it.
+  void fill(std::size_t slot, T value) {
+    Slot& s = slots_[slot];
+    s.put = true;
+    s.count = value.size();
+    if (auto extents = std::apply([this](const auto&... v) { return spill_.put_vectors(v...); },
+                                  value.vectors())) {
+      s.extents = std::move(*extents);
+    } else {
+      s.pinned_bytes = bytes_of(value);
+      pinned_bytes_ += s.pinned_bytes;
+    }
+    s.in_memory = std::make_shared<const T>(std::move(value));
+    if (!s.extents.empty()) keep(slot);
+  }
 
   static std::uint64_t bytes_of(const T& value) {
     return std::apply([](const auto&... v) { return ((v.size() * sizeof(v[0])) + ... + 0); },

@@ -72,10 +72,9 @@ nlohmann::json to_report(const RegisterCommandResult& out) {
   nlohmann::json report;
   report["pairs"] = nlohmann::json::array();
   for (const auto& pair : r.pairs) report["pairs"].push_back(pair_json(pair, ids));
-  report["global"] = {{"rounds", r.global.rounds},
-                      {"converged", r.global.converged},
-                      {"inliers", r.global.correspondences},
-                      {"seconds", r.global.seconds}};
+  report["global"] = {{"rounds", r.global.rounds},           {"converged", r.global.converged},
+                      {"inliers", r.global.correspondences}, {"seconds", r.global.seconds},
+                      {"patch_visits", r.patch_visits},      {"scan_visits", r.scan_visits}};
   report["edges"] = nlohmann::json::array();
   for (const auto& e : r.edges) {
     report["edges"].push_back({{"source", ids[static_cast<std::size_t>(e.source)]},

@@ -6,17 +6,21 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "registration/prepared_scan.hpp"
 #include "registration/sample_cloud.hpp"
+#include "registration/target_patch.hpp"
 
 namespace scanbench::registration {
 
 struct Correspondence {
   std::uint32_t sample = 0;  // index into the SampleCloud
-  std::int64_t pixel = 0;    // row-major pixel of the target scan (usable)
+  // Row-major pixel of the target scan (usable); through a patch, the
+  // pixel's position in the patch.
+  std::int64_t pixel = 0;
 };
 
 struct AssociationGate {
@@ -46,6 +50,14 @@ std::vector<Correspondence> associate_samples(const SampleCloud& source, const P
                                               const AssociationGate& gate, int threads,
                                               const SampleIndex* nearest = nullptr);
 
+// associate_samples by projection through a patch of the target: the same
+// matches as through the whole scan, or nullopt when a sample falls on a
+// pixel that the patch does not hold (the pose moved too far from the
+// patch's; then only the whole scan can tell).
+std::optional<std::vector<Correspondence>> associate_samples(
+    const SampleCloud& source, const PatchedTarget& target,
+    const Eigen::Isometry3d& T_target_source, const AssociationGate& gate, int threads);
+
 // The share of the samples seen by the target scan that the pose puts in
 // the target's free space: in front of the surface that the target measured
 // on that beam, by more than tolerance_m, plus twice the pixel's footprint,
@@ -73,6 +85,10 @@ ProjectiveAssociation associate_with_free_space(const SampleCloud& source,
                                                 const PreparedScan& target,
                                                 const Eigen::Isometry3d& T_target_source,
                                                 const AssociationGate& gate, int threads);
+// The same through a patch; nullopt as for associate_samples.
+std::optional<ProjectiveAssociation> associate_with_free_space(
+    const SampleCloud& source, const PatchedTarget& target,
+    const Eigen::Isometry3d& T_target_source, const AssociationGate& gate, int threads);
 
 // A correspondence as the point-to-plane costs read it: the source sample
 // and the target point and normal, in double.
@@ -83,6 +99,9 @@ struct PlaneCorrespondence {
 };
 std::vector<PlaneCorrespondence> plane_correspondences(const SampleCloud& source,
                                                        const PreparedScan& target,
+                                                       std::span<const Correspondence> matches);
+std::vector<PlaneCorrespondence> plane_correspondences(const SampleCloud& source,
+                                                       const PatchedTarget& target,
                                                        std::span<const Correspondence> matches);
 
 // Signed distance [m] of the sample, moved by T_target_source, from the

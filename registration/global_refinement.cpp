@@ -12,7 +12,6 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <numbers>
 #include <optional>
 
@@ -102,27 +101,46 @@ ceres::Solver::Options solver_options(const GlobalSettings& settings) {
   return options;
 }
 
-// One round: associate every edge at the current poses and reduce it to
-// its quadratic, then solve the pose graph. Edges are associated target by
-// target (each target scan taken from the stream once), and enter the
-// problem in their own order. Returns the number of correspondences used.
-std::size_t solve_round(SampleShelf& samples, ScanStream& scans, std::span<const ScanEdge> edges,
+// One round: associate every edge at the current poses, through its
+// patch or its target scan, and reduce it to its quadratic, then solve the
+// pose graph. The edges enter the problem in their own order. `sources`
+// are the round's samples (all of `samples`, or thinned); a patch made
+// anew holds the pixels of all. Returns the number of correspondences used.
+std::size_t solve_round(SampleShelf& samples, SampleShelf& sources, ScanStream& scans,
+                        EdgePatches& patches, std::span<const ScanEdge> edges,
                         std::vector<PoseParameters>& poses, double gate_m,
                         const GlobalSettings& settings) {
   const double min_cos = std::cos(settings.icp.max_normal_angle_deg * std::numbers::pi / 180.0);
+  const AssociationGate gate{gate_m, min_cos};
   std::vector<std::optional<EdgeQuadratic>> quadratics(edges.size());
-  for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
+  const auto T_target_source = [&](std::size_t e) {
     const auto a = static_cast<std::size_t>(edges[e].source);
     const auto b = static_cast<std::size_t>(edges[e].target);
-    const Eigen::Isometry3d T_target_source = poses[b].isometry().inverse() * poses[a].isometry();
-    const std::shared_ptr<const SampleCloud> source = samples.get(a);
-    const std::vector<PlaneCorrespondence> matches =
-        plane_correspondences(*source, target,
-                              associate_samples(*source, target, T_target_source, {gate_m, min_cos},
-                                                settings.icp.threads));
+    return Eigen::Isometry3d(poses[b].isometry().inverse() * poses[a].isometry());
+  };
+  const auto reduce = [&](std::size_t e, const std::vector<PlaneCorrespondence>& matches) {
     if (matches.size() < settings.icp.min_correspondences) return;
-    quadratics[e] = edge_quadratic(matches, T_target_source, settings.icp.loss_scale_m);
-  });
+    quadratics[e] = edge_quadratic(matches, T_target_source(e), settings.icp.loss_scale_m);
+  };
+  patches.visit(
+      scans, edges,
+      [&](const PatchedTarget& target, std::size_t e) {
+        const std::shared_ptr<const SampleCloud> source =
+            sources.get(static_cast<std::size_t>(edges[e].source));
+        const std::optional<std::vector<Correspondence>> matches =
+            associate_samples(*source, target, T_target_source(e), gate, settings.icp.threads);
+        if (!matches) return false;
+        reduce(e, plane_correspondences(*source, target, *matches));
+        return true;
+      },
+      [&](const PreparedScan& target, std::size_t e) {
+        const auto a = static_cast<std::size_t>(edges[e].source);
+        const std::shared_ptr<const SampleCloud> source = sources.get(a);
+        reduce(e, plane_correspondences(*source, target,
+                                        associate_samples(*source, target, T_target_source(e), gate,
+                                                          settings.icp.threads)));
+        patches.make(edges[e], *samples.get(a), target, T_target_source(e));
+      });
   ceres::Problem problem;
   std::size_t total = 0;
   for (std::size_t e = 0; e < edges.size(); ++e) {
@@ -150,20 +168,7 @@ std::size_t solve_round(SampleShelf& samples, ScanStream& scans, std::span<const
 
 }  // namespace
 
-void for_each_target(ScanStream& scans, std::span<const ScanEdge> edges,
-                     const std::function<void(const PreparedScan&, std::size_t)>& visit) {
-  std::map<int, std::vector<std::size_t>> by_target;
-  for (std::size_t e = 0; e < edges.size(); ++e) by_target[edges[e].target].push_back(e);
-  std::vector<int> order;
-  for (const auto& [target, indices] : by_target) order.push_back(target);
-  scans.plan(order);
-  for (const auto& [target, indices] : by_target) {
-    const std::shared_ptr<const PreparedScan> scan = scans.get(target);
-    for (const std::size_t e : indices) visit(*scan, e);
-  }
-}
-
-GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans,
+GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans, EdgePatches& patches,
                              std::vector<Eigen::Isometry3d> T_first_scan,
                              std::span<const ScanEdge> edges, const GlobalSettings& settings) {
   assert(samples.size() == scans.size() && T_first_scan.size() == scans.size());
@@ -184,8 +189,8 @@ GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans,
   double gate = settings.initial_gate_m;
   for (int round = 0; round < settings.max_rounds; ++round) {
     result.rounds = round + 1;
-    result.correspondences =
-        solve_round(full ? samples : thinned, scans, edges, poses, gate, settings);
+    result.correspondences = solve_round(samples, full ? samples : thinned, scans, patches, edges,
+                                         poses, gate, settings);
     double largest_rotation = 0.0;
     double largest_translation = 0.0;
     for (std::size_t i = 0; i < poses.size(); ++i) {

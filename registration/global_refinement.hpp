@@ -5,21 +5,15 @@
 #pragma once
 
 #include <Eigen/Geometry>
-#include <functional>
 #include <span>
 #include <vector>
 
+#include "registration/edge_targets.hpp"
 #include "registration/icp.hpp"
 #include "registration/sample_shelf.hpp"
 #include "registration/scan_stream.hpp"
 
 namespace scanbench::registration {
-
-// An overlapping pair: samples of `source` are matched into `target`.
-struct ScanEdge {
-  int source = 0;
-  int target = 0;
-};
 
 struct GlobalSettings {
   // Association is redone this many times at most; each round solves the
@@ -48,19 +42,15 @@ struct GlobalResult {
   double seconds = 0.0;
 };
 
-// Calls visit(target scan, edge index) for every edge, target by target in
-// ascending order (each target taken from `scans` once, after announcing
-// the order), the edges of a target in their order.
-void for_each_target(ScanStream& scans, std::span<const ScanEdge> edges,
-                     const std::function<void(const PreparedScan&, std::size_t)>& visit);
-
 // Refines `T_first_scan` (poses of all scans in the first scan's frame;
 // [0] must be the identity, asserted) over `edges`. The cloud of slot i of
 // `samples` (every slot put) and scan i of `scans` belong to scan i; each
-// round takes every target scan from the stream once, and the samples of
-// its edges' sources from the shelf. Edges with too few correspondences in
-// a round add nothing to it.
-GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans,
+// round visits every edge's target through `patches` (the edge's patch
+// where it holds the round's pixels, else the target scan from the
+// stream, after which the patch is made anew at the round's pose), and
+// takes the samples of its source from the shelf. Edges with too few
+// correspondences in a round add nothing to it.
+GlobalResult refine_globally(SampleShelf& samples, ScanStream& scans, EdgePatches& patches,
                              std::vector<Eigen::Isometry3d> T_first_scan,
                              std::span<const ScanEdge> edges, const GlobalSettings& settings);
 

@@ -125,11 +125,14 @@ IcpResult point_to_plane_icp(const SampleCloud& source, const PreparedScan& targ
   return result;
 }
 
-AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan& target,
-                                   const Eigen::Isometry3d& T_target_source,
-                                   const IcpSettings& settings) {
-  const ProjectiveAssociation associated = associate_with_free_space(
-      source, target, T_target_source, gate_of(settings.min_gate_m, settings), settings.threads);
+namespace {
+
+// The quality of a pose from its association with `target` (a prepared
+// scan or a patch of one).
+template <typename Target>
+AlignmentQuality quality_of(const SampleCloud& source, const Target& target,
+                            const ProjectiveAssociation& associated,
+                            const Eigen::Isometry3d& T_target_source) {
   const std::vector<Correspondence>& matches = associated.matches;
   AlignmentQuality quality;
   quality.correspondences = matches.size();
@@ -142,6 +145,28 @@ AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan
   quality.rms_m = matches.empty() ? 0.0 : std::sqrt(sum_squared / matches.size());
   quality.free_space_violation = associated.free_space_violation;
   return quality;
+}
+
+}  // namespace
+
+AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan& target,
+                                   const Eigen::Isometry3d& T_target_source,
+                                   const IcpSettings& settings) {
+  return quality_of(
+      source, target,
+      associate_with_free_space(source, target, T_target_source,
+                                gate_of(settings.min_gate_m, settings), settings.threads),
+      T_target_source);
+}
+
+std::optional<AlignmentQuality> measure_alignment(const SampleCloud& source,
+                                                  const PatchedTarget& target,
+                                                  const Eigen::Isometry3d& T_target_source,
+                                                  const IcpSettings& settings) {
+  const std::optional<ProjectiveAssociation> associated = associate_with_free_space(
+      source, target, T_target_source, gate_of(settings.min_gate_m, settings), settings.threads);
+  if (!associated) return std::nullopt;
+  return quality_of(source, target, *associated, T_target_source);
 }
 
 }  // namespace scanbench::registration

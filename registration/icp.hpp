@@ -4,9 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <optional>
 
 #include "registration/prepared_scan.hpp"
 #include "registration/sample_cloud.hpp"
+#include "registration/target_patch.hpp"
 
 namespace scanbench::registration {
 
@@ -77,5 +79,11 @@ struct AlignmentQuality {
 AlignmentQuality measure_alignment(const SampleCloud& source, const PreparedScan& target,
                                    const Eigen::Isometry3d& T_target_source,
                                    const IcpSettings& settings);
+// The same through a patch of the target; nullopt when a sample falls on a
+// pixel the patch does not hold (association.hpp).
+std::optional<AlignmentQuality> measure_alignment(const SampleCloud& source,
+                                                  const PatchedTarget& target,
+                                                  const Eigen::Isometry3d& T_target_source,
+                                                  const IcpSettings& settings);
 
 }  // namespace scanbench::registration

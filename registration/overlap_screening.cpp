@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -103,6 +104,7 @@ double reachable_share(const SampleCloud& cloud, const Eigen::Isometry3d& T_firs
 // (max_overlap_tests_per_scan) are measured on the target scan, target by
 // target: the pair tests grow with the scans, not with the scans in sight.
 std::vector<ScanEdge> overlapping_edges(ScanStream& scans, SampleShelf& samples,
+                                        EdgePatches& patches,
                                         const std::vector<Eigen::Isometry3d>& T_first_scan,
                                         const std::vector<bool>& registered,
                                         const RegistrationSettings& settings,
@@ -147,10 +149,12 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, SampleShelf& samples,
   for_each_target(scans, candidates, [&](const PreparedScan& target, std::size_t e) {
     const auto a = static_cast<std::size_t>(candidates[e].source);
     const auto b = static_cast<std::size_t>(candidates[e].target);
-    const AlignmentQuality quality = measure_alignment(
-        *estimates.get(a), target, T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
+    const Eigen::Isometry3d T_target_source = T_first_scan[b].inverse() * T_first_scan[a];
+    const AlignmentQuality quality =
+        measure_alignment(*estimates.get(a), target, T_target_source, settings.icp);
     ++pair_tests;
     overlapping[e] = quality.overlap >= settings.min_global_overlap;
+    if (overlapping[e]) patches.make(candidates[e], *samples.get(a), target, T_target_source);
   });
   std::vector<ScanEdge> edges;
   for (std::size_t e = 0; e < candidates.size(); ++e) {
@@ -159,17 +163,29 @@ std::vector<ScanEdge> overlapping_edges(ScanStream& scans, SampleShelf& samples,
   return edges;
 }
 
-void report_edges(ScanStream& scans, SampleShelf& samples,
+void report_edges(ScanStream& scans, SampleShelf& samples, EdgePatches& patches,
                   const std::vector<Eigen::Isometry3d>& T_first_scan,
                   const std::vector<ScanEdge>& edges, const RegistrationSettings& settings,
                   RegistrationResult& result) {
   std::vector<AlignmentQuality> qualities(edges.size());
-  for_each_target(scans, edges, [&](const PreparedScan& target, std::size_t e) {
-    const auto a = static_cast<std::size_t>(edges[e].source);
-    const auto b = static_cast<std::size_t>(edges[e].target);
-    qualities[e] = measure_alignment(*samples.get(a), target,
-                                     T_first_scan[b].inverse() * T_first_scan[a], settings.icp);
-  });
+  const auto T_target_source = [&](std::size_t e) {
+    return Eigen::Isometry3d(T_first_scan[static_cast<std::size_t>(edges[e].target)].inverse() *
+                             T_first_scan[static_cast<std::size_t>(edges[e].source)]);
+  };
+  const auto source = [&](std::size_t e) {
+    return samples.get(static_cast<std::size_t>(edges[e].source));
+  };
+  patches.visit(
+      scans, edges,
+      [&](const PatchedTarget& target, std::size_t e) {
+        const std::optional<AlignmentQuality> quality =
+            measure_alignment(*source(e), target, T_target_source(e), settings.icp);
+        if (quality) qualities[e] = *quality;
+        return quality.has_value();
+      },
+      [&](const PreparedScan& target, std::size_t e) {
+        qualities[e] = measure_alignment(*source(e), target, T_target_source(e), settings.icp);
+      });
   double sum_squared = 0.0;
   std::size_t sample_count = 0;
   for (std::size_t e = 0; e < edges.size(); ++e) {

@@ -400,15 +400,22 @@ RegistrationResult register_scans(ScanStream& scans,
   SampleShelf samples(n, kSamplesKept);
   Chain chain = register_chain(scans, initial_T_world_scan, settings, steps, samples, result);
 
+  // The target scans of the edges found, as patches around their sources'
+  // samples: the global refinement and the report load a target scan only
+  // where a pose leaves its patch.
+  EdgePatches patches(n);
   const std::vector<ScanEdge> edges = overlapping_edges(
-      scans, samples, chain.T_first_scan, chain.registered, settings, result.pair_tests);
+      scans, samples, patches, chain.T_first_scan, chain.registered, settings, result.pair_tests);
   if (settings.refine_globally && n > 1 && !edges.empty()) {
-    result.global = refine_globally(samples, scans, chain.T_first_scan, edges, settings.global);
+    result.global =
+        refine_globally(samples, scans, patches, chain.T_first_scan, edges, settings.global);
     chain.T_first_scan = result.global.T_first_scan;
     result.iterations += result.global.rounds;
     result.fine_seconds += result.global.seconds;
   }
-  report_edges(scans, samples, chain.T_first_scan, edges, settings, result);
+  report_edges(scans, samples, patches, chain.T_first_scan, edges, settings, result);
+  result.patch_visits = patches.patch_visits();
+  result.scan_visits = patches.scan_visits();
   steps.step("global refinement");
 
   for (std::size_t k = 0; k < n; ++k) {

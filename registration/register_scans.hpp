@@ -134,6 +134,11 @@ struct RegistrationResult {
   // Pairs of scans tested against each other: registered as a pair, or
   // measured for overlap to decide the global refinement's edges.
   std::size_t pair_tests = 0;
+  // Visits of an edge's target by the global refinement and the report:
+  // through the edge's patch, and through the whole target scan (a pose
+  // left the patch, or the target has no spherical grid).
+  std::size_t patch_visits = 0;
+  std::size_t scan_visits = 0;
   // Sampling, features, matching, hypotheses and their verifying ICP runs.
   double coarse_seconds = 0.0;
   double fine_seconds = 0.0;  // ICP of every pair and the global refinement
@@ -150,9 +155,11 @@ struct RegistrationResult {
 //
 // Scans are taken from `scans` a few at a time: each scan and its target
 // for the pairs (the features of two scans in hand), every target once for
-// the overlap tests of the pairs whose samples' bounds meet, once per round
-// of the global refinement and once for the report. What is kept of every
-// scan is its ICP sample cloud.
+// the overlap tests of the pairs whose samples' bounds meet, where a patch
+// of it is made for every pair that overlaps (target_patch.hpp). The rounds
+// of the global refinement and the report read the patches, and take a
+// target again only where a pose leaves its patch. What is kept of every
+// scan is its ICP sample cloud, and of every pair its patch.
 RegistrationResult register_scans(ScanStream& scans,
                                   std::span<const Eigen::Isometry3d> initial_T_world_scan,
                                   const RegistrationSettings& settings,

@@ -13,6 +13,7 @@
 
 #include "core/spill_file.hpp"
 #include "core/spill_shelf.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::core {
 namespace {
@@ -34,26 +35,7 @@ Values values_of(std::size_t n) {
   return v;
 }
 
-// TMPDIR at a folder where no file can be made (/proc), for one scope.
-class NoTemporaryFiles {
- public:
-  NoTemporaryFiles() {
-    if (const char* old = std::getenv("TMPDIR")) old_ = old;
-    ::setenv("TMPDIR", "/proc", 1);
-  }
-  ~NoTemporaryFiles() {
-    if (old_) {
-      ::setenv("TMPDIR", old_->c_str(), 1);
-    } else {
-      ::unsetenv("TMPDIR");
-    }
-  }
-  NoTemporaryFiles(const NoTemporaryFiles&) = delete;
-  NoTemporaryFiles& operator=(const NoTemporaryFiles&) = delete;
-
- private:
-  std::optional<std::string> old_;
-};
+using test::NoTemporaryFiles;
 
 TEST(SpillShelf, WithoutASpillFileValuesStayInMemoryAndAreCounted) {
   const NoTemporaryFiles no_files;

@@ -1,7 +1,7 @@
 // registration::SampleShelf (core::SpillShelf of sample clouds) gives back
 // every cloud as it was put, whether it stayed in memory or was read back
 // from its file; a cloud handed out stays whole after the shelf lets it go,
-// and a released one is gone.
+// and a released one is gone; slots added later work as the first ones.
 #include <gtest/gtest.h>
 
 #include "core/spill_file.hpp"
@@ -70,6 +70,22 @@ TEST(SampleShelf, AReleasedCloudIsGoneAndTheOthersStay) {
   if (core::SpillFile().usable()) {
     EXPECT_EQ(shelf.bytes_in_memory(), 0U);  // the file took every cloud
   }
+}
+
+// Slots added after the shelf was made (as the patches of a registration's
+// edges are) come after the first ones, and come back as they were put.
+TEST(SampleShelf, AddedCloudsTakeNewSlotsAfterTheOthers) {
+  SampleShelf shelf(2, 1);
+  shelf.put(0, cloud_of(0, 30));
+  EXPECT_EQ(shelf.add(cloud_of(2, 20)), 2U);
+  EXPECT_EQ(shelf.add(cloud_of(3, 10)), 3U);
+  EXPECT_EQ(shelf.size(), 4U);
+  EXPECT_FALSE(shelf.has(1));
+  shelf.release(2);
+  EXPECT_FALSE(shelf.has(2));
+  expect_same(*shelf.get(3), cloud_of(3, 10));
+  expect_same(*shelf.get(0), cloud_of(0, 30));
+  expect_same(*shelf.get(3), cloud_of(3, 10));
 }
 
 }  // namespace

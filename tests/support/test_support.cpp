@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -34,6 +35,19 @@ std::string read_file_bytes(const std::filesystem::path& path) {
   std::ostringstream bytes;
   bytes << in.rdbuf();
   return bytes.str();
+}
+
+NoTemporaryFiles::NoTemporaryFiles() {
+  if (const char* old = std::getenv("TMPDIR")) old_ = old;
+  ::setenv("TMPDIR", "/proc", 1);
+}
+
+NoTemporaryFiles::~NoTemporaryFiles() {
+  if (old_) {
+    ::setenv("TMPDIR", old_->c_str(), 1);
+  } else {
+    ::unsetenv("TMPDIR");
+  }
 }
 
 }  // namespace scanbench::test

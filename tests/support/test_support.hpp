@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace scanbench::test {
@@ -25,6 +26,19 @@ class ScratchDir {
 
  private:
   std::filesystem::path path_;
+};
+
+// TMPDIR at a folder where no file can be made (/proc), for one scope: a
+// spill file (core::SpillFile) made meanwhile is unusable.
+class NoTemporaryFiles {
+ public:
+  NoTemporaryFiles();
+  ~NoTemporaryFiles();
+  NoTemporaryFiles(const NoTemporaryFiles&) = delete;
+  NoTemporaryFiles& operator=(const NoTemporaryFiles&) = delete;
+
+ private:
+  std::optional<std::string> old_;
 };
 
 // Whole file contents as bytes in a string; empty string for a missing file.
