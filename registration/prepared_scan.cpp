@@ -3,23 +3,27 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <optional>
 
 #include "acquisition/geometry/sampling.hpp"
 #include "acquisition/geometry/scattered_geometry.hpp"
+#include "core/memory.hpp"
 #include "core/parallel.hpp"
 
 namespace scanbench::registration {
 namespace {
 
-void prepare_row(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry, int row,
-                 PreparedScan& out) {
+// `spherical`: the scan's directions, for a spherical grid (else nullptr).
+void prepare_row(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry,
+                 const acquisition::SphericalDirections* spherical, int row, PreparedScan& out) {
   // Spherical grids share one solid angle per row.
   const float row_solid_angle =
       scan.is_spherical() ? acquisition::pixel_solid_angle(scan, row, 0) : 0.0f;
   for (int col = 0; col < scan.columns; ++col) {
     const std::size_t i = scan.index(row, col);
     if (!acquisition::in_model(scan, geometry, i)) continue;
-    const Eigen::Vector3f d = acquisition::direction(scan, row, col);
+    const Eigen::Vector3f d =
+        spherical != nullptr ? (*spherical)(row, col) : acquisition::direction(scan, row, col);
     const float range = scan.range_m[i];
     out.points[i] = range * d;
     out.in_model[i] = 1;
@@ -45,12 +49,16 @@ PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::Scan
   PreparedScan out;
   out.scan = &scan;
   out.geometry = &geometry;
-  out.points.assign(n, Eigen::Vector3f::Zero());
-  out.in_model.assign(n, 0);
-  out.usable.assign(n, 0);
-  out.sample_area_m2.assign(n, 0.0f);
+  core::assign_mapped(out.points, n, Eigen::Vector3f::Zero().eval());
+  core::assign_mapped(out.in_model, n, std::uint8_t{0});
+  core::assign_mapped(out.usable, n, std::uint8_t{0});
+  core::assign_mapped(out.sample_area_m2, n, 0.0f);
+  std::optional<acquisition::SphericalDirections> spherical;
+  if (scan.is_spherical()) spherical.emplace(scan);
   core::parallel_for_index(
-      scan.rows, threads, [&](int row) { prepare_row(scan, geometry, row, out); }, 8);
+      scan.rows, threads,
+      [&](int row) { prepare_row(scan, geometry, spherical ? &*spherical : nullptr, row, out); },
+      8);
   if (scan.is_spherical()) {
     out.grid.emplace(scan);
   } else {

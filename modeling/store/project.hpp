@@ -46,6 +46,7 @@
 #include "acquisition/scan.hpp"
 #include "acquisition/scan_source.hpp"
 #include "acquisition/scan_summary.hpp"
+#include "core/memory.hpp"
 #include "core/project_file.hpp"
 #include "modeling/store/color_edit.hpp"
 #include "modeling/store/layer_store.hpp"
@@ -262,7 +263,9 @@ class Project {
     std::optional<std::vector<T>> values;
     const bool found = read_layer(id, name, type, [&values](std::size_t bytes) {
       assert(bytes % sizeof(T) == 0 && "layer elements are not whole values of T");
-      values.emplace(bytes / sizeof(T));
+      values.emplace();
+      core::reserve_mapped(*values, bytes / sizeof(T));  // in bulk: a layer may be a gigabyte
+      values->resize(bytes / sizeof(T));
       return std::as_writable_bytes(std::span<T>(*values));
     });
     if (!found) return std::nullopt;
