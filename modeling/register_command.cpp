@@ -68,7 +68,7 @@ void refuse_when_nothing_registered(const store::Project& project,
                              "no pair of scans registered, nothing stored (" + why + ")");
 }
 
-// Every scan's world bounds at its new pose, from its channels alone (one
+// Every scan's world bounds at its new pose, from its ranges alone (one
 // scan at a time, without its geometry or prepared view).
 std::vector<std::optional<Eigen::AlignedBox3d>> world_bounds_at(
     const store::Project& project, const std::vector<std::int64_t>& ids,
@@ -76,7 +76,8 @@ std::vector<std::optional<Eigen::AlignedBox3d>> world_bounds_at(
   std::vector<std::optional<Eigen::AlignedBox3d>> bounds;
   for (std::size_t k = 0; k < ids.size(); ++k) {
     progress.throw_if_cancelled("register");
-    bounds.push_back(acquisition::world_bounds(project.load_scan(ids[k]), poses[k]));
+    bounds.push_back(acquisition::world_bounds(
+        project.load_scan(ids[k], {.intensity = false, .color = false}), poses[k]));
   }
   return bounds;
 }

@@ -58,15 +58,13 @@ void release(std::vector<T>& v) {
   v.shrink_to_fit();
 }
 
-// Drops what a stage of `form` does not read.
+// Drops what a stage of `form` does not read, of what it loaded (it was
+// needed to prepare the scan).
 void trim_to(ScanForm form, LoadedScan& loaded) {
-  if (form == ScanForm::kWhole) return;
+  if (form != ScanForm::kMerge) return;
   release(loaded.scan.valid);
-  release(loaded.scan.intensity);
-  release(loaded.scan.rgb);
   release(loaded.geometry.confidence);
   release(loaded.geometry.flags);
-  if (loaded.prepared.grid) release(loaded.prepared.points);
 }
 
 }  // namespace
@@ -214,8 +212,12 @@ std::shared_ptr<LoadedScan> ScanCache::load_from_project(std::int64_t id) const 
         "scan " + std::to_string(id) + " has no geometry: run scanbench geometry first");
   }
   loaded->geometry = std::move(*geometry);
-  loaded->scan = project_.load_scan(id);
-  loaded->prepared = registration::prepare_scan(loaded->scan, loaded->geometry, threads_);
+  const bool whole = settings_.form == ScanForm::kWhole;
+  loaded->scan = project_.load_scan(id, {.intensity = whole, .color = whole});
+  loaded->prepared = registration::prepare_scan(loaded->scan, loaded->geometry, threads_,
+                                                settings_.form == ScanForm::kMerge
+                                                    ? registration::GridPoints::kLeftOut
+                                                    : registration::GridPoints::kComputed);
   return loaded;
 }
 

@@ -46,12 +46,16 @@ struct LoadedScan {
 // What of a scan a stage reads.
 enum class ScanForm {
   kWhole,
+  // What registration reads: the whole scan but its intensity and colour,
+  // which are not read from the project.
+  kGeometric,
   // What the merge compares (registration/merge.hpp): ranges, footprints,
   // normals and the prepared in_model, usable and sample areas, about 26
   // bytes a pixel instead of about 51. The scan's valid, intensity and
   // colour, the geometry's confidence and flags are dropped, and so are
   // the prepared points of a spherical grid (the merge recomputes them
-  // from the ranges, registration/merge.hpp).
+  // from the ranges, registration/merge.hpp); intensity, colour and those
+  // points are not even read or computed.
   kMerge,
 };
 
@@ -160,14 +164,15 @@ class ScanCache {
 };
 
 // The project's scans as a registration::ScanStream: position k is the
-// scan ids[k], loaded through a ScanCache.
+// scan ids[k], loaded through a ScanCache in ScanForm::kGeometric.
 class CachedScans final : public registration::ScanStream {
  public:
   CachedScans(const store::Project& project, std::vector<std::int64_t> ids,
               std::uint64_t memory_limit_bytes, int threads, std::string stage,
               core::Progress& progress)
       : ids_(std::move(ids)),
-        cache_(project, memory_limit_bytes, threads, std::move(stage), progress) {}
+        cache_(project, memory_limit_bytes, threads, std::move(stage), progress,
+               {.form = ScanForm::kGeometric}) {}
 
   std::size_t size() const override { return ids_.size(); }
   void plan(std::vector<int> order) override;

@@ -25,7 +25,7 @@ void prepare_row(const acquisition::Scan& scan, const acquisition::ScanGeometry&
     const Eigen::Vector3f d =
         spherical != nullptr ? (*spherical)(row, col) : acquisition::direction(scan, row, col);
     const float range = scan.range_m[i];
-    out.points[i] = range * d;
+    if (!out.points.empty()) out.points[i] = range * d;
     out.in_model[i] = 1;
     out.usable[i] = geometry.has_normal(i) ? 1 : 0;
     const float cos_incidence = out.usable[i] ? geometry.normal[i].dot(d) : 1.0f;
@@ -42,14 +42,15 @@ void prepare_row(const acquisition::Scan& scan, const acquisition::ScanGeometry&
 }  // namespace
 
 PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry,
-                          int threads) {
+                          int threads, GridPoints grid_points) {
   const std::size_t n = scan.pixel_count();
   assert(geometry.normal.size() == n && geometry.flags.size() == n &&
          "geometry must belong to the scan");
   PreparedScan out;
   out.scan = &scan;
   out.geometry = &geometry;
-  core::assign_mapped(out.points, n, Eigen::Vector3f::Zero().eval());
+  const bool with_points = !scan.is_spherical() || grid_points == GridPoints::kComputed;
+  if (with_points) core::assign_mapped(out.points, n, Eigen::Vector3f::Zero().eval());
   core::assign_mapped(out.in_model, n, std::uint8_t{0});
   core::assign_mapped(out.usable, n, std::uint8_t{0});
   core::assign_mapped(out.sample_area_m2, n, 0.0f);

@@ -40,11 +40,15 @@ struct PreparedScan {
   std::unique_ptr<PointIndex> tree;
 };
 
+// Whether prepare_scan computes the points of a spherical grid (other
+// grids need them for their index).
+enum class GridPoints { kComputed, kLeftOut };
+
 // Builds the arrays and the index for `scan` with its `geometry` (same pixel
 // count; asserted). `threads` workers, 0 = all cores; the result does not
 // depend on it.
 PreparedScan prepare_scan(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry,
-                          int threads);
+                          int threads, GridPoints grid_points = GridPoints::kComputed);
 
 // The pixel of `target` associated with `p_target` (a point in the target's
 // scan frame [m]): for spherical grids the pixel on whose beam it lies

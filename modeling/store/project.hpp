@@ -213,11 +213,21 @@ class Project {
   // bounds, scanner metadata) ordered by id, without reading channel data.
   std::vector<StoredScanSummary> scans() const;
 
+  // Which of a scan's optional channels load_scan reads (range and validity
+  // it always reads): a stage that reads neither intensity nor colour
+  // saves their decoding and memory.
+  struct ScanChannels {
+    bool intensity = true;
+    bool color = true;
+  };
+
   // The scan stored under `id` at its current pose, its channels
-  // bit-identical to what insert_scan stored. Throws core::InputError "no
-  // scan with id N" when there is none (or its import was undone), and names
-  // the scan and layer when its data is damaged.
-  acquisition::Scan load_scan(std::int64_t id) const;
+  // bit-identical to what insert_scan stored; those `channels` leaves out
+  // are empty. Throws core::InputError "no scan with id N" when there is
+  // none (or its import was undone), and names the scan and layer when its
+  // data is damaged.
+  acquisition::Scan load_scan(std::int64_t id, ScanChannels channels) const;
+  acquisition::Scan load_scan(std::int64_t id) const { return load_scan(id, ScanChannels{}); }
 
   // Stores a new scan (metadata, pose, summary, channel layers) as part of
   // `edit` and returns its id, which no other scan of the project ever gets.

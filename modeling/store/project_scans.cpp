@@ -305,7 +305,7 @@ ORDER BY id LIMIT 1)sql",
   return select.column_int(0);
 }
 
-acquisition::Scan Project::load_scan(std::int64_t id) const {
+acquisition::Scan Project::load_scan(std::int64_t id, ScanChannels channels) const {
   const std::string sql = kSelectScans + " AND s.id = ?1";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
@@ -322,10 +322,10 @@ acquisition::Scan Project::load_scan(std::int64_t id) const {
   scan.scanner = summary.scanner;
   scan.range_m = required_layer<float>(*this, id, layer::kRange, ElementType::kF32);
   scan.valid = required_layer<std::uint8_t>(*this, id, layer::kValid, ElementType::kU8);
-  if (summary.has_intensity) {
+  if (summary.has_intensity && channels.intensity) {
     scan.intensity = required_layer<float>(*this, id, layer::kIntensity, ElementType::kF32);
   }
-  if (summary.has_color) {
+  if (summary.has_color && channels.color) {
     scan.rgb = required_layer<std::uint8_t>(*this, id, layer::kRgb, ElementType::kU8x3);
   }
   if (!summary.spherical) {
