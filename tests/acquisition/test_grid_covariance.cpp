@@ -8,11 +8,12 @@
 #include <random>
 
 #include "acquisition/geometry/grid_covariance.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 // A spherical grid at 0.2° steps looking around +x, its ranges from `range`
 // (≤ 0: no return), with the mask and NaN-marked log-range the fit reads.

@@ -19,7 +19,7 @@ namespace {
 using test::fixture;
 using test::ScratchDir;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 // Channels and pose must match bit for bit; the refitted angle model to 1e-12 rad.
 void expect_same_scan(const Scan& a, const Scan& b) {

@@ -5,11 +5,12 @@
 #include <numbers>
 
 #include "acquisition/geometry/sampling.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 TEST(PixelSolidAngle, SphericalCellIsStepTimesStepTimesCosElevation) {
   Scan scan = make_empty_scan(40, 90, false, false);

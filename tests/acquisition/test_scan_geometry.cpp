@@ -12,11 +12,12 @@
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/geometry/window_moments.hpp"
 #include "acquisition/local_origin.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 // A spherical scan of `rows` × `columns` at `step_deg`, looking around +x,
 // whose range along a direction comes from `cast` (≤ 0: no return).

@@ -4,11 +4,12 @@
 #include <random>
 
 #include "acquisition/spherical_fit.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 struct Grid {
   int rows;

@@ -7,12 +7,13 @@
 #include <numbers>
 
 #include "acquisition/spherical_grid.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::acquisition {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
+using scanbench::test::kDeg;
 
 // A full panorama laid out like the virtual scanner's: column c looks at
 // azimuth −(c + 0.5) · 360° / columns, row r at 45° − (r + 0.5) · 7.5°.

@@ -11,9 +11,18 @@
 #include <string>
 
 #include "acquisition/scan.hpp"
+#include "core/progress.hpp"
+#include "modeling/import_command.hpp"
 #include "modeling/store/project.hpp"
 
 namespace scanbench::test {
+
+// Imports `files` into `project` as one command, without progress output.
+inline modeling::ImportResult import_files(const std::filesystem::path& project,
+                                           std::vector<std::filesystem::path> files) {
+  core::Progress quiet;
+  return modeling::import_scan_files(project, files, {}, quiet);
+}
 
 // A georeferenced pose (10^5-10^6 m) whose rotation holds a -0.0, so that a
 // round trip through the project must keep every bit.

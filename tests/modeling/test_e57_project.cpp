@@ -9,6 +9,7 @@
 #include "modeling/color_commands.hpp"
 #include "modeling/export_command.hpp"
 #include "modeling/import_command.hpp"
+#include "modeling/project_test_support.hpp"
 #include "modeling/selection_commands.hpp"
 #include "support/test_support.hpp"
 
@@ -16,13 +17,8 @@ namespace scanbench::modeling {
 namespace {
 
 using test::fixture;
+using test::import_files;
 using test::ScratchDir;
-
-ImportResult import_files(const std::filesystem::path& project,
-                          std::vector<std::filesystem::path> files) {
-  core::Progress quiet;
-  return import_scan_files(project, files, {}, quiet);
-}
 
 std::filesystem::path export_e57(const std::filesystem::path& project,
                                  const std::filesystem::path& output) {

@@ -21,6 +21,7 @@ namespace scanbench::modeling {
 namespace {
 
 using test::fixture;
+using test::import_files;
 using test::ScratchDir;
 
 std::vector<std::string> scan_names(const std::filesystem::path& project) {
@@ -28,12 +29,6 @@ std::vector<std::string> scan_names(const std::filesystem::path& project) {
   for (const auto& stored : store::Project::open(project).scans())
     names.push_back(stored.summary.name);
   return names;
-}
-
-ImportResult import_files(const std::filesystem::path& project,
-                          std::vector<std::filesystem::path> files) {
-  core::Progress quiet;
-  return import_scan_files(project, files, {}, quiet);
 }
 
 TEST(ImportScans, AllFilesOfOneCallLandTogether) {

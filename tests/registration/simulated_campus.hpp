@@ -16,10 +16,11 @@
 #include "acquisition/simulation/virtual_scanner.hpp"
 #include "registration/pose_parameters.hpp"
 #include "registration/prepared_scan.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::registration::test {
 
-inline constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 struct SimulatedCampus {
   static constexpr int kScans = 3;

@@ -11,11 +11,12 @@
 #include "acquisition/simulation/random.hpp"
 #include "registration/coarse_hypotheses.hpp"
 #include "registration/pose_parameters.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::registration {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 Eigen::Isometry3d levelled_pose() {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

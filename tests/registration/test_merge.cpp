@@ -16,7 +16,7 @@
 namespace scanbench::registration {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 constexpr int kSize = 30;         // rows and columns
 constexpr double kStepDeg = 1.0;  // pixel centres from −14.5° to +14.5°
 constexpr double kHalfWindowDeg = 0.5 * kSize * kStepDeg;

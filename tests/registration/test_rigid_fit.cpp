@@ -8,11 +8,12 @@
 #include "acquisition/simulation/random.hpp"
 #include "registration/pose_parameters.hpp"
 #include "registration/rigid_fit.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::registration {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using scanbench::test::kDeg;
 
 Eigen::Isometry3d known_transform() {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

@@ -8,7 +8,7 @@
 namespace scanbench::render {
 namespace {
 
-const Eigen::Vector3d kOrigin(1000.0, 2000.0, 0.0);
+using test::kOrigin;
 
 TEST(FramePlan, AWallInFullViewIsDrawnWholeNearestTileFirst) {
   const RenderModel model = test::wall_model();

@@ -8,7 +8,7 @@
 namespace scanbench::render {
 namespace {
 
-const Eigen::Vector3d kOrigin(1000.0, 2000.0, 0.0);
+using test::kOrigin;
 
 RenderView front_view() {
   return make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 640, 480), kOrigin);

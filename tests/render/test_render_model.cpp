@@ -26,10 +26,10 @@ using modeling::select_at;
 using modeling::SelectionTools;
 using modeling::store_room;
 
-using test::ScratchDir;
+using scanbench::test::ScratchDir;
 
 std::size_t usable_points() {
-  const test::RoomScan& room = test::shared_room();
+  const scanbench::test::RoomScan& room = scanbench::test::shared_room();
   std::size_t n = 0;
   for (std::size_t i = 0; i < room.scan.pixel_count(); ++i)
     n += acquisition::in_model(room.scan, room.geometry, i);
@@ -118,7 +118,7 @@ TEST(RenderModel, OnlyWhatTheMergeKeptUnlessAskedForAll) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = store_room(project);
-  std::vector<std::uint8_t> keep(test::shared_room().scan.pixel_count());
+  std::vector<std::uint8_t> keep(scanbench::test::shared_room().scan.pixel_count());
   for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = i % 3 != 0;
   store::Project::Edit edit = project.begin_command("merge", "{}");
   project.put_layer(
@@ -139,7 +139,7 @@ TEST(RenderModel, AnUnstructuredCloudIsDrawnWithRoundSplatsOfItsSpacing) {
   const ScratchDir dir;
   core::Progress quiet;
   const std::vector<std::filesystem::path> files = {
-      test::fixture("good/e57/unstructured_sphere.e57")};
+      scanbench::test::fixture("good/e57/unstructured_sphere.e57")};
   modeling::import_scan_files(dir / "p.sbproj", files, {}, quiet);
   store::Project project = store::Project::open(dir / "p.sbproj");
   modeling::geometry_project(project, {}, quiet);
@@ -157,7 +157,7 @@ TEST(RenderModel, AnUnstructuredCloudIsDrawnWithRoundSplatsOfItsSpacing) {
 TEST(RenderModel, AScanWithoutGeometryIsRefusedByName) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
-  test::insert_committed(project, test::shared_room().scan);
+  scanbench::test::insert_committed(project, scanbench::test::shared_room().scan);
   try {
     build_render_model(project, {});
     ADD_FAILURE() << "built without geometry";

@@ -14,7 +14,7 @@
 namespace scanbench::render {
 namespace {
 
-const Eigen::Vector3d kOrigin(1000.0, 2000.0, 0.0);
+using test::kOrigin;
 
 // One device for the whole executable: creating contexts is slow on llvmpipe.
 RenderDevice& device() {

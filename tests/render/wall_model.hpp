@@ -14,6 +14,9 @@
 
 namespace scanbench::render::test {
 
+// The model's origin [world]: the wall stands 10 m from it along +x.
+inline const Eigen::Vector3d kOrigin(1000.0, 2000.0, 0.0);
+
 inline RenderModel wall_model(bool hide_right = false, bool ground_strip = false) {
   RenderPoints p;
   for (int i = 0; i < 80; ++i) {
@@ -48,8 +51,7 @@ inline RenderModel wall_model(bool hide_right = false, bool ground_strip = false
   tree[1].hidden = hide_right;
   tree[2].id = 3;
   tree[2].kind = store::NodeKind::kGroup;
-  return assemble_render_model(std::move(p), Eigen::Vector3d(1000.0, 2000.0, 0.0), tree,
-                               {600, 1.0f});
+  return assemble_render_model(std::move(p), kOrigin, tree, {600, 1.0f});
 }
 
 // A camera at `position` [world] looking at the wall's centre.

@@ -2,10 +2,14 @@
 #pragma once
 
 #include <filesystem>
+#include <numbers>
 #include <optional>
 #include <string>
 
 namespace scanbench::test {
+
+// One degree [rad].
+inline constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Absolute path of fixtures/<relative>. Fails the current test (ADD_FAILURE)
 // when the file is missing, so a lost fixture can never pass silently.
