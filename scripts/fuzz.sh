@@ -23,20 +23,6 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Re
   -DSCANBENCH_BENCH=OFF >/dev/null
 cmake --build "$build" --target fuzz_targets --parallel "$(nproc)"
 
-seed() {  # target -> the fixtures its corpus starts from
-  case $1 in
-    fuzz_ptx) ls "$root"/fixtures/good/ptx/*.ptx "$root"/fixtures/bad/ptx_*.ptx ;;
-    fuzz_pcd) ls "$root"/fixtures/good/pcd/*.pcd "$root"/fixtures/bad/pcd_*.pcd ;;
-    fuzz_triplet) ls "$root"/fixtures/good/triplet/*.json "$root"/fixtures/bad/triplet_*.json ;;
-    fuzz_e57) ls "$root"/fixtures/good/e57/*.e57 "$root"/fixtures/bad/e57_*.e57 ;;
-    fuzz_ply) ls "$root"/fixtures/good/ply/*.ply ;;
-    fuzz_las) ls "$root"/fixtures/good/las/*.las ;;
-    fuzz_project) ls "$root"/fixtures/projects/*.sbproj "$root"/fixtures/bad/project_*.sbproj ;;
-    fuzz_view) ls "$root"/scripts/views/*.json "$root"/fixtures/bad/view_*.json ;;
-    fuzz_script) ls "$root"/scripts/*.json "$root"/fixtures/bad/script_*.json ;;
-    fuzz_replay) ls "$root"/fixtures/good/replay/*.json "$root"/fixtures/bad/replay_*.json ;;
-  esac
-}
 max_len() {  # projects hold compressed layers; the text readers' inputs are small
   case $1 in fuzz_project) echo 1048576 ;; *) echo 65536 ;; esac
 }
@@ -56,7 +42,8 @@ status=0
 for target in "${targets[@]}"; do
   corpus=$build/corpus/$target
   mkdir -p "$corpus"
-  seed "$target" | while read -r file; do cp -n "$file" "$corpus/" 2>/dev/null || true; done
+  # The seeds fuzz/CMakeLists.txt names for the target.
+  while read -r file; do cp -n "$file" "$corpus/" 2>/dev/null || true; done <"$build/fuzz/$target.seeds"
   log=$build/$target.log
   if [ -n "${FUZZ_RUNS:-}" ]; then limit=(-runs="$FUZZ_RUNS"); else limit=(-max_total_time="$seconds"); fi
   started=$(date +%s)
