@@ -5,8 +5,9 @@
 #   scripts/test.sh           one build, clang with AddressSanitizer and
 #                             UndefinedBehaviorSanitizer at -O1 (every
 #                             programmer-error assert on): every test but the
-#                             Release-only ones (label release_only: the bench
-#                             smoke runs), and each fuzz target's seeds replayed
+#                             Release-only ones (label release_only: the
+#                             simulator's own tests, the bench smoke runs), and
+#                             each fuzz target's seeds replayed
 #   scripts/test.sh --full    that, then the Release build that scripts/demo.sh
 #                             makes (GCC, with the benches and their PCL peers)
 #                             with every test, then each fuzz target fuzzed for
@@ -14,8 +15,8 @@
 #                             (scripts/fuzz.sh)
 #   scripts/test.sh --fast    the Release pass only
 #
-# One build keeps CI within its time on two cores: a cold build of each
-# tree takes 8 (sanitizers) to 13 (Release) minutes.
+# One build keeps CI short on two cores: a cold build takes about 10
+# minutes for the sanitizer tree, 13 for Release (docs/CONTRIBUTING.md).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 mode=default
