@@ -247,6 +247,7 @@ void feed(render::WindowInput& input, const ReplayEvent& event) {
       break;
     case Kind::kWait:
     case Kind::kScreenshot:
+    case Kind::kLayout:
       break;
   }
 }

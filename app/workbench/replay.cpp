@@ -35,10 +35,74 @@ struct Reader {
 
   [[noreturn]] void refuse(const std::string& problem) const { place().refuse(problem); }
 
-  std::array<double, 2> point(const json& j) const {
-    if (!j.is_array() || j.size() != 2) refuse("expected a point [x, y] in window pixels");
-    return {acquisition::finite_number(j[0], -kMaxCoordinatePx, kMaxCoordinatePx, place(), "x"),
-            acquisition::finite_number(j[1], -kMaxCoordinatePx, kMaxCoordinatePx, place(), "y")};
+  std::array<double, 2> pair(const json& j, double lo, double hi, const char* what, const char* x,
+                             const char* y) const {
+    if (!j.is_array() || j.size() != 2) refuse(std::string("expected ") + what);
+    return {acquisition::finite_number(j[0], lo, hi, place(), x),
+            acquisition::finite_number(j[1], lo, hi, place(), y)};
+  }
+
+  // A place P (replay.hpp).
+  ReplayPlace point(const json& j) const {
+    ReplayPlace out;
+    if (j.is_array()) {
+      out.at =
+          pair(j, -kMaxCoordinatePx, kMaxCoordinatePx, "a point [x, y] in window pixels", "x", "y");
+      return out;
+    }
+    if (j.is_string()) {
+      out.kind = ReplayPlace::Kind::kWidget;
+      out.widget = widget_name(j);
+      return out;
+    }
+    const char* kinds =
+        "a place is [x, y], a widget's name, or an object with one of \"widget\", "
+        "\"pixel\", \"view3d\" (and an \"offset\")";
+    if (!j.is_object()) refuse(kinds);
+    int named = 0;
+    for (const auto& [key, value] : j.items()) {
+      if (key == "widget") {
+        out.kind = ReplayPlace::Kind::kWidget;
+        out.widget = widget_name(value);
+      } else if (key == "pixel") {
+        out.kind = ReplayPlace::Kind::kPixel;
+        out.at = pair(value, -kMaxCoordinatePx, kMaxCoordinatePx, "a pixel [column, row]", "column",
+                      "row");
+      } else if (key == "view3d") {
+        out.kind = ReplayPlace::Kind::kView3d;
+        out.at = pair(value, 0.0, 1.0, "view3d [x, y] in fractions of the view (0 to 1)", "x", "y");
+      } else if (key == "offset") {
+        out.offset = pair(value, -kMaxCoordinatePx, kMaxCoordinatePx,
+                          "an offset [dx, dy] in window pixels", "dx", "dy");
+        continue;
+      } else {
+        refuse("unknown key \"" + key + "\" in a place; " + kinds);
+      }
+      ++named;
+    }
+    if (named != 1) refuse(kinds);
+    return out;
+  }
+
+  std::string widget_name(const json& j) const {
+    if (!j.is_string() || j.get<std::string>().empty() || j.get<std::string>().size() > 256 ||
+        !core::is_valid_utf8(j.get<std::string>()))
+      refuse("a widget is named by a string of 1 to 256 bytes of UTF-8");
+    return j.get<std::string>();
+  }
+
+  // A file the replay writes, relative to the events file's folder: checked
+  // now, so that a replay never stops half-way for a bad path.
+  std::filesystem::path output(const json& j, const char* what, const char* extension) const {
+    const std::string expected = std::string(what) + " names a " + extension + " file";
+    if (!j.is_string() || j.get<std::string>().empty()) refuse(expected);
+    std::filesystem::path out(j.get<std::string>());
+    if (out.is_relative()) out = file.parent_path() / out;
+    if (out.extension() != extension) refuse(expected);
+    const std::filesystem::path folder = out.parent_path().empty() ? "." : out.parent_path();
+    if (!std::filesystem::is_directory(folder))
+      refuse("the " + std::string(what) + "'s folder " + folder.string() + " does not exist");
+    return out;
   }
 
   int button(const json& j) const {
@@ -94,7 +158,8 @@ struct Reader {
         {"hold", {"hold", "frames", "mods"}},
         {"text", {"text", "mods"}},
         {"wait", {"wait", "mods"}},
-        {"screenshot", {"screenshot", "mods"}}};
+        {"screenshot", {"screenshot", "mods"}},
+        {"layout", {"layout", "mods"}}};
     for (const auto& [kind, keys] : kinds) {
       if (!event.contains(kind)) continue;
       for (const auto& [key, value] : event.items()) {
@@ -125,12 +190,18 @@ void add_button(std::vector<ReplayEvent>& out, int button, bool pressed, int mod
   out.push_back(e);
 }
 
-void add_move(std::vector<ReplayEvent>& out, double x, double y) {
+void add_move(std::vector<ReplayEvent>& out, const ReplayPlace& from, const ReplayPlace& to,
+              double t) {
   ReplayEvent e;
   e.kind = Kind::kMove;
-  e.x = x;
-  e.y = y;
+  e.from = from;
+  e.to = to;
+  e.t = t;
   out.push_back(e);
+}
+
+void add_move(std::vector<ReplayEvent>& out, const ReplayPlace& at) {
+  add_move(out, at, at, 0.0);
 }
 
 void add_waits(std::vector<ReplayEvent>& out, int frames) {
@@ -164,38 +235,31 @@ std::vector<unsigned> codepoints(const std::string& text, const Reader& reader) 
 bool add_pointer_event(const json& e, const Reader& reader, int mods,
                        std::vector<ReplayEvent>& out) {
   if (e.contains("move")) {
-    const auto [x, y] = reader.point(e["move"]);
-    add_move(out, x, y);
+    add_move(out, reader.point(e["move"]));
   } else if (e.contains("press") || e.contains("release")) {
     const bool press = e.contains("press");
     add_button(out, reader.button(press ? e["press"] : e["release"]), press, mods);
   } else if (e.contains("click")) {
-    const auto [x, y] = reader.point(e["click"]);
+    const ReplayPlace at = reader.point(e["click"]);
     const int button = e.contains("button") ? reader.button(e["button"]) : 0;
-    add_move(out, x, y);
+    add_move(out, at);
     add_button(out, button, true, mods);
     add_button(out, button, false, mods);
   } else if (e.contains("drag")) {
     if (!e["drag"].is_array() || e["drag"].size() != 2)
-      reader.refuse("drag is [[x0, y0], [x1, y1]]");
-    const auto [x0, y0] = reader.point(e["drag"][0]);
-    const auto [x1, y1] = reader.point(e["drag"][1]);
+      reader.refuse("drag is [P0, P1]: two places");
+    const ReplayPlace from = reader.point(e["drag"][0]);
+    const ReplayPlace to = reader.point(e["drag"][1]);
     const int button = e.contains("button") ? reader.button(e["button"]) : 0;
     const int steps = std::max(1, e.contains("steps") ? reader.count(e["steps"], "steps") : 10);
-    add_move(out, x0, y0);
+    add_move(out, from, to, 0.0);
     add_button(out, button, true, mods);
-    for (int s = 1; s <= steps; ++s) {
-      const double t = static_cast<double>(s) / steps;
-      add_move(out, x0 + t * (x1 - x0), y0 + t * (y1 - y0));
-    }
+    for (int s = 1; s <= steps; ++s) add_move(out, from, to, static_cast<double>(s) / steps);
     add_button(out, button, false, mods);
   } else if (e.contains("scroll")) {
     const double steps =
         acquisition::finite_number(e["scroll"], -1000.0, 1000.0, reader.place(), "scroll");
-    if (e.contains("at")) {
-      const auto [x, y] = reader.point(e["at"]);
-      add_move(out, x, y);
-    }
+    if (e.contains("at")) add_move(out, reader.point(e["at"]));
     ReplayEvent s;
     s.kind = Kind::kScroll;
     s.scroll = steps;
@@ -233,18 +297,12 @@ void add_event(const json& e, const Reader& reader, std::vector<ReplayEvent>& ou
     }
   } else if (e.contains("wait")) {
     add_waits(out, reader.count(e["wait"], "wait"));
-  } else if (e.contains("screenshot")) {
-    if (!e["screenshot"].is_string() || e["screenshot"].get<std::string>().empty())
-      reader.refuse("screenshot names a .png file");
+  } else if (e.contains("screenshot") || e.contains("layout")) {
+    const bool shot = e.contains("screenshot");
     ReplayEvent s;
-    s.kind = Kind::kScreenshot;
-    s.file = std::filesystem::path(e["screenshot"].get<std::string>());
-    if (s.file.is_relative()) s.file = reader.file.parent_path() / s.file;
-    // Checked now, so that a replay never stops half-way for a bad path.
-    if (s.file.extension() != ".png") reader.refuse("screenshot names a .png file");
-    const std::filesystem::path folder = s.file.parent_path().empty() ? "." : s.file.parent_path();
-    if (!std::filesystem::is_directory(folder))
-      reader.refuse("the screenshot's folder " + folder.string() + " does not exist");
+    s.kind = shot ? Kind::kScreenshot : Kind::kLayout;
+    s.file = shot ? reader.output(e["screenshot"], "screenshot", ".png")
+                  : reader.output(e["layout"], "layout", ".json");
     out.push_back(s);
   }
 }
@@ -297,7 +355,9 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
     const json& e = events[k];
     if (!e.is_object() || e.empty())
       reader.refuse("an event is an object such as {\"key\": \"Z\"}");
+    const std::size_t first = out.size();
     add_event(e, reader, out);
+    for (std::size_t i = first; i < out.size(); ++i) out[i].entry = k;
     if (out.size() > kMaxEvents) {
       reader.refuse("the replay expands to more than " + std::to_string(kMaxEvents) +
                     " events (frames): split it");

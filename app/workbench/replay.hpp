@@ -3,22 +3,37 @@
 // path live input takes. The file:
 //
 //   {"events": [
-//     {"move": [x, y]},                          the cursor [window pixels]
+//     {"move": P},                               the cursor
 //     {"press": "left"}, {"release": "left"},    buttons: left, right, middle
-//     {"click": [x, y], "button": "left", "mods": ["ctrl"]},  move, press, release
-//     {"drag": [[x0, y0], [x1, y1]], "button": "left", "steps": 10},
-//     {"scroll": 1.0, "at": [x, y]},             wheel steps (positive: away from the user)
+//     {"click": P, "button": "left", "mods": ["ctrl"]},  move, press, release
+//     {"drag": [P0, P1], "button": "left", "steps": 10},
+//     {"scroll": 1.0, "at": P},                  wheel steps (positive: away from the user)
 //     {"key": "Z", "mods": ["ctrl"]},           press and release; names below
 //     {"key_down": "W"}, {"key_up": "W"},        press or release alone
 //     {"hold": "W", "frames": 20},               held down for that many frames
 //     {"text": "north wall"},                    typed characters
 //     {"wait": 3},                               frames without input
-//     {"screenshot": "step.png"}]}               relative to the events file's folder
+//     {"screenshot": "step.png"},                relative to the events file's folder
+//     {"layout": "step.json"}]}                  as --layout writes it, at that point
+//
+// A place P is window pixels [x, y], or where something is drawn when the
+// event is fed (so that a replay needs no layout written beforehand):
+//   "apply colour"                               a named widget's centre (--layout lists them)
+//   {"widget": "hue", "offset": [55, 0]}         that, moved by window pixels
+//   {"pixel": [654, 116]}                        a scan pixel's centre (column, row) in the
+//                                                panoramic view
+//   {"view3d": [0.5, 0.5]}                       a point of the 3D view, in fractions of its
+//                                                width and height from its top left
+// Any of the three objects takes an "offset". A drag finds both its ends
+// when it starts. A place not drawn in that frame (a widget of a panel
+// closed, no scan shown) stops the replay with an error naming the event.
 //
 // Keys: A–Z, 0–9, Enter, Escape, Tab, Backspace, Delete, Left, Right, Up,
 // Down, Home, End, Space. Mods: ctrl, shift, alt.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -30,9 +45,26 @@
 
 namespace scanbench::app::workbench {
 
+// A place a pointer event goes to (P above).
+struct ReplayPlace {
+  enum class Kind { kWindow, kWidget, kPixel, kView3d };
+  Kind kind = Kind::kWindow;
+  std::string widget;                 // kWidget: its name
+  std::array<double, 2> at = {};      // kWindow: window pixels; kPixel: column, row;
+                                      // kView3d: fractions of the view
+  std::array<double, 2> offset = {};  // window pixels, added
+};
+
 struct ReplayEvent {
-  enum class Kind { kMove, kButton, kScroll, kKey, kText, kWait, kScreenshot };
+  enum class Kind { kMove, kButton, kScroll, kKey, kText, kWait, kScreenshot, kLayout };
   Kind kind = Kind::kWait;
+  // The file's entry this event comes from (events[entry]).
+  std::size_t entry = 0;
+  // kMove: the cursor goes to `from` + t × (`to` − `from`) (a drag's steps),
+  // the places found once per entry. x, y: where, once found.
+  ReplayPlace from;
+  ReplayPlace to;
+  double t = 0.0;
   double x = 0.0;
   double y = 0.0;
   int button = 0;
@@ -41,7 +73,7 @@ struct ReplayEvent {
   int mods = 0;
   double scroll = 0.0;
   unsigned codepoint = 0;
-  std::filesystem::path file;
+  std::filesystem::path file;  // kScreenshot, kLayout
 };
 
 // The events in the order they are fed (a click is a move, a press and a

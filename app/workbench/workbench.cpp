@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "acquisition/formats/json_input.hpp"
 #include "acquisition/formats/picture_file.hpp"
 #include "app/workbench/input.hpp"
 #include "app/workbench/panels.hpp"
@@ -112,6 +113,7 @@ class Workbench {
       s.command_status = s.session.status();
     }
     s.layout(width, height);
+    s.probes.clear();  // the widgets this frame draws name themselves again
     input_.fly_keys(seconds);
     ImGui_ImplOpenGL3_NewFrame();
     scale_fonts_and_style();  // after the backend made its font texture
@@ -151,6 +153,35 @@ class Workbench {
                   rgb.begin() + static_cast<std::ptrdiff_t>(row * y));
     }
     acquisition::write_rgb_picture(file, width, height, rgb);
+  }
+
+  // Where `place` is in the frame drawn last; none when it is not drawn
+  // there (a widget of a panel closed, no scan shown, no 3D view).
+  std::optional<std::array<double, 2>> locate(const ReplayPlace& place) const {
+    const WorkbenchState& s = state_;
+    std::array<double, 2> at = place.at;
+    switch (place.kind) {
+      case ReplayPlace::Kind::kWindow:
+        break;
+      case ReplayPlace::Kind::kWidget: {
+        const auto found = s.probes.find(place.widget);
+        if (found == s.probes.end()) return std::nullopt;
+        at = {found->second[0], found->second[1]};
+        break;
+      }
+      case ReplayPlace::Kind::kPixel: {
+        if (!s.session.has_grid() || s.panorama.w <= 0.0f || s.panorama.h <= 0.0f)
+          return std::nullopt;
+        const ImVec2 p = s.panorama_screen(Eigen::Vector2d(at[0], at[1]));
+        at = {p.x, p.y};
+        break;
+      }
+      case ReplayPlace::Kind::kView3d:
+        if (s.view3d.w <= 0.0f || s.view3d.h <= 0.0f) return std::nullopt;
+        at = {s.view3d.x + at[0] * s.view3d.w, s.view3d.y + at[1] * s.view3d.h};
+        break;
+    }
+    return std::array<double, 2>{at[0] + place.offset[0], at[1] + place.offset[1]};
   }
 
   // The centres of the named widgets, the scan shown, the status line and
@@ -247,15 +278,55 @@ class Workbench {
   float fonts_scale_ = 1.0f;  // what the font atlas and style were made for
 };
 
+// What a place is called in a replay's error.
+std::string describe(const ReplayPlace& place) {
+  switch (place.kind) {
+    case ReplayPlace::Kind::kWidget:
+      return "the widget \"" + place.widget + "\" is not drawn";
+    case ReplayPlace::Kind::kPixel:
+      return "no scan's panoramic view is shown for the pixel";
+    case ReplayPlace::Kind::kView3d:
+      return "the 3D view is not shown";
+    case ReplayPlace::Kind::kWindow:
+      break;
+  }
+  return "the place is not in the window";
+}
+
 // Feeds the events, a frame each, to `input` (the workbench's, or a
 // recorder in front of it), then takes the screenshot and layout asked for.
+// The places a pointer event names are found in the frame before it is
+// fed (a drag's ends when it starts). Throws core::InputError naming the
+// file and the event when a place is not drawn; the events before it have
+// acted, as a user's would have, and the journal keeps their commands.
 void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions& options,
             const std::vector<ReplayEvent>& events, render::WindowInput& input,
             ReplayRecorder* recorder) {
   bench.frame(kReplayFrameSeconds);  // the first frame lays the panels out
   window.swap_buffers();
+  std::optional<std::size_t> located_entry;
+  std::array<double, 2> from{}, to{};
   for (const ReplayEvent& e : events) {
-    feed(input, e);
+    ReplayEvent fed = e;
+    if (e.kind == ReplayEvent::Kind::kMove) {
+      if (located_entry != e.entry) {
+        const auto find = [&](const ReplayPlace& place) {
+          const std::optional<std::array<double, 2>> at = bench.locate(place);
+          if (!at) {
+            const acquisition::JsonPlace where{options.replay.string(),
+                                               "events[" + std::to_string(e.entry) + "]"};
+            where.refuse(describe(place) + " in the frame this event is fed to");
+          }
+          return *at;
+        };
+        from = find(e.from);
+        to = find(e.to);
+        located_entry = e.entry;
+      }
+      fed.x = from[0] + e.t * (to[0] - from[0]);
+      fed.y = from[1] + e.t * (to[1] - from[1]);
+    }
+    feed(input, fed);
     bench.frame(kReplayFrameSeconds);
     // The next event waits for the command this one started, as a user
     // does: the window takes no presses meanwhile.
@@ -265,6 +336,7 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
     }
     if (recorder) recorder->next_frame();
     if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
+    if (e.kind == ReplayEvent::Kind::kLayout) bench.write_layout(e.file);
     window.swap_buffers();
   }
   do {

@@ -152,6 +152,11 @@ TEST(Refusals, ReplaysAreBoundedAndTheirIntegersNeverWrap) {
            {R"({"events": [{"wait": 4294967297}]})", "wait must be a whole number from 0"},
            {R"({"events": [{"wait": 2.5}]})", "wait must be a whole number"},
            {R"({"events": [{"click": [10, 10], "buton": "left"}]})", "unknown key \"buton\""},
+           {R"({"events": [{"click": {"pixel": [1, 2], "view3d": [0.5, 0.5]}}]})",
+            "a place is [x, y], a widget's name"},
+           {R"({"events": [{"click": {"view3d": [2, 0.5]}}]})", "x must be"},
+           {R"({"events": [{"drag": ["commit", {"widget": ""}]}]})", "a widget is named"},
+           {R"({"events": [{"layout": "step.txt"}]})", "layout names a .json file"},
            {R"({"events": [], "speed": 2})", "unknown key \"speed\""}}) {
     const std::filesystem::path replay = write_text(dir, "replay.json", text);
     // Refused before a window opens: no display is needed.

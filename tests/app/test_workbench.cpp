@@ -3,10 +3,11 @@
 // segmented into its two walls seen from scan 1 (seed clicks in the
 // panoramic view, names typed, Enter to commit), the walls are grouped, one
 // is recoloured with the colour editor's slider, Ctrl+Z takes the recolour
-// back, and the 3D view is flown through. Each stage is a replay of its own
-// process; the widgets' places come from the layout the previous stage
-// wrote. SCANBENCH_SCREENSHOTS (a folder) keeps the screenshots for the
-// user guide.
+// back, and the 3D view is flown through. A replay names the widgets it
+// clicks and the scan pixels it seeds from; the workbench finds them in the
+// frame each event is fed to, so one process plays a whole session, and a
+// test checks the project between processes. SCANBENCH_SCREENSHOTS (a
+// folder) keeps the screenshots for the user guide.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -83,23 +84,41 @@ std::filesystem::path events(const ScratchDir& dir, const std::string& name, con
   return file;
 }
 
+// Places a replay names (app/workbench/replay.hpp), found when the event is
+// fed: a widget by its name is the string itself.
+json pixel(int col, int row) {
+  return {{"pixel", {col, row}}};
+}
+json widget(const std::string& name, double dx, double dy) {
+  return {{"widget", name}, {"offset", {dx, dy}}};
+}
+json view3d(double fx, double fy, double dx = 0.0, double dy = 0.0) {
+  return {{"view3d", {fx, fy}}, {"offset", {dx, dy}}};
+}
+
+// The events that grow a region from a seed click at scan pixel (col, row)
+// and commit it under `name`, typed over the name field's text.
+json commit_events(int col, int row, const std::string& name) {
+  return {{{"click", pixel(col, row)}},       {{"wait", 2}},    {{"click", "name"}},
+          {{"key", "A"}, {"mods", {"ctrl"}}}, {{"text", name}}, {{"key", "Enter"}}};
+}
+
+// The event lists `parts` one after the other.
+json concat(std::initializer_list<json> parts) {
+  json out = json::array();
+  for (const json& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
+// A layout the workbench wrote (--layout, or a replay's "layout" event):
+// the widgets drawn in that frame, the views, the scan shown, the selection.
 struct Layout {
   json data;
   json widget(const std::string& name) const {
     EXPECT_TRUE(data["widgets"].contains(name)) << name;
     return data["widgets"][name];
   }
-  // The window position of a scan pixel's centre in the panoramic view.
-  json pixel(int col, int row) const {
-    const json& p = data["panorama"];
-    const double scale = p["scale"].get<double>();
-    return {p["x"].get<double>() + (col + 0.5) * scale, p["y"].get<double>() + (row + 0.5) * scale};
-  }
-  json view3d_centre() const {
-    const json& v = data["view3d"];
-    return {v[0].get<double>() + 0.5 * v[2].get<double>(),
-            v[1].get<double>() + 0.5 * v[3].get<double>()};
-  }
+  bool draws(const std::string& name) const { return data["widgets"].contains(name); }
 };
 
 json nodes(const ScratchDir& dir, const std::filesystem::path& project) {
@@ -128,114 +147,114 @@ Layout run_stage(const ScratchDir& dir, const std::filesystem::path& project,
   return Layout{read_json(layout)};
 }
 
+// The commands of the project's journal, oldest first: name, state,
+// settings and result.
+json commands(const ScratchDir& dir, const std::filesystem::path& project) {
+  return json::parse(run_cli(dir, {"history", project.string(), "--json"}).out)["commands"];
+}
+
 TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const auto run = [&](const std::string& stage, const json& list) {
-    return run_stage(dir, project, stage, list);
-  };
+  // Opening the project, then two walls: a seed click each, named in the
+  // name field, Enter commits. Grouped: click one wall, Ctrl+click the
+  // other, name the group, Group. The west wall recoloured: its hue slider
+  // clicked three quarters along and its saturation raised, Apply. Then
+  // Ctrl+Z takes the recolour back, and V flies: forward, a look aside.
+  const json session =
+      concat({{{{"screenshot", "workbench_open.png"}}, {{"layout", "layout_open.json"}}},
+              commit_events(654, 116, "wall west"),
+              commit_events(617, 82, "wall south"),
+              {{{"wait", 2}},
+               {{"screenshot", "workbench_segment.png"}},
+               {{"layout", "layout_segment.json"}},
+               {{"click", "node wall west"}},
+               {{"click", "node wall south"}, {"mods", {"ctrl"}}},
+               {{"click", "name"}},
+               {{"text", "keller hall"}},
+               {{"click", "group"}},
+               {{"wait", 2}},
+               {{"screenshot", "workbench_group.png"}},
+               {{"click", "node wall west"}},
+               {{"click", widget("hue", 55.0, 0.0)}},
+               {{"click", widget("saturation", 80.0, 0.0)}},
+               {{"click", "apply colour"}},
+               {{"wait", 2}},
+               {{"screenshot", "workbench_recolored.png"}},
+               {{"key", "Z"}, {"mods", {"ctrl"}}},
+               {{"move", view3d(0.5, 0.5)}},
+               {{"key", "V"}},
+               {{"hold", "W"}, {"frames", 12}},
+               {{"drag", {view3d(0.5, 0.5), view3d(0.5, 0.5, 120.0, 0.0)}}, {"steps", 4}}}});
+  run_stage(dir, project, "fly", session);
+  for (const char* shot : {"workbench_open.png", "workbench_segment.png", "workbench_group.png",
+                           "workbench_recolored.png"})
+    keep_screenshot(dir / shot);
+  EXPECT_EQ(read_json(dir / "layout_open.json")["panorama"]["columns"], 900);
+  const Layout segmented{read_json(dir / "layout_segment.json")};
+  EXPECT_TRUE(segmented.draws("node wall west") && segmented.draws("node wall south"));
+  EXPECT_FALSE(segmented.draws("node keller hall"));
 
-  // Opening the project: the panels and views laid out.
-  const Layout start = run("open", json::array());
-  EXPECT_EQ(start.data["panorama"]["columns"], 900);
-
-  // Two walls: a seed click each, named in the name field, Enter commits.
-  const Layout segmented = run("segment", {{{"click", start.pixel(654, 116)}},
-                                           {{"wait", 2}},
-                                           {{"click", start.widget("name")}},
-                                           {{"key", "A"}, {"mods", {"ctrl"}}},
-                                           {{"text", "wall west"}},
-                                           {{"key", "Enter"}},
-                                           {{"click", start.pixel(617, 82)}},
-                                           {{"wait", 2}},
-                                           {{"click", start.widget("name")}},
-                                           {{"text", "wall south"}},
-                                           {{"key", "Enter"}}});
   json tree = nodes(dir, project);
-  ASSERT_EQ(tree.size(), 2u);
+  ASSERT_EQ(tree.size(), 3u);
   EXPECT_EQ(tree[0]["name"], "wall west");
   EXPECT_EQ(tree[1]["name"], "wall south");
   EXPECT_GT(tree[0]["points"].get<int>(), 1500);
   EXPECT_GT(tree[1]["points"].get<int>(), 1500);
-
-  // Grouped: click one wall, Ctrl+click the other, name the group, Group.
-  const Layout grouped =
-      run("group", {{{"click", segmented.widget("node wall west")}},
-                    {{"click", segmented.widget("node wall south")}, {"mods", {"ctrl"}}},
-                    {{"click", segmented.widget("name")}},
-                    {{"text", "keller hall"}},
-                    {{"click", segmented.widget("group")}},
-                    {{"wait", 2}}});
-  tree = nodes(dir, project);
-  ASSERT_EQ(tree.size(), 3u);
   EXPECT_EQ(tree[2]["name"], "keller hall");
   EXPECT_EQ(tree[2]["kind"], "group");
   EXPECT_EQ(tree[0]["parent"], tree[2]["id"]);
   EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
-
-  // The west wall recoloured: its hue slider clicked three quarters along
-  // and its saturation raised, Apply; the screenshot shows it; then Ctrl+Z.
-  json hue = grouped.widget("hue");
-  hue[0] = hue[0].get<double>() + 55.0;
-  json saturation = grouped.widget("saturation");
-  saturation[0] = saturation[0].get<double>() + 80.0;
-  run("recolor", {{{"click", grouped.widget("node wall west")}},
-                  {{"click", hue}},
-                  {{"click", saturation}},
-                  {{"click", grouped.widget("apply colour")}},
-                  {{"wait", 2}},
-                  {{"screenshot", "workbench_recolored.png"}}});
-  keep_screenshot(dir / "workbench_recolored.png");
-  tree = nodes(dir, project);
-  ASSERT_TRUE(tree[0].contains("color"));
-  EXPECT_GT(tree[0]["color"]["hue_deg"].get<double>(), 30.0);
-  EXPECT_GT(tree[0]["color"]["saturation"].get<double>(), 1.5);
-
-  // Undo, then fly: V, forward for a second, a look to the side.
-  const json centre = grouped.view3d_centre();
-  run("fly", {{{"key", "Z"}, {"mods", {"ctrl"}}},
-              {{"move", centre}},
-              {{"key", "V"}},
-              {{"hold", "W"}, {"frames", 30}},
-              {{"drag", {centre, {centre[0].get<double>() + 120.0, centre[1]}}}, {"steps", 8}}});
-  tree = nodes(dir, project);
-  EXPECT_FALSE(tree[0].contains("color"));
-  const json history =
-      json::parse(run_cli(dir, {"history", project.string(), "--json"}).out)["commands"];
+  EXPECT_FALSE(tree[0].contains("color"));  // undone
+  // The recolour, kept in the journal as undone (redo would bring it back).
+  json history = commands(dir, project);
+  std::vector<std::string> names;
+  for (const json& c : history) names.push_back(c["name"].get<std::string>());
+  EXPECT_EQ(names, (std::vector<std::string>{"import", "geometry", "commit", "commit", "group",
+                                             "recolor"}));
   ASSERT_FALSE(history.empty());
-  EXPECT_EQ(history.back()["name"], "recolor");
-  EXPECT_EQ(history.back()["state"], "undone");
+  json& recolor = history.back();
+  EXPECT_EQ(recolor["state"], "undone");
+  EXPECT_EQ(recolor["result"]["node"], tree[0]["id"]);
+  EXPECT_GT(recolor["result"]["color"]["hue_deg"].get<double>(), 30.0) << recolor.dump();
+  EXPECT_GT(recolor["result"]["color"]["saturation"].get<double>(), 1.5) << recolor.dump();
 
   // Drag and drop in the object tree: the south wall out of the group to
-  // the roots (the panel's empty part), then back onto the group.
-  json empty = grouped.widget("node wall south");
-  empty[1] = empty[1].get<double>() + 100.0;
-  const Layout out =
-      run("reparent_out", {{{"drag", {grouped.widget("node wall south"), empty}}}, {{"wait", 2}}});
-  tree = nodes(dir, project);
-  EXPECT_TRUE(tree[1]["parent"].is_null());
-  const Layout in = run(
-      "reparent_in",
-      {{{"drag", {out.widget("node wall south"), out.widget("node keller hall")}}}, {{"wait", 2}}});
-  tree = nodes(dir, project);
-  EXPECT_EQ(tree[1]["parent"], tree[2]["id"]);
-
-  // Deleting the group asks first: cancelled, nothing changes; confirmed,
-  // the group goes with its walls.
-  const json ask = {
-      {{"click", in.widget("node keller hall")}}, {{"click", in.widget("delete")}}, {{"wait", 2}}};
-  const Layout asked = run("delete_group", ask);
-  EXPECT_EQ(nodes(dir, project).size(), 3u);
-  json cancel = ask;
-  cancel.push_back({{"click", asked.widget("question no")}});
-  cancel.push_back({{"wait", 2}});
-  run("delete_group_cancel", cancel);
-  EXPECT_EQ(nodes(dir, project).size(), 3u);
-  json confirm = ask;
-  confirm.push_back({{"click", asked.widget("question yes")}});
-  confirm.push_back({{"wait", 2}});
-  run("delete_group_confirm", confirm);
+  // the roots (the panel's empty part), then back onto the group. Deleting
+  // the group asks first: cancelled, nothing changes (the group is still
+  // drawn); confirmed, the group goes with its walls.
+  const json ask = {{{"click", "node keller hall"}}, {{"click", "delete"}}, {{"wait", 2}}};
+  json arrange = {
+      {{"drag", {"node wall south", widget("node wall south", 0.0, 100.0)}}},
+      {{"wait", 2}},
+      {{"layout", "layout_reparent_out.json"}},
+      {{"drag", {"node wall south", "node keller hall"}}},
+      {{"wait", 2}},
+  };
+  arrange.insert(arrange.end(), ask.begin(), ask.end());
+  arrange.push_back({{"screenshot", "workbench_delete_asked.png"}});
+  arrange.push_back({{"click", "question no"}});
+  arrange.push_back({{"wait", 2}});
+  arrange.push_back({{"layout", "layout_delete_cancelled.json"}});
+  arrange.insert(arrange.end(), ask.begin(), ask.end());
+  arrange.push_back({{"click", "question yes"}});
+  arrange.push_back({{"wait", 2}});
+  run_stage(dir, project, "arrange", arrange);
+  EXPECT_TRUE(Layout{read_json(dir / "layout_reparent_out.json")}.draws("node wall south"));
+  const Layout cancelled{read_json(dir / "layout_delete_cancelled.json")};
+  EXPECT_TRUE(cancelled.draws("node keller hall") && cancelled.draws("node wall west"));
+  EXPECT_FALSE(cancelled.draws("question yes"));
   EXPECT_TRUE(nodes(dir, project).empty());
+  // The journal: the recolour's redo branch ended by the first move, the
+  // south wall moved to the roots and back, one delete.
+  json after = commands(dir, project);
+  ASSERT_EQ(after.size(), 8u) << after.dump();
+  EXPECT_EQ(after[5]["name"], "edit");
+  EXPECT_TRUE(after[5]["settings"].contains("parent") && after[5]["settings"]["parent"].is_null())
+      << after[5].dump();
+  EXPECT_EQ(after[6]["name"], "edit");
+  EXPECT_EQ(after[6]["settings"]["parent"], tree[2]["id"]) << after[6].dump();
+  EXPECT_EQ(after[7]["name"], "delete");
 }
 
 // Whether a screenshot's pixel (B, G, R) is the 3D view's background.
@@ -297,41 +316,40 @@ TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
     const CliResult result = run_cli(dir, step);
     ASSERT_EQ(result.exit_code, 0) << step.front() << ": " << result.err;
   }
-  const auto run = [&](const std::string& stage, const json& list) {
-    return run_stage(dir, project, stage, list);
-  };
-  const Layout start = run("carry_open", json::array());
-  const Layout committed = run("carry_commit", {{{"click", start.pixel(654, 116)}},
-                                                {{"wait", 2}},
-                                                {{"click", start.widget("name")}},
-                                                {{"key", "A"}, {"mods", {"ctrl"}}},
-                                                {{"text", "wall west"}},
-                                                {{"key", "Enter"}},
-                                                {{"wait", 2}}});
+  // The west wall committed from scan 1; Frame; its brightness near its
+  // lowest (−50), clicked at the slider's left end, Apply; then the
+  // clipping box around it.
+  const json frame_wall = {
+      {{"click", "node wall west"}}, {{"wait", 1}}, {{"key", "F"}}, {{"wait", 3}}};
+  json session = concat(
+      {commit_events(654, 116, "wall west"), {{{"wait", 2}}, {{"layout", "layout_carry.json"}}}});
+  session.insert(session.end(), frame_wall.begin(), frame_wall.end());
+  for (const json& e : json::array({{{"screenshot", "workbench_carry_before.png"}},
+                                    {{"click", widget("brightness", -105.0, 0.0)}},
+                                    {{"click", "apply colour"}},
+                                    {{"wait", 3}},
+                                    {{"screenshot", "workbench_carry_after.png"}}}))
+    session.push_back(e);
+  session.insert(session.end(), frame_wall.begin(), frame_wall.end());
+  session.push_back({{"click", "clip to selection"}});
+  session.push_back({{"wait", 3}});
+  session.push_back({{"screenshot", "workbench_clip.png"}});
+  run_stage(dir, project, "carry", session);
+  for (const char* shot :
+       {"workbench_carry_before.png", "workbench_carry_after.png", "workbench_clip.png"})
+    keep_screenshot(dir / shot);
   const json tree = nodes(dir, project);
   ASSERT_EQ(tree.size(), 1u);
-  const json commit = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
-  const json& result = commit["commands"].back()["result"];
+  json history = commands(dir, project);
+  ASSERT_EQ(history.size(), 5u) << history.dump();  // import, geometry, merge, commit, recolor
+  json& result = history[3]["result"];
   EXPECT_GT(result["other_scans_points"].get<int>(), result["points"].get<int>() / 2);
-  // Brightness near its lowest (−50), clicked at the slider's left end.
-  json brightness = committed.widget("brightness");
-  brightness[0] = brightness[0].get<double>() - 105.0;
-  run("carry_recolor", {{{"click", committed.widget("node wall west")}},
-                        {{"wait", 1}},
-                        {{"key", "F"}},
-                        {{"wait", 3}},
-                        {{"screenshot", "workbench_carry_before.png"}},
-                        {{"click", brightness}},
-                        {{"click", committed.widget("apply colour")}},
-                        {{"wait", 3}},
-                        {{"screenshot", "workbench_carry_after.png"}}});
-  keep_screenshot(dir / "workbench_carry_before.png");
-  keep_screenshot(dir / "workbench_carry_after.png");
+  EXPECT_EQ(history[4]["name"], "recolor");
   // Frame puts the wall at the 3D view's centre, filling its middle: there
   // nearly every pixel darkens (had the object only scan 1's points, the
   // merge's share of scan 2 would stay as it was). The view's left edge
   // shows another building, which keeps its colour.
-  const json& v = committed.data["view3d"];
+  const json v = read_json(dir / "layout_carry.json")["view3d"];
   const int x = v[0].get<int>(), y = v[1].get<int>(), w = v[2].get<int>(), h = v[3].get<int>();
   const std::filesystem::path before = dir / "workbench_carry_before.png";
   const std::filesystem::path after = dir / "workbench_carry_after.png";
@@ -341,13 +359,6 @@ TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
   EXPECT_LT(darkened_share(before, after, x, y + h / 4, w / 10, h / 2), 0.05);
 
   // The clipping box around the wall leaves the other building out.
-  const Layout clipped = run("carry_clip", {{{"click", committed.widget("node wall west")}},
-                                            {{"wait", 1}},
-                                            {{"key", "F"}},
-                                            {{"click", committed.widget("clip to selection")}},
-                                            {{"wait", 3}},
-                                            {{"screenshot", "workbench_clip.png"}}});
-  keep_screenshot(dir / "workbench_clip.png");
   const std::filesystem::path clip = dir / "workbench_clip.png";
   EXPECT_GT(drawn_share(after, x, y + h / 4, w / 10, h / 2), 0.5);
   EXPECT_LT(drawn_share(clip, x, y + h / 4, w / 10, h / 2), 0.02);
@@ -369,32 +380,37 @@ std::vector<std::string> journal(const ScratchDir& dir, const std::filesystem::p
 TEST(Workbench, CtrlZStopsBeforeABatchStageAndAsks) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const auto run = [&](const std::string& stage, const json& list) {
-    return run_stage(dir, project, stage, list);
-  };
-  const Layout start = run("undo_open", json::array());
   const json undo = {{"key", "Z"}, {"mods", {"ctrl"}}};
-  const Layout asked =
-      run("undo_question",
-          {{{"click", start.pixel(654, 116)}}, {{"wait", 2}}, undo, undo, {{"wait", 2}}});
-  // The click grew a selection (session state: no command), the first
-  // Ctrl+Z took it back, and the second asks.
-  const std::vector<std::string> after_click = {"import done", "geometry done"};
-  EXPECT_EQ(journal(dir, project), after_click);
-  run("undo_cancel",
-      {undo, {{"wait", 2}}, {{"click", asked.widget("question no")}}, {{"wait", 1}}});
-  EXPECT_EQ(journal(dir, project), after_click);
-  run("undo_geometry",
-      {undo, {{"wait", 2}}, {{"click", asked.widget("question yes")}}, {{"wait", 2}}});
+  // The click grows a selection (session state: no command), the first
+  // Ctrl+Z takes it back, and the second asks: No, then again and Yes.
+  // Had No undone the geometry, Yes would have undone the import.
+  run_stage(dir, project, "undo_geometry",
+            {{{"click", pixel(654, 116)}},
+             {{"wait", 2}},
+             undo,
+             undo,
+             {{"wait", 2}},
+             {{"screenshot", "workbench_undo_question.png"}},
+             {{"layout", "layout_asked.json"}},
+             {{"click", "question no"}},
+             {{"wait", 1}},
+             {{"layout", "layout_cancelled.json"}},
+             undo,
+             {{"wait", 2}},
+             {{"click", "question yes"}},
+             {{"wait", 2}}});
+  keep_screenshot(dir / "workbench_undo_question.png");
+  EXPECT_TRUE(Layout{read_json(dir / "layout_asked.json")}.draws("question yes"));
+  EXPECT_FALSE(Layout{read_json(dir / "layout_cancelled.json")}.draws("question yes"));
   EXPECT_EQ(journal(dir, project), (std::vector<std::string>{"import done", "geometry undone"}));
-  // With the import undone too the project has no scans; it still opens.
+  // With the import undone too the project has no scans; it still opens,
+  // and Ctrl+Y there brings the import back.
   ASSERT_EQ(run_cli(dir, {"undo", project.string()}).exit_code, 0);
-  const std::filesystem::path shot = dir / "workbench_no_scans.png";
-  const CliResult empty = run_on_display(dir, {project.string(), "--screenshot", shot.string()});
-  EXPECT_EQ(empty.exit_code, 0) << empty.err;
-  keep_screenshot(shot);
-  // Ctrl+Y there brings the import back.
-  run("redo_import", {{{"key", "Y"}, {"mods", {"ctrl"}}}, {{"wait", 2}}});
+  run_stage(dir, project, "redo_import",
+            {{{"screenshot", "workbench_no_scans.png"}},
+             {{"key", "Y"}, {"mods", {"ctrl"}}},
+             {{"wait", 2}}});
+  keep_screenshot(dir / "workbench_no_scans.png");
   EXPECT_EQ(journal(dir, project).front(), "import done");
 }
 
@@ -403,64 +419,66 @@ TEST(Workbench, CtrlZStopsBeforeABatchStageAndAsks) {
 TEST(Workbench, ProposalsAreReviewedOneByOne) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const auto run = [&](const std::string& stage, const json& list) {
-    return run_stage(dir, project, stage, list);
-  };
-  const auto count = [&] { return nodes(dir, project).size(); };
-  const Layout start = run("proposals_open", json::array());
-  const Layout proposed = run("proposals", {{{"click", start.widget("propose")}}, {{"wait", 3}}});
-  const std::size_t made = count();
-  ASSERT_GE(made, 5u);  // the group and its proposals
-  const Layout accepted =
-      run("proposal_accept", {{{"click", proposed.widget("proposal proposal 1")}},
-                              {{"wait", 2}},
-                              {{"click", proposed.widget("name")}},
-                              {{"key", "A"}, {"mods", {"ctrl"}}},
-                              {{"text", "north hall"}},
-                              {{"click", proposed.widget("accept proposal")}},
-                              {{"wait", 2}}});
-  json tree = nodes(dir, project);
+  run_stage(dir, project, "proposals_reviewed",
+            {{{"click", "propose"}},
+             {{"wait", 3}},
+             {{"screenshot", "workbench_proposals.png"}},
+             {{"click", "proposal proposal 1"}},
+             {{"wait", 2}},
+             {{"click", "name"}},
+             {{"key", "A"}, {"mods", {"ctrl"}}},
+             {{"text", "north hall"}},
+             {{"click", "accept proposal"}},
+             {{"wait", 2}},
+             {{"layout", "layout_accepted.json"}},
+             {{"click", "proposal proposal 2"}},
+             {{"wait", 2}},
+             {{"click", "reject proposal"}},
+             {{"wait", 2}},
+             {{"layout", "layout_rejected.json"}},
+             {{"click", "proposal proposal 3"}},
+             {{"wait", 1}},
+             {{"click", "proposal proposal 4"}, {"mods", {"ctrl"}}},
+             {{"wait", 1}},
+             {{"click", "merge proposals"}},
+             {{"wait", 2}}});
+  keep_screenshot(dir / "workbench_proposals.png");
+  // The group and its proposals, less the one rejected and one of the two
+  // merged; the accepted one at the roots under its name.
+  json history = commands(dir, project);
+  ASSERT_GE(history.size(), 3u);
+  ASSERT_EQ(history[2]["name"], "propose") << history.dump();
+  const std::size_t made = 1 + history[2]["result"]["proposals"].get<std::size_t>();
+  ASSERT_GE(made, 5u);
+  const json tree = nodes(dir, project);
+  EXPECT_EQ(tree.size(), made - 2);
   const auto accepted_node = std::find_if(tree.begin(), tree.end(),
                                           [](const json& n) { return n["name"] == "north hall"; });
   ASSERT_NE(accepted_node, tree.end());
   EXPECT_TRUE((*accepted_node)["parent"].is_null());
-  EXPECT_EQ(count(), made);
-  const Layout rejected =
-      run("proposal_reject", {{{"click", accepted.widget("proposal proposal 2")}},
-                              {{"wait", 2}},
-                              {{"click", accepted.widget("reject proposal")}},
-                              {{"wait", 2}}});
-  EXPECT_EQ(count(), made - 1);
-  run("proposal_merge", {{{"click", rejected.widget("proposal proposal 3")}},
-                         {{"wait", 1}},
-                         {{"click", rejected.widget("proposal proposal 4")}, {"mods", {"ctrl"}}},
-                         {{"wait", 1}},
-                         {{"click", rejected.widget("merge proposals")}},
-                         {{"wait", 2}}});
-  EXPECT_EQ(count(), made - 2);
+  const Layout accepted{read_json(dir / "layout_accepted.json")};
+  EXPECT_TRUE(accepted.draws("node north hall") && accepted.draws("proposal proposal 2"));
+  EXPECT_FALSE(Layout{read_json(dir / "layout_rejected.json")}.draws("proposal proposal 2"));
 }
 
-// Ticks "pick points" and clicks window points `a` then `b`, as stage
-// `stage`: the points of the distance the journal's newest command saved
+// The events that tick "measure" and click places `a` then `b`.
+json measure_events(const json& a, const json& b) {
+  return {{{"click", "measure"}}, {{"wait", 1}},  {{"click", a}},
+          {{"wait", 2}},          {{"click", b}}, {{"wait", 2}}};
+}
+
+// The points of the distance the journal's newest "measure" command saved
 // (none, with a failure, when it saved no distance).
-json measured_distance(const ScratchDir& dir, const std::filesystem::path& project,
-                       const std::string& stage, const Layout& start, const json& a,
-                       const json& b) {
-  run_stage(dir, project, stage,
-            {{{"click", start.widget("measure")}},
-             {{"wait", 1}},
-             {{"click", a}},
-             {{"wait", 2}},
-             {{"click", b}},
-             {{"wait", 2}}});
-  const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
-  const json& last = history["commands"].back();
-  const json& list = last["result"]["measurements"];
-  if (last["name"] != "measure" || list.size() != 1 || list[0]["kind"] != "distance") {
-    ADD_FAILURE() << stage << ": no distance saved: " << last.dump();
-    return json::array();
+json measured_distance(const ScratchDir& dir, const std::filesystem::path& project) {
+  json history = commands(dir, project);
+  for (auto c = history.rbegin(); c != history.rend(); ++c) {
+    if ((*c)["name"] != "measure") continue;
+    json& list = (*c)["result"]["measurements"];
+    if (list.size() != 1 || list[0]["kind"] != "distance") break;
+    return list[0]["points"];
   }
-  return list[0]["points"];
+  ADD_FAILURE() << "no distance saved: " << history.dump();
+  return json::array();
 }
 
 // Measuring: with "measure" on, two clicks in the 3D view pick two points
@@ -469,19 +487,8 @@ json measured_distance(const ScratchDir& dir, const std::filesystem::path& proje
 TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const Layout start = run_stage(dir, project, "measure_open", json::array());
-  const json centre = start.view3d_centre();
-  const json aside = {centre[0].get<double>() + 80.0, centre[1].get<double>() + 40.0};
-  const json points = measured_distance(dir, project, "measure", start, centre, aside);
-  ASSERT_EQ(points.size(), 2u);
-  double squared = 0.0;
-  for (int a = 0; a < 3; ++a) {
-    const double d = points[1][a].get<double>() - points[0][a].get<double>();
-    squared += d * d;
-  }
-  EXPECT_GT(std::sqrt(squared), 0.5);  // two points of the campus, apart
-  // Export CSV to the file the field names (by default beside the project),
-  // replacing an earlier one only once confirmed.
+  // Export CSV writes to the file the field names (by default beside the
+  // project), replacing an earlier one only once confirmed: declined first.
   std::filesystem::path written = project;
   written.replace_extension();
   written += "_measurements.csv";
@@ -490,12 +497,28 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
     std::ifstream in(file);
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   };
-  const Layout listed = run_stage(dir, project, "measure_list", json::array());
-  const json export_csv = {{"click", listed.widget("export csv")}};
-  const Layout asked = run_stage(dir, project, "measure_csv_asked", {export_csv, {{"wait", 1}}});
+  json declined = measure_events(view3d(0.5, 0.5), view3d(0.5, 0.5, 80.0, 40.0));
+  for (const json& e : json::array({{{"screenshot", "workbench_measure.png"}},
+                                    {{"click", "export csv"}},
+                                    {{"wait", 1}},
+                                    {{"layout", "layout_csv_asked.json"}},
+                                    {{"click", "question no"}},
+                                    {{"wait", 1}}}))
+    declined.push_back(e);
+  run_stage(dir, project, "measure_csv_declined", declined);
+  keep_screenshot(dir / "workbench_measure.png");
+  EXPECT_TRUE(Layout{read_json(dir / "layout_csv_asked.json")}.draws("question yes"));
   EXPECT_EQ(text_of(written), "an earlier export\n");
+  const json points = measured_distance(dir, project);
+  ASSERT_EQ(points.size(), 2u);
+  double squared = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = points[1][a].get<double>() - points[0][a].get<double>();
+    squared += d * d;
+  }
+  EXPECT_GT(std::sqrt(squared), 0.5);  // two points of the campus, apart
   run_stage(dir, project, "measure_csv",
-            {export_csv, {{"wait", 1}}, {{"click", asked.widget("question yes")}}, {{"wait", 1}}});
+            {{{"click", "export csv"}}, {{"wait", 1}}, {{"click", "question yes"}}, {{"wait", 1}}});
   EXPECT_THAT(text_of(written), HasSubstr("\"distance 1\",distance,"));
   // The command line lists them and writes the CSV too, never over the project.
   const json listed_json =
@@ -518,11 +541,10 @@ TEST(Workbench, TwoClicksInThe3dViewMeasureADistance) {
 TEST(Workbench, ClicksInThePanoramaMeasureTheScansSamples) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const Layout start = run_stage(dir, project, "measure_panorama_open", json::array());
   const std::vector<std::array<int, 2>> pixels = {{654, 116}, {617, 82}};  // column, row
-  const json points = measured_distance(dir, project, "measure_panorama", start,
-                                        start.pixel(pixels[0][0], pixels[0][1]),
-                                        start.pixel(pixels[1][0], pixels[1][1]));
+  run_stage(dir, project, "measure_panorama",
+            measure_events(pixel(pixels[0][0], pixels[0][1]), pixel(pixels[1][0], pixels[1][1])));
+  const json points = measured_distance(dir, project);
   ASSERT_EQ(points.size(), 2u);
   const json truth = read_json(dir / "sim" / "truth.json");
   const json& pose = truth["scans"][0]["T_world_scan"];  // row-major 4 × 4
@@ -543,8 +565,7 @@ TEST(Workbench, ClicksInThePanoramaMeasureTheScansSamples) {
 // Pixels of scan 1 around (col, row) on the same simulated surface, away
 // from its edges (the truth's object ids agree over 5 × 5 pixels, none
 // mixed), at least 4 pixels apart: picks that surely hit a sample.
-std::vector<json> surface_pixels(const ScratchDir& dir, const Layout& layout, int col, int row,
-                                 std::size_t count) {
+std::vector<json> surface_pixels(const ScratchDir& dir, int col, int row, std::size_t count) {
   const auto truth = [&](const char* name) {
     return acquisition::decode_image(dir / "sim" / "truth" / name, 225, 900).pixels;
   };
@@ -578,7 +599,7 @@ std::vector<json> surface_pixels(const ScratchDir& dir, const Layout& layout, in
   }
   EXPECT_EQ(found.size(), count) << "surface pixels near " << col << ", " << row;
   std::vector<json> out;
-  for (const auto& [c, r] : found) out.push_back(layout.pixel(c, r));
+  for (const auto& [c, r] : found) out.push_back(pixel(c, r));
   return out;
 }
 
@@ -588,16 +609,13 @@ std::vector<json> surface_pixels(const ScratchDir& dir, const Layout& layout, in
 TEST(Workbench, EveryKindOfMeasurementIsTaken) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const Layout start = run_stage(dir, project, "measure_kinds_open", json::array());
-  const Layout listed = run_stage(dir, project, "measure_kinds_list",
-                                  {{{"click", start.widget("measure kind")}}, {{"wait", 1}}});
-  const std::vector<json> at = surface_pixels(dir, start, 654, 116, 3);
+  const std::vector<json> at = surface_pixels(dir, 654, 116, 3);
   ASSERT_EQ(at.size(), 3u);
-  json list = {{{"click", start.widget("measure")}}, {{"wait", 1}}};
+  json list = {{{"click", "measure"}}, {{"wait", 1}}};
   const auto choose = [&](const std::string& kind, std::size_t points) {
-    list.push_back({{"click", start.widget("measure kind")}});
+    list.push_back({{"click", "measure kind"}});
     list.push_back({{"wait", 1}});
-    list.push_back({{"click", listed.widget("measure kind " + kind)}});
+    list.push_back({{"click", "measure kind " + kind}});
     list.push_back({{"wait", 1}});
     for (std::size_t k = 0; k < points; ++k) {
       list.push_back({{"click", at[k]}});
@@ -632,19 +650,18 @@ TEST(Workbench, EveryKindOfMeasurementIsTaken) {
 TEST(Workbench, AClickInThe3dViewSelectsTheObjectDrawnThere) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const Layout start = run_stage(dir, project, "select3d_open", json::array());
   const Layout done = run_stage(dir, project, "select3d",
-                                {{{"click", start.pixel(654, 116)}},
+                                {{{"click", pixel(654, 116)}},
                                  {{"wait", 2}},
                                  {{"key", "C"}},
                                  {{"wait", 2}},
                                  {{"key", "F"}},
                                  {{"wait", 2}},
-                                 {{"click", start.pixel(617, 82)}},
+                                 {{"click", pixel(617, 82)}},
                                  {{"wait", 2}},
                                  {{"key", "C"}},
                                  {{"wait", 2}},
-                                 {{"click", start.view3d_centre()}},
+                                 {{"click", view3d(0.5, 0.5)}},
                                  {{"wait", 2}}});
   const json list = nodes(dir, project);
   ASSERT_EQ(list.size(), 2u);
@@ -659,26 +676,15 @@ TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
   const std::filesystem::path project = campus_project(dir);
   const std::filesystem::path copy = dir / "copy.sbproj";
   std::filesystem::copy_file(project, copy);
-  const std::filesystem::path layout = dir / "layout.json";
-  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
-                                 events(dir, "look.json", json::array()).string(), "--layout",
-                                 layout.string()})
-                .exit_code,
-            0);
-  const Layout start{read_json(layout)};
-  const json session = {{{"click", start.pixel(654, 116)}},
-                        {{"wait", 2}},
-                        {{"click", start.widget("name")}},
-                        {{"key", "A"}, {"mods", {"ctrl"}}},
-                        {{"text", "wall west"}},
-                        {{"key", "Enter"}},
-                        {{"wait", 2}},
-                        {{"click", start.pixel(617, 82)}},
-                        {{"wait", 2}},
-                        {{"key", "C"}},
-                        {{"wait", 2}},
-                        {{"key", "Z"}, {"mods", {"ctrl"}}},
-                        {{"wait", 2}}};
+  // The recording holds the window points the named places were found at.
+  const json session = concat({commit_events(654, 116, "wall west"),
+                               {{{"wait", 2}},
+                                {{"click", pixel(617, 82)}},
+                                {{"wait", 2}},
+                                {{"key", "C"}},
+                                {{"wait", 2}},
+                                {{"key", "Z"}, {"mods", {"ctrl"}}},
+                                {{"wait", 2}}}});
   const std::filesystem::path record = dir / "recorded.json";
   const CliResult recorded = run_on_display(
       dir, {project.string(), "--replay", events(dir, "session.json", session).string(), "--record",
@@ -714,15 +720,8 @@ TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
 TEST(Workbench, ReadOnlyWritesNothing) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
-  const std::filesystem::path layout = dir / "layout.json";
-  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
-                                 events(dir, "look.json", json::array()).string(), "--layout",
-                                 layout.string()})
-                .exit_code,
-            0);
-  const Layout start{read_json(layout)};
   const json edits = {
-      {{"click", start.pixel(654, 116)}}, {{"wait", 2}}, {{"key", "C"}}, {{"wait", 1}},
+      {{"click", pixel(654, 116)}},       {{"wait", 2}}, {{"key", "C"}}, {{"wait", 1}},
       {{"key", "Z"}, {"mods", {"ctrl"}}}, {{"wait", 1}}};
   const std::vector<std::string> before = journal(dir, project);
   const std::filesystem::path shot = dir / "workbench_read_only.png";
@@ -743,16 +742,6 @@ TEST(Workbench, ReadOnlyWritesNothing) {
   EXPECT_EQ(journal(dir, project), before);
 }
 
-// The layout the workbench opens `project` with, written to `file`.
-Layout opening_layout(const ScratchDir& dir, const std::filesystem::path& project,
-                      const std::filesystem::path& file) {
-  const CliResult run = run_on_display(
-      dir, {project.string(), "--replay", events(dir, "look.json", {{{"wait", 1}}}).string(),
-            "--layout", file.string()});
-  EXPECT_EQ(run.exit_code, 0) << run.err;
-  return Layout{read_json(file)};
-}
-
 // Clicking another scan in the Scans panel opens it: the panel's list,
 // which opening a scan reloads, was walked while it was replaced
 // (std::bad_alloc or SIGSEGV, 5 times in 5).
@@ -764,11 +753,10 @@ TEST(Workbench, ClickingAnotherScanOpensIt) {
             0);
   ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
   const std::filesystem::path layout = dir / "layout.json";
-  const json click = opening_layout(dir, project, layout).widget("scan 2");
   const CliResult run = run_on_display(dir, {project.string(), "--replay",
                                              events(dir, "open.json",
                                                     {{{"screenshot", "a.png"}},
-                                                     {{"click", click}},
+                                                     {{"click", "scan 2"}},
                                                      {{"wait", 3}},
                                                      {{"screenshot", "b.png"}}})
                                                  .string(),
@@ -789,14 +777,22 @@ TEST(Workbench, AnUnstructuredCloudSaysItHasNoRangeImage) {
                 .exit_code,
             0);
   ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
+  // A click where scan 1's pixel (0, 0) was in the panoramic view (the
+  // cloud has no pixels for a named place to find: window pixels, from the
+  // layout scan 1 opens with).
   const std::filesystem::path layout = dir / "layout.json";
-  const Layout grid = opening_layout(dir, project, layout);
-  const json open = grid.widget("scan 2");
-  const json corner = grid.pixel(0, 0);
+  ASSERT_EQ(run_on_display(dir, {project.string(), "--replay",
+                                 events(dir, "look.json", {{{"wait", 1}}}).string(), "--layout",
+                                 layout.string()})
+                .exit_code,
+            0);
+  const json p = read_json(layout)["panorama"];
+  const double half = 0.5 * p["scale"].get<double>();
+  const json corner = {p["x"].get<double>() + half, p["y"].get<double>() + half};
   const CliResult run = run_on_display(
       dir, {project.string(), "--replay",
             events(dir, "cloud.json",
-                   {{{"click", open}}, {{"wait", 2}}, {{"click", corner}}, {{"wait", 1}}})
+                   {{{"click", "scan 2"}}, {{"wait", 2}}, {{"click", corner}}, {{"wait", 1}}})
                 .string(),
             "--layout", layout.string(), "--screenshot", (dir / "workbench_cloud.png").string()});
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -830,8 +826,14 @@ TEST(Workbench, PanelsScaleWithTheWindow) {
     keep_screenshot(shot);
     return Layout{read_json(layout)};
   };
+  // On the large screen, a click on "scan 2" (found where the large window
+  // draws it) then opens it.
   const Layout small = layout_at(1280, {{{"wait", 1}}});
-  const Layout large = layout_at(2560, {{{"wait", 1}}});
+  const Layout opened = layout_at(
+      2560,
+      {{{"wait", 1}}, {{"layout", "layout_2560_open.json"}}, {{"click", "scan 2"}}, {{"wait", 2}}});
+  EXPECT_EQ(opened.data["scan"], 2);
+  const Layout large{read_json(dir / "layout_2560_open.json")};
   EXPECT_EQ(small.data["ui_scale"], 1.0);
   EXPECT_EQ(large.data["ui_scale"], 2.0);
   EXPECT_NEAR(large.data["panorama"]["x"].get<double>(),
@@ -845,9 +847,6 @@ TEST(Workbench, PanelsScaleWithTheWindow) {
           << widget << " axis " << axis;
     }
   }
-  // A click at the large window's place of "scan 2" opens it.
-  const Layout opened = layout_at(2560, {{{"click", large.widget("scan 2")}}, {{"wait", 2}}});
-  EXPECT_EQ(opened.data["scan"], 2);
 }
 
 TEST(Workbench, BadEventsAndProjectsAreRefusedByName) {
@@ -863,6 +862,15 @@ TEST(Workbench, BadEventsAndProjectsAreRefusedByName) {
   EXPECT_THAT(refused.err, HasSubstr("bad.json"));
   EXPECT_THAT(refused.err, HasSubstr("events[1]"));
   EXPECT_THAT(refused.err, HasSubstr("NoSuchKey"));
+  // A widget the frame does not draw: refused when the event is fed, by
+  // its place in the file and its name.
+  const std::filesystem::path missing =
+      events(dir, "missing.json", {{{"wait", 1}}, {{"click", "no such widget"}}});
+  const CliResult not_drawn = run_on_display(dir, {project.string(), "--replay", missing.string()});
+  EXPECT_EQ(not_drawn.exit_code, 2);
+  EXPECT_THAT(not_drawn.err, HasSubstr("missing.json"));
+  EXPECT_THAT(not_drawn.err, HasSubstr("events[1]"));
+  EXPECT_THAT(not_drawn.err, HasSubstr("\"no such widget\" is not drawn"));
   const std::filesystem::path not_json = dir / "not.json";
   std::ofstream(not_json) << "{\"events\": [";
   EXPECT_EQ(run_on_display(dir, {project.string(), "--replay", not_json.string()}).exit_code, 2);
