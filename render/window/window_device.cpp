@@ -7,7 +7,17 @@
 
 #include <string>
 
+// AddressSanitizer's build: GCC defines __SANITIZE_ADDRESS__, clang 14
+// answers __has_feature(address_sanitizer) instead.
 #if defined(__SANITIZE_ADDRESS__)
+#define SCANBENCH_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SCANBENCH_ADDRESS_SANITIZER 1
+#endif
+#endif
+
+#if defined(SCANBENCH_ADDRESS_SANITIZER)
 #include <dlfcn.h>
 #include <link.h>
 #endif
@@ -26,7 +36,7 @@ std::string glfw_error() {
   return out;
 }
 
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(SCANBENCH_ADDRESS_SANITIZER)
 // Under AddressSanitizer: pins every library loaded so far (the GL driver
 // that GLFW and ImGui's loader open, and close again at exit), so that
 // LeakSanitizer can still name them at exit and tests/lsan.supp applies to
