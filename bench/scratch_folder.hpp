@@ -6,27 +6,17 @@
 
 #include <filesystem>
 #include <string>
-#include <system_error>
+
+#include "core/scratch_folder.hpp"
 
 namespace scanbench::bench {
 
-class ScratchFolder {
+// temp_directory_path() / "scanbench-bench-SUITE-PID".
+class ScratchFolder : public core::ScratchFolder {
  public:
   explicit ScratchFolder(const std::string& suite)
-      : path_(std::filesystem::temp_directory_path() /
-              ("scanbench-bench-" + suite + "-" + std::to_string(::getpid()))) {
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchFolder() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  ScratchFolder(const ScratchFolder&) = delete;
-  ScratchFolder& operator=(const ScratchFolder&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
+      : core::ScratchFolder(std::filesystem::temp_directory_path(),
+                            "scanbench-bench-" + suite + "-" + std::to_string(::getpid())) {}
 };
 
 }  // namespace scanbench::bench

@@ -11,33 +11,20 @@
 #include <exception>
 #include <filesystem>
 #include <string>
-#include <system_error>
-#include <utility>
 
 #include "core/errors.hpp"
+#include "core/scratch_folder.hpp"
 
 namespace scanbench::fuzz {
 
 // A folder of this process in /dev/shm (or the temporary folder), removed
 // when the process exits normally.
 inline const std::filesystem::path& work_folder() {
-  struct Folder {
-    std::filesystem::path path;
-    explicit Folder(std::filesystem::path where) : path(std::move(where)) {
-      std::filesystem::create_directories(path);
-    }
-    ~Folder() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-    Folder(const Folder&) = delete;
-    Folder& operator=(const Folder&) = delete;
-  };
-  static const Folder folder((std::filesystem::exists("/dev/shm")
-                                  ? std::filesystem::path("/dev/shm")
-                                  : std::filesystem::temp_directory_path()) /
-                             ("scanbench-fuzz-" + std::to_string(::getpid())));
-  return folder.path;
+  static const core::ScratchFolder folder(std::filesystem::exists("/dev/shm")
+                                              ? std::filesystem::path("/dev/shm")
+                                              : std::filesystem::temp_directory_path(),
+                                          "scanbench-fuzz-" + std::to_string(::getpid()));
+  return folder.path();
 }
 
 // Writes `data` to work_folder() / name and returns the path.
