@@ -205,7 +205,11 @@ void add_move(std::vector<ReplayEvent>& out, const ReplayPlace& at) {
 }
 
 void add_waits(std::vector<ReplayEvent>& out, int frames) {
-  for (int k = 0; k < frames; ++k) out.push_back(ReplayEvent{});
+  if (frames == 0) return;
+  ReplayEvent e;
+  e.kind = Kind::kWait;
+  e.frames = frames;
+  out.push_back(e);
 }
 
 // UTF-8 to code points (ASCII and 2–4 byte sequences).
@@ -349,6 +353,7 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
     reader.refuse("expected {\"events\": [...]}");
   acquisition::refuse_unknown_keys(root, {"events"}, reader.place());
   std::vector<ReplayEvent> out;
+  std::size_t frames = 0;  // the events fed, a wait's frames each one
   const json& events = root["events"];
   for (std::size_t k = 0; k < events.size(); ++k) {
     reader.where = "events[" + std::to_string(k) + "]";
@@ -357,8 +362,11 @@ std::vector<ReplayEvent> read_replay(const std::filesystem::path& file) {
       reader.refuse("an event is an object such as {\"key\": \"Z\"}");
     const std::size_t first = out.size();
     add_event(e, reader, out);
-    for (std::size_t i = first; i < out.size(); ++i) out[i].entry = k;
-    if (out.size() > kMaxEvents) {
+    for (std::size_t i = first; i < out.size(); ++i) {
+      out[i].entry = k;
+      frames += out[i].kind == Kind::kWait ? static_cast<std::size_t>(out[i].frames) : 1;
+    }
+    if (frames > kMaxEvents) {
       reader.refuse("the replay expands to more than " + std::to_string(kMaxEvents) +
                     " events (frames): split it");
     }

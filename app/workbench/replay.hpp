@@ -73,11 +73,13 @@ struct ReplayEvent {
   int mods = 0;
   double scroll = 0.0;
   unsigned codepoint = 0;
+  int frames = 1;              // kWait: frames that pass without input
   std::filesystem::path file;  // kScreenshot, kLayout
 };
 
 // The events in the order they are fed (a click is a move, a press and a
-// release; a drag its moves in between). Throws core::InputError naming the
+// release; a drag its moves in between; a wait or a hold's frames one
+// event). Throws core::InputError naming the
 // file, the event ("events[3]") and the problem.
 std::vector<ReplayEvent> read_replay(const std::filesystem::path& file);
 

@@ -327,17 +327,21 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
       fed.y = from[1] + e.t * (to[1] - from[1]);
     }
     feed(input, fed);
-    bench.frame(kReplayFrameSeconds);
-    // The next event waits for the command this one started, as a user
-    // does: the window takes no presses meanwhile.
-    while (bench.busy()) {
-      window.swap_buffers();
+    // A wait's frames one after the other; any other event takes one.
+    const int frames = e.kind == ReplayEvent::Kind::kWait ? e.frames : 1;
+    for (int f = 0; f < frames; ++f) {
       bench.frame(kReplayFrameSeconds);
+      // The next event waits for the command this one started, as a user
+      // does: the window takes no presses meanwhile.
+      while (bench.busy()) {
+        window.swap_buffers();
+        bench.frame(kReplayFrameSeconds);
+      }
+      if (recorder) recorder->next_frame();
+      if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
+      if (e.kind == ReplayEvent::Kind::kLayout) bench.write_layout(e.file);
+      window.swap_buffers();
     }
-    if (recorder) recorder->next_frame();
-    if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
-    if (e.kind == ReplayEvent::Kind::kLayout) bench.write_layout(e.file);
-    window.swap_buffers();
   }
   do {
     bench.frame(kReplayFrameSeconds);

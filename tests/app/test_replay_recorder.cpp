@@ -77,7 +77,10 @@ TEST(ReplayRecorder, WritesWhatALiveSessionActedOn) {
       {"wait": 2}, {"key_down": "Z", "mods": ["ctrl"]}]})");
   EXPECT_EQ(written, expected) << written.dump();
   // And the file reads back as a replay.
-  EXPECT_EQ(app::workbench::read_replay(file).size(), 8u);  // the wait is two frames
+  const std::vector<app::workbench::ReplayEvent> replayed = app::workbench::read_replay(file);
+  ASSERT_EQ(replayed.size(), 7u);  // the wait of two frames is one event
+  EXPECT_EQ(replayed[5].kind, app::workbench::ReplayEvent::Kind::kWait);
+  EXPECT_EQ(replayed[5].frames, 2);
 }
 
 }  // namespace
