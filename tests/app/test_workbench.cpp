@@ -367,9 +367,8 @@ TEST(Workbench, ARecolouredWallChangesColourInEveryScanOfTheModel) {
 
 // The states of the journal's commands, oldest first.
 std::vector<std::string> journal(const ScratchDir& dir, const std::filesystem::path& project) {
-  const json history = json::parse(run_cli(dir, {"history", project.string(), "--json"}).out);
   std::vector<std::string> out;
-  for (const json& c : history["commands"])
+  for (const json& c : commands(dir, project))
     out.push_back(c["name"].get<std::string>() + " " + c["state"].get<std::string>());
   return out;
 }
@@ -693,21 +692,20 @@ TEST(Workbench, ARecordedSessionReplaysToTheSameJournal) {
   ASSERT_TRUE(std::filesystem::exists(record));
   const CliResult replayed = run_on_display(dir, {copy.string(), "--replay", record.string()});
   ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
-  const auto commands = [&](const std::filesystem::path& file) {
+  const auto summary = [&](const std::filesystem::path& file) {
     json out = json::array();
-    const json history = json::parse(run_cli(dir, {"history", file.string(), "--json"}).out);
-    for (const json& c : history["commands"])
+    for (const json& c : commands(dir, file))
       out.push_back({c["name"], c["state"], c["settings"], c["result"]});
     return out;
   };
-  const json original = commands(project);
+  const json original = summary(project);
   // import, geometry, commit, commit (undone): the undo gave the second
   // commit's selection back, and closing did not keep it, which would have
   // ended the redo chain.
   ASSERT_EQ(original.size(), 4u);
   EXPECT_EQ(original[3][0], "commit");
   EXPECT_EQ(original[3][1], "undone");
-  EXPECT_EQ(commands(copy), original);
+  EXPECT_EQ(summary(copy), original);
   // An existing file is never replaced by a recording.
   const CliResult again = run_on_display(dir, {project.string(), "--record", record.string()});
   EXPECT_EQ(again.exit_code, 2);
