@@ -23,6 +23,15 @@ class RenderDevice {
 // describe() of the context current on the calling thread.
 std::string describe_current_context();
 
+// Under AddressSanitizer: pins every library loaded so far (the GL driver
+// that EGL, GLFW and ImGui's loader open, and close again at exit), so that
+// LeakSanitizer can still name them at exit, tests/lsan.supp applies to the
+// allocations the driver keeps for the process's life, and the thread-local
+// blocks they registered are still mapped when LeakSanitizer scans them.
+// Does nothing in other builds. Called by each device once its context is
+// current.
+void pin_loaded_libraries();
+
 // A context without any surface, on EGL's surfaceless platform (Mesa;
 // llvmpipe on machines without a GPU), made current on return. Throws
 // core::RuntimeFailure naming what is missing (EGL, the platform, a 4.5

@@ -50,6 +50,7 @@ class HeadlessDevice final : public RenderDevice {
       eglDestroyContext(display_, context_);
       fail("cannot make the context current", error);
     }
+    pin_loaded_libraries();
   }
 
   // The display stays initialised: EGL gives every device of the process

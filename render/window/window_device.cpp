@@ -7,21 +7,6 @@
 
 #include <string>
 
-// AddressSanitizer's build: GCC defines __SANITIZE_ADDRESS__, clang 14
-// answers __has_feature(address_sanitizer) instead.
-#if defined(__SANITIZE_ADDRESS__)
-#define SCANBENCH_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SCANBENCH_ADDRESS_SANITIZER 1
-#endif
-#endif
-
-#if defined(SCANBENCH_ADDRESS_SANITIZER)
-#include <dlfcn.h>
-#include <link.h>
-#endif
-
 #include "core/errors.hpp"
 
 namespace scanbench::render {
@@ -35,24 +20,6 @@ std::string glfw_error() {
   out.append(" (GLFW error ").append(std::to_string(code)).append(")");
   return out;
 }
-
-#if defined(SCANBENCH_ADDRESS_SANITIZER)
-// Under AddressSanitizer: pins every library loaded so far (the GL driver
-// that GLFW and ImGui's loader open, and close again at exit), so that
-// LeakSanitizer can still name them at exit and tests/lsan.supp applies to
-// the allocations the driver keeps for the process's life.
-void pin_loaded_libraries() {
-  dl_iterate_phdr(
-      [](dl_phdr_info* info, std::size_t, void*) {
-        if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0')
-          dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
-        return 0;
-      },
-      nullptr);
-}
-#else
-void pin_loaded_libraries() {}
-#endif
 
 WindowInput* input_of(GLFWwindow* window) {
   return static_cast<WindowInput*>(glfwGetWindowUserPointer(window));
