@@ -19,6 +19,9 @@ function(scanbench_target_settings target)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                              -fno-sanitize-recover=undefined -UNDEBUG)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    if(SCANBENCH_UBSAN_SKIP)
+      target_compile_options(${target} PRIVATE -fno-sanitize=${SCANBENCH_UBSAN_SKIP})
+    endif()
     # Eigen switches to its own aligned allocator under AddressSanitizer; the
     # prebuilt Ceres (and the benches' PCL) libraries use malloc. Objects
     # crossing that line (Eigen matrices inside their objects) would be freed
