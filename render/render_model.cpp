@@ -134,6 +134,11 @@ void gather_scan(const store::Project& project, const store::StoredScanSummary& 
   std::vector<std::uint8_t> usable(scan.pixel_count());
   for (std::size_t i = 0; i < usable.size(); ++i)
     usable[i] = acquisition::in_model(scan, geometry, i);
+  // Room for this scan's points, at least doubling: one copy per scan at
+  // most, and none of the many a point at a time would make.
+  const auto in_model = static_cast<std::size_t>(std::count(usable.begin(), usable.end(), 1));
+  const std::size_t needed = p.size() + in_model;
+  if (needed > p.position.capacity()) p.reserve(std::max(needed, 2 * p.position.capacity()));
   const auto [low, high] = acquisition::intensity_range(scan, usable);
   const float spread = high > low ? high - low : 1.0f;
   const Eigen::Matrix3f rotation = scan.T_world_scan.linear().cast<float>();
@@ -263,6 +268,16 @@ void extend_group_boxes(RenderModel& model) {
 
 }  // namespace
 
+void RenderPoints::reserve(std::size_t n) {
+  position.reserve(n);
+  normal.reserve(n);
+  radii_m.reserve(n);
+  major_axis.reserve(n);
+  rgba.reserve(n);
+  intensity.reserve(n);
+  node.reserve(n);
+}
+
 RenderModel build_render_model(const store::Project& project, const RenderModelSettings& settings) {
   const std::vector<store::StoredScanSummary> scans = project.scans();
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
@@ -289,6 +304,7 @@ RenderModel assemble_render_model(RenderPoints points, const Eigen::Vector3d& or
   RenderModel model;
   model.origin = origin;
   model.counts.in_model = points.size();
+  model.points.reserve(points.size());
   const std::map<std::int64_t, std::size_t> index_of = link_tree(tree, model);
   // Each node's points (a node not in the tree owns nothing), tiled.
   std::map<std::int64_t, std::vector<std::uint32_t>> by_node;

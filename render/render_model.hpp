@@ -45,6 +45,8 @@ struct RenderPoints {
   std::vector<std::uint32_t> node;  // the owning object, 0 for none
 
   std::size_t size() const { return position.size(); }
+  // Room for `n` points in every array.
+  void reserve(std::size_t n);
 };
 
 struct RenderTile {
