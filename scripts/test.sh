@@ -17,7 +17,7 @@
 #                             (scripts/fuzz.sh, every UBSan check)
 #   scripts/test.sh --fast    the Release pass only
 #
-# One build keeps CI short on two cores: a cold build takes about 8 minutes
+# One build keeps CI short on two cores: a cold build takes about 6 minutes
 # for the sanitizer tree, 13 for Release (docs/CONTRIBUTING.md).
 #
 # The UBSan checks the default pass leaves out: alignment, null,
