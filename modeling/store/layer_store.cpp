@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "core/memory.hpp"
 #include "modeling/store/checksummed_rows.hpp"
+#include "modeling/store/layer_rows.hpp"
 #include "modeling/store/project.hpp"
 #include "modeling/store/sqlite_statement.hpp"
 #include "modeling/store/zstd_blob.hpp"
@@ -42,7 +43,7 @@ const TypeInfo& info(ElementType type) {
 // and then its row read by key: sorting the rows with their data would copy
 // each version's data through a temporary b-tree (a temporary file for a
 // layer of megabytes) on every read.
-const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data
+const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.rowid, l.data
 FROM scan_layers l
 WHERE l.scan_id = ?1 AND l.name = ?2 AND l.command_id = (
   SELECT k.command_id FROM scan_layers k JOIN commands c ON c.id = k.command_id
@@ -117,8 +118,11 @@ namespace {
 
 // Writes (or replaces, within one command) the row of a layer version, with
 // its checksum; `blob` empty for a removal.
+// With `zeroblob_bytes`, the data is that many zero bytes, to be written in
+// place.
 void write_layer_row(sqlite3* db, const std::string& file, const LayerFields& fields,
-                     std::span<const std::uint8_t> blob) {
+                     std::span<const std::uint8_t> blob,
+                     std::optional<std::uint64_t> zeroblob_bytes = std::nullopt) {
   sqlite::Statement insert(db, R"sql(
 INSERT OR REPLACE INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec,
                                     data, checksum)
@@ -129,6 +133,8 @@ VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8))sql",
   insert.bind_text(6, fields.codec);
   if (fields.codec == "removed") {
     insert.bind_null(7);
+  } else if (zeroblob_bytes) {
+    insert.bind_zeroblob(7, *zeroblob_bytes);
   } else {
     insert.bind_blob(7, blob);
   }
@@ -167,6 +173,40 @@ void Project::remove_layer(Edit& edit, std::int64_t id, std::string_view name) {
                   {});
 }
 
+namespace {
+
+// The current version of a layer, its row verified and its fields checked
+// against the scan's pixel count and the `expected` type.
+struct CurrentLayer {
+  ElementType type;
+  std::int64_t rowid;
+  BlobContext context;
+};
+
+std::optional<CurrentLayer> current_layer(const sqlite::Statement& select, const std::string& file,
+                                          std::int64_t id, std::string_view name, std::size_t n,
+                                          std::optional<ElementType> expected) {
+  const LayerFields fields = verified(select, file);
+  if (fields.codec == "removed") return std::nullopt;
+  if (fields.codec != "zstd") damaged(file, id, name, "unknown codec");
+  const std::optional<ElementType> stored = element_type_from_name(fields.element_type);
+  if (!stored) damaged(file, id, name, "unknown element type " + fields.element_type);
+  if (expected && *stored != *expected) {
+    damaged(file, id, name,
+            "holds " + fields.element_type + " elements, expected " + element_type_name(*expected));
+  }
+  if (fields.element_count != static_cast<std::int64_t>(n)) {
+    damaged(file, id, name,
+            "has " + std::to_string(fields.element_count) + " elements, expected " +
+                std::to_string(n) + " (one per pixel)");
+  }
+  return CurrentLayer{*stored,
+                      select.column_int(7),
+                      {file, "scan " + std::to_string(id) + ", layer " + std::string(name)}};
+}
+
+}  // namespace
+
 bool Project::read_layer(
     std::int64_t id, std::string_view name, std::optional<ElementType> expected,
     const std::function<std::span<std::byte>(std::size_t bytes)>& allocate) const {
@@ -174,29 +214,60 @@ bool Project::read_layer(
   sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
   select.bind_int(1, id).bind_text(2, name);
   if (!select.step()) return false;
-  const LayerFields fields = verified(select, file_name());
-  if (fields.codec == "removed") return false;
-  if (fields.codec != "zstd") damaged(file_name(), id, name, "unknown codec");
-  const std::optional<ElementType> stored = element_type_from_name(fields.element_type);
-  if (!stored) damaged(file_name(), id, name, "unknown element type " + fields.element_type);
-  if (expected && *stored != *expected) {
-    damaged(file_name(), id, name,
-            "holds " + fields.element_type + " elements, expected " + element_type_name(*expected));
-  }
-  const ElementType type = *stored;
-  if (fields.element_count != static_cast<std::int64_t>(n)) {
-    damaged(file_name(), id, name,
-            "has " + std::to_string(fields.element_count) + " elements, expected " +
-                std::to_string(n) + " (one per pixel)");
-  }
-  const BlobContext context{file_name(),
-                            "scan " + std::to_string(id) + ", layer " + std::string(name)};
+  const std::optional<CurrentLayer> layer =
+      current_layer(select, file_name(), id, name, n, expected);
+  if (!layer) return false;
+  const std::size_t bytes = n * element_size(layer->type);
   // The frame must hold what the grid needs before a buffer is made for it.
-  const std::span<const std::uint8_t> blob = select.column_blob(7);
-  check_blob_size(blob, n * element_size(type), context);
-  core::check_memory(n * element_size(type), file_name());
-  decompress_into(blob, allocate(n * element_size(type)), context);
+  const std::span<const std::uint8_t> blob = select.column_blob(8);
+  check_blob_size(blob, bytes, layer->context);
+  core::check_memory(bytes, file_name());
+  decompress_into(blob, allocate(bytes), layer->context);
   return true;
+}
+
+std::optional<LayerRowReader> Project::open_layer_rows(std::int64_t id, std::string_view name,
+                                                       ElementType expected) const {
+  const acquisition::ScanSummary grid = current_summary(id).summary;
+  sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
+  select.bind_int(1, id).bind_text(2, name);
+  if (!select.step()) return std::nullopt;
+  const std::optional<CurrentLayer> layer = current_layer(
+      select, file_name(), id, name,
+      static_cast<std::size_t>(grid.rows) * static_cast<std::size_t>(grid.columns), expected);
+  if (!layer) return std::nullopt;
+  return LayerRowReader::open_blob(db(), layer->rowid, grid.rows, grid.columns, layer->type,
+                                   layer->context);
+}
+
+void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer) {
+  check_edit(edit);
+  assert(layer.complete() && "every row written");
+  [[maybe_unused]] const std::size_t n = stored_pixel_count(id, &edit);
+  assert(static_cast<std::size_t>(layer.rows()) * static_cast<std::size_t>(layer.columns()) == n &&
+         "a layer holds one element per pixel");
+  [[maybe_unused]] const EncodedLayer described{layer.name(), layer.type(), n, {}};
+  assert(has_its_type(described) && "a layer named in layer_store.hpp has the type listed there");
+  const LayerFields fields{id,
+                           layer.name(),
+                           edit.command_id(),
+                           element_type_name(layer.type()),
+                           static_cast<std::int64_t>(n),
+                           "zstd"};
+  write_layer_row(db(), file_name(), fields, {}, layer.compressed_bytes());
+  sqlite3_blob* blob = nullptr;
+  const int code = sqlite3_blob_open(db(), "main", "scan_layers", "data",
+                                     sqlite3_last_insert_rowid(db()), 1, &blob);
+  if (code != SQLITE_OK) sqlite::throw_error(db(), code, file_name(), "writing a layer");
+  const std::unique_ptr<sqlite3_blob, decltype(&sqlite3_blob_close)> closing(blob,
+                                                                             &sqlite3_blob_close);
+  std::uint64_t offset = 0;
+  layer.for_each_piece([&](std::span<const std::byte> piece) {
+    const int written = sqlite3_blob_write(blob, piece.data(), static_cast<int>(piece.size()),
+                                           static_cast<int>(offset));
+    if (written != SQLITE_OK) sqlite::throw_error(db(), written, file_name(), "writing a layer");
+    offset += piece.size();
+  });
 }
 
 void Project::verify_current_layer(std::int64_t id, std::string_view name) const {

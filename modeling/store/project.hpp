@@ -49,6 +49,7 @@
 #include "core/memory.hpp"
 #include "core/project_file.hpp"
 #include "modeling/store/color_edit.hpp"
+#include "modeling/store/layer_rows.hpp"
 #include "modeling/store/layer_store.hpp"
 
 struct sqlite3;
@@ -257,6 +258,10 @@ class Project {
   // there is no such scan.
   void put_layer(Edit& edit, std::int64_t id, const EncodedLayer& layer);
 
+  // The same, from a layer written by rows (layer_rows.hpp), copied into
+  // the project in pieces; asserts every row was written.
+  void put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer);
+
   // Removes layer `name` of scan `id` as part of `edit` (a version saying
   // "none": undo brings the earlier version back). No effect on a layer the
   // scan does not have; throws core::InputError when there is no such scan.
@@ -281,6 +286,12 @@ class Project {
     if (!found) return std::nullopt;
     return values;
   }
+
+  // The current version of layer `name` of scan `id`, to be read a band
+  // of rows at a time (layer_rows.hpp), checked as load_layer checks it;
+  // none when the scan has no such layer.
+  std::optional<LayerRowReader> open_layer_rows(std::int64_t id, std::string_view name,
+                                                ElementType type) const;
 
   // Names of the current layers of scan `id`, sorted.
   std::vector<std::string> layer_names(std::int64_t id) const;

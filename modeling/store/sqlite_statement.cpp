@@ -159,6 +159,12 @@ Statement& Statement::bind_blob(int index, std::span<const std::uint8_t> value) 
   return *this;
 }
 
+Statement& Statement::bind_zeroblob(int index, std::uint64_t bytes) {
+  const int code = sqlite3_bind_zeroblob64(statement_, index, bytes);
+  if (code != SQLITE_OK) throw_error(db_, code, file_, "binding a blob");
+  return *this;
+}
+
 bool Statement::step() {
   const int code = sqlite3_step(statement_);
   if (code == SQLITE_ROW) return true;

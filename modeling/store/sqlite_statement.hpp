@@ -52,6 +52,8 @@ class Statement {
   Statement& bind_text(int index, std::string_view value);  // copied by SQLite
   // Not copied: `value` must outlive the next step().
   Statement& bind_blob(int index, std::span<const std::uint8_t> value);
+  // A blob of `bytes` zero bytes, to be filled in place (sqlite3_blob_write).
+  Statement& bind_zeroblob(int index, std::uint64_t bytes);
 
   // Advances; true when a row is available, false when the statement is done.
   // Throws as throw_error on failure.

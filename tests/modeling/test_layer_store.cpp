@@ -2,6 +2,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "core/errors.hpp"
 #include "modeling/store/project.hpp"
 #include "modeling/store/typed_layers.hpp"
@@ -149,6 +151,132 @@ TEST(Poses, SetPoseMovesPoseScannerAndBoundsAndKeepsTheOldPose) {
   stored = project.scans().at(0);
   EXPECT_TRUE(test::same_bytes(Eigen::Matrix4d(stored.summary.T_world_scan.matrix()),
                                Eigen::Matrix4d(before.matrix())));
+}
+
+// Values that compress poorly (so a layer spans several of the reader's and
+// writer's pieces of 1 MB) with runs that compress well.
+std::vector<Eigen::Vector3f> noisy_vectors(std::size_t n) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> value(-1.0f, 1.0f);
+  std::vector<Eigen::Vector3f> values(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    values[i] = i % 5 == 0 ? Eigen::Vector3f::Zero()
+                           : Eigen::Vector3f(value(random), value(random), value(random));
+  }
+  return values;
+}
+
+// Reads a layer back in bands of the given heights, in turn, until its end.
+std::vector<Eigen::Vector3f> read_in_bands(store::LayerRowReader reader,
+                                           const std::vector<int>& heights) {
+  std::vector<Eigen::Vector3f> values;
+  for (std::size_t k = 0; reader.rows_read() < reader.rows(); ++k) {
+    const int rows = std::min(heights[k % heights.size()], reader.rows() - reader.rows_read());
+    std::vector<Eigen::Vector3f> band(static_cast<std::size_t>(rows) * reader.columns());
+    reader.read(std::span(band));
+    values.insert(values.end(), band.begin(), band.end());
+  }
+  return values;
+}
+
+TEST(LayerRows, ALayerStoredWholeReadsInAnyBandsOfRows) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const acquisition::Scan scan = test::tiny_scan(true, false, false, 301, 700);
+  const std::int64_t id = test::insert_committed(project, scan);
+  const std::vector<Eigen::Vector3f> normals = noisy_vectors(scan.pixel_count());
+  put_committed(project, id,
+                {store::encode_layer<Eigen::Vector3f>(store::layer::kNormal,
+                                                      store::ElementType::kF32x3, normals)});
+  for (const std::vector<int>& heights : {std::vector<int>{301}, {1}, {17, 100, 3}}) {
+    auto reader = project.open_layer_rows(id, store::layer::kNormal, store::ElementType::kF32x3);
+    ASSERT_TRUE(reader.has_value());
+    EXPECT_EQ(reader->rows(), 301);
+    EXPECT_EQ(reader->columns(), 700);
+    EXPECT_TRUE(test::same_bytes(read_in_bands(std::move(*reader), heights), normals));
+  }
+  EXPECT_FALSE(project.open_layer_rows(id, store::layer::kKeep, store::ElementType::kU8));
+  // Checked as load_layer checks it, before anything is decoded.
+  try {
+    project.open_layer_rows(id, store::layer::kNormal, store::ElementType::kF32);
+    FAIL() << "expected core::InputError";
+  } catch (const core::InputError& error) {
+    EXPECT_THAT(error.problem(), HasSubstr("holds f32x3 elements, expected f32"));
+  }
+}
+
+TEST(LayerRows, ALayerWrittenByRowsIsTheLayerStoredWhole) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const acquisition::Scan scan = test::tiny_scan(true, false, false, 301, 700);
+  const std::int64_t id = test::insert_committed(project, scan);
+  const std::vector<Eigen::Vector3f> normals = noisy_vectors(scan.pixel_count());
+  store::LayerRowWriter writer(store::layer::kNormal, store::ElementType::kF32x3, 301, 700);
+  for (int row = 0; row < 301;) {
+    const int rows = std::min(row % 3 == 0 ? 50 : 1, 301 - row);
+    writer.write(std::span(normals).subspan(static_cast<std::size_t>(row) * 700,
+                                            static_cast<std::size_t>(rows) * 700));
+    row += rows;
+  }
+  ASSERT_TRUE(writer.complete());
+  {
+    store::Project::Edit edit = project.begin_command("test", "{}");
+    project.put_layer(edit, id, writer);
+    edit.commit("{}");
+  }
+  const store::Project reopened = store::Project::open(dir / "p.sbproj");
+  EXPECT_TRUE(test::same_bytes(
+      *reopened.load_layer<Eigen::Vector3f>(id, store::layer::kNormal, store::ElementType::kF32x3),
+      normals));
+  EXPECT_TRUE(reopened.check().damage.empty());
+}
+
+// Reads every row of layer `name` of scan `id` in bands of 10 rows.
+void read_every_row(const store::Project& project, std::int64_t id, const char* name) {
+  auto reader = project.open_layer_rows(id, name, store::ElementType::kF32);
+  ASSERT_TRUE(reader.has_value());
+  std::vector<float> band(static_cast<std::size_t>(reader->columns()) * 10);
+  while (reader->rows_read() < reader->rows()) {
+    const int rows = std::min(10, reader->rows() - reader->rows_read());
+    reader->read(std::span(band).first(static_cast<std::size_t>(rows) * reader->columns()));
+  }
+}
+
+TEST(LayerRows, DamageIsFoundWhereverItIs) {
+  const ScratchDir dir;
+  const auto file = dir / "p.sbproj";
+  std::int64_t id = 0;
+  {
+    store::Project project = store::Project::create(file);
+    id = test::insert_committed(project, test::tiny_scan(true, false, false, 200, 300));
+    std::vector<float> weights(200 * 300);
+    for (std::size_t i = 0; i < weights.size(); ++i) weights[i] = std::sin(0.001f * i);
+    put_committed(project, id,
+                  {store::encode_layer<float>("weights", store::ElementType::kF32, weights)});
+  }
+  test::RawDatabase(file).execute(
+      "CREATE TABLE intact AS SELECT data FROM scan_layers WHERE name = 'weights'");
+  // Changes the layer's data by `change` (SQL of the column `data`), expects
+  // `problem` when its rows are read, and puts the intact data back.
+  const auto expect_damage = [&](const std::string& change, const char* problem) {
+    SCOPED_TRACE(change);
+    test::RawDatabase(file).execute("UPDATE scan_layers SET data = " + change +
+                                    " WHERE name = 'weights'");
+    try {
+      read_every_row(store::Project::open(file), id, "weights");
+      ADD_FAILURE() << "expected core::InputError";
+    } catch (const core::InputError& error) {
+      EXPECT_EQ(error.position().detail, "scan " + std::to_string(id) + ", layer weights");
+      EXPECT_THAT(error.problem(), HasSubstr(problem));
+    }
+    test::RawDatabase(file).execute(
+        "UPDATE scan_layers SET data = (SELECT data FROM intact) WHERE name = 'weights'");
+  };
+  read_every_row(store::Project::open(file), id, "weights");  // intact
+  expect_damage("substr(data, 1, length(data) - 40)", "damaged channel data");
+  expect_damage("data || x'00'", "bytes follow the frame");
+  expect_damage("substr(data, 1, 9000) || x'5a' || substr(data, 9002)", "damaged channel data");
+  expect_damage("x'0102'", "not a zstd frame");
 }
 
 }  // namespace
