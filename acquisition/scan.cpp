@@ -65,11 +65,11 @@ Scan make_scattered_scan(std::size_t points, bool with_intensity, bool with_colo
   return scan;
 }
 
-Eigen::Vector3d direction_precise(const Scan& scan, int row, int col) {
-  assert(row >= 0 && row < scan.rows && col >= 0 && col < scan.columns);
+Eigen::Vector3d direction_precise(const Scan& scan, int row, int col, int first_row) {
+  assert(row >= 0 && row < scan.rows && col >= 0 && col < scan.columns && first_row >= 0);
   if (const auto* spherical = std::get_if<SphericalAngles>(&scan.angles)) {
     const double az = spherical->azimuth(col);
-    const double el = spherical->elevation(row);
+    const double el = spherical->elevation(first_row + row);
     const double cos_el = std::cos(el);
     return {cos_el * std::cos(az), cos_el * std::sin(az), std::sin(el)};
   }
@@ -102,9 +102,9 @@ Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col) {
   return scan.range_m[scan.index(row, col)] * direction(scan, row, col);
 }
 
-Eigen::Vector3d point_in_world(const Scan& scan, int row, int col) {
+Eigen::Vector3d point_in_world(const Scan& scan, int row, int col, int first_row) {
   const double range = scan.range_m[scan.index(row, col)];
-  return scan.T_world_scan * (range * direction_precise(scan, row, col));
+  return scan.T_world_scan * (range * direction_precise(scan, row, col, first_row));
 }
 
 bool wraps_around(const Scan& scan) {

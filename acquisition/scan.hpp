@@ -174,13 +174,17 @@ class SphericalDirections {
 
 // The same direction in double precision, normalised in double (per-pixel
 // directions are re-normalised), for exporters and world coordinates.
-Eigen::Vector3d direction_precise(const Scan& scan, int row, int col);
+// Where `scan` holds a band of a grid's rows from grid row `first_row`
+// (acquisition/geometry/row_band.hpp), `row` counts the held rows and the
+// direction is the grid's, bit for bit.
+Eigen::Vector3d direction_precise(const Scan& scan, int row, int col, int first_row = 0);
 
 // Point of pixel (row, col) in the scan frame [m]; meaningless where !valid.
 Eigen::Vector3f point_in_scan(const Scan& scan, int row, int col);
 
-// Point of pixel (row, col) in the world frame [m], in double precision.
-Eigen::Vector3d point_in_world(const Scan& scan, int row, int col);
+// Point of pixel (row, col) in the world frame [m], in double precision;
+// `first_row` as for direction_precise.
+Eigen::Vector3d point_in_world(const Scan& scan, int row, int col, int first_row = 0);
 
 // True when the scan's columns close the full circle of azimuth (a
 // spherical grid whose columns × |azimuth step| is 2π within half a step):

@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "core/project_file.hpp"
 #include "modeling/color_pipeline.hpp"
+#include "modeling/scan_rows.hpp"
 #include "modeling/shown_nodes.hpp"
 #include "modeling/store/typed_layers.hpp"
 
@@ -175,16 +176,27 @@ class E57Export {
 class ModelView {
  public:
   ModelView(const store::Project& project, const ExportSettings& settings)
-      : project_(project),
-        settings_(settings),
+      : settings_(settings),
         tree_(project.object_nodes()),
         shown_(shown_nodes(tree_)),
         colors_(project.scan_color_corrections(), resolve_color_edits(tree_)) {}
 
+  // Whether show() reads the scans' membership (their objects).
+  bool wants_membership() const {
+    return settings_.colors == ExportColors::kShown || !settings_.all_points;
+  }
+
+  // Scan `id` as the model shows it: the points of hidden objects and
+  // deleted ones left out (unless every point is exported), the shown
+  // colours. `scan` may hold a band of the scan's rows, then `keep` and
+  // `membership` are the band's; `membership` is the scan's layer, none
+  // where it has none.
   void show(std::int64_t id, acquisition::Scan& scan,
-            std::optional<std::vector<std::uint8_t>>& keep, ExportResult& result) const {
+            std::optional<std::vector<std::uint8_t>>& keep,
+            const std::optional<std::vector<std::uint32_t>>& membership,
+            ExportResult& result) const {
     const bool recolour = settings_.colors == ExportColors::kShown;
-    if (!recolour && settings_.all_points) return;
+    if (!wants_membership()) return;
     const bool grid_format =
         settings_.format == ExportFormat::kPtx || settings_.format == ExportFormat::kTriplet;
     const auto leave_out = [&](std::size_t i) {
@@ -195,8 +207,6 @@ class ModelView {
       if (!keep) keep = scan.valid;
       (*keep)[i] = 0;
     };
-    const auto membership =
-        project_.load_layer<std::uint32_t>(id, store::layer::kMembership, store::ElementType::kU32);
     for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
       if (!scan.valid[i] || (keep && (*keep)[i] == 0)) continue;
       std::uint32_t owner = membership ? (*membership)[i] : 0;
@@ -225,7 +235,6 @@ class ModelView {
   }
 
  private:
-  const store::Project& project_;
   const ExportSettings& settings_;
   std::vector<store::ObjectNode> tree_;
   std::map<std::int64_t, bool> shown_;
@@ -378,6 +387,63 @@ acquisition::PointListWriter::LasSettings las_settings(
 
 }  // namespace
 
+// The next `rows` rows of `reader` (none without one).
+template <typename T>
+std::optional<std::vector<T>> next_rows(std::optional<store::LayerRowReader>& reader, int rows,
+                                        std::size_t per_pixel = 1) {
+  if (!reader) return std::nullopt;
+  std::vector<T> values(static_cast<std::size_t>(rows) *
+                        static_cast<std::size_t>(reader->columns()) * per_pixel);
+  reader->read(std::span(values));
+  return values;
+}
+
+// Scan `id` shown and added to `points` a band of rows at a time: what
+// loading it whole and adding it writes, byte for byte.
+void add_by_bands(const store::Project& project, std::int64_t id, const ModelView& view,
+                  const ExportSettings& settings, acquisition::PointChannels channels,
+                  std::uint16_t source_id, acquisition::PointListWriter& points,
+                  ExportResult& result) {
+  using store::ElementType;
+  ScanRows rows(project, id, {channels.intensity, channels.color});
+  const acquisition::Scan& description = rows.description();
+  std::optional<store::LayerRowReader> footprint, normal, confidence, flags, keep, membership;
+  if (channels.geometry) {
+    footprint = project.open_layer_rows(id, store::layer::kFootprint, ElementType::kF32);
+    normal = project.open_layer_rows(id, store::layer::kNormal, ElementType::kF32x3);
+    confidence = project.open_layer_rows(id, store::layer::kConfidence, ElementType::kF32);
+    flags = project.open_layer_rows(id, store::layer::kGeometryFlags, ElementType::kU8);
+    if (!footprint || !normal || !confidence || !flags) {
+      core::FilePosition position;
+      position.detail = "scan " + std::to_string(id);
+      throw core::InputError(project.path().string(), position,
+                             "project is damaged: only some of the geometry layers are stored");
+    }
+  }
+  if (settings.merged) {  // check_merged made sure there is one
+    keep = project.open_layer_rows(id, store::layer::kKeep, ElementType::kU8);
+  }
+  if (view.wants_membership()) {
+    membership = project.open_layer_rows(id, store::layer::kMembership, ElementType::kU32);
+  }
+  const int band = store::band_rows(settings.band_pixels, description.columns);
+  for (int first = 0; first < description.rows; first += band) {
+    const int end = std::min(description.rows, first + band), n = end - first;
+    acquisition::Scan held = rows.hold(first, end);
+    std::optional<acquisition::ScanGeometry> geometry;
+    if (channels.geometry) {
+      geometry.emplace();
+      geometry->footprint_m = *next_rows<float>(footprint, n);
+      geometry->normal = *next_rows<Eigen::Vector3f>(normal, n);
+      geometry->confidence = *next_rows<float>(confidence, n);
+      geometry->flags = *next_rows<std::uint8_t>(flags, n);
+    }
+    std::optional<std::vector<std::uint8_t>> kept = next_rows<std::uint8_t>(keep, n);
+    view.show(id, held, kept, next_rows<std::uint32_t>(membership, n), result);
+    points.add(held, geometry ? &*geometry : nullptr, kept ? &*kept : nullptr, source_id, first);
+  }
+}
+
 ExportResult export_project(const store::Project& project, const ExportSettings& settings,
                             core::Progress* progress) {
   // Masks, poses and channels from one state, whatever commits meanwhile.
@@ -408,6 +474,7 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
   // One writer per format; every scan is loaded, shown and written in turn.
   const bool point_list = is_point_list(settings.format);
   std::optional<acquisition::PointListWriter> points;
+  acquisition::PointChannels channels;  // of `points`
   std::optional<acquisition::PtxWriter> ptx;
   std::optional<E57Export> e57;
   if (point_list) {
@@ -418,7 +485,8 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
     const acquisition::PointListWriter::LasSettings las =
         settings.format == ExportFormat::kLas ? las_settings(project, ids, summaries, result)
                                               : acquisition::PointListWriter::LasSettings{};
-    points.emplace(settings.output, format, common_channels(project, ids, summaries), las);
+    channels = common_channels(project, ids, summaries);
+    points.emplace(settings.output, format, channels, las);
   } else if (settings.format == ExportFormat::kPtx) {
     ptx.emplace(settings.output);
   } else if (settings.format == ExportFormat::kE57) {
@@ -426,28 +494,32 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
   }
   for (std::size_t s = 0; s < ids.size(); ++s) {
     const std::int64_t id = ids[s];
-    acquisition::Scan scan = triplet_scan ? std::move(*triplet_scan) : project.load_scan(id);
-    std::optional<std::vector<std::uint8_t>> keep;
-    if (settings.merged) keep = store::load_keep_mask(project, id);
-    view.show(id, scan, keep, result);
-    const std::vector<std::uint8_t>* keep_of = keep ? &*keep : nullptr;
-    if (points) {
-      const std::optional<acquisition::ScanGeometry> geometry = store::load_geometry(project, id);
-      points->add(scan, geometry ? &*geometry : nullptr, keep_of,
-                  source_ids.empty() ? 0 : source_ids[s]);
-    } else {
+    const std::string& name = summaries[s]->name;
+    if (points) {  // a band of rows at a time
+      add_by_bands(project, id, view, settings, channels, source_ids.empty() ? 0 : source_ids[s],
+                   *points, result);
+    } else {  // grids and E57 files are written a scan at a time
+      acquisition::Scan scan = triplet_scan ? std::move(*triplet_scan) : project.load_scan(id);
+      std::optional<std::vector<std::uint8_t>> keep;
+      if (settings.merged) keep = store::load_keep_mask(project, id);
+      std::optional<std::vector<std::uint32_t>> membership;
+      if (view.wants_membership()) {
+        membership = project.load_layer<std::uint32_t>(id, store::layer::kMembership,
+                                                       store::ElementType::kU32);
+      }
+      view.show(id, scan, keep, membership, result);
       result.points += count_points(scan, keep);
       if (ptx) ptx->add(scan);
-      if (e57) e57->add(id, scan, keep_of);
+      if (e57) e57->add(id, scan, keep ? &*keep : nullptr);
+      if (settings.format == ExportFormat::kTriplet) triplet_scan = std::move(scan);
     }
     if (progress != nullptr) {
-      progress->update({"export", s + 1, ids.size(), scan.name});
+      progress->update({"export", s + 1, ids.size(), name});
       progress->throw_if_cancelled("export");
     }
     // A triplet's files are complete once written: written after the last
     // chance to cancel, as the other formats commit.
-    if (settings.format == ExportFormat::kTriplet)
-      acquisition::write_triplet(scan, settings.output);
+    if (triplet_scan) acquisition::write_triplet(*triplet_scan, settings.output);
   }
   if (points) {
     result.points = points->points();

@@ -44,6 +44,10 @@ struct ExportSettings {
   // Replace an existing output file (--force). A project, or a file a scan
   // was imported from, is never replaced.
   bool replace_existing = false;
+  // PLY, CSV and LAS read and write each scan a band of rows of about this
+  // many pixels at a time (docs/scale.md, "Big scans"): some 200 MB at the
+  // default, whatever the scan's size. The file does not depend on it.
+  std::size_t band_pixels = std::size_t{1} << 22;
 };
 
 struct ExportResult {

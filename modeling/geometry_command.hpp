@@ -42,8 +42,18 @@ struct GeometryCommandResult {
 // visible on any error or when cancelled (core::Cancelled). Throws
 // core::InputError when the project has no scans, core::RuntimeFailure when
 // another process changed its scans meanwhile.
+//   A grid scan is read, computed and written a band of rows at a time
+// (docs/scale.md, "Big scans"): bands of about `band_pixels` pixels, at
+// least one tile of the window fits (acquisition::geometry_band_cuts), so
+// that memory does not grow with the scan (a band's inputs, scratch and
+// results take about 45 bytes a pixel: some 200 MB at the default, where a
+// 3600 × 900 station is one band); the result is the whole scan's
+// geometry bit for bit, whatever the bands. A cloud (scattered scan) is
+// computed whole: its neighbours may lie anywhere in it.
+inline constexpr std::size_t kGeometryBandPixels = std::size_t{1} << 22;
 GeometryCommandResult geometry_project(store::Project& project,
                                        const acquisition::GeometrySettings& settings,
-                                       core::Progress& progress);
+                                       core::Progress& progress,
+                                       std::size_t band_pixels = kGeometryBandPixels);
 
 }  // namespace scanbench::modeling

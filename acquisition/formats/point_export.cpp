@@ -37,10 +37,12 @@ Channels common_channels(std::span<const Scan> scans,
 
 // Calls visit(pixel index, world point) for every exported pixel of one
 // scan (valid, not a mixed pixel when geometry is exported, and kept when a
-// keep mask is given), row-major.
+// keep mask is given), row-major; `scan` holds the grid's rows from
+// `first_row` (direction_precise).
 template <typename Visit>
 void for_each_scan_point(const Scan& scan, const ScanGeometry* geometry,
-                         const std::vector<std::uint8_t>* keep, bool with_geometry, Visit&& visit) {
+                         const std::vector<std::uint8_t>* keep, bool with_geometry, int first_row,
+                         Visit&& visit) {
   assert((keep == nullptr || keep->size() == scan.pixel_count()) && "a byte per pixel");
   assert((!with_geometry || geometry != nullptr) && "geometry to leave mixed pixels out");
   for (int row = 0; row < scan.rows; ++row) {
@@ -48,7 +50,7 @@ void for_each_scan_point(const Scan& scan, const ScanGeometry* geometry,
       const std::size_t i = scan.index(row, col);
       if (with_geometry ? !in_model(scan, *geometry, i) : !scan.valid[i]) continue;
       if (keep != nullptr && (*keep)[i] == 0) continue;
-      visit(i, point_in_world(scan, row, col));
+      visit(i, point_in_world(scan, row, col, first_row));
     }
   }
 }
@@ -62,7 +64,7 @@ void for_each_point(std::span<const Scan> scans, std::span<const ScanGeometry* c
   assert((keep.empty() || keep.size() == scans.size()) && "one keep entry per scan");
   for (std::size_t s = 0; s < scans.size(); ++s) {
     for_each_scan_point(scans[s], channels.geometry ? geometry[s] : nullptr,
-                        keep.empty() ? nullptr : keep[s], channels.geometry,
+                        keep.empty() ? nullptr : keep[s], channels.geometry, 0,
                         [&](std::size_t i, const Eigen::Vector3d& p) { visit(s, i, p); });
   }
 }
@@ -346,7 +348,8 @@ PointListWriter::PointListWriter(const std::filesystem::path& path, PointListFor
 PointListWriter::~PointListWriter() = default;
 
 void PointListWriter::add(const Scan& scan, const ScanGeometry* geometry,
-                          const std::vector<std::uint8_t>* keep, std::uint16_t source_id) {
+                          const std::vector<std::uint8_t>* keep, std::uint16_t source_id,
+                          int first_row) {
   State& s = *state_;
   const auto refuse = [&](const char* what) {
     throw core::InputError(
@@ -356,7 +359,7 @@ void PointListWriter::add(const Scan& scan, const ScanGeometry* geometry,
   if (s.channels.intensity && !scan.has_intensity()) refuse("intensity");
   if (s.channels.color && !scan.has_color()) refuse("colour");
   if (s.channels.geometry && geometry == nullptr) refuse("geometry");
-  for_each_scan_point(scan, geometry, keep, s.channels.geometry,
+  for_each_scan_point(scan, geometry, keep, s.channels.geometry, first_row,
                       [&](std::size_t i, const Eigen::Vector3d& p) {
                         switch (s.format) {
                           case PointListFormat::kPly:

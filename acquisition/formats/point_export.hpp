@@ -96,9 +96,13 @@ class PointListWriter {
   // channels have geometry, `source_id` is LAS's point source id. Throws
   // core::InputError naming the file and the scan when the scan lacks a
   // channel the file has, or a LAS point falls outside `bounds` by more than
-  // its integers hold; as OutputFile on write errors.
+  // its integers hold; as OutputFile on write errors. A scan too large to
+  // hold is added a band of rows at a time, in order: `scan` then holds
+  // the grid's rows from `first_row` (direction_precise), and `geometry`
+  // and `keep` theirs.
   void add(const Scan& scan, const ScanGeometry* geometry,
-           const std::vector<std::uint8_t>* keep = nullptr, std::uint16_t source_id = 0);
+           const std::vector<std::uint8_t>* keep = nullptr, std::uint16_t source_id = 0,
+           int first_row = 0);
   std::size_t points() const;
   // Completes the header and replaces the target (all-or-nothing).
   void commit();

@@ -9,7 +9,7 @@
 
 namespace scanbench::acquisition {
 
-GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
+GridDirections::GridDirections(const Scan& scan, int first_row) : columns(scan.columns) {
   if (const auto* p = std::get_if<PerPixelDirections>(&scan.angles)) {
     per_pixel = p->directions;
     return;
@@ -21,7 +21,7 @@ GridDirections::GridDirections(const Scan& scan) : columns(scan.columns) {
     sin_az.push_back(static_cast<float>(std::sin(az)));
   }
   for (int row = 0; row < scan.rows; ++row) {
-    const double el = a.elevation(row);
+    const double el = a.elevation(first_row + row);
     cos_el.push_back(static_cast<float>(std::cos(el)));
     sin_el.push_back(static_cast<float>(std::sin(el)));
   }

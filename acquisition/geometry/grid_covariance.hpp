@@ -24,7 +24,10 @@ struct GridDirections {
   std::span<const Eigen::Vector3f> per_pixel;         // per-pixel grids only, rows × columns
   int columns = 0;
 
-  explicit GridDirections(const Scan& scan);
+  // Of `scan`'s pixels; where `scan` holds a band of a grid's rows, the
+  // first of them grid row `first_row` (row_band.hpp), whose elevations
+  // the rows get: the whole grid's directions, bit for bit.
+  explicit GridDirections(const Scan& scan, int first_row = 0);
 
   // (An empty per-pixel grid counts as spherical: it has no pixel to ask about.)
   bool is_per_pixel() const { return !per_pixel.empty(); }

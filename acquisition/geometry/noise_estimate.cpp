@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -128,25 +129,56 @@ std::optional<RangeNoise> fit(const std::vector<NoiseBand>& bands) {
 }  // namespace
 
 NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback, int threads) {
-  NoiseEstimate out;
-  out.noise = fallback;
-  if (scan.is_scattered() || scan.rows < 5 || scan.columns < 5) return out;
-  const int tile_rows = (scan.rows + kTile - 1) / kTile;
-  const int tile_columns = (scan.columns + kTile - 1) / kTile;
-  std::vector<std::optional<TileSigma>> tiles(static_cast<std::size_t>(tile_rows) * tile_columns);
-  core::parallel_for_index(tile_rows, threads, [&](int tr) {
+  NoiseTiles tiles(scan.rows, scan.columns, scan.is_scattered());
+  tiles.add(scan, RowBand::whole(scan.rows), threads);
+  return tiles.finish(fallback);
+}
+
+NoiseTiles::NoiseTiles(int rows, int columns, bool scattered)
+    : rows_(rows),
+      columns_(columns),
+      tile_columns_((columns + kTile - 1) / kTile),
+      usable_(!scattered && rows >= 5 && columns >= 5) {
+  static_assert(kRowMultiple == kTile);
+  if (usable_) tiles_.resize(static_cast<std::size_t>((rows + kTile - 1) / kTile) * tile_columns_);
+}
+
+void NoiseTiles::add(const Scan& held, const RowBand& band, int threads) {
+  if (!usable_) return;
+  assert(held.columns == columns_ && band.rows == rows_ && band.begin % kTile == 0 &&
+         (band.end % kTile == 0 || band.end == rows_) && band.first_row >= 0 &&
+         band.first_row <= std::max(0, band.begin - kHaloRows) &&
+         band.first_row + held.rows >= std::min(rows_, band.end + kHaloRows) &&
+         "a band of whole tiles with the rows its residuals reach");
+  // tile_sigma's border tests on the held rows are the grid's: the held
+  // rows reach kHaloRows beyond the band, or the grid's end.
+  const int first_tile = band.begin / kTile, end_tile = (band.end + kTile - 1) / kTile;
+  core::parallel_for_index(end_tile - first_tile, threads, [&](int k) {
+    const int tr = first_tile + k;
     std::vector<double> residuals;
-    for (int tc = 0; tc < tile_columns; ++tc) {
-      tiles[static_cast<std::size_t>(tr) * tile_columns + tc] =
-          tile_sigma(scan, tr * kTile, tc * kTile, residuals);
+    for (int tc = 0; tc < tile_columns_; ++tc) {
+      const std::optional<TileSigma> tile =
+          tile_sigma(held, tr * kTile - band.first_row, tc * kTile, residuals);
+      if (tile) {
+        tiles_[static_cast<std::size_t>(tr) * tile_columns_ + tc] =
+            NoiseBand{tile->range_m, tile->sigma_m, tile->samples};
+      }
     }
   });
+}
+
+NoiseEstimate NoiseTiles::finish(const RangeNoise& fallback) const {
+  NoiseEstimate out;
+  out.noise = fallback;
   std::array<std::vector<TileSigma>, kBands> by_band;
-  for (const std::optional<TileSigma>& tile : tiles) {
+  for (const std::optional<NoiseBand>& tile : tiles_) {
     if (!tile) continue;
     const int band =
         static_cast<int>(std::floor(kBandsPerOctave * std::log2(tile->range_m / kNearestM)));
-    if (band >= 0 && band < kBands) by_band[static_cast<std::size_t>(band)].push_back(*tile);
+    if (band >= 0 && band < kBands) {
+      by_band[static_cast<std::size_t>(band)].push_back(
+          {tile->range_m, tile->sigma_m, tile->samples});
+    }
   }
   for (std::vector<TileSigma>& band : by_band) {
     if (band.size() < kBandMinimumTiles) continue;

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
+#include "acquisition/geometry/row_band.hpp"
 #include "acquisition/range_noise.hpp"
 #include "acquisition/scan.hpp"
 
@@ -51,5 +53,31 @@ struct NoiseEstimate {
 // not depend on `threads` (0: all cores).
 NoiseEstimate estimate_range_noise(const Scan& scan, const RangeNoise& fallback = {},
                                    int threads = 0);
+
+// The same estimate made band by band, for a scan too large to hold whole:
+// add() each band of rows (its limits multiples of kRowMultiple, or the
+// grid's end; the held rows kHaloRows beyond them, or the grid's end), in
+// any order, then finish(): the estimate of the whole scan, bit for bit.
+class NoiseTiles {
+ public:
+  static constexpr int kRowMultiple = 16;  // the tiles' height
+  static constexpr int kHaloRows = 2;      // the residuals' reach
+
+  // Of a grid scan of rows × columns (scattered: `scattered`, then no tile is kept).
+  NoiseTiles(int rows, int columns, bool scattered);
+
+  // The tiles of rows [band.begin, band.end) of `held`, which holds rows
+  // from band.first_row (asserted).
+  void add(const Scan& held, const RowBand& band, int threads = 0);
+
+  NoiseEstimate finish(const RangeNoise& fallback) const;
+
+ private:
+  int rows_, columns_, tile_columns_;
+  bool usable_;
+  // Per tile, row-major: its σ at its mean range and its residuals (a
+  // NoiseBand of one tile); none until added, or too few residuals.
+  std::vector<std::optional<NoiseBand>> tiles_;
+};
 
 }  // namespace scanbench::acquisition

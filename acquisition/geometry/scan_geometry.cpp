@@ -210,11 +210,12 @@ struct RowFactors {
   float elevation_gradient = 0.0f;  // 1 / Δel
   float azimuth_step_sq = 0.0f, elevation_step_sq = 0.0f;  // Δaz², Δel² [rad²]
 
-  explicit RowFactors(const Scan& scan) {
+  // `first_row` as for GridDirections.
+  RowFactors(const Scan& scan, int first_row) {
     const auto* a = std::get_if<SphericalAngles>(&scan.angles);
     if (a == nullptr) return;
     for (int row = 0; row < scan.rows; ++row) {
-      const double cos_el = std::cos(a->elevation(row));
+      const double cos_el = std::cos(a->elevation(first_row + row));
       azimuth_gradient.push_back(
           static_cast<float>(1.0 / a->azimuth_step_rad / std::max(cos_el, 1e-3)));
       const double az = std::abs(a->azimuth_step_rad) * cos_el, el = a->elevation_step_rad;
@@ -520,7 +521,11 @@ void allocate(ScanGeometry& g, std::size_t n) {
 
 namespace {
 
-GeometryResult compute_grid_geometry(const Scan& scan, const GeometrySettings& settings) {
+// The geometry of `band`'s rows of a grid held in `scan` (row_band.hpp):
+// the passes run over every held row, the fits and the counts over the
+// band's rows only, whose values the result keeps.
+GeometryResult compute_grid_geometry(const Scan& scan, const GeometrySettings& settings,
+                                     const RowBand& band) {
   const auto start = std::chrono::steady_clock::now();
   GeometryResult result;
   ScanGeometry& g = result.geometry;
@@ -535,20 +540,31 @@ GeometryResult compute_grid_geometry(const Scan& scan, const GeometrySettings& s
                            mark_jumps(scan, settings, in);
                          });
   });
-  const GridDirections directions(scan);
-  const RowFactors factors(scan);
+  const GridDirections directions(scan, band.first_row);
+  const RowFactors factors(scan, band.first_row);
   Counts counts;
   const StageContext context{scan, settings, in, directions, factors, g, counts};
+  const int begin = band.begin - band.first_row, end = band.end - band.first_row;
   if (scan.is_spherical()) {
     const std::vector<int> radii = cascade_radii(settings);
-    visit_window_slopes(scan.rows, scan.columns, radii, {in.clean.get(), scan.pixel_count()},
-                        {in.inverse_range.get(), scan.pixel_count()}, settings.threads,
-                        [&](int row, int begin, int end, const WindowSlopeRow& slopes) {
-                          store_window_fits(context, row, begin, end, slopes);
-                        });
+    visit_window_slopes(
+        scan.rows, scan.columns, radii, {in.clean.get(), scan.pixel_count()},
+        {in.inverse_range.get(), scan.pixel_count()}, settings.threads,
+        [&](int row, int col_begin, int col_end, const WindowSlopeRow& slopes) {
+          store_window_fits(context, row, col_begin, col_end, slopes);
+        },
+        band);
   } else {
-    parallel_rows(scan.rows, settings.threads,
-                  [&](int row) { store_covariance_fits(context, row); });
+    parallel_rows(end - begin, settings.threads,
+                  [&](int k) { store_covariance_fits(context, begin + k); });
+  }
+  if (begin > 0 || end < scan.rows) {  // the band's rows only
+    const auto keep = [&](auto& values) {
+      const auto columns = static_cast<std::ptrdiff_t>(scan.columns);
+      values.erase(values.begin() + end * columns, values.end());
+      values.erase(values.begin(), values.begin() + begin * columns);
+    };
+    keep(g.footprint_m), keep(g.normal), keep(g.confidence), keep(g.flags);
   }
   result.valid_points = counts.valid, result.normals = counts.normals;
   result.mixed_pixels = counts.mixed, result.edge_pixels = counts.edges;
@@ -576,10 +592,43 @@ GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settin
       noise = estimate_range_noise(scan, settings.range_noise, settings.threads);
       used.range_noise = noise.noise;
     }
-    result = compute_grid_geometry(scan, used);
+    result = compute_grid_geometry(scan, used, RowBand::whole(scan.rows));
     result.noise = std::move(noise);
   }
   result.geometry.range_noise = result.noise.noise;
+  result.seconds = core::seconds_since(start);
+  return result;
+}
+
+int geometry_halo_rows(const GeometrySettings& settings) {
+  // A window fit reads the clean marks window_radius rows away (its
+  // integral images one more), a clean mark the rows next to it, a mixed
+  // pixel three rows on either side (mixed_pixels.cpp): rows nearer the
+  // held rows' ends than that see a border where the grid has none.
+  return settings.window_radius + 8;
+}
+
+std::vector<int> geometry_band_cuts(int rows) {
+  return window_tile_row_cuts(rows);
+}
+
+GeometryResult compute_geometry_rows(const Scan& held, const RowBand& band,
+                                     const GeometrySettings& settings) {
+  [[maybe_unused]] const int halo = geometry_halo_rows(settings);
+  [[maybe_unused]] const std::vector<int> cuts = geometry_band_cuts(band.rows);
+  assert(!held.is_scattered() && check_consistency(held).empty() &&
+         settings.edge_window_radius >= 1 &&
+         settings.window_radius >= settings.edge_window_radius &&
+         settings.window_radius <= kMaxWindowRadius && band.begin <= band.end &&
+         std::binary_search(cuts.begin(), cuts.end(), band.begin) &&
+         std::binary_search(cuts.begin(), cuts.end(), band.end) &&
+         band.first_row == std::max(0, band.begin - halo) &&
+         band.first_row + held.rows == std::min(band.rows, band.end + halo) &&
+         "a band between tile cuts, held with its halo");
+  const auto start = std::chrono::steady_clock::now();
+  GeometryResult result = compute_grid_geometry(held, settings, band);
+  result.noise.noise = settings.range_noise;
+  result.geometry.range_noise = settings.range_noise;
   result.seconds = core::seconds_since(start);
   return result;
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "acquisition/geometry/noise_estimate.hpp"
+#include "acquisition/geometry/row_band.hpp"
 #include "acquisition/range_noise.hpp"
 #include "acquisition/scan.hpp"
 
@@ -123,5 +124,31 @@ struct GeometryResult {
 // value per pixel).
 GeometryResult compute_geometry(const Scan& scan, const GeometrySettings& settings = {},
                                 const RecordedGeometry& recorded = {});
+
+// ---- A grid scan too large to hold whole, band by band (docs/scale.md) ----
+//
+// The geometry of a pixel depends on the rows around it only, so a grid
+// scan's geometry can be computed a band of rows at a time, each band from
+// its rows and geometry_halo_rows() on either side; with band limits at
+// geometry_band_cuts() (the window fits' tiles) and the σ(range) of the
+// whole scan (NoiseTiles, noise_estimate.hpp), the bands together are
+// compute_geometry's result bit for bit.
+
+// Rows a band needs on either side of the rows it computes.
+int geometry_halo_rows(const GeometrySettings& settings);
+
+// Where bands may begin and end in a grid of `rows` rows: ascending, from 0
+// to `rows` (about every 256 rows).
+std::vector<int> geometry_band_cuts(int rows);
+
+// The geometry of grid rows [band.begin, band.end) of a grid scan (not
+// scattered): `held` holds the grid's rows from band.first_row =
+// max(0, begin − halo) to min(band.rows, end + halo), with the grid's angle
+// model (per-pixel directions of the held rows only). The result's arrays
+// and counts are the band's rows'; its noise, settings.range_noise, which
+// is used as it is (never estimated). Asserts the band's limits are cuts
+// and its held rows as said.
+GeometryResult compute_geometry_rows(const Scan& held, const RowBand& band,
+                                     const GeometrySettings& settings);
 
 }  // namespace scanbench::acquisition

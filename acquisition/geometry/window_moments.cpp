@@ -21,16 +21,27 @@ struct Tile {
   int row_begin, row_end, col_begin, col_end;
 };
 
-// The grid split evenly into tiles of at most the target size; the split
-// depends on the grid size alone, so results do not depend on the threads.
-std::vector<Tile> make_tiles(int rows, int columns) {
+// The row tiles' limits: the grid's rows split evenly into tiles of at most
+// kTileRows; the split depends on the grid size alone, so results do not
+// depend on the threads.
+std::vector<int> row_cuts(int rows) {
   const int row_tiles = (rows + kTileRows - 1) / kTileRows;
+  std::vector<int> cuts = {0};
+  for (int i = 1; i <= row_tiles; ++i) cuts.push_back(rows * i / row_tiles);
+  return cuts;
+}
+
+// The tiles of `band`'s rows, in held rows: the whole grid's row tiles
+// (row_cuts) that lie in [band.begin, band.end), cut evenly across.
+std::vector<Tile> make_tiles(const RowBand& band, int columns) {
+  const std::vector<int> cuts = row_cuts(band.rows);
   const int col_tiles = (columns + kTileColumns - 1) / kTileColumns;
   std::vector<Tile> tiles;
-  for (int i = 0; i < row_tiles; ++i) {
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    if (cuts[i] < band.begin || cuts[i + 1] > band.end || cuts[i] == cuts[i + 1]) continue;
     for (int j = 0; j < col_tiles; ++j) {
-      tiles.push_back({rows * i / row_tiles, rows * (i + 1) / row_tiles, columns * j / col_tiles,
-                       columns * (j + 1) / col_tiles});
+      tiles.push_back({cuts[i] - band.first_row, cuts[i + 1] - band.first_row,
+                       columns * j / col_tiles, columns * (j + 1) / col_tiles});
     }
   }
   return tiles;
@@ -247,9 +258,13 @@ void visit_tile(const Grid& grid, const Tile& tile, std::span<const int> radii,
 
 }  // namespace
 
+std::vector<int> window_tile_row_cuts(int rows) {
+  return row_cuts(rows);
+}
+
 void visit_window_slopes(int rows, int columns, std::span<const int> radii,
                          std::span<const std::uint8_t> clean, std::span<const float> value,
-                         int threads, const SlopeVisitor& visit) {
+                         int threads, const SlopeVisitor& visit, std::optional<RowBand> band) {
   assert(clean.size() == static_cast<std::size_t>(rows) * columns && value.size() == clean.size() &&
          !radii.empty() && "spans of rows × columns, radii");
   assert(std::is_sorted(radii.rbegin(), radii.rend()) && radii.back() >= 1 &&
@@ -257,7 +272,11 @@ void visit_window_slopes(int rows, int columns, std::span<const int> radii,
   std::vector<double> inverse(radii.size());
   std::transform(radii.begin(), radii.end(), inverse.begin(), inverse_sxx);
   const Grid grid{rows, columns, clean.data(), value.data()};
-  const std::vector<Tile> tiles = make_tiles(rows, columns);
+  if (!band) band = RowBand::whole(rows);
+  assert(band->first_row >= 0 && band->first_row + rows <= band->rows &&
+         band->begin >= band->first_row && band->end <= band->first_row + rows &&
+         "the band's computed rows are held");
+  const std::vector<Tile> tiles = make_tiles(*band, columns);
   core::parallel_for_index(static_cast<int>(tiles.size()), threads,
                            [&](int t) { visit_tile(grid, tiles[t], radii, inverse, visit); });
 }

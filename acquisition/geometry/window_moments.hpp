@@ -17,8 +17,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
+
+#include "acquisition/geometry/row_band.hpp"
 
 namespace scanbench::acquisition {
 
@@ -47,11 +50,23 @@ struct WindowSlopeRow {
 // only where clean is 1. `threads` as in the Settings structs (0 = all
 // cores). Asserts the spans hold rows × columns entries and the radii are
 // descending, ≥ 1 and ≤ 127 (so `used` fits 16 bits).
+//
+// With a `band`, the spans hold rows [band.first_row, band.first_row + rows)
+// of a grid of band.rows rows, and only grid rows [band.begin, band.end)
+// are visited, `row` counting the held rows: the tiles are the whole
+// grid's, so a band whose limits are window_tile_row_cuts gets the slopes
+// of the whole grid bit for bit, provided it holds the rows of its windows
+// (radii[0] beyond its limits, or the grid's end).
 using SlopeVisitor =
     std::function<void(int row, int col_begin, int col_end, const WindowSlopeRow& slopes)>;
 void visit_window_slopes(int rows, int columns, std::span<const int> radii,
                          std::span<const std::uint8_t> clean, std::span<const float> value,
-                         int threads, const SlopeVisitor& visit);
+                         int threads, const SlopeVisitor& visit,
+                         std::optional<RowBand> band = std::nullopt);
+
+// The rows at which the tiles of a grid of `rows` rows begin, and `rows`:
+// ascending, from 0.
+std::vector<int> window_tile_row_cuts(int rows);
 
 // All slopes at once (rows × columns, row-major), for tests and small grids.
 std::vector<WindowSlope> window_slopes(int rows, int columns, std::span<const int> radii,

@@ -101,19 +101,21 @@ LayerRowReader::~LayerRowReader() = default;
 
 void LayerRowReader::read(std::span<std::byte> out) {
   const std::size_t row_bytes = static_cast<std::size_t>(columns_) * element_size(type_);
-  assert(row_bytes > 0 && out.size() % row_bytes == 0 && "whole rows");
-  const auto rows = static_cast<int>(out.size() / row_bytes);
+  assert((row_bytes == 0 ? out.empty() : out.size() % row_bytes == 0) && "whole rows");
+  // Rows of no pixels are all read at once.
+  const int rows = row_bytes == 0 ? rows_ - next_row_ : static_cast<int>(out.size() / row_bytes);
   assert(rows <= rows_ - next_row_ && "no more rows than remain");
   stream_->decode(out);
   next_row_ += rows;
   if (next_row_ == rows_) stream_->finish();
 }
 
-LayerRowReader LayerRowReader::open_blob(sqlite3* db, std::int64_t rowid, int rows, int columns,
-                                         ElementType type, const BlobContext& context) {
+LayerRowReader LayerRowReader::open_blob(sqlite3* db, std::int64_t rowid, const char* column,
+                                         int rows, int columns, ElementType type,
+                                         const BlobContext& context) {
   auto stream = std::make_unique<Stream>();
   stream->context = context;
-  const int code = sqlite3_blob_open(db, "main", "scan_layers", "data", rowid, 0, &stream->blob);
+  const int code = sqlite3_blob_open(db, "main", "scan_layers", column, rowid, 0, &stream->blob);
   if (code != SQLITE_OK) sqlite::throw_error(db, code, context.file, "opening a layer");
   stream->blob_bytes = static_cast<std::uint64_t>(sqlite3_blob_bytes(stream->blob));
   // The frame's header first: it must record the layer's size.
@@ -131,6 +133,20 @@ LayerRowReader LayerRowReader::open_blob(sqlite3* db, std::int64_t rowid, int ro
   if (stream->zstd == nullptr) throw std::bad_alloc();
   stream->input.resize(kPieceBytes);
   return LayerRowReader(std::move(stream), rows, columns, type);
+}
+
+void check_stored_frame(sqlite3* db, std::int64_t rowid, const char* column, int rows, int columns,
+                        ElementType type, const BlobContext& context) {
+  LayerRowReader reader =
+      LayerRowReader::open_blob(db, rowid, column, rows, columns, type, context);
+  const int band = band_rows(kPieceBytes / element_size(type), columns);
+  std::vector<std::byte> values;
+  do {  // once at least: the frame of a layer of no pixels is read too
+    const int n = std::min(band, rows - reader.rows_read());
+    values.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(columns) *
+                  element_size(type));
+    reader.read(std::span(values));
+  } while (reader.rows_read() < rows);
 }
 
 // ---- Writing -----------------------------------------------------------------------------

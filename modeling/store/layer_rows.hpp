@@ -64,11 +64,14 @@ class LayerRowReader {
 
  private:
   friend class Project;
+  friend void check_stored_frame(sqlite3* db, std::int64_t rowid, const char* column, int rows,
+                                 int columns, ElementType type, const BlobContext& context);
   struct Stream;
   LayerRowReader(std::unique_ptr<Stream> stream, int rows, int columns, ElementType type);
-  // The data of scan_layers row `rowid`, whose fields the caller verified.
-  static LayerRowReader open_blob(sqlite3* db, std::int64_t rowid, int rows, int columns,
-                                  ElementType type, const BlobContext& context);
+  // The frame in `column` ("data" or "frame") of scan_layers row `rowid`,
+  // whose fields the caller verified.
+  static LayerRowReader open_blob(sqlite3* db, std::int64_t rowid, const char* column, int rows,
+                                  int columns, ElementType type, const BlobContext& context);
 
   std::unique_ptr<Stream> stream_;
   int rows_ = 0;
@@ -76,6 +79,13 @@ class LayerRowReader {
   ElementType type_ = ElementType::kU8;
   int next_row_ = 0;
 };
+
+// For `check`: decodes the frame in `column` ("data" or "frame") of
+// scan_layers row `rowid`, a layer of rows × columns elements of `type`,
+// a band at a time, as a reader does; throws core::InputError naming
+// `context` where it is damaged.
+void check_stored_frame(sqlite3* db, std::int64_t rowid, const char* column, int rows, int columns,
+                        ElementType type, const BlobContext& context);
 
 // A layer of rows × columns elements compressed as its rows come, for
 // Project::put_layer. Memory: zstd's window and a buffer of a few MB.

@@ -43,12 +43,20 @@ const TypeInfo& info(ElementType type) {
 // and then its row read by key: sorting the rows with their data would copy
 // each version's data through a temporary b-tree (a temporary file for a
 // layer of megabytes) on every read.
-const std::string kSelectCurrent = sql_of({"SELECT ", kLayerColumns, R"sql(, l.rowid, l.data
+// `data` names what is selected after the layer's columns and its rowid.
+std::string select_current(const char* data) {
+  return sql_of({"SELECT ", kLayerColumns, ", l.rowid, ", data, R"sql(
 FROM scan_layers l
 WHERE l.scan_id = ?1 AND l.name = ?2 AND l.command_id = (
   SELECT k.command_id FROM scan_layers k JOIN commands c ON c.id = k.command_id
   WHERE k.scan_id = ?1 AND k.name = ?2 AND c.state = 'done'
   ORDER BY c.seq DESC LIMIT 1))sql"});
+}
+// With the frame, wherever it is stored (schema.cpp, version 10).
+const std::string kSelectCurrent = select_current("coalesce(l.frame, l.data)");
+// With the column that holds the frame, "frame" or "data", not the frame.
+const std::string kSelectCurrentPlace =
+    select_current("CASE WHEN l.frame IS NULL THEN 'data' ELSE 'frame' END");
 
 // The layers whose name fixes their type (layer_store.hpp).
 struct KnownLayer {
@@ -118,25 +126,25 @@ namespace {
 
 // Writes (or replaces, within one command) the row of a layer version, with
 // its checksum; `blob` empty for a removal.
-// With `zeroblob_bytes`, the data is that many zero bytes, to be written in
-// place.
+// With `frame_bytes`, the frame goes in the column `frame`, last in the
+// row, as that many zero bytes to be written in place, and `data` is empty.
 void write_layer_row(sqlite3* db, const std::string& file, const LayerFields& fields,
                      std::span<const std::uint8_t> blob,
-                     std::optional<std::uint64_t> zeroblob_bytes = std::nullopt) {
+                     std::optional<std::uint64_t> frame_bytes = std::nullopt) {
   sqlite::Statement insert(db, R"sql(
 INSERT OR REPLACE INTO scan_layers (scan_id, name, command_id, element_type, element_count, codec,
-                                    data, checksum)
-VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8))sql",
+                                    data, checksum, frame)
+VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9))sql",
                            file);
   insert.bind_int(1, fields.scan_id).bind_text(2, fields.name).bind_int(3, fields.command_id);
   insert.bind_text(4, fields.element_type).bind_int(5, fields.element_count);
   insert.bind_text(6, fields.codec);
   if (fields.codec == "removed") {
-    insert.bind_null(7);
-  } else if (zeroblob_bytes) {
-    insert.bind_zeroblob(7, *zeroblob_bytes);
+    insert.bind_null(7).bind_null(9);
+  } else if (frame_bytes) {
+    insert.bind_blob(7, {}).bind_zeroblob(9, *frame_bytes);
   } else {
-    insert.bind_blob(7, blob);
+    insert.bind_blob(7, blob).bind_null(9);
   }
   insert.bind_int(8, checksum(fields)).run();
 }
@@ -229,15 +237,15 @@ bool Project::read_layer(
 std::optional<LayerRowReader> Project::open_layer_rows(std::int64_t id, std::string_view name,
                                                        ElementType expected) const {
   const acquisition::ScanSummary grid = current_summary(id).summary;
-  sqlite::Statement select(db(), kSelectCurrent.c_str(), file_name());
+  sqlite::Statement select(db(), kSelectCurrentPlace.c_str(), file_name());
   select.bind_int(1, id).bind_text(2, name);
   if (!select.step()) return std::nullopt;
   const std::optional<CurrentLayer> layer = current_layer(
       select, file_name(), id, name,
       static_cast<std::size_t>(grid.rows) * static_cast<std::size_t>(grid.columns), expected);
   if (!layer) return std::nullopt;
-  return LayerRowReader::open_blob(db(), layer->rowid, grid.rows, grid.columns, layer->type,
-                                   layer->context);
+  return LayerRowReader::open_blob(db(), layer->rowid, select.column_text(8).c_str(), grid.rows,
+                                   grid.columns, layer->type, layer->context);
 }
 
 void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer) {
@@ -256,7 +264,7 @@ void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer
                            "zstd"};
   write_layer_row(db(), file_name(), fields, {}, layer.compressed_bytes());
   sqlite3_blob* blob = nullptr;
-  const int code = sqlite3_blob_open(db(), "main", "scan_layers", "data",
+  const int code = sqlite3_blob_open(db(), "main", "scan_layers", "frame",
                                      sqlite3_last_insert_rowid(db()), 1, &blob);
   if (code != SQLITE_OK) sqlite::throw_error(db(), code, file_name(), "writing a layer");
   const std::unique_ptr<sqlite3_blob, decltype(&sqlite3_blob_close)> closing(blob,

@@ -65,8 +65,9 @@ inline constexpr std::uint32_t kProjectApplicationId = core::kProjectApplication
 // 2: scan_geometry; 3: registration_runs, merge_masks; 4: the command journal,
 // versioned poses and the per-scan layer store; 5: the object tree; 6: colour
 // edits of objects and colour corrections of scans; 7: scan sources and images;
-// 8: indexes of the journal's undone and pending commands.
-inline constexpr int kProjectSchemaVersion = 9;
+// 8: indexes of the journal's undone and pending commands; 9: scattered
+// scans; 10: a layer's frame in a column of its own, written in place.
+inline constexpr int kProjectSchemaVersion = 10;
 
 // How long a write waits for another process's write to finish [ms].
 inline constexpr int kBusyTimeoutMs = 5000;
@@ -229,6 +230,10 @@ class Project {
   // data is damaged.
   acquisition::Scan load_scan(std::int64_t id, ScanChannels channels) const;
   acquisition::Scan load_scan(std::int64_t id) const { return load_scan(id, ScanChannels{}); }
+  // The same without its per-pixel arrays (acquisition::without_arrays):
+  // its name, grid size, angle model, pose and scanner, for a stage that
+  // reads its layers by rows (layer_rows.hpp).
+  acquisition::Scan load_scan_description(std::int64_t id) const;
 
   // Stores a new scan (metadata, pose, summary, channel layers) as part of
   // `edit` and returns its id, which no other scan of the project ever gets.

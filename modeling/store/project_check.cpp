@@ -5,6 +5,7 @@
 
 #include "core/errors.hpp"
 #include "modeling/store/checksummed_rows.hpp"
+#include "modeling/store/layer_rows.hpp"
 #include "modeling/store/project.hpp"
 #include "modeling/store/row_checksum.hpp"
 #include "modeling/store/sqlite_statement.hpp"
@@ -61,7 +62,8 @@ std::size_t check_commands(sqlite3* db, const std::string& file, std::vector<std
 
 std::size_t check_layers(sqlite3* db, const std::string& file, std::vector<std::string>& damage) {
   std::size_t checked = 0;
-  const std::string sql = sql_of({"SELECT ", kLayerColumns, R"sql(, l.data, s.rows * s.columns
+  const std::string sql = sql_of({"SELECT ", kLayerColumns, R"sql(, l.rowid,
+  CASE WHEN l.frame IS NULL THEN 'data' ELSE 'frame' END, s.rows, s.columns
 FROM scan_layers l JOIN scans s ON s.id = l.scan_id)sql"});
   for (sqlite::Statement layers(db, sql.c_str(), file); layers.step(); ++checked) {
     const auto [fields, stored] = read_layer_fields(layers, 0);
@@ -79,16 +81,17 @@ FROM scan_layers l JOIN scans s ON s.id = l.scan_id)sql"});
       damage.push_back(where + ": unknown element type");
       continue;
     }
-    if (fields.element_count != layers.column_int(8)) {
+    const auto rows = static_cast<int>(layers.column_int(9));
+    const auto columns = static_cast<int>(layers.column_int(10));
+    const std::int64_t pixels = std::int64_t{rows} * columns;
+    if (fields.element_count != pixels) {
       damage.push_back(where + ": holds " + std::to_string(fields.element_count) +
-                       " elements, the scan has " + std::to_string(layers.column_int(8)) +
-                       " pixels");
+                       " elements, the scan has " + std::to_string(pixels) + " pixels");
       continue;
     }
-    try {
-      decompress(layers.column_blob(7),
-                 static_cast<std::size_t>(fields.element_count) * element_size(*type),
-                 BlobContext{file, where});
+    try {  // a band at a time: a layer may be larger than memory
+      check_stored_frame(db, layers.column_int(7), layers.column_text(8).c_str(), rows, columns,
+                         *type, BlobContext{file, where});
     } catch (const core::InputError& error) {
       damage.push_back(where + ": " + error.problem());
     }

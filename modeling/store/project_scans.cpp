@@ -305,7 +305,7 @@ ORDER BY id LIMIT 1)sql",
   return select.column_int(0);
 }
 
-acquisition::Scan Project::load_scan(std::int64_t id, ScanChannels channels) const {
+acquisition::Scan Project::load_scan_description(std::int64_t id) const {
   const std::string sql = kSelectScans + " AND s.id = ?1";
   sqlite::Statement select(db(), sql.c_str(), file_name());
   select.bind_int(1, id);
@@ -320,6 +320,12 @@ acquisition::Scan Project::load_scan(std::int64_t id, ScanChannels channels) con
   scan.angles = read_angles(select, summary);
   scan.T_world_scan = summary.T_world_scan;
   scan.scanner = summary.scanner;
+  return scan;
+}
+
+acquisition::Scan Project::load_scan(std::int64_t id, ScanChannels channels) const {
+  acquisition::Scan scan = load_scan_description(id);
+  const acquisition::ScanSummary summary = current_summary(id).summary;
   scan.range_m = required_layer<float>(*this, id, layer::kRange, ElementType::kF32);
   scan.valid = required_layer<std::uint8_t>(*this, id, layer::kValid, ElementType::kU8);
   if (summary.has_intensity && channels.intensity) {

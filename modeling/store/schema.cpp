@@ -393,6 +393,17 @@ ALTER TABLE scans ADD COLUMN layout TEXT NOT NULL DEFAULT 'grid'
   CHECK (layout IN ('grid', 'scattered'));
 )sql";
 
+// Version 10: a layer's zstd frame may sit in a column of its own, last in
+// the row, with `data` left empty: SQLite writes a blob that ends its row
+// in place (sqlite3_blob_write into a zeroblob), where a blob followed by
+// another column is first built whole in memory, twice its size. A stage
+// that writes a layer by rows (layer_rows.hpp) stores it there. The rows'
+// checksums leave both columns out, as before.
+constexpr const char* kMigrate9To10 = R"sql(
+ALTER TABLE scan_layers ADD COLUMN frame BLOB
+  CHECK (frame IS NULL OR (codec = 'zstd' AND length(data) = 0));
+)sql";
+
 // Upgrades the schema from `version` to version + 1 inside the caller's
 // transaction; `original_version` is the version the file had when opened.
 void migrate_step(sqlite3* db, int version, int original_version, const std::string& file) {
@@ -421,6 +432,9 @@ void migrate_step(sqlite3* db, int version, int original_version, const std::str
       return;
     case 8:
       sqlite::execute(db, kMigrate8To9, file);
+      return;
+    case 9:
+      sqlite::execute(db, kMigrate9To10, file);
       return;
     default:
       assert(false && "no migration step from this schema version");

@@ -63,6 +63,24 @@ std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& g) {
   return layers;
 }
 
+GeometryLayerWriter::GeometryLayerWriter(int rows, int columns)
+    : footprint_(layer::kFootprint, ElementType::kF32, rows, columns),
+      normal_(layer::kNormal, ElementType::kF32x3, rows, columns),
+      confidence_(layer::kConfidence, ElementType::kF32, rows, columns),
+      flags_(layer::kGeometryFlags, ElementType::kU8, rows, columns) {}
+
+void GeometryLayerWriter::write(const acquisition::ScanGeometry& g) {
+  footprint_.write(std::span(g.footprint_m));
+  normal_.write(std::span(g.normal));
+  confidence_.write(std::span(g.confidence));
+  flags_.write(std::span(g.flags));
+}
+
+void GeometryLayerWriter::put(Project& project, Project::Edit& edit, std::int64_t id) const {
+  for (const LayerRowWriter* layer : {&footprint_, &normal_, &confidence_, &flags_})
+    project.put_layer(edit, id, *layer);
+}
+
 std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, std::int64_t id) {
   auto footprint = project.load_layer<float>(id, layer::kFootprint, ElementType::kF32);
   auto normal = project.load_layer<Eigen::Vector3f>(id, layer::kNormal, ElementType::kF32x3);

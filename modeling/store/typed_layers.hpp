@@ -14,6 +14,21 @@ namespace scanbench::store {
 // The four geometry layers of `geometry` (layer_store.hpp).
 std::vector<EncodedLayer> encode_geometry(const acquisition::ScanGeometry& geometry);
 
+// The same layers written a band of rows at a time (layer_rows.hpp), for a
+// scan computed band by band.
+class GeometryLayerWriter {
+ public:
+  GeometryLayerWriter(int rows, int columns);
+  // The geometry of the next rows, in order (whole rows, asserted).
+  void write(const acquisition::ScanGeometry& rows);
+  // Stores the four layers of scan `id` as part of `edit`; asserts every
+  // row was written.
+  void put(Project& project, Project::Edit& edit, std::int64_t id) const;
+
+ private:
+  LayerRowWriter footprint_, normal_, confidence_, flags_;
+};
+
 // The stored geometry of scan `id`, or none when `scanbench geometry` has
 // not run on it (or was undone). Its range_noise is the one the command
 // that computed it recorded for the scan (its estimate; for commands older

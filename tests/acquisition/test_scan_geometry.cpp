@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <numbers>
 #include <random>
@@ -301,6 +302,124 @@ TEST(ScanGeometry, ResultDoesNotDependOnTheThreadCount) {
   EXPECT_EQ(a.geometry.normal, b.geometry.normal);
   EXPECT_EQ(a.geometry.flags, b.geometry.flags);
   EXPECT_EQ(a.geometry.footprint_m, b.geometry.footprint_m);
+}
+
+// Equal bit for bit (a vector of plain values, or one).
+template <typename T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+template <typename T>
+bool same_bytes(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+// Rows [first, end) of `scan`, as the geometry stage holds a band of them.
+Scan held_rows(const Scan& scan, int first, int end) {
+  Scan held = without_arrays(scan);
+  held.rows = end - first;
+  const auto begin = static_cast<std::ptrdiff_t>(scan.index(first, 0));
+  const auto stop = static_cast<std::ptrdiff_t>(scan.index(end, 0));
+  held.range_m.assign(scan.range_m.begin() + begin, scan.range_m.begin() + stop);
+  held.valid.assign(scan.valid.begin() + begin, scan.valid.begin() + stop);
+  if (const auto* per_pixel = std::get_if<PerPixelDirections>(&scan.angles)) {
+    held.angles = PerPixelDirections{
+        {per_pixel->directions.begin() + begin, per_pixel->directions.begin() + stop}, false};
+  }
+  return held;
+}
+
+// The geometry of `scan` computed band by band, `tiles` of the window fits'
+// row tiles a band, its σ(range) from bands of 48 rows: as the geometry
+// stage computes a scan too large to hold.
+GeometryResult geometry_by_bands(const Scan& scan, GeometrySettings settings, int tiles) {
+  NoiseTiles noise(scan.rows, scan.columns, false);
+  for (int begin = 0; begin < scan.rows; begin += 48) {
+    const int end = std::min(scan.rows, begin + 48);
+    const int first = std::max(0, begin - NoiseTiles::kHaloRows);
+    noise.add(held_rows(scan, first, std::min(scan.rows, end + NoiseTiles::kHaloRows)),
+              {scan.rows, first, begin, end});
+  }
+  GeometryResult result;
+  result.noise = noise.finish(settings.range_noise);
+  settings.range_noise = result.noise.noise;
+  const std::vector<int> cuts = geometry_band_cuts(scan.rows);
+  const int halo = geometry_halo_rows(settings);
+  for (std::size_t k = 0; k + 1 < cuts.size(); k += static_cast<std::size_t>(tiles)) {
+    const int begin = cuts[k], end = cuts[std::min(k + tiles, cuts.size() - 1)];
+    const int first = std::max(0, begin - halo);
+    const GeometryResult band =
+        compute_geometry_rows(held_rows(scan, first, std::min(scan.rows, end + halo)),
+                              {scan.rows, first, begin, end}, settings);
+    ScanGeometry& g = result.geometry;
+    const auto append = [](auto& to, const auto& from) {
+      to.insert(to.end(), from.begin(), from.end());
+    };
+    append(g.footprint_m, band.geometry.footprint_m), append(g.normal, band.geometry.normal);
+    append(g.confidence, band.geometry.confidence), append(g.flags, band.geometry.flags);
+    result.valid_points += band.valid_points, result.normals += band.normals;
+    result.mixed_pixels += band.mixed_pixels, result.edge_pixels += band.edge_pixels;
+  }
+  return result;
+}
+
+void expect_same_geometry(const GeometryResult& a, const GeometryResult& b) {
+  EXPECT_TRUE(same_bytes(a.geometry.normal, b.geometry.normal));
+  EXPECT_TRUE(same_bytes(a.geometry.footprint_m, b.geometry.footprint_m));
+  EXPECT_TRUE(same_bytes(a.geometry.confidence, b.geometry.confidence));
+  EXPECT_EQ(a.geometry.flags, b.geometry.flags);
+  EXPECT_EQ(a.valid_points, b.valid_points);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.mixed_pixels, b.mixed_pixels);
+  EXPECT_EQ(a.edge_pixels, b.edge_pixels);
+}
+
+TEST(ScanGeometry, BandsOfRowsGiveTheWholeScansGeometryBitForBit) {
+  // Ground, a wall and a pillar before it (depth steps, so edges, fallback
+  // fits and blends at the pillar's sides), sky, noise and dropouts, over
+  // 700 rows: three tiles of the window fits.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  std::uniform_real_distribution<double> uniform;
+  Scan scan = cast_scan(700, 160, 0.1, [&](const Eigen::Vector3d& d) {
+    if (d.y() > 0.1 && uniform(rng) < 0.01) return -1.0;  // dropouts, on one side only
+    const double ground = plane(d, Eigen::Vector3d(0.0, 0.0, -1.0), 1.5);
+    const double wall = plane(d, Eigen::Vector3d(1.0, 0.2, 0.0).normalized(), 12.0);
+    double range = ground < 0 ? wall : (wall < 0 ? ground : std::min(ground, wall));
+    if (std::abs(d.y() / d.x()) < 0.02 && d.z() > -0.1) range = std::min(range, 6.0 / d.x());
+    return range < 0 || range > 40.0 ? -1.0 : range + noise(rng);
+  });
+  for (int i = 0; i < 40; ++i) {  // blends at the pillar's edge
+    const std::size_t pixel = scan.index(100 + 13 * i, 80 + (i % 2 ? 9 : -9));
+    if (scan.valid[pixel]) scan.range_m[pixel] = 9.0f;
+  }
+  GeometrySettings settings;
+  settings.estimate_range_noise = true;
+  const GeometryResult whole = compute_geometry(scan, settings);
+  ASSERT_TRUE(whole.noise.estimated);
+  ASSERT_GT(whole.mixed_pixels, 0u);
+  ASSERT_GT(whole.edge_pixels, 0u);
+  // Most of the wall and the ground get the widest window (a run of the
+  // cascade down to the fallback fits near the edges).
+  ASSERT_GT(whole.normals, scan.pixel_count() / 2);
+  ASSERT_EQ(geometry_band_cuts(scan.rows).size(), 4u);
+  for (const int tiles : {1, 2}) {
+    SCOPED_TRACE(tiles);
+    const GeometryResult banded = geometry_by_bands(scan, settings, tiles);
+    EXPECT_TRUE(same_bytes(banded.noise.noise, whole.noise.noise));
+    expect_same_geometry(banded, whole);
+  }
+  // A grid of per-pixel directions: covariance fits only.
+  Scan per_pixel = scan;
+  std::vector<Eigen::Vector3f> directions(scan.pixel_count());
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col)
+      directions[scan.index(row, col)] = direction(scan, row, col);
+  }
+  per_pixel.angles = PerPixelDirections{std::move(directions), false};
+  expect_same_geometry(geometry_by_bands(per_pixel, settings, 1),
+                       compute_geometry(per_pixel, settings));
 }
 
 // Least-squares mean and slopes of v over the window of radius k around (r, c), by

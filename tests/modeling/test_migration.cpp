@@ -37,27 +37,62 @@ std::size_t count_ones(const std::vector<std::uint8_t>& mask) {
   return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1}));
 }
 
-// fixtures/projects/version9.sbproj: version8.sbproj (below) opened by the
-// build that introduced version 9, then fixtures/good/e57/unstructured_sphere.e57
-// imported: an unstructured cloud of 4 000 points kept as a scattered scan.
-TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithItsScatteredScan) {
-  static_assert(store::kProjectSchemaVersion == 9, "add fixtures/projects/version10.sbproj");
+// fixtures/projects/version10.sbproj: version9.sbproj (below) opened by the
+// build that introduced version 10, then `scanbench geometry` run on it: the
+// grids' geometry layers written by rows, their frames in the column
+// `frame`; the scattered scan's written whole, in `data`.
+TEST(CurrentVersion, AFileOfTheCurrentVersionOpensUnchangedWithLayersWrittenByRows) {
+  static_assert(store::kProjectSchemaVersion == 10, "add fixtures/projects/version11.sbproj");
   const ScratchDir dir;
-  const auto file = migrated_copy(dir, 9);
+  const auto file = migrated_copy(dir, 10);
   const std::string before = test::read_file_bytes(file);
   {
     const store::Project project = store::Project::open(file);
     const std::vector<store::StoredScanSummary> scans = project.scans();
     ASSERT_EQ(scans.size(), 6u);
-    EXPECT_FALSE(scans[4].summary.scattered);
-    EXPECT_TRUE(scans[5].summary.scattered);
-    EXPECT_EQ(scans[5].summary.valid_points, 4000u);
-    const acquisition::Scan sphere = project.load_scan(scans[5].id);
-    EXPECT_TRUE(sphere.is_scattered());
-    EXPECT_EQ(acquisition::check_consistency(sphere), "");
-    EXPECT_TRUE(project.check().damage.empty());
+    const std::optional<acquisition::ScanGeometry> grid =
+        store::load_geometry(project, scans[3].id);
+    ASSERT_TRUE(grid.has_value());
+    EXPECT_EQ(std::count_if(grid->confidence.begin(), grid->confidence.end(),
+                            [](float c) { return c > 0.0f; }),
+              33);
+    EXPECT_EQ(store::load_geometry(project, scans[5].id)->normal.size(), 63u * 64u);
+    auto normals =
+        project.open_layer_rows(scans[3].id, store::layer::kNormal, store::ElementType::kF32x3);
+    ASSERT_TRUE(normals.has_value());
+    std::vector<Eigen::Vector3f> by_rows(grid->normal.size());
+    normals->read(std::span(by_rows));
+    EXPECT_EQ(by_rows, grid->normal);
+    const store::Project::CheckReport report = project.check();
+    EXPECT_TRUE(report.damage.empty());
+    EXPECT_EQ(report.layers, 45u);
   }
   EXPECT_EQ(test::read_file_bytes(file), before);
+}
+
+// fixtures/projects/version9.sbproj: version8.sbproj (below) opened by the
+// build that introduced version 9, then fixtures/good/e57/unstructured_sphere.e57
+// imported: an unstructured cloud of 4 000 points kept as a scattered scan.
+TEST(Migration, VersionNineKeepsItsScatteredScanAndItsLayersReadByRows) {
+  const ScratchDir dir;
+  const auto file = migrated_copy(dir, 9);
+  const store::Project project = store::Project::open(file);
+  EXPECT_EQ(project.schema_version(), store::kProjectSchemaVersion);
+  const std::vector<store::StoredScanSummary> scans = project.scans();
+  ASSERT_EQ(scans.size(), 6u);
+  EXPECT_FALSE(scans[4].summary.scattered);
+  EXPECT_TRUE(scans[5].summary.scattered);
+  EXPECT_EQ(scans[5].summary.valid_points, 4000u);
+  const acquisition::Scan sphere = project.load_scan(scans[5].id);
+  EXPECT_TRUE(sphere.is_scattered());
+  EXPECT_EQ(acquisition::check_consistency(sphere), "");
+  // A layer stored whole before version 10 reads by rows.
+  auto range = project.open_layer_rows(scans[5].id, store::layer::kRange, store::ElementType::kF32);
+  ASSERT_TRUE(range.has_value());
+  std::vector<float> by_rows(sphere.pixel_count());
+  range->read(std::span(by_rows));
+  EXPECT_EQ(by_rows, sphere.range_m);
+  EXPECT_TRUE(project.check().damage.empty());
 }
 
 // fixtures/projects/version8.sbproj: version7.sbproj (below) opened by the

@@ -5,11 +5,13 @@
 
 #include <map>
 #include <memory>
+#include <numbers>
 #include <vector>
 
 #include "acquisition/formats/point_export.hpp"
 #include "core/errors.hpp"
 #include "modeling/export_command.hpp"
+#include "modeling/geometry_command.hpp"
 #include "modeling/harmonize_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
@@ -375,6 +377,15 @@ TEST_F(StreamedStagesTest, ExportWritesScanByScanTheFileOfEveryScanInMemory) {
   EXPECT_NE(in_memory_ply.find("element vertex " + std::to_string(result.points) + "\n"),
             std::string::npos)
       << "the points reported are the points written";
+  // A band of rows at a time (one row, seven): the same file, for a scan
+  // too large to hold.
+  for (const std::size_t band_pixels : {std::size_t{1}, std::size_t{7 * 720}}) {
+    settings.band_pixels = band_pixels;
+    settings.output = dir_ / ("bands" + std::to_string(band_pixels) + ".ply");
+    EXPECT_EQ(export_project(project_, settings).points, result.points);
+    EXPECT_EQ(test::read_file_bytes(settings.output), in_memory_ply) << band_pixels;
+  }
+  settings.band_pixels = ExportSettings{}.band_pixels;
 
   // Cancelled after the second scan: no file, not even a partial one.
   settings.output = dir_ / "cancelled.las";
@@ -386,6 +397,54 @@ TEST_F(StreamedStagesTest, ExportWritesScanByScanTheFileOfEveryScanInMemory) {
     EXPECT_EQ(entry.path().filename().string().find("cancelled"), std::string::npos)
         << entry.path();
   }
+}
+
+// The room cast over 600 rows of 0.1° (three tiles of the window fits)
+// and 300 columns of 0.3°.
+acquisition::Scan tall_room() {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  acquisition::Scan scan = acquisition::make_empty_scan(600, 300, false, false);
+  scan.angles = acquisition::SphericalAngles{-60.0 * kDeg, 0.3 * kDeg, 25.0 * kDeg, -0.1 * kDeg};
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col) {
+      const auto [range, object] =
+          test::room_detail::cast(acquisition::direction_precise(scan, row, col));
+      if (object == test::kNothing) continue;
+      const std::size_t i = scan.index(row, col);
+      scan.valid[i] = 1;
+      scan.range_m[i] = static_cast<float>(range * (1.0 + 1e-4 * ((i * 7919) % 13)));
+    }
+  }
+  return scan;
+}
+
+TEST(GeometryStage, ComputesAGridBandByBandAsTheWholeScanInMemory) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "tall.sbproj");
+  const acquisition::Scan scan = tall_room();
+  const std::int64_t id = test::insert_committed(project, scan);
+  acquisition::GeometrySettings settings;
+  settings.estimate_range_noise = true;
+  const acquisition::GeometryResult whole = acquisition::compute_geometry(scan, settings);
+  ASSERT_GT(whole.normals, scan.pixel_count() / 4);
+  core::Progress quiet;
+  // One band (the default), then a band per tile (three).
+  for (const std::size_t band_pixels : {kGeometryBandPixels, std::size_t{1}}) {
+    SCOPED_TRACE(band_pixels);
+    const GeometryCommandResult result = geometry_project(project, settings, quiet, band_pixels);
+    ASSERT_EQ(result.scans.size(), 1u);
+    EXPECT_EQ(result.scans[0].normals, whole.normals);
+    EXPECT_EQ(result.scans[0].mixed_pixels, whole.mixed_pixels);
+    EXPECT_EQ(result.scans[0].edge_pixels, whole.edge_pixels);
+    EXPECT_TRUE(test::same_bytes(result.scans[0].range_noise, whole.noise.noise));
+    const std::optional<acquisition::ScanGeometry> stored = store::load_geometry(project, id);
+    ASSERT_TRUE(stored.has_value());
+    EXPECT_TRUE(test::same_bytes(stored->normal, whole.geometry.normal));
+    EXPECT_TRUE(test::same_bytes(stored->footprint_m, whole.geometry.footprint_m));
+    EXPECT_TRUE(test::same_bytes(stored->confidence, whole.geometry.confidence));
+    EXPECT_EQ(stored->flags, whole.geometry.flags);
+  }
+  EXPECT_TRUE(project.check().damage.empty());
 }
 
 TEST_F(StreamedStagesTest, ALimitTooSmallToLoadAScanIsRefusedAndChangesNothing) {
