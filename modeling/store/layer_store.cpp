@@ -279,11 +279,18 @@ void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer
 }
 
 void Project::verify_current_layer(std::int64_t id, std::string_view name) const {
-  std::vector<std::byte> values;
-  read_layer(id, name, std::nullopt, [&values](std::size_t bytes) {
-    values.resize(bytes);
-    return std::span<std::byte>(values);
-  });
+  const acquisition::ScanSummary grid = current_summary(id).summary;
+  sqlite::Statement select(db(), kSelectCurrentPlace.c_str(), file_name());
+  select.bind_int(1, id).bind_text(2, name);
+  if (!select.step()) return;
+  const std::optional<CurrentLayer> layer = current_layer(
+      select, file_name(), id, name,
+      static_cast<std::size_t>(grid.rows) * static_cast<std::size_t>(grid.columns), std::nullopt);
+  // A band at a time: a layer may be larger than memory.
+  if (layer) {
+    check_stored_frame(db(), layer->rowid, select.column_text(8).c_str(), grid.rows, grid.columns,
+                       layer->type, layer->context);
+  }
 }
 
 std::vector<std::string> Project::layer_names(std::int64_t id) const {

@@ -481,7 +481,8 @@ class Project {
   // full. Throws core::InputError naming the damage.
   void verify_current_rows(std::int64_t command_id) const;
   // Reads the current version of layer `name` of live scan `id`, its row
-  // verified and its data decoded; nothing when there is none.
+  // verified and its data decoded a band of rows at a time (a layer may be
+  // larger than memory); nothing when there is none.
   void verify_current_layer(std::int64_t id, std::string_view name) const;
   // Decodes the current version of a layer into the buffer `allocate`
   // returns for its size in bytes; false when there is none. Refused as
