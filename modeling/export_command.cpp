@@ -399,11 +399,12 @@ std::optional<std::vector<T>> next_rows(std::optional<store::LayerRowReader>& re
 }
 
 // Scan `id` shown and added to `points` a band of rows at a time: what
-// loading it whole and adding it writes, byte for byte.
+// loading it whole and adding it writes, byte for byte. Cancellable
+// between bands (core::Cancelled) through `progress`, when given.
 void add_by_bands(const store::Project& project, std::int64_t id, const ModelView& view,
                   const ExportSettings& settings, acquisition::PointChannels channels,
                   std::uint16_t source_id, acquisition::PointListWriter& points,
-                  ExportResult& result) {
+                  ExportResult& result, core::Progress* progress) {
   using store::ElementType;
   ScanRows rows(project, id, {channels.intensity, channels.color});
   const acquisition::Scan& description = rows.description();
@@ -428,6 +429,7 @@ void add_by_bands(const store::Project& project, std::int64_t id, const ModelVie
   }
   const int band = store::band_rows(settings.band_pixels, description.columns);
   for (int first = 0; first < description.rows; first += band) {
+    if (progress != nullptr) progress->throw_if_cancelled("export");
     const int end = std::min(description.rows, first + band), n = end - first;
     acquisition::Scan held = rows.hold(first, end);
     std::optional<acquisition::ScanGeometry> geometry;
@@ -497,7 +499,7 @@ ExportResult export_project(const store::Project& project, const ExportSettings&
     const std::string& name = summaries[s]->name;
     if (points) {  // a band of rows at a time
       add_by_bands(project, id, view, settings, channels, source_ids.empty() ? 0 : source_ids[s],
-                   *points, result);
+                   *points, result, progress);
     } else {  // grids and E57 files are written a scan at a time
       acquisition::Scan scan = triplet_scan ? std::move(*triplet_scan) : project.load_scan(id);
       std::optional<std::vector<std::uint8_t>> keep;

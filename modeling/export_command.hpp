@@ -65,7 +65,8 @@ struct ExportResult {
 // Writes the project's scans as the settings say, all read from one state of
 // the project (Project::read_snapshot), one scan at a time: memory holds the
 // scan being written, whatever the number of scans (E57 holds the
-// project's images too). What the model shows unless the
+// project's images too), and for PLY, CSV and LAS only a band of its rows
+// (ExportSettings::band_pixels), whatever the scan's size. What the model shows unless the
 // settings ask for recorded colours or all points. Points left out are
 // marked invalid in the grid formats (PTX, triplet, E57's structured scans)
 // and not written in the others. Outputs are checked first

@@ -55,9 +55,10 @@ acquisition::NoiseEstimate estimate_noise_by_bands(const store::Project& project
 
 // The geometry of grid scan `id`, band by band into `out`: the counts and
 // σ(range) of compute_geometry, whose result it is bit for bit.
+// Cancellable between bands (core::Cancelled).
 acquisition::GeometryResult geometry_by_bands(const store::Project& project, std::int64_t id,
                                               acquisition::GeometrySettings settings,
-                                              std::size_t band_pixels,
+                                              std::size_t band_pixels, core::Progress& progress,
                                               store::GeometryLayerWriter& out) {
   const auto start = std::chrono::steady_clock::now();
   acquisition::GeometryResult result;
@@ -72,6 +73,7 @@ acquisition::GeometryResult geometry_by_bands(const store::Project& project, std
       band_limits(acquisition::geometry_band_cuts(scan.rows), scan.columns, band_pixels);
   const int halo = acquisition::geometry_halo_rows(settings);
   for (std::size_t k = 0; k + 1 < limits.size(); ++k) {
+    progress.throw_if_cancelled(kStage);
     const int first = std::max(0, limits[k] - halo);
     const acquisition::Scan& held = rows.hold(first, std::min(scan.rows, limits[k + 1] + halo));
     const acquisition::GeometryResult band = acquisition::compute_geometry_rows(
@@ -122,7 +124,7 @@ GeometryCommandResult geometry_project(store::Project& project,
                                "footprints, which only an unstructured cloud's file gives");
       }
       bands.emplace(description.rows, description.columns);
-      geometry = geometry_by_bands(project, stored.id, settings, band_pixels, *bands);
+      geometry = geometry_by_bands(project, stored.id, settings, band_pixels, progress, *bands);
     }
     store::Project::Edit part = command.part();
     for (const store::EncodedLayer& layer : whole) project.put_layer(part, stored.id, layer);

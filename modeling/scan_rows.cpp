@@ -30,11 +30,9 @@ ScanRows::ScanRows(const store::Project& project, std::int64_t id,
       valid_(required(project, id, store::layer::kValid, store::ElementType::kU8)) {
   held_.rows = 0;
   if (channels.intensity) {
-    intensity_ = project.open_layer_rows(id, store::layer::kIntensity, store::ElementType::kF32);
+    intensity_ = required(project, id, store::layer::kIntensity, store::ElementType::kF32);
   }
-  if (channels.color) {
-    rgb_ = project.open_layer_rows(id, store::layer::kRgb, store::ElementType::kU8x3);
-  }
+  if (channels.color) rgb_ = required(project, id, store::layer::kRgb, store::ElementType::kU8x3);
   if (!description_.is_spherical()) {
     directions_ = required(project, id, store::layer::kDirections, store::ElementType::kF32x3);
   }

@@ -15,8 +15,8 @@ class ScanRows {
  public:
   // Scan `id` of `project` (which must outlive this), with range, validity
   // and per-pixel directions, and intensity and colour where `channels`
-  // asks for them and the scan has them. Throws core::InputError as
-  // Project::load_scan does.
+  // asks for them: only channels the scan has (its summary). Throws
+  // core::InputError as Project::load_scan does, a layer missing included.
   ScanRows(const store::Project& project, std::int64_t id,
            store::Project::ScanChannels channels = {false, false});
 

@@ -70,8 +70,9 @@ struct PointChannels {
 
 enum class PointListFormat { kPly, kCsv, kLas };
 
-// A PLY, CSV or LAS file written one scan at a time, so that an export holds
-// one scan in memory whatever the size of the campaign: the files are those
+// A PLY, CSV or LAS file written one scan (or one band of a scan's rows) at
+// a time, so that an export holds that in memory whatever the size of the
+// campaign: the files are those
 // of write_ply, write_csv and write_las. The channels are fixed up front (a
 // project knows them from its scans' summaries); the counts, and LAS's
 // bounds, go into the header at commit().

@@ -34,6 +34,7 @@ constexpr std::uint64_t kFrameHeaderMaxBytes = 18;
 // ---- Reading -----------------------------------------------------------------------------
 
 struct LayerRowReader::Stream {
+  sqlite3* db = nullptr;
   sqlite3_blob* blob = nullptr;
   ZSTD_DCtx* zstd = nullptr;
   std::uint64_t blob_bytes = 0;
@@ -55,12 +56,8 @@ struct LayerRowReader::Stream {
     if (offset == blob_bytes) return false;
     const auto n = static_cast<int>(std::min<std::uint64_t>(kPieceBytes, blob_bytes - offset));
     const int code = sqlite3_blob_read(blob, input.data(), n, static_cast<int>(offset));
-    if (code != SQLITE_OK) {
-      core::FilePosition position;
-      position.detail = context.location;
-      throw core::RuntimeFailure(context.file, position,
-                                 std::string("cannot read the layer: ") + sqlite3_errstr(code));
-    }
+    // A damaged page is damage (InputError), a failing disk a RuntimeFailure.
+    if (code != SQLITE_OK) sqlite::throw_error(db, code, context.file, context.location);
     offset += static_cast<std::uint64_t>(n);
     in = {input.data(), static_cast<std::size_t>(n), 0};
     return true;
@@ -114,16 +111,17 @@ LayerRowReader LayerRowReader::open_blob(sqlite3* db, std::int64_t rowid, const 
                                          int rows, int columns, ElementType type,
                                          const BlobContext& context) {
   auto stream = std::make_unique<Stream>();
+  stream->db = db;
   stream->context = context;
   const int code = sqlite3_blob_open(db, "main", "scan_layers", column, rowid, 0, &stream->blob);
-  if (code != SQLITE_OK) sqlite::throw_error(db, code, context.file, "opening a layer");
+  if (code != SQLITE_OK) sqlite::throw_error(db, code, context.file, context.location);
   stream->blob_bytes = static_cast<std::uint64_t>(sqlite3_blob_bytes(stream->blob));
   // The frame's header first: it must record the layer's size.
   std::vector<std::uint8_t> header(std::min(kFrameHeaderMaxBytes, stream->blob_bytes));
   if (const int read =
           sqlite3_blob_read(stream->blob, header.data(), static_cast<int>(header.size()), 0);
       read != SQLITE_OK) {
-    sqlite::throw_error(db, read, context.file, "reading a layer");
+    sqlite::throw_error(db, read, context.file, context.location);
   }
   check_blob_size(
       header,
@@ -210,7 +208,9 @@ void LayerRowWriter::write(std::span<const std::byte> values) {
   for (;;) {
     ZSTD_outBuffer out{sink_->output.data(), sink_->output.size(), 0};
     const std::size_t left = ZSTD_compressStream2(sink_->zstd, &out, &in, mode);
-    if (ZSTD_isError(left)) throw std::bad_alloc();  // the input is plain bytes: memory only
+    // The input is plain bytes, and as long as pledged (asserted above):
+    // what is left to fail is memory for zstd's tables.
+    if (ZSTD_isError(left)) throw std::bad_alloc();
     emit(std::span(sink_->output).first(out.pos));
     const bool done = mode == ZSTD_e_end ? left == 0 : in.pos == in.size;
     if (done) break;

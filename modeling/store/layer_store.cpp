@@ -256,6 +256,18 @@ void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer
          "a layer holds one element per pixel");
   [[maybe_unused]] const EncodedLayer described{layer.name(), layer.type(), n, {}};
   assert(has_its_type(described) && "a layer named in layer_store.hpp has the type listed there");
+  const std::string where = "scan " + std::to_string(id) + ", layer " + layer.name();
+  // A blob over SQLite's limit (1 GB unless built otherwise) cannot be
+  // stored: said before anything is, naming the layer.
+  const auto limit = static_cast<std::uint64_t>(sqlite3_limit(db(), SQLITE_LIMIT_LENGTH, -1));
+  if (layer.compressed_bytes() > limit) {
+    core::FilePosition position;
+    position.detail = where;
+    throw core::InputError(file_name(), position,
+                           "the layer takes " + std::to_string(layer.compressed_bytes()) +
+                               " bytes compressed, more than a project can store in one piece (" +
+                               std::to_string(limit) + "): the scan is too large");
+  }
   const LayerFields fields{id,
                            layer.name(),
                            edit.command_id(),
@@ -266,14 +278,14 @@ void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer
   sqlite3_blob* blob = nullptr;
   const int code = sqlite3_blob_open(db(), "main", "scan_layers", "frame",
                                      sqlite3_last_insert_rowid(db()), 1, &blob);
-  if (code != SQLITE_OK) sqlite::throw_error(db(), code, file_name(), "writing a layer");
+  if (code != SQLITE_OK) sqlite::throw_error(db(), code, file_name(), where);
   const std::unique_ptr<sqlite3_blob, decltype(&sqlite3_blob_close)> closing(blob,
                                                                              &sqlite3_blob_close);
   std::uint64_t offset = 0;
   layer.for_each_piece([&](std::span<const std::byte> piece) {
     const int written = sqlite3_blob_write(blob, piece.data(), static_cast<int>(piece.size()),
                                            static_cast<int>(offset));
-    if (written != SQLITE_OK) sqlite::throw_error(db(), written, file_name(), "writing a layer");
+    if (written != SQLITE_OK) sqlite::throw_error(db(), written, file_name(), where);
     offset += piece.size();
   });
 }

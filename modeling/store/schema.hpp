@@ -11,6 +11,9 @@
 //   6  object_nodes.color_edit, scan_colors.
 //   7  scan_sources, scan_images.
 //   8  indexes of the commands that are undone or pending.
+//   9  scans.layout: a grid, or a scattered scan (an unstructured cloud).
+//  10  scan_layers.frame: the frame of a layer written by rows, last in its
+//      row so that SQLite writes it in place.
 // To change the schema: bump kProjectSchemaVersion and add a case to
 // migrate_step() in schema.cpp that upgrades from the previous
 // version. The version 1 script is never edited: new projects are created by

@@ -224,11 +224,25 @@ TEST(LayerRows, ALayerWrittenByRowsIsTheLayerStoredWhole) {
     project.put_layer(edit, id, writer);
     edit.commit("{}");
   }
-  const store::Project reopened = store::Project::open(dir / "p.sbproj");
-  EXPECT_TRUE(test::same_bytes(
-      *reopened.load_layer<Eigen::Vector3f>(id, store::layer::kNormal, store::ElementType::kF32x3),
-      normals));
-  EXPECT_TRUE(reopened.check().damage.empty());
+  {
+    const store::Project reopened = store::Project::open(dir / "p.sbproj");
+    EXPECT_TRUE(test::same_bytes(*reopened.load_layer<Eigen::Vector3f>(id, store::layer::kNormal,
+                                                                       store::ElementType::kF32x3),
+                                 normals));
+    EXPECT_TRUE(reopened.check().damage.empty());
+  }
+  // Its frame is in the column `frame` (schema 10), where damage is found too.
+  test::RawDatabase(dir / "p.sbproj")
+      .execute(
+          "UPDATE scan_layers SET frame = substr(frame, 1, 5000) || x'00' || "
+          "substr(frame, 5002) WHERE name = 'normal' AND length(data) = 0");
+  const store::Project damaged = store::Project::open(dir / "p.sbproj");
+  const store::Project::CheckReport report = damaged.check();
+  ASSERT_EQ(report.damage.size(), 1u);
+  EXPECT_THAT(report.damage[0], HasSubstr("layer normal"));
+  EXPECT_THROW(
+      damaged.load_layer<Eigen::Vector3f>(id, store::layer::kNormal, store::ElementType::kF32x3),
+      core::InputError);
 }
 
 // Reads every row of layer `name` of scan `id` in bands of 10 rows.
