@@ -49,8 +49,14 @@ void ScanRows::advance(std::optional<store::LayerRowReader>& reader, std::vector
   const int drop = std::min(first, held_end) - first_;
   values.erase(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(drop * row_values));
   const int from = std::max(first, held_end);
-  std::vector<T> skipped((first > held_end ? first - held_end : 0) * row_values);
-  reader->read(std::span(skipped));
+  if (first > held_end) {  // rows no band holds: read a band's worth at a time, and dropped
+    const int rows = std::max(1, std::min(first - held_end, std::max(end - first, 1)));
+    std::vector<T> skipped(static_cast<std::size_t>(rows) * row_values);
+    for (int row = held_end; row < first; row += rows) {
+      const int n = std::min(rows, first - row);
+      reader->read(std::span(skipped).first(static_cast<std::size_t>(n) * row_values));
+    }
+  }
   const std::size_t kept = values.size();
   values.resize(kept + static_cast<std::size_t>(end - from) * row_values);
   reader->read(std::span(values).subspan(kept));

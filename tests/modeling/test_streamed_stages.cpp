@@ -447,6 +447,27 @@ TEST(GeometryStage, ComputesAGridBandByBandAsTheWholeScanInMemory) {
   EXPECT_TRUE(project.check().damage.empty());
 }
 
+TEST(GeometryStage, ComputesAGridOfPerPixelDirectionsBandByBandAsInMemory) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "tall.sbproj");
+  acquisition::Scan scan = tall_room();
+  std::vector<Eigen::Vector3f> directions(scan.pixel_count());
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.columns; ++col)
+      directions[scan.index(row, col)] = acquisition::direction(scan, row, col);
+  }
+  scan.angles = acquisition::PerPixelDirections{std::move(directions), false};
+  const std::int64_t id = test::insert_committed(project, scan);
+  const acquisition::GeometryResult whole = acquisition::compute_geometry(scan, {});
+  core::Progress quiet;
+  geometry_project(project, {}, quiet, 1);  // a band per tile of the window fits
+  const std::optional<acquisition::ScanGeometry> stored = store::load_geometry(project, id);
+  ASSERT_TRUE(stored.has_value());
+  EXPECT_TRUE(test::same_bytes(stored->normal, whole.geometry.normal));
+  EXPECT_TRUE(test::same_bytes(stored->footprint_m, whole.geometry.footprint_m));
+  EXPECT_EQ(stored->flags, whole.geometry.flags);
+}
+
 TEST_F(StreamedStagesTest, ALimitTooSmallToLoadAScanIsRefusedAndChangesNothing) {
   const std::int64_t revision = project_.revision();
   core::Progress progress;
