@@ -389,11 +389,10 @@ acquisition::PointListWriter::LasSettings las_settings(
 
 // The next `rows` rows of `reader` (none without one).
 template <typename T>
-std::optional<std::vector<T>> next_rows(std::optional<store::LayerRowReader>& reader, int rows,
-                                        std::size_t per_pixel = 1) {
+std::optional<std::vector<T>> next_rows(std::optional<store::LayerRowReader>& reader, int rows) {
   if (!reader) return std::nullopt;
   std::vector<T> values(static_cast<std::size_t>(rows) *
-                        static_cast<std::size_t>(reader->columns()) * per_pixel);
+                        static_cast<std::size_t>(reader->columns()));
   reader->read(std::span(values));
   return values;
 }
@@ -408,19 +407,9 @@ void add_by_bands(const store::Project& project, std::int64_t id, const ModelVie
   using store::ElementType;
   ScanRows rows(project, id, {channels.intensity, channels.color});
   const acquisition::Scan& description = rows.description();
-  std::optional<store::LayerRowReader> footprint, normal, confidence, flags, keep, membership;
-  if (channels.geometry) {
-    footprint = project.open_layer_rows(id, store::layer::kFootprint, ElementType::kF32);
-    normal = project.open_layer_rows(id, store::layer::kNormal, ElementType::kF32x3);
-    confidence = project.open_layer_rows(id, store::layer::kConfidence, ElementType::kF32);
-    flags = project.open_layer_rows(id, store::layer::kGeometryFlags, ElementType::kU8);
-    if (!footprint || !normal || !confidence || !flags) {
-      core::FilePosition position;
-      position.detail = "scan " + std::to_string(id);
-      throw core::InputError(project.path().string(), position,
-                             "project is damaged: only some of the geometry layers are stored");
-    }
-  }
+  std::optional<store::GeometryLayerReader> geometry_rows;
+  if (channels.geometry) geometry_rows = store::GeometryLayerReader::open(project, id);
+  std::optional<store::LayerRowReader> keep, membership;
   if (settings.merged) {  // check_merged made sure there is one
     keep = project.open_layer_rows(id, store::layer::kKeep, ElementType::kU8);
   }
@@ -433,13 +422,7 @@ void add_by_bands(const store::Project& project, std::int64_t id, const ModelVie
     const int end = std::min(description.rows, first + band), n = end - first;
     acquisition::Scan held = rows.hold(first, end);
     std::optional<acquisition::ScanGeometry> geometry;
-    if (channels.geometry) {
-      geometry.emplace();
-      geometry->footprint_m = *next_rows<float>(footprint, n);
-      geometry->normal = *next_rows<Eigen::Vector3f>(normal, n);
-      geometry->confidence = *next_rows<float>(confidence, n);
-      geometry->flags = *next_rows<std::uint8_t>(flags, n);
-    }
+    if (geometry_rows) geometry = geometry_rows->read(n);
     std::optional<std::vector<std::uint8_t>> kept = next_rows<std::uint8_t>(keep, n);
     view.show(id, held, kept, next_rows<std::uint32_t>(membership, n), result);
     points.add(held, geometry ? &*geometry : nullptr, kept ? &*kept : nullptr, source_id, first);

@@ -81,6 +81,61 @@ void GeometryLayerWriter::put(Project& project, Project::Edit& edit, std::int64_
     project.put_layer(edit, id, *layer);
 }
 
+namespace {
+
+// Whether scan `id` has its geometry, from which of its four layers are
+// `present`: all of them, or none; throws core::InputError for some.
+bool has_geometry(const Project& project, std::int64_t id, int present) {
+  if (present == 0) return false;
+  if (present != 4) {
+    core::FilePosition position;
+    position.detail = "scan " + std::to_string(id);
+    throw core::InputError(project.path().string(), position,
+                           "project is damaged: only some of the geometry layers are stored");
+  }
+  return true;
+}
+
+// The next `rows` rows of `reader`.
+template <typename T>
+std::vector<T> next_rows(LayerRowReader& reader, int rows) {
+  std::vector<T> values(static_cast<std::size_t>(rows) *
+                        static_cast<std::size_t>(reader.columns()));
+  reader.read(std::span(values));
+  return values;
+}
+
+}  // namespace
+
+std::optional<GeometryLayerReader> GeometryLayerReader::open(const Project& project,
+                                                             std::int64_t id) {
+  auto footprint = project.open_layer_rows(id, layer::kFootprint, ElementType::kF32);
+  auto normal = project.open_layer_rows(id, layer::kNormal, ElementType::kF32x3);
+  auto confidence = project.open_layer_rows(id, layer::kConfidence, ElementType::kF32);
+  auto flags = project.open_layer_rows(id, layer::kGeometryFlags, ElementType::kU8);
+  const int present =
+      footprint.has_value() + normal.has_value() + confidence.has_value() + flags.has_value();
+  if (!has_geometry(project, id, present)) return std::nullopt;
+  return GeometryLayerReader(std::move(*footprint), std::move(*normal), std::move(*confidence),
+                             std::move(*flags));
+}
+
+GeometryLayerReader::GeometryLayerReader(LayerRowReader footprint, LayerRowReader normal,
+                                         LayerRowReader confidence, LayerRowReader flags)
+    : footprint_(std::move(footprint)),
+      normal_(std::move(normal)),
+      confidence_(std::move(confidence)),
+      flags_(std::move(flags)) {}
+
+acquisition::ScanGeometry GeometryLayerReader::read(int rows) {
+  acquisition::ScanGeometry g;
+  g.footprint_m = next_rows<float>(footprint_, rows);
+  g.normal = next_rows<Eigen::Vector3f>(normal_, rows);
+  g.confidence = next_rows<float>(confidence_, rows);
+  g.flags = next_rows<std::uint8_t>(flags_, rows);
+  return g;
+}
+
 std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, std::int64_t id) {
   auto footprint = project.load_layer<float>(id, layer::kFootprint, ElementType::kF32);
   auto normal = project.load_layer<Eigen::Vector3f>(id, layer::kNormal, ElementType::kF32x3);
@@ -88,13 +143,7 @@ std::optional<acquisition::ScanGeometry> load_geometry(const Project& project, s
   auto flags = project.load_layer<std::uint8_t>(id, layer::kGeometryFlags, ElementType::kU8);
   const int present =
       footprint.has_value() + normal.has_value() + confidence.has_value() + flags.has_value();
-  if (present == 0) return std::nullopt;
-  if (present != 4) {
-    core::FilePosition position;
-    position.detail = "scan " + std::to_string(id);
-    throw core::InputError(project.path().string(), position,
-                           "project is damaged: only some of the geometry layers are stored");
-  }
+  if (!has_geometry(project, id, present)) return std::nullopt;
   acquisition::ScanGeometry g;
   g.footprint_m = std::move(*footprint);
   g.normal = std::move(*normal);

@@ -29,6 +29,22 @@ class GeometryLayerWriter {
   LayerRowWriter footprint_, normal_, confidence_, flags_;
 };
 
+// The stored geometry of scan `id` read a band of rows at a time, as
+// load_geometry checks it (all four layers or none).
+class GeometryLayerReader {
+ public:
+  // None when the scan has no geometry; throws as load_geometry.
+  static std::optional<GeometryLayerReader> open(const Project& project, std::int64_t id);
+  // The geometry of the next `rows` rows, in order (no more than remain,
+  // asserted); its range_noise is left as it is. Throws as LayerRowReader::read.
+  acquisition::ScanGeometry read(int rows);
+
+ private:
+  GeometryLayerReader(LayerRowReader footprint, LayerRowReader normal, LayerRowReader confidence,
+                      LayerRowReader flags);
+  LayerRowReader footprint_, normal_, confidence_, flags_;
+};
+
 // The stored geometry of scan `id`, or none when `scanbench geometry` has
 // not run on it (or was undone). Its range_noise is the one the command
 // that computed it recorded for the scan (its estimate; for commands older
