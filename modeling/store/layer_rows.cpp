@@ -133,18 +133,20 @@ LayerRowReader LayerRowReader::open_blob(sqlite3* db, std::int64_t rowid, const 
   return LayerRowReader(std::move(stream), rows, columns, type);
 }
 
+void LayerRowReader::read_rest() {
+  const int band = band_rows(kPieceBytes / element_size(type_), columns_);
+  std::vector<std::byte> values;
+  do {
+    const int n = std::min(band, rows_ - next_row_);
+    values.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(columns_) *
+                  element_size(type_));
+    read(std::span(values));
+  } while (next_row_ < rows_);
+}
+
 void check_stored_frame(sqlite3* db, std::int64_t rowid, const char* column, int rows, int columns,
                         ElementType type, const BlobContext& context) {
-  LayerRowReader reader =
-      LayerRowReader::open_blob(db, rowid, column, rows, columns, type, context);
-  const int band = band_rows(kPieceBytes / element_size(type), columns);
-  std::vector<std::byte> values;
-  do {  // once at least: the frame of a layer of no pixels is read too
-    const int n = std::min(band, rows - reader.rows_read());
-    values.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(columns) *
-                  element_size(type));
-    reader.read(std::span(values));
-  } while (reader.rows_read() < rows);
+  LayerRowReader::open_blob(db, rowid, column, rows, columns, type, context).read_rest();
 }
 
 // ---- Writing -----------------------------------------------------------------------------

@@ -62,6 +62,11 @@ class LayerRowReader {
     read(std::as_writable_bytes(out));
   }
 
+  // Decodes the rows left, a band at a time, and drops them: checks the
+  // rest of the frame (once at least: a layer of no pixels has one too).
+  // Throws as read().
+  void read_rest();
+
  private:
   friend class Project;
   friend void check_stored_frame(sqlite3* db, std::int64_t rowid, const char* column, int rows,

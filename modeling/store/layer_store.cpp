@@ -235,7 +235,7 @@ bool Project::read_layer(
 }
 
 std::optional<LayerRowReader> Project::open_layer_rows(std::int64_t id, std::string_view name,
-                                                       ElementType expected) const {
+                                                       std::optional<ElementType> expected) const {
   const acquisition::ScanSummary grid = current_summary(id).summary;
   sqlite::Statement select(db(), kSelectCurrentPlace.c_str(), file_name());
   select.bind_int(1, id).bind_text(2, name);
@@ -291,18 +291,9 @@ void Project::put_layer(Edit& edit, std::int64_t id, const LayerRowWriter& layer
 }
 
 void Project::verify_current_layer(std::int64_t id, std::string_view name) const {
-  const acquisition::ScanSummary grid = current_summary(id).summary;
-  sqlite::Statement select(db(), kSelectCurrentPlace.c_str(), file_name());
-  select.bind_int(1, id).bind_text(2, name);
-  if (!select.step()) return;
-  const std::optional<CurrentLayer> layer = current_layer(
-      select, file_name(), id, name,
-      static_cast<std::size_t>(grid.rows) * static_cast<std::size_t>(grid.columns), std::nullopt);
   // A band at a time: a layer may be larger than memory.
-  if (layer) {
-    check_stored_frame(db(), layer->rowid, select.column_text(8).c_str(), grid.rows, grid.columns,
-                       layer->type, layer->context);
-  }
+  if (std::optional<LayerRowReader> rows = open_layer_rows(id, name, std::nullopt))
+    rows->read_rest();
 }
 
 std::vector<std::string> Project::layer_names(std::int64_t id) const {

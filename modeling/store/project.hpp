@@ -293,10 +293,11 @@ class Project {
   }
 
   // The current version of layer `name` of scan `id`, to be read a band
-  // of rows at a time (layer_rows.hpp), checked as load_layer checks it;
-  // none when the scan has no such layer.
+  // of rows at a time (layer_rows.hpp), checked as load_layer checks it
+  // (its type against `type` when given); none when the scan has no such
+  // layer.
   std::optional<LayerRowReader> open_layer_rows(std::int64_t id, std::string_view name,
-                                                ElementType type) const;
+                                                std::optional<ElementType> type) const;
 
   // Names of the current layers of scan `id`, sorted.
   std::vector<std::string> layer_names(std::int64_t id) const;
