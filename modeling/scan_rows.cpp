@@ -12,10 +12,11 @@ namespace {
 store::LayerRowReader required(const store::Project& project, std::int64_t id, const char* name,
                                store::ElementType type) {
   std::optional<store::LayerRowReader> reader = project.open_layer_rows(id, name, type);
-  if (!reader) {
+  if (!reader) {  // as Project::load_scan says it
     core::FilePosition position;
-    position.detail = "scan " + std::to_string(id) + ", layer " + name;
-    throw core::InputError(project.path().string(), position, "project is damaged: layer missing");
+    position.detail = "scan " + std::to_string(id);
+    throw core::InputError(project.path().string(), position,
+                           std::string("project is damaged: layer ") + name + " is missing");
   }
   return std::move(*reader);
 }
@@ -38,33 +39,26 @@ ScanRows::ScanRows(const store::Project& project, std::int64_t id,
   }
 }
 
-// Drops the rows before `first` from `values` and reads the rows up to
-// `end` (per_pixel values a pixel) from `reader`, when there is one.
+// Drops the rows before `first` from `values` and reads the rows from the
+// held ones' end up to `end` (per_pixel values a pixel) from `reader`,
+// when there is one.
 template <typename T>
 void ScanRows::advance(std::optional<store::LayerRowReader>& reader, std::vector<T>& values,
                        std::size_t per_pixel, int first, int end) {
   if (!reader) return;
   const auto row_values = static_cast<std::size_t>(description_.columns) * per_pixel;
   const int held_end = first_ + held_.rows;
-  const int drop = std::min(first, held_end) - first_;
-  values.erase(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(drop * row_values));
-  const int from = std::max(first, held_end);
-  if (first > held_end) {  // rows no band holds: read a band's worth at a time, and dropped
-    const int rows = std::max(1, std::min(first - held_end, std::max(end - first, 1)));
-    std::vector<T> skipped(static_cast<std::size_t>(rows) * row_values);
-    for (int row = held_end; row < first; row += rows) {
-      const int n = std::min(rows, first - row);
-      reader->read(std::span(skipped).first(static_cast<std::size_t>(n) * row_values));
-    }
-  }
+  values.erase(values.begin(),
+               values.begin() + static_cast<std::ptrdiff_t>((first - first_) * row_values));
   const std::size_t kept = values.size();
-  values.resize(kept + static_cast<std::size_t>(end - from) * row_values);
+  values.resize(kept + static_cast<std::size_t>(end - held_end) * row_values);
   reader->read(std::span(values).subspan(kept));
 }
 
 const acquisition::Scan& ScanRows::hold(int first, int end) {
-  assert(first >= first_ && end >= first_ + held_.rows && first <= end &&
-         end <= description_.rows && "bands go forward");
+  assert(first >= first_ && first <= first_ + held_.rows && end >= first_ + held_.rows &&
+         end <= description_.rows &&
+         "bands go forward, each from within or at the end of the last");
   advance(range_, held_.range_m, 1, first, end);
   advance(valid_, held_.valid, 1, first, end);
   advance(intensity_, held_.intensity, 1, first, end);

@@ -24,9 +24,9 @@ class ScanRows {
   const acquisition::Scan& description() const { return description_; }
 
   // The scan's rows [first, end): a Scan of end − first rows with the
-  // scan's angle model (per-pixel directions of those rows only). `first`
-  // and `end` never go back from one call to the next (asserted); rows
-  // between the two bands are read and dropped. Valid until the next call.
+  // scan's angle model (per-pixel directions of those rows only). Bands go
+  // forward: `first` lies within the last band or at its end, and `end`
+  // at or after the last band's end (asserted). Valid until the next call.
   // Throws core::InputError naming the layer when its data is damaged.
   const acquisition::Scan& hold(int first, int end);
 
