@@ -159,12 +159,14 @@ Eigen::Vector3f direction(const Scan& scan, int row, int col);
 class SphericalDirections {
  public:
   explicit SphericalDirections(const Scan& scan);
-  Eigen::Vector3f operator()(int row, int col) const {
+  Eigen::Vector3f operator()(int row, int col) const { return precise(row, col).cast<float>(); }
+  // direction_precise's, bit for bit.
+  Eigen::Vector3d precise(int row, int col) const {
     assert(row >= 0 && static_cast<std::size_t>(row) < rows_.size() && col >= 0 &&
            static_cast<std::size_t>(col) < columns_.size());
     const Eigen::Vector2d& el = rows_[static_cast<std::size_t>(row)];
     const Eigen::Vector2d& az = columns_[static_cast<std::size_t>(col)];
-    return Eigen::Vector3d(el.x() * az.x(), el.x() * az.y(), el.y()).cast<float>();
+    return {el.x() * az.x(), el.x() * az.y(), el.y()};
   }
 
  private:

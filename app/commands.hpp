@@ -30,6 +30,7 @@ inline constexpr const char* kBenchDescription =
     "Measure a stage: accuracy against ground truth and speed against PCL, one run.";
 void add_simulate_command(CLI::App& app);
 void add_geometry_command(CLI::App& app);
+void add_lod_command(CLI::App& app);
 void add_register_command(CLI::App& app);
 void add_merge_command(CLI::App& app);
 // history, undo and redo.

@@ -112,6 +112,7 @@ int run_command(int argc, char** argv) {
   sb::add_history_commands(app);
   sb::add_segment_command(app);
   sb::add_recolor_command(app);
+  sb::add_lod_command(app);
   sb::add_render_command(app);
   sb::add_workbench_command(app);
   sb::add_objects_command(app);

@@ -99,23 +99,9 @@ std::vector<std::uint8_t> sampled_mask(const sim::TruthImage& truth,
 // The campaign in a project (true poses, geometry, the merge's keep masks)
 // and its render model: the path `scanbench render` takes.
 render::RenderModel campus_model(const SimulatedSite& site, const ScratchFolder& scratch) {
-  std::vector<registration::PreparedScan> prepared;
-  for (std::size_t k = 0; k < site.scans.size(); ++k)
-    prepared.push_back(registration::prepare_scan(site.scans[k], site.geometry[k], 0));
-  const registration::MergeResult merged =
-      registration::merge_by_sampling_rate(prepared, site.true_poses, {});
-  store::Project project = store::Project::create(scratch.path() / "render.sbproj");
-  store::Project::Edit edit = project.begin_command("import", "{}");
-  for (std::size_t k = 0; k < site.scans.size(); ++k) {
-    const std::int64_t id = project.insert_scan(edit, store::encode_scan(site.scans[k]));
-    for (const store::EncodedLayer& layer : store::encode_geometry(site.geometry[k]))
-      project.put_layer(edit, id, layer);
-    project.put_layer(edit, id,
-                      store::encode_layer<std::uint8_t>(
-                          store::layer::kKeep, store::ElementType::kU8, merged.scans[k].keep));
-  }
-  edit.commit("{}");
-  return render::build_render_model(project, {});
+  const std::filesystem::path file = scratch.path() / "render.sbproj";
+  store_site_project(site, file);
+  return render::build_render_model(store::Project::open(file), {});
 }
 
 struct ViewFigures {

@@ -30,9 +30,7 @@ constexpr double kStageTimeoutS = 1800.0;
 // A stage run in its own process.
 ChildRun run_stage(const std::string& stage, const std::vector<std::string>& arguments,
                    const fs::path& dir) {
-  const fs::path beside = scanbench_beside_this();
-  return run_process(beside.empty() ? this_executable() : beside, arguments, dir / (stage + ".out"),
-                     dir / (stage + ".err"), kStageTimeoutS);
+  return run_scanbench(stage, arguments, dir, kStageTimeoutS);
 }
 
 // The same for a stage the campaign cannot do without: throws naming it

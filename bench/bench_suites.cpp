@@ -5,6 +5,7 @@
 #include "bench/bench_color.hpp"
 #include "bench/bench_geometry.hpp"
 #include "bench/bench_io.hpp"
+#include "bench/bench_lod.hpp"
 #include "bench/bench_merge.hpp"
 #include "bench/bench_registration.hpp"
 #include "bench/bench_render.hpp"
@@ -14,7 +15,8 @@
 namespace scanbench::bench {
 
 std::vector<std::string> suite_names() {
-  return {"io", "geometry", "registration", "merge", "segmentation", "render", "color", "scale"};
+  return {"io",     "geometry", "registration", "merge", "segmentation",
+          "render", "color",    "scale",        "lod"};
 }
 
 nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
@@ -26,6 +28,7 @@ nlohmann::json run_suite(const std::string& name, const BenchOptions& options) {
   if (name == "render") return run_render_bench(options);
   if (name == "color") return run_color_bench(options);
   if (name == "scale") return run_scale_bench(options);
+  if (name == "lod") return run_lod_bench(options);
   assert(false && "unknown bench suite");
   return {};
 }

@@ -95,4 +95,11 @@ ChildRun run_process(const std::filesystem::path& program,
   return run;
 }
 
+ChildRun run_scanbench(const std::string& stage, const std::vector<std::string>& arguments,
+                       const std::filesystem::path& dir, double timeout_s) {
+  const std::filesystem::path beside = scanbench_beside_this();
+  return run_process(beside.empty() ? this_executable() : beside, arguments, dir / (stage + ".out"),
+                     dir / (stage + ".err"), timeout_s);
+}
+
 }  // namespace scanbench::bench

@@ -40,4 +40,10 @@ ChildRun run_process(const std::filesystem::path& program,
                      const std::vector<std::string>& arguments, const std::filesystem::path& out,
                      const std::filesystem::path& err, double timeout_s = 0.0);
 
+// Runs `scanbench` (the one beside this executable, else this one) with
+// `arguments`, its output and errors in `dir`/STAGE.out and STAGE.err, as
+// run_process does.
+ChildRun run_scanbench(const std::string& stage, const std::vector<std::string>& arguments,
+                       const std::filesystem::path& dir, double timeout_s = 0.0);
+
 }  // namespace scanbench::bench

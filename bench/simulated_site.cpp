@@ -2,6 +2,11 @@
 
 #include "acquisition/simulation/random.hpp"
 #include "acquisition/simulation/sites.hpp"
+#include "modeling/store/layer_store.hpp"
+#include "modeling/store/project.hpp"
+#include "modeling/store/typed_layers.hpp"
+#include "registration/merge.hpp"
+#include "registration/prepared_scan.hpp"
 
 namespace scanbench::bench {
 
@@ -39,6 +44,25 @@ SimulatedSite simulate_site(const std::string& name, const acquisition::sim::Sca
     out.truth.push_back(std::move(simulated.truth));
   }
   return out;
+}
+
+void store_site_project(const SimulatedSite& site, const std::filesystem::path& file) {
+  std::vector<registration::PreparedScan> prepared;
+  for (std::size_t k = 0; k < site.scans.size(); ++k)
+    prepared.push_back(registration::prepare_scan(site.scans[k], site.geometry[k], 0));
+  const registration::MergeResult merged =
+      registration::merge_by_sampling_rate(prepared, site.true_poses, {});
+  store::Project project = store::Project::create(file);
+  store::Project::Edit edit = project.begin_command("import", "{}");
+  for (std::size_t k = 0; k < site.scans.size(); ++k) {
+    const std::int64_t id = project.insert_scan(edit, store::encode_scan(site.scans[k]));
+    for (const store::EncodedLayer& layer : store::encode_geometry(site.geometry[k]))
+      project.put_layer(edit, id, layer);
+    project.put_layer(edit, id,
+                      store::encode_layer<std::uint8_t>(
+                          store::layer::kKeep, store::ElementType::kU8, merged.scans[k].keep));
+  }
+  edit.commit("{}");
 }
 
 }  // namespace scanbench::bench

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -44,5 +45,10 @@ acquisition::sim::ScanLighting scan_lighting(SiteLighting lighting, int k);
 // then computes every scan's geometry with the default settings.
 SimulatedSite simulate_site(const std::string& name, const acquisition::sim::ScannerModel& model,
                             int scan_count, SiteLighting lighting = SiteLighting::kPerScan);
+
+// The campaign stored in a new project `file` at its true poses, with its
+// geometry and the keep masks of a merge at those poses: the model
+// `scanbench render` and `scanbench lod` read.
+void store_site_project(const SimulatedSite& site, const std::filesystem::path& file);
 
 }  // namespace scanbench::bench

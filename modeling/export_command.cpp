@@ -387,16 +387,6 @@ acquisition::PointListWriter::LasSettings las_settings(
 
 }  // namespace
 
-// The next `rows` rows of `reader` (none without one).
-template <typename T>
-std::optional<std::vector<T>> next_rows(std::optional<store::LayerRowReader>& reader, int rows) {
-  if (!reader) return std::nullopt;
-  std::vector<T> values(static_cast<std::size_t>(rows) *
-                        static_cast<std::size_t>(reader->columns()));
-  reader->read(std::span(values));
-  return values;
-}
-
 // Scan `id` shown and added to `points` a band of rows at a time: what
 // loading it whole and adding it writes, byte for byte. Cancellable
 // between bands (core::Cancelled) through `progress`, when given.
@@ -423,8 +413,8 @@ void add_by_bands(const store::Project& project, std::int64_t id, const ModelVie
     acquisition::Scan held = rows.hold(first, end);
     std::optional<acquisition::ScanGeometry> geometry;
     if (geometry_rows) geometry = geometry_rows->read(n);
-    std::optional<std::vector<std::uint8_t>> kept = next_rows<std::uint8_t>(keep, n);
-    view.show(id, held, kept, next_rows<std::uint32_t>(membership, n), result);
+    std::optional<std::vector<std::uint8_t>> kept = store::read_rows<std::uint8_t>(keep, n);
+    view.show(id, held, kept, store::read_rows<std::uint32_t>(membership, n), result);
     points.add(held, geometry ? &*geometry : nullptr, kept ? &*kept : nullptr, source_id, first);
   }
 }

@@ -4,109 +4,17 @@
 #include <cmath>
 #include <map>
 #include <optional>
-#include <variant>
 
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "core/errors.hpp"
 #include "modeling/color_pipeline.hpp"
+#include "modeling/lod/splat_shape.hpp"
 #include "modeling/shown_nodes.hpp"
 #include "modeling/store/typed_layers.hpp"
 
 namespace scanbench::render {
 
 namespace {
-
-// Half the diagonal of pixel (row, col)'s cell [rad]: a sample's footprint
-// per metre of range seen head on. Per-pixel grids have no cell: none.
-std::optional<float> half_cell_rad(const acquisition::Scan& scan, int row) {
-  const auto* a = std::get_if<acquisition::SphericalAngles>(&scan.angles);
-  if (a == nullptr) return std::nullopt;
-  const double across =
-      a->azimuth_step_rad * std::cos(a->elevation_start_rad + row * a->elevation_step_rad);
-  return static_cast<float>(0.5 * std::hypot(across, a->elevation_step_rad));
-}
-
-// How far the pixel's samples reach along its surface, when the pixel lies
-// inside ground its scan sampled; none elsewhere. Only there may a splat
-// stretch beyond the edge-on limit, and never further than the samples
-// beside it. Ground (facing up within 30°, below the scanner) is what a
-// terrestrial scanner sees at grazing incidence over tens of metres, its
-// rows far apart. Elsewhere a beam that grazes a surface is mostly on a
-// silhouette (a post, a lamp's head, a wall's edge), and the normals of
-// small objects seen edge on are too rough for 1 / cos θ. Each neighbour
-// must be a return within `reach` [m] and within 20° of the tangent plane,
-// or a dropout (far grazing ground loses returns; beyond ground there is no
-// sky); at least two must be returns.
-std::optional<float> sample_reach(const acquisition::Scan& scan,
-                                  const acquisition::ScanGeometry& geometry, int row, int col,
-                                  float reach, const Eigen::Vector3f& up) {
-  const Eigen::Vector3f p = acquisition::point_in_scan(scan, row, col);
-  const Eigen::Vector3f& n = geometry.normal[scan.index(row, col)];
-  if (n.dot(up) < 0.866f || p.dot(up) >= 0.0f) return std::nullopt;  // not ground seen from above
-  constexpr int kSteps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
-  int returns = 0;
-  float widest = 0.0f;
-  for (const auto& step : kSteps) {
-    const int r = row + step[0];
-    int c = col + step[1];
-    if (c < 0 || c >= scan.columns) {
-      if (!acquisition::wraps_around(scan)) return std::nullopt;
-      c = (c + scan.columns) % scan.columns;
-    }
-    if (r < 0 || r >= scan.rows) return std::nullopt;
-    if (!scan.valid[scan.index(r, c)]) continue;  // far grazing ground loses returns
-    ++returns;
-    const Eigen::Vector3f step_to = acquisition::point_in_scan(scan, r, c) - p;
-    const float distance = step_to.norm();
-    // Too far, or off the tangent plane by more than 20°: another surface.
-    if (distance > reach || std::abs(n.dot(step_to)) > 0.35f * distance) return std::nullopt;
-    widest = std::max(widest, distance);
-  }
-  if (returns < 2) return std::nullopt;
-  return widest;
-}
-
-// The splat of pixel (row, col): its normal, and radii and major axis from
-// the incidence of the scanner's beam (RenderPoints::radii_m).
-void append_splat(const acquisition::Scan& scan, const acquisition::ScanGeometry& geometry, int row,
-                  int col, const Eigen::Matrix3f& rotation, float max_stretch, RenderPoints& p) {
-  const std::size_t i = scan.index(row, col);
-  const float footprint = geometry.footprint_m[i];
-  if (!geometry.has_normal(i)) {
-    p.normal.push_back(Eigen::Vector3f::Zero());
-    p.radii_m.emplace_back(footprint, footprint);
-    p.major_axis.push_back(Eigen::Vector3f::Zero());
-    return;
-  }
-  const Eigen::Vector3f n = geometry.normal[i];
-  if (scan.is_scattered()) {  // its footprint is a spacing on the surface: a round splat
-    p.normal.push_back(rotation * n);
-    p.radii_m.emplace_back(footprint, footprint);
-    p.major_axis.push_back(Eigen::Vector3f::Zero());
-    return;
-  }
-  const Eigen::Vector3f beam = acquisition::direction(scan, row, col);  // scanner → point
-  constexpr float kEdgeOnStretch = 4.0f;  // the geometry stage's footprint limit
-  float cos_incidence = std::clamp(std::abs(n.dot(beam)), 1.0f / max_stretch, 1.0f);
-  const std::optional<float> half_cell = half_cell_rad(scan, row);
-  const float head_on = half_cell ? scan.range_m[i] * *half_cell : footprint * cos_incidence;
-  if (cos_incidence < 1.0f / kEdgeOnStretch) {
-    const std::optional<float> along =
-        sample_reach(scan, geometry, row, col, 2.0f * head_on / cos_incidence,
-                     scan.T_world_scan.linear().transpose().col(2).cast<float>());
-    const float limit = along ? std::max(*along / head_on, kEdgeOnStretch) : kEdgeOnStretch;
-    cos_incidence = std::max(cos_incidence, 1.0f / limit);
-  }
-  const Eigen::Vector3f slope = beam - n.dot(beam) * n;  // the beam's trace on the surface
-  p.normal.push_back(rotation * n);
-  if (slope.norm() < 1e-3f) {  // head on: round
-    p.radii_m.emplace_back(head_on, head_on);
-    p.major_axis.push_back(Eigen::Vector3f::Zero());
-    return;
-  }
-  p.radii_m.emplace_back(head_on, head_on / cos_incidence);
-  p.major_axis.push_back(rotation * slope.normalized());
-}
 
 // Scan `id`'s geometry; refused, naming the scan, when it has none.
 acquisition::ScanGeometry require_geometry(const store::Project& project, std::int64_t id,
@@ -141,7 +49,7 @@ void gather_scan(const store::Project& project, const store::StoredScanSummary& 
   if (needed > p.position.capacity()) p.reserve(std::max(needed, 2 * p.position.capacity()));
   const auto [low, high] = acquisition::intensity_range(scan, usable);
   const float spread = high > low ? high - low : 1.0f;
-  const Eigen::Matrix3f rotation = scan.T_world_scan.linear().cast<float>();
+  const lod::ScanSplats splats(scan, settings.max_stretch);
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.columns; ++col) {
       const std::size_t i = scan.index(row, col);
@@ -176,7 +84,10 @@ void gather_scan(const store::Project& project, const store::StoredScanSummary& 
         rgba = {grey, grey, grey, 255};
       }
       p.position.push_back((acquisition::point_in_world(scan, row, col) - origin).cast<float>());
-      append_splat(scan, geometry, row, col, rotation, settings.max_stretch, p);
+      const lod::Splat splat = splats.splat(scan, 0, geometry, i, row, col);
+      p.normal.push_back(splat.normal);
+      p.radii_m.push_back(splat.radii_m);
+      p.major_axis.push_back(splat.major_axis);
       p.rgba.push_back(rgba);
       p.intensity.push_back(level);
       p.node.push_back(owner);

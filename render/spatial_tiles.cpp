@@ -8,6 +8,8 @@
 #include <numbers>
 #include <random>
 
+#include "modeling/lod/octree_cube.hpp"
+
 namespace scanbench::render {
 
 namespace {
@@ -17,17 +19,6 @@ Eigen::AlignedBox3f box_of(std::span<const Eigen::Vector3f> positions,
   Eigen::AlignedBox3f box;
   for (const std::uint32_t p : points) box.extend(positions[p]);
   return box;
-}
-
-// Spreads the low 21 bits of v to every third bit (bit k to bit 3k).
-std::uint64_t spread_bits(std::uint64_t v) {
-  v &= 0x1fffffULL;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
 }
 
 }  // namespace
@@ -80,12 +71,10 @@ std::vector<std::uint32_t> order_for_level_of_detail(std::span<const Eigen::Vect
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector3d cell =
         ((positions[points[k]].cast<double>() - corner) * (kCells / edge)).array().floor();
-    std::uint64_t code = 0;
-    for (int a = 0; a < 3; ++a) {
-      const auto q = static_cast<std::uint64_t>(std::clamp(cell[a], 0.0, kCells - 1.0));
-      code |= spread_bits(q) << (2 - a);
-    }
-    coded[k] = {code, points[k]};
+    std::array<std::uint32_t, 3> q{};
+    for (int a = 0; a < 3; ++a)
+      q[a] = static_cast<std::uint32_t>(std::clamp(cell[a], 0.0, kCells - 1.0));
+    coded[k] = {lod::interleave(q, kLodDepth), points[k]};
   }
   std::sort(coded.begin(), coded.end());
   // In Morton order a point is the first of its depth-L cell exactly when

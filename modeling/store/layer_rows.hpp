@@ -61,6 +61,13 @@ class LayerRowReader {
   void read(std::span<T> out) {
     read(std::as_writable_bytes(out));
   }
+  // The next `rows` rows in a new array. Throws as read().
+  template <typename T>
+  std::vector<T> read_rows(int rows) {
+    std::vector<T> values(static_cast<std::size_t>(rows) * static_cast<std::size_t>(columns_));
+    read(std::span(values));
+    return values;
+  }
 
   // Decodes the rows left, a band at a time, and drops them: checks the
   // rest of the frame (once at least: a layer of no pixels has one too).
@@ -139,6 +146,14 @@ class LayerRowWriter {
   int rows_written_ = 0;
   std::unique_ptr<Sink> sink_;
 };
+
+// The next `rows` rows of `reader`; none without one (a layer the scan
+// does not have). Throws as LayerRowReader::read.
+template <typename T>
+std::optional<std::vector<T>> read_rows(std::optional<LayerRowReader>& reader, int rows) {
+  if (!reader) return std::nullopt;
+  return reader->read_rows<T>(rows);
+}
 
 // Rows of a band that holds about `pixels` pixels of a grid `columns`
 // wide: a multiple of `multiple` (at least one multiple).

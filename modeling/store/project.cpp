@@ -24,17 +24,7 @@ namespace {
 // check and this call must not be recreated empty. NOMUTEX: one connection
 // per Project, used from one thread at a time (see project.hpp).
 sqlite3* connect(const std::filesystem::path& file, int flags = SQLITE_OPEN_READWRITE) {
-  sqlite3* db = nullptr;
-  const int code = sqlite3_open_v2(file.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr);
-  if (code != SQLITE_OK) {
-    const std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
-    sqlite3_close(db);
-    core::FilePosition position;
-    position.detail = "opening the project";
-    throw core::RuntimeFailure(file.string(), position, message);
-  }
-  sqlite3_extended_result_codes(db, 1);
-  return db;
+  return sqlite::open_connection(file.string(), flags, "opening the project");
 }
 
 // "file:/path?immutable=1": SQLite then reads without any lock or

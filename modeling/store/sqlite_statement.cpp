@@ -81,6 +81,20 @@ void throw_error(sqlite3* db, int code, const std::string& file, const std::stri
   throw core::InputError(file, position, message);
 }
 
+sqlite3* open_connection(const std::string& file, int flags, const std::string& action) {
+  sqlite3* db = nullptr;
+  const int code = sqlite3_open_v2(file.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr);
+  if (code != SQLITE_OK) {
+    const std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
+    sqlite3_close(db);
+    core::FilePosition position;
+    position.detail = action;
+    throw core::RuntimeFailure(file, position, message);
+  }
+  sqlite3_extended_result_codes(db, 1);
+  return db;
+}
+
 void execute(sqlite3* db, const char* sql, const std::string& file) {
   const int code = sqlite3_exec(db, sql, nullptr, nullptr, nullptr);
   if (code != SQLITE_OK) throw_error(db, code, file, "running " + statement_summary(sql));

@@ -26,6 +26,12 @@ namespace scanbench::store::sqlite {
 [[noreturn]] void throw_error(sqlite3* db, int code, const std::string& file,
                               const std::string& action);
 
+// Opens a connection to `file` with `flags` (SQLITE_OPEN_*; NOMUTEX added:
+// a connection serves one thread at a time) and extended result codes.
+// Throws core::RuntimeFailure naming the file, with detail `action`, when
+// it cannot.
+sqlite3* open_connection(const std::string& file, int flags, const std::string& action);
+
 // Runs SQL that returns no rows (may hold several statements); throws as
 // throw_error on failure.
 void execute(sqlite3* db, const char* sql, const std::string& file);

@@ -96,15 +96,6 @@ bool has_geometry(const Project& project, std::int64_t id, int present) {
   return true;
 }
 
-// The next `rows` rows of `reader`.
-template <typename T>
-std::vector<T> next_rows(LayerRowReader& reader, int rows) {
-  std::vector<T> values(static_cast<std::size_t>(rows) *
-                        static_cast<std::size_t>(reader.columns()));
-  reader.read(std::span(values));
-  return values;
-}
-
 }  // namespace
 
 std::optional<GeometryLayerReader> GeometryLayerReader::open(const Project& project,
@@ -129,10 +120,10 @@ GeometryLayerReader::GeometryLayerReader(LayerRowReader footprint, LayerRowReade
 
 acquisition::ScanGeometry GeometryLayerReader::read(int rows) {
   acquisition::ScanGeometry g;
-  g.footprint_m = next_rows<float>(footprint_, rows);
-  g.normal = next_rows<Eigen::Vector3f>(normal_, rows);
-  g.confidence = next_rows<float>(confidence_, rows);
-  g.flags = next_rows<std::uint8_t>(flags_, rows);
+  g.footprint_m = footprint_.read_rows<float>(rows);
+  g.normal = normal_.read_rows<Eigen::Vector3f>(rows);
+  g.confidence = confidence_.read_rows<float>(rows);
+  g.flags = flags_.read_rows<std::uint8_t>(rows);
   return g;
 }
 

@@ -678,6 +678,18 @@ TEST(Cli, MergedExportWritesTheKeptPointsOnly) {
   for (const auto& scan : report["scans"]) kept += scan["kept"].get<std::size_t>();
   EXPECT_EQ(lines("merged.csv"), kept);
   EXPECT_LT(lines("merged.csv"), lines("all.csv"));
+
+  // The level-of-detail store holds the same merged model.
+  const CliResult lod = run_cli(dir, {"lod", project.string(), "--json", "--threads", "2"});
+  ASSERT_EQ(lod.exit_code, 0) << lod.err;
+  const nlohmann::json built = nlohmann::json::parse(lod.out);
+  EXPECT_EQ(built["points"].get<std::size_t>(), kept);
+  EXPECT_EQ(built["scans"].get<std::size_t>(), 2u);
+  EXPECT_TRUE(std::filesystem::exists(dir / "p.sbproj.lod"));
+  // Refused in too little memory, the store built before stays.
+  const std::string before = scanbench::test::read_file_bytes(dir / "p.sbproj.lod");
+  EXPECT_EQ(run_cli(dir, {"lod", project.string(), "--memory-limit", "1kB"}).exit_code, 1);
+  EXPECT_EQ(scanbench::test::read_file_bytes(dir / "p.sbproj.lod"), before);
 }
 
 // Every CLI call is a process of its own: undo, redo and history must work

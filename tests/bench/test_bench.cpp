@@ -255,5 +255,21 @@ TEST(BenchScale, SmokeRunMeasuresEveryStageOfEachCampaignInItsOwnProcess) {
   EXPECT_GT(bench["campaigns"][1]["stages"]["harmonize"]["seconds"].get<double>(), 0.0);
 }
 
+TEST(BenchLod, SmokeRunMeasuresTheBuildInItsOwnProcess) {
+  test::ScratchDir dir;
+  const test::CliResult result = test::run_cli(dir, {"bench", "lod", "--json", "--smoke"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json bench = nlohmann::json::parse(result.out);
+  EXPECT_EQ(bench["suite"], "lod");
+  EXPECT_GT(bench["points"].get<double>(), 0.0);
+  EXPECT_GE(bench["threads"].get<int>(), 1);
+  for (const char* field : {"build_points_per_second", "build_points_per_second_per_thread",
+                            "build_peak_rss_bytes", "full_rebuild_seconds"}) {
+    EXPECT_GT(bench[field].get<double>(), 0.0) << field;
+  }
+  EXPECT_GT(bench["one_thread"]["build_points_per_second"].get<double>(), 0.0);
+  EXPECT_TRUE(bench["frame_ms_p95"].is_null());  // the streaming renderer is still to come
+}
+
 }  // namespace
 }  // namespace scanbench

@@ -1,0 +1,348 @@
+#include "modeling/lod/build_lod.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+#include <unordered_map>
+
+#include "core/errors.hpp"
+#include "core/memory.hpp"
+#include "core/parallel.hpp"
+#include "modeling/lod/lod_store.hpp"
+#include "modeling/lod/parked_points.hpp"
+#include "modeling/scan_cache.hpp"
+
+namespace scanbench::lod {
+namespace {
+
+// The survey counts points in the cells of this depth (1024 an edge), or
+// of the cube's deepest: a chunk is at least one of them.
+constexpr int kSurveyDepth = 10;
+// What building a chunk takes per point: the point read back, its sort
+// order, the sorted copy and its code, and the samples drawn from it.
+constexpr std::uint64_t kChunkBytesPerPoint = 256;
+// Points a worker collects for a chunk before parking them.
+constexpr std::size_t kParkedPoints = 1024;
+// Chunks per worker at least, where the model is large enough: work to
+// share, whatever the memory allows.
+constexpr std::uint64_t kChunksPerWorker = 4;
+constexpr std::uint64_t kMinChunkPoints = 1u << 16;
+
+struct Chunk {
+  NodeKey key;
+  std::uint64_t points = 0;
+  Subtree root;  // once built, without its sample (parked)
+};
+
+// The survey's counts, sorted by cell, and each cell's chunk.
+struct CellCounts {
+  int depth = 0;
+  std::vector<std::uint64_t> codes;  // Morton codes of the cells at `depth`
+  std::vector<std::uint64_t> below;  // points in cells before each; one more entry
+  std::vector<std::uint32_t> chunk;
+
+  std::uint64_t total() const { return below.back(); }
+};
+
+std::uint64_t cell_code(const OctreeCube& cube, const std::array<std::uint32_t, 3>& q, int depth) {
+  return interleave(cube.node_of(q, depth).xyz, depth);
+}
+
+// Splits the cube into chunks from the survey's counts: a node whose
+// region holds at most `chunk_points` points, or is one survey cell, is a
+// chunk; the nodes above them are `top`.
+class ChunkPlanner {
+ public:
+  ChunkPlanner(CellCounts& counts, std::uint64_t chunk_points, std::vector<Chunk>& chunks,
+               std::vector<NodeKey>& top)
+      : counts_(counts), chunk_points_(chunk_points), chunks_(chunks), top_(top) {}
+
+  void plan(const NodeKey& node, std::size_t begin, std::size_t end) {
+    const std::uint64_t points = counts_.below[end] - counts_.below[begin];
+    if (points <= chunk_points_ || node.depth == counts_.depth) {
+      for (std::size_t k = begin; k < end; ++k)
+        counts_.chunk[k] = static_cast<std::uint32_t>(chunks_.size());
+      chunks_.push_back({node, points, {}});
+      return;
+    }
+    top_.push_back(node);
+    const int shift = 3 * (counts_.depth - node.depth - 1);
+    std::size_t start = begin;
+    for (int octant = 0; octant < 8 && start < end; ++octant) {
+      const auto stop = std::partition_point(
+          counts_.codes.begin() + static_cast<std::ptrdiff_t>(start),
+          counts_.codes.begin() + static_cast<std::ptrdiff_t>(end),
+          [&](std::uint64_t code) { return static_cast<int>((code >> shift) & 7u) <= octant; });
+      const auto stop_index = static_cast<std::size_t>(stop - counts_.codes.begin());
+      if (stop_index > start) plan(node.child(octant), start, stop_index);
+      start = stop_index;
+    }
+  }
+
+ private:
+  CellCounts& counts_;
+  std::uint64_t chunk_points_;
+  std::vector<Chunk>& chunks_;
+  std::vector<NodeKey>& top_;
+};
+
+// The model's origin: the first scanner, rounded to metres (as the render
+// model's), so floats relative to it keep sub-millimetre precision.
+Eigen::Vector3d model_origin(const std::vector<store::StoredScanSummary>& scans) {
+  return scans.front().summary.T_world_scan.translation().array().round();
+}
+
+OctreeCube model_cube(const std::vector<store::StoredScanSummary>& scans,
+                      const Eigen::Vector3d& origin) {
+  Eigen::AlignedBox3d box;
+  for (const store::StoredScanSummary& s : scans) {
+    if (s.summary.bbox_world) {
+      box.extend(s.summary.bbox_world->min() - origin);
+      box.extend(s.summary.bbox_world->max() - origin);
+    }
+  }
+  return OctreeCube::enclosing(box);
+}
+
+// One worker's points on their way to their chunks: collected a thousand a
+// chunk at a time, then parked.
+class ChunkSorter {
+ public:
+  ChunkSorter(const OctreeCube& cube, const CellCounts& counts, ParkedPoints& parked,
+              std::size_t chunks)
+      : cube_(cube), counts_(counts), parked_(parked), waiting_(chunks) {}
+  ~ChunkSorter() = default;
+
+  void add(std::span<const BuildPoint> points) {
+    for (const BuildPoint& p : points) {
+      const std::uint64_t code = cell_code(cube_, p.point.offset, counts_.depth);
+      const auto at = std::lower_bound(counts_.codes.begin(), counts_.codes.end(), code);
+      assert(at != counts_.codes.end() && *at == code && "the survey counted every cell");
+      const std::uint32_t chunk =
+          counts_.chunk[static_cast<std::size_t>(at - counts_.codes.begin())];
+      waiting_[chunk].push_back(p);
+      if (waiting_[chunk].size() >= kParkedPoints) park(chunk);
+    }
+  }
+
+  void finish() {
+    for (std::size_t chunk = 0; chunk < waiting_.size(); ++chunk) park(chunk);
+  }
+
+ private:
+  void park(std::size_t chunk) {
+    parked_.add(chunk, waiting_[chunk]);
+    waiting_[chunk].clear();
+  }
+
+  const OctreeCube& cube_;
+  const CellCounts& counts_;
+  ParkedPoints& parked_;
+  std::vector<std::vector<BuildPoint>> waiting_;
+};
+
+// Builds the nodes above the chunks from the chunks' roots, depth first.
+class TopBuilder {
+ public:
+  TopBuilder(const OctreeCube& cube, std::vector<Chunk>& chunks, const std::vector<NodeKey>& top,
+             ParkedPoints& roots, LodStoreWriter& writer)
+      : cube_(cube), chunks_(chunks), roots_(roots), writer_(writer) {
+    for (const NodeKey& key : top) top_.emplace(key.code(), true);
+    for (std::size_t k = 0; k < chunks_.size(); ++k) chunk_of_.emplace(chunks_[k].key.code(), k);
+  }
+
+  Subtree build(const NodeKey& key) {
+    if (const auto chunk = chunk_of_.find(key.code()); chunk != chunk_of_.end()) {
+      Subtree node = std::move(chunks_[chunk->second].root);
+      node.sample = roots_.take(chunk->second);
+      return node;
+    }
+    Subtree node;
+    node.key = key;
+    std::vector<Subtree> children;
+    for (int octant = 0; octant < 8; ++octant) {
+      const NodeKey child = key.child(octant);
+      if (top_.count(child.code()) || chunk_of_.count(child.code()))
+        children.push_back(build(child));
+    }
+    draw_from_children(cube_, node, children);
+    for (Subtree& child : children) writer_.put(finish_node(cube_, std::move(child)));
+    return node;
+  }
+
+ private:
+  const OctreeCube& cube_;
+  std::vector<Chunk>& chunks_;
+  ParkedPoints& roots_;
+  LodStoreWriter& writer_;
+  std::unordered_map<std::uint64_t, bool> top_;
+  std::unordered_map<std::uint64_t, std::size_t> chunk_of_;
+};
+
+std::uint64_t chunk_points_for(const LodBuildSettings& settings, std::uint64_t limit, int workers,
+                               std::uint64_t total) {
+  if (settings.chunk_points > 0) return settings.chunk_points;
+  const auto w = static_cast<std::uint64_t>(workers);
+  const std::uint64_t fit = limit / (kChunkBytesPerPoint * w);
+  const std::uint64_t shared = std::max(kMinChunkPoints, total / (kChunksPerWorker * w));
+  return std::clamp<std::uint64_t>(std::min(fit, shared), kMinChunkPoints, 1u << 23);
+}
+
+// Calls body(k, connection) for every scan k on the workers, a batch of
+// one scan per worker at a time, reporting each batch as `stage` and
+// checking for a cancel between batches (on the calling thread, as
+// Progress wants). A project's connection serves one thread: each worker
+// reads through a connection of its own, at the revision `project` read.
+// Throws core::RuntimeFailure when the project changed since.
+template <typename Body>
+void for_each_scan(const store::Project& project, std::int64_t revision,
+                   const std::vector<store::StoredScanSummary>& scans, int workers,
+                   core::Progress& progress, std::string_view stage, Body&& body) {
+  const auto w = static_cast<std::size_t>(workers);
+  for (std::size_t batch = 0; batch < scans.size(); batch += w) {
+    progress.throw_if_cancelled("lod");
+    const std::size_t end = std::min(scans.size(), batch + w);
+    core::parallel_for_index(static_cast<int>(end - batch), workers, [&](int k) {
+      const store::Project own = store::Project::open_read_only(project.path());
+      const store::Project::ReadSnapshot snapshot = own.read_snapshot();
+      if (own.revision() != revision) {
+        core::FilePosition position;
+        position.detail = "building the level-of-detail store";
+        throw core::RuntimeFailure(project.path().string(), position,
+                                   "the project changed meanwhile: run `scanbench lod` again");
+      }
+      body(batch + static_cast<std::size_t>(k), own);
+    });
+    progress.update({stage, end, scans.size(), scans[end - 1].summary.name});
+  }
+}
+
+}  // namespace
+
+// Longer than 60 lines, but flat: the five phases in order, sharing the
+// counts, chunks and parked points.
+LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& settings,
+                         core::Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  auto lap_start = start;
+  // Seconds since the last lap.
+  const auto lap = [&lap_start] {
+    const auto now = std::chrono::steady_clock::now();
+    return std::chrono::duration<double>(now - std::exchange(lap_start, now)).count();
+  };
+  const store::Project::ReadSnapshot snapshot = project.read_snapshot();
+  const std::vector<store::StoredScanSummary> scans = modeling::scans_with_geometry(project);
+  LodBuildResult result;
+  result.store = settings.output.empty() ? LodStore::path_for(project.path()) : settings.output;
+  result.project_revision = project.revision();
+  result.scans = scans.size();
+  result.threads = core::worker_count(settings.threads);
+  const std::uint64_t limit = modeling::memory_limit_or_default(settings.memory_limit_bytes);
+
+  LodHeader header;
+  header.project_revision = result.project_revision;
+  header.origin = model_origin(scans);
+  header.cube = model_cube(scans, header.origin);
+  header.octree = settings.octree;
+  const OctreeCube& cube = header.cube;
+
+  // 1. Survey, a scan per worker.
+  CellCounts counts;
+  counts.depth = std::min(kSurveyDepth, cube.max_depth());
+  std::vector<LodScan> lod_scans(scans.size());
+  {
+    std::unordered_map<std::uint64_t, std::uint64_t> cells;
+    std::mutex merging;
+    for_each_scan(project, result.project_revision, scans, result.threads, progress, "lod: survey",
+                  [&](std::size_t s, const store::Project& own_project) {
+                    std::unordered_map<std::uint64_t, std::uint64_t> own;
+                    const ScanSurvey survey =
+                        survey_scan(own_project, scans[s], cube, header.origin, settings.points,
+                                    [&](std::span<const std::array<std::uint32_t, 3>> positions) {
+                                      for (const auto& q : positions)
+                                        ++own[cell_code(cube, q, counts.depth)];
+                                    });
+                    lod_scans[s] = {static_cast<std::uint16_t>(s), scans[s].id,
+                                    scans[s].summary.name,         survey.intensity_low,
+                                    survey.intensity_high,         scans[s].summary.T_world_scan};
+                    const std::lock_guard lock(merging);
+                    for (const auto& [code, n] : own) cells[code] += n;
+                    result.in_model += survey.in_model;
+                    result.merged_away += survey.merged_away;
+                    result.deleted += survey.deleted;
+                  });
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> sorted(cells.begin(), cells.end());
+    std::sort(sorted.begin(), sorted.end());
+    counts.below.push_back(0);
+    for (const auto& [code, n] : sorted) {
+      counts.codes.push_back(code);
+      counts.below.push_back(counts.below.back() + n);
+    }
+    counts.chunk.assign(counts.codes.size(), 0);
+  }
+  result.survey_seconds = lap();
+
+  // 2. Chunks.
+  std::vector<Chunk> chunks;
+  std::vector<NodeKey> top;
+  if (!counts.codes.empty()) {
+    const std::uint64_t chunk_points =
+        chunk_points_for(settings, limit, result.threads, counts.total());
+    ChunkPlanner(counts, chunk_points, chunks, top).plan({}, 0, counts.codes.size());
+  }
+  for (const Chunk& chunk : chunks) {
+    core::check_memory_limit(
+        chunk.points * kChunkBytesPerPoint, limit, project.path().string(), "lod",
+        "the densest part of the model (" + std::to_string(chunk.points) + " points in one cell)");
+  }
+  result.chunks = chunks.size();
+
+  // 3. Distribute, a scan per worker; in memory when the model fits half
+  // the limit.
+  ParkedPoints parked(chunks.size(), counts.total() * sizeof(BuildPoint) <= limit / 2);
+  for (std::size_t c = 0; c < chunks.size(); ++c) parked.reserve(c, chunks[c].points);
+  for_each_scan(project, result.project_revision, scans, result.threads, progress,
+                "lod: distribute", [&](std::size_t s, const store::Project& own_project) {
+                  ChunkSorter sorter(cube, counts, parked, chunks.size());
+                  read_shown_points(
+                      own_project, scans[s], lod_scans[s], cube, header.origin, settings.points,
+                      [&](std::span<const BuildPoint> points) { sorter.add(points); });
+                  sorter.finish();
+                });
+  result.distribute_seconds = lap();
+
+  // 4. Chunks, a batch of one per worker at a time; their roots wait.
+  LodStoreWriter writer(result.store, header, lod_scans);
+  ParkedPoints roots(chunks.size(), false);
+  const auto workers = static_cast<std::size_t>(result.threads);
+  for (std::size_t batch = 0; batch < chunks.size(); batch += workers) {
+    progress.throw_if_cancelled("lod");
+    const std::size_t end = std::min(chunks.size(), batch + workers);
+    core::parallel_for_index(static_cast<int>(end - batch), result.threads, [&](int k) {
+      const std::size_t c = batch + static_cast<std::size_t>(k);
+      Subtree root = build_subtree(cube, chunks[c].key, parked.take(c), settings.octree,
+                                   [&](BuiltNode&& node) { writer.put(node); });
+      roots.add(c, root.sample);
+      root.sample = {};
+      chunks[c].root = std::move(root);
+    });
+    progress.update({"lod: build", end, chunks.size(), ""});
+  }
+  result.chunk_seconds = lap();
+
+  // 5. The nodes above the chunks, and the root.
+  if (!chunks.empty()) {
+    TopBuilder builder(cube, chunks, top, roots, writer);
+    writer.put(finish_node(cube, builder.build({})));
+  }
+  writer.commit();
+  result.top_seconds = lap();
+  result.points = writer.points();
+  result.nodes = writer.nodes();
+  std::error_code error;
+  result.store_bytes = std::filesystem::file_size(result.store, error);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace scanbench::lod

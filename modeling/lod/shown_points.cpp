@@ -1,0 +1,250 @@
+#include "modeling/lod/shown_points.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <optional>
+
+#include "core/errors.hpp"
+#include "core/memory.hpp"
+#include "modeling/lod/splat_shape.hpp"
+#include "modeling/scan_rows.hpp"
+#include "modeling/store/layer_rows.hpp"
+#include "modeling/store/typed_layers.hpp"
+
+namespace scanbench::lod {
+namespace {
+
+// A band of a scan's rows with everything the passes read.
+struct Band {
+  const acquisition::Scan& description;  // the scan without its arrays
+  const acquisition::Scan& held;  // the band's rows and a row of context either side the grid has
+  int held_first = 0;             // the grid row of held's row 0
+  int first = 0, end = 0;         // the band's grid rows
+  const acquisition::ScanGeometry& geometry;  // the band's rows
+  const std::optional<std::vector<std::uint8_t>>& keep;
+  const std::optional<std::vector<std::uint32_t>>& membership;
+};
+
+[[noreturn]] void refuse(const store::Project& project, const store::StoredScanSummary& stored,
+                         const std::string& problem) {
+  core::FilePosition position;
+  position.detail = "scan " + std::to_string(stored.id) + " (" + stored.summary.name + ")";
+  throw core::InputError(project.path().string(), position, problem);
+}
+
+// What a pass reads: the first, what says where the shown points are and
+// the intensities; the second, everything.
+enum class Reading { kPositions, kEverything };
+
+// Reads scan `stored` band by band.
+void for_each_band(const store::Project& project, const store::StoredScanSummary& stored,
+                   Reading reading, std::size_t band_pixels,
+                   const std::function<void(const Band&)>& visit) {
+  const std::int64_t id = stored.id;
+  const bool everything = reading == Reading::kEverything;
+  modeling::ScanRows rows(project, id,
+                          {stored.summary.has_intensity, everything && stored.summary.has_color});
+  const acquisition::Scan& description = rows.description();
+  // The geometry whole, or its flags alone (which pixels are mixed).
+  std::optional<store::GeometryLayerReader> geometry_rows;
+  std::optional<store::LayerRowReader> flag_rows;
+  if (everything) {
+    geometry_rows = store::GeometryLayerReader::open(project, id);
+  } else {
+    flag_rows = project.open_layer_rows(id, store::layer::kGeometryFlags, store::ElementType::kU8);
+  }
+  if (!geometry_rows && !flag_rows) {
+    refuse(project, stored, "has no geometry (footprints and normals): run `scanbench geometry`");
+  }
+  std::optional<store::LayerRowReader> keep =
+      project.open_layer_rows(id, store::layer::kKeep, store::ElementType::kU8);
+  std::optional<store::LayerRowReader> membership =
+      project.open_layer_rows(id, store::layer::kMembership, store::ElementType::kU32);
+  const int band = store::band_rows(band_pixels, description.columns);
+  for (int first = 0; first < description.rows; first += band) {
+    const int end = std::min(description.rows, first + band);
+    const int held_first = std::max(0, first - 1);
+    const acquisition::Scan& held = rows.hold(held_first, std::min(description.rows, end + 1));
+    acquisition::ScanGeometry geometry;
+    if (geometry_rows) {
+      geometry = geometry_rows->read(end - first);
+    } else {
+      geometry.flags = flag_rows->read_rows<std::uint8_t>(end - first);
+    }
+    const auto kept = store::read_rows<std::uint8_t>(keep, end - first);
+    const auto owners = store::read_rows<std::uint32_t>(membership, end - first);
+    visit({description, held, held_first, first, end, geometry, kept, owners});
+  }
+}
+
+// A float's bits in an order that sorts as the floats do.
+std::uint32_t sortable(float value) {
+  const auto bits = std::bit_cast<std::uint32_t>(value);
+  return (bits & 0x80000000u) != 0 ? ~bits : bits | 0x80000000u;
+}
+
+float unsortable(std::uint32_t key) {
+  return std::bit_cast<float>((key & 0x80000000u) != 0 ? key & 0x7fffffffu : ~key);
+}
+
+// Percentiles of a scan's intensities from a histogram of their top 20
+// sortable bits: a bin spans 1/2048 of its value, so its middle is within
+// 1/4096 of every value in it.
+class IntensityHistogram {
+ public:
+  static constexpr int kDropped = 12;
+  IntensityHistogram() : counts_(std::size_t{1} << (32 - kDropped), 0) {}
+  void add(float value) {
+    if (!std::isfinite(value)) return;
+    ++counts_[sortable(value) >> kDropped];
+    ++total_;
+  }
+  // The value of rank floor(share · (n − 1)), as acquisition::intensity_range
+  // chooses it; none below two values.
+  std::optional<float> at(double share) const {
+    if (total_ < 2) return std::nullopt;
+    const auto rank = static_cast<std::uint64_t>(share * static_cast<double>(total_ - 1));
+    std::uint64_t below = 0;
+    for (std::size_t bin = 0; bin < counts_.size(); ++bin) {
+      below += counts_[bin];
+      if (below > rank) {
+        return unsortable(static_cast<std::uint32_t>(bin << kDropped) | (1u << (kDropped - 1)));
+      }
+    }
+    return std::nullopt;
+  }
+
+ private:
+  std::vector<std::uint32_t> counts_;
+  std::uint64_t total_ = 0;
+};
+
+// Calls `shown(g, r, c)` for every shown pixel of the band (g: its index
+// in the band's arrays, r: its row in held, c: its column), counting into
+// `survey`; `in_model(i)` first for every in-model pixel (i: in held).
+template <typename InModel, typename Shown>
+void visit_band(const Band& band, ScanSurvey& survey, InModel&& in_model, Shown&& shown) {
+  const int columns = band.held.columns;
+  for (int row = band.first; row < band.end; ++row) {
+    const int r = row - band.held_first;
+    for (int c = 0; c < columns; ++c) {
+      const std::size_t i = band.held.index(r, c);
+      const std::size_t g = static_cast<std::size_t>(row - band.first) * columns + c;
+      if (!band.held.valid[i] || band.geometry.is_mixed(g)) continue;
+      ++survey.in_model;
+      in_model(i);
+      if (band.keep && (*band.keep)[g] == 0) {
+        ++survey.merged_away;
+      } else if (band.membership && (*band.membership)[g] == store::kDeletedPoints) {
+        ++survey.deleted;
+      } else {
+        ++survey.shown;
+        shown(g, r, c);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+ScanSurvey survey_scan(
+    const store::Project& project, const store::StoredScanSummary& stored, const OctreeCube& cube,
+    const Eigen::Vector3d& origin, const ShownPointsSettings& settings,
+    const std::function<void(std::span<const std::array<std::uint32_t, 3>>)>& visit) {
+  ScanSurvey survey;
+  IntensityHistogram intensities;
+  std::vector<std::array<std::uint32_t, 3>> positions;
+  std::optional<ScanSplats> directions;
+  for_each_band(project, stored, Reading::kPositions, settings.band_pixels, [&](const Band& band) {
+    if (!directions) directions.emplace(band.description, settings.max_stretch);
+    positions.clear();
+    const bool has_intensity = band.held.has_intensity();
+    visit_band(
+        band, survey,
+        [&](std::size_t i) {
+          if (has_intensity) intensities.add(band.held.intensity[i]);
+        },
+        [&](std::size_t, int r, int c) {
+          const double range = band.held.range_m[band.held.index(r, c)];
+          const Eigen::Vector3d world =
+              stored.summary.T_world_scan *
+              (range * directions->direction(band.held, band.held_first, r, c));
+          const auto q = cube.quantize(world - origin);
+          if (!q)
+            refuse(project, stored,
+                   "has a point outside its recorded bounds: run `scanbench check`");
+          positions.push_back(*q);
+        });
+    visit(positions);
+  });
+  if (const auto low = intensities.at(0.02)) {
+    survey.intensity_low = *low;
+    survey.intensity_high = *intensities.at(0.98);
+  }
+  return survey;
+}
+
+void read_shown_points(const store::Project& project, const store::StoredScanSummary& stored,
+                       const LodScan& scan, const OctreeCube& cube, const Eigen::Vector3d& origin,
+                       const ShownPointsSettings& settings,
+                       const std::function<void(std::span<const BuildPoint>)>& visit) {
+  ScanSurvey counts;
+  std::vector<BuildPoint> points;
+  std::optional<ScanSplats> splats;
+  const float spread =
+      scan.intensity_high > scan.intensity_low ? scan.intensity_high - scan.intensity_low : 1.0f;
+  for_each_band(project, stored, Reading::kEverything, settings.band_pixels, [&](const Band& band) {
+    const acquisition::Scan& held = band.held;
+    if (!splats) {
+      splats.emplace(band.description, settings.max_stretch);
+      core::reserve_mapped(points, static_cast<std::size_t>(band.end - band.first) *
+                                       static_cast<std::size_t>(held.columns));
+    }
+    points.clear();
+    visit_band(
+        band, counts, [](std::size_t) {},
+        [&](std::size_t g, int r, int c) {
+          const std::size_t i = held.index(r, c);
+          const Eigen::Vector3d beam = splats->direction(held, band.held_first, r, c);
+          const Eigen::Vector3d world =
+              stored.summary.T_world_scan * (double{held.range_m[i]} * beam);
+          const auto q = cube.quantize(world - origin);
+          if (!q)
+            refuse(project, stored,
+                   "has a point outside its recorded bounds: run `scanbench check`");
+          BuildPoint p;
+          p.point.offset = *q;
+          p.point.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(band.held_first + r) *
+                                                         static_cast<std::size_t>(held.columns) +
+                                                     static_cast<std::size_t>(c));
+          p.priority = point_priority(stored.id, p.point.pixel);
+          p.point.scan = scan.index;
+          p.point.object = band.membership ? (*band.membership)[g] : 0;
+          const float level =
+              held.has_intensity() && std::isfinite(held.intensity[i])
+                  ? std::clamp((held.intensity[i] - scan.intensity_low) / spread, 0.0f, 1.0f)
+                  : 0.5f;
+          p.point.intensity = static_cast<std::uint8_t>(std::lround(255.0f * level));
+          if (held.has_color()) {
+            p.point.flags |= LodPoint::kHasColor;
+            p.point.rgb = {held.rgb[3 * i], held.rgb[3 * i + 1], held.rgb[3 * i + 2], 0};
+          }
+          const Splat splat = splats->splat(held, band.held_first, band.geometry, g, r, c);
+          if (!splat.normal.isZero()) {
+            p.point.flags |= LodPoint::kHasNormal;
+            p.point.normal = encode_unit(splat.normal);
+          }
+          if (splat.major_axis.isZero()) {
+            p.point.flags |= LodPoint::kRound;
+          } else {
+            p.point.major_axis = encode_unit(splat.major_axis);
+          }
+          p.point.radii = {to_half(splat.radii_m.x()), to_half(splat.radii_m.y())};
+          points.push_back(p);
+        });
+    visit(points);
+  });
+}
+
+}  // namespace scanbench::lod

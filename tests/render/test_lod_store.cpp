@@ -1,0 +1,247 @@
+// The level-of-detail store built from a project: it holds the shown model
+// point for point, the same tree whatever the chunks and threads, and a
+// build that fails leaves the store it would have replaced.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "core/errors.hpp"
+#include "modeling/lod/build_lod.hpp"
+#include "modeling/lod/lod_store.hpp"
+#include "modeling/room_project.hpp"
+#include "modeling/store/layer_store.hpp"
+#include "support/test_support.hpp"
+
+namespace scanbench::lod {
+namespace {
+
+using scanbench::test::ScratchDir;
+
+// The room twice: as scanned, and from a second station 0.4 m away whose
+// merge kept two pixels in three; in the first, objects own some pixels and
+// a band of them is deleted.
+struct LodRoomProject {
+  std::int64_t first = 0, second = 0;
+  std::vector<std::uint32_t> membership;
+  std::vector<std::uint8_t> keep;
+};
+
+LodRoomProject store_two_rooms(store::Project& project) {
+  LodRoomProject room;
+  room.first = modeling::store_room(project);
+  acquisition::Scan moved = test::shared_room().scan;
+  moved.T_world_scan.translation() += Eigen::Vector3d(0.4, -0.1, 0.0);
+  moved.T_world_scan.rotate(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()));
+  room.second = test::insert_committed(project, moved);
+  const std::size_t n = moved.pixel_count();
+  room.membership.assign(n, 0);
+  room.keep.assign(n, 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % 7 == 0) room.membership[i] = 5;
+    if (i / 720 == 100) room.membership[i] = store::kDeletedPoints;
+    if (i % 3 == 0) room.keep[i] = 0;
+  }
+  store::Project::Edit edit = project.begin_command("geometry", "{}");
+  for (const store::EncodedLayer& layer : store::encode_geometry(test::shared_room().geometry))
+    project.put_layer(edit, room.second, layer);
+  project.put_layer(edit, room.first,
+                    store::encode_layer<std::uint32_t>(store::layer::kMembership,
+                                                       store::ElementType::kU32, room.membership));
+  project.put_layer(
+      edit, room.second,
+      store::encode_layer<std::uint8_t>(store::layer::kKeep, store::ElementType::kU8, room.keep));
+  edit.commit("{}");
+  return room;
+}
+
+LodBuildResult build_quietly(const store::Project& project, LodBuildSettings settings = {}) {
+  core::Progress quiet;
+  if (settings.threads == 0) settings.threads = 1;
+  return build_lod(project, settings, quiet);
+}
+
+// Every node's description and points, by code.
+std::map<std::uint64_t, std::pair<LodNodeInfo, std::vector<LodPoint>>> read_store(
+    const LodStore& store) {
+  std::map<std::uint64_t, std::pair<LodNodeInfo, std::vector<LodPoint>>> nodes;
+  for (const LodNodeInfo& info : store.nodes())
+    nodes[info.key.code()] = {info, store.read_points(info.key)};
+  return nodes;
+}
+
+TEST(LodStore, HoldsTheShownModelPointForPoint) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const LodRoomProject room = store_two_rooms(project);
+  const LodBuildResult result = build_quietly(project);
+  const test::RoomScan& truth = test::shared_room();
+
+  std::size_t in_model = 0, merged_away = 0, deleted = 0;
+  std::set<std::pair<std::int64_t, std::uint32_t>> expected;
+  for (const std::int64_t id : {room.first, room.second}) {
+    for (std::size_t i = 0; i < truth.scan.pixel_count(); ++i) {
+      if (!acquisition::in_model(truth.scan, truth.geometry, i)) continue;
+      ++in_model;
+      if (id == room.second && room.keep[i] == 0) {
+        ++merged_away;
+      } else if (id == room.first && room.membership[i] == store::kDeletedPoints) {
+        ++deleted;
+      } else {
+        expected.insert({id, static_cast<std::uint32_t>(i)});
+      }
+    }
+  }
+  EXPECT_EQ(result.in_model, in_model);
+  EXPECT_EQ(result.merged_away, merged_away);
+  EXPECT_EQ(result.deleted, deleted);
+  EXPECT_EQ(result.points, expected.size());
+  EXPECT_EQ(result.project_revision, project.revision());
+
+  const LodStore store = LodStore::open(result.store);
+  EXPECT_EQ(store.header().points, expected.size());
+  EXPECT_EQ(store.header().project_revision, project.revision());
+  ASSERT_EQ(store.scans().size(), 2u);
+  std::map<std::uint16_t, acquisition::Scan> posed;  // the room at each store scan's pose
+  for (const LodScan& scan : store.scans()) {
+    posed[scan.index] = truth.scan;
+    posed[scan.index].T_world_scan = scan.T_world_scan;
+  }
+  std::set<std::pair<std::int64_t, std::uint32_t>> found;
+  float worst_m = 0.0f;
+  for (const auto& [code, node] : read_store(store)) {
+    const Eigen::AlignedBox3d box = store.header().cube.node_box(node.first.key);
+    for (const LodPoint& p : node.second) {
+      const LodScan& scan = store.scans().at(p.scan);
+      EXPECT_TRUE(found.insert({scan.scan_id, p.pixel}).second) << "a pixel twice";
+      const int row = static_cast<int>(p.pixel / 720), col = static_cast<int>(p.pixel % 720);
+      const Eigen::Vector3d at = store.header().origin + box.min() +
+                                 Eigen::Vector3d(p.offset[0], p.offset[1], p.offset[2]) * kQuantumM;
+      worst_m = std::max(
+          worst_m, static_cast<float>(
+                       (at - acquisition::point_in_world(posed.at(p.scan), row, col)).norm()));
+      const std::uint32_t owner = scan.scan_id == room.first ? room.membership[p.pixel] : 0u;
+      EXPECT_EQ(p.object, owner);
+      EXPECT_EQ(p.flags & LodPoint::kHasColor, LodPoint::kHasColor);
+      EXPECT_EQ(p.rgb[0], truth.scan.rgb[3 * p.pixel]);
+      EXPECT_EQ((p.flags & LodPoint::kHasNormal) != 0, truth.geometry.has_normal(p.pixel));
+      EXPECT_TRUE(node.first.bounds.contains((at - store.header().origin).cast<float>()));
+    }
+    EXPECT_EQ(node.first.points, node.second.size());
+  }
+  EXPECT_EQ(found, expected);
+  EXPECT_LE(worst_m, 1.8e-4f);  // a quantum on each axis
+}
+
+TEST(LodStore, IsTheSameTreeWhateverTheChunksAndThreads) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  store_two_rooms(project);
+  LodBuildSettings whole;
+  whole.output = dir / "whole.lod";
+  whole.octree.max_leaf_points = 3000;
+  whole.chunk_points = std::size_t{1} << 30;  // the whole model in one
+  const LodBuildResult one = build_quietly(project, whole);
+  EXPECT_EQ(one.chunks, 1u);
+  LodBuildSettings cut = whole;
+  cut.output = dir / "cut.lod";
+  cut.chunk_points = 9000;
+  cut.threads = 2;
+  const LodBuildResult many = build_quietly(project, cut);
+  EXPECT_GT(many.chunks, 4u);
+  // In a memory limit that parks the points in a temporary file.
+  LodBuildSettings parked = cut;
+  parked.output = dir / "parked.lod";
+  parked.memory_limit_bytes = 8'000'000;
+  const LodBuildResult spilled = build_quietly(project, parked);
+  const auto a = read_store(LodStore::open(one.store));
+  ASSERT_GT(a.size(), 10u);
+  for (const LodBuildResult* other_build : {&many, &spilled}) {
+    const auto b = read_store(LodStore::open(other_build->store));
+    ASSERT_EQ(a.size(), b.size());
+    for (const auto& [code, node] : a) {
+      ASSERT_TRUE(b.count(code)) << code;
+      const auto& other = b.at(code);
+      EXPECT_EQ(node.first.points_below, other.first.points_below);
+      EXPECT_EQ(node.first.leaf, other.first.leaf);
+      EXPECT_EQ(node.first.level_ends, other.first.level_ends);
+      EXPECT_TRUE(node.second == other.second) << "node " << code;
+    }
+  }
+}
+
+class CancelAtOnce : public core::Progress {
+ public:
+  void update(const core::ProgressStep&) override { request_cancel(); }
+};
+
+TEST(LodStore, ACancelledBuildLeavesTheStoreItWouldHaveReplaced) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  store_two_rooms(project);
+  const LodBuildResult first = build_quietly(project);
+  const std::string before = test::read_file_bytes(first.store);
+  CancelAtOnce cancel;
+  EXPECT_THROW(build_lod(project, {}, cancel), core::Cancelled);
+  EXPECT_EQ(test::read_file_bytes(first.store), before);
+  EXPECT_FALSE(std::filesystem::exists(first.store.string() + ".partial"));
+  EXPECT_EQ(LodStore::open(first.store).header().points, first.points);
+}
+
+TEST(LodStore, RefusesWhatIsNotAStoreNamingTheFile) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const auto refused = [](const std::filesystem::path& file, const std::string& words) {
+    try {
+      LodStore::open(file);
+      ADD_FAILURE() << file << " opened";
+    } catch (const core::FileError& e) {
+      EXPECT_NE(std::string(e.what()).find(file.filename().string()), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused(dir / "missing.lod", "scanbench lod");
+  refused(dir / "p.sbproj", "not a scanbench level-of-detail store");
+  std::ofstream(dir / "garbage.lod") << "this is not an SQLite file at all, not even close";
+  refused(dir / "garbage.lod", "garbage.lod");
+  // A scan without geometry: refused before anything is written.
+  test::insert_committed(project, test::shared_room().scan);
+  core::Progress quiet;
+  EXPECT_THROW(build_lod(project, {}, quiet), core::InputError);
+  EXPECT_FALSE(std::filesystem::exists(LodStore::path_for(project.path())));
+}
+
+TEST(LodStore, ADamagedNodeIsReportedByName) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  modeling::store_room(project);
+  const LodBuildResult result = build_quietly(project);
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(result.store.c_str(), &db), SQLITE_OK);
+    EXPECT_EQ(sqlite3_exec(db, "UPDATE lod_nodes SET data = zeroblob(length(data)) WHERE code = 1",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  const LodStore store = LodStore::open(result.store);
+  try {
+    store.read_points(NodeKey{});
+    ADD_FAILURE() << "a damaged node read";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("node 1 (depth 0)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("p.sbproj.lod"), std::string::npos) << e.what();
+  }
+  // The other nodes still read.
+  for (const LodNodeInfo& info : store.nodes()) {
+    if (info.key.depth > 0) {
+      EXPECT_EQ(store.read_points(info.key).size(), info.points);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace scanbench::lod
