@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/errors.hpp"
 #include "core/memory.hpp"
@@ -22,7 +24,7 @@ constexpr int kSurveyDepth = 10;
 // order, the sorted copy and its code, and the samples drawn from it.
 constexpr std::uint64_t kChunkBytesPerPoint = 256;
 // Points a worker collects for a chunk before parking them.
-constexpr std::size_t kParkedPoints = 1024;
+constexpr std::size_t kParkingBatch = 1024;
 // Chunks per worker at least, where the model is large enough: work to
 // share, whatever the memory allows.
 constexpr std::uint64_t kChunksPerWorker = 4;
@@ -92,26 +94,44 @@ Eigen::Vector3d model_origin(const std::vector<store::StoredScanSummary>& scans)
   return scans.front().summary.T_world_scan.translation().array().round();
 }
 
-OctreeCube model_cube(const std::vector<store::StoredScanSummary>& scans,
+[[noreturn]] void refuse_scan(const store::Project& project, const store::StoredScanSummary& s,
+                              const std::string& problem) {
+  core::FilePosition position;
+  position.detail = "scan " + std::to_string(s.id) + " (" + s.summary.name + ")";
+  throw core::InputError(project.path().string(), position, problem);
+}
+
+// The cube on the scans' bounds. Refuses a scan whose bounds are not
+// finite or lie so far that the cube would pass 2^32 quanta (429 km): a
+// wrong pose or range, which the store's 32-bit positions cannot hold.
+OctreeCube model_cube(const store::Project& project,
+                      const std::vector<store::StoredScanSummary>& scans,
                       const Eigen::Vector3d& origin) {
+  constexpr double kFarthestM = 2e5;
   Eigen::AlignedBox3d box;
   for (const store::StoredScanSummary& s : scans) {
-    if (s.summary.bbox_world) {
-      box.extend(s.summary.bbox_world->min() - origin);
-      box.extend(s.summary.bbox_world->max() - origin);
+    if (!s.summary.bbox_world) continue;
+    const Eigen::AlignedBox3d own(s.summary.bbox_world->min() - origin,
+                                  s.summary.bbox_world->max() - origin);
+    if (!own.min().allFinite() || !own.max().allFinite() ||
+        own.min().cwiseAbs().maxCoeff() > kFarthestM ||
+        own.max().cwiseAbs().maxCoeff() > kFarthestM) {
+      refuse_scan(project, s,
+                  "has points more than 200 km from the first scanner: check its pose "
+                  "(`scanbench info`)");
     }
+    box.extend(own);
   }
   return OctreeCube::enclosing(box);
 }
 
-// One worker's points on their way to their chunks: collected a thousand a
-// chunk at a time, then parked.
-class ChunkSorter {
+// Routes one worker's points to their chunks: collected a thousand a chunk
+// at a time, then parked.
+class ChunkRouter {
  public:
-  ChunkSorter(const OctreeCube& cube, const CellCounts& counts, ParkedPoints& parked,
+  ChunkRouter(const OctreeCube& cube, const CellCounts& counts, ParkedPoints& parked,
               std::size_t chunks)
       : cube_(cube), counts_(counts), parked_(parked), waiting_(chunks) {}
-  ~ChunkSorter() = default;
 
   void add(std::span<const BuildPoint> points) {
     for (const BuildPoint& p : points) {
@@ -121,7 +141,7 @@ class ChunkSorter {
       const std::uint32_t chunk =
           counts_.chunk[static_cast<std::size_t>(at - counts_.codes.begin())];
       waiting_[chunk].push_back(p);
-      if (waiting_[chunk].size() >= kParkedPoints) park(chunk);
+      if (waiting_[chunk].size() >= kParkingBatch) park(chunk);
     }
   }
 
@@ -147,7 +167,7 @@ class TopBuilder {
   TopBuilder(const OctreeCube& cube, std::vector<Chunk>& chunks, const std::vector<NodeKey>& top,
              ParkedPoints& roots, LodStoreWriter& writer)
       : cube_(cube), chunks_(chunks), roots_(roots), writer_(writer) {
-    for (const NodeKey& key : top) top_.emplace(key.code(), true);
+    for (const NodeKey& key : top) top_.insert(key.code());
     for (std::size_t k = 0; k < chunks_.size(); ++k) chunk_of_.emplace(chunks_[k].key.code(), k);
   }
 
@@ -175,7 +195,7 @@ class TopBuilder {
   std::vector<Chunk>& chunks_;
   ParkedPoints& roots_;
   LodStoreWriter& writer_;
-  std::unordered_map<std::uint64_t, bool> top_;
+  std::unordered_set<std::uint64_t> top_;
   std::unordered_map<std::uint64_t, std::size_t> chunk_of_;
 };
 
@@ -232,6 +252,9 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   };
   const store::Project::ReadSnapshot snapshot = project.read_snapshot();
   const std::vector<store::StoredScanSummary> scans = modeling::scans_with_geometry(project);
+  if (scans.size() > std::size_t{std::numeric_limits<std::uint16_t>::max()} + 1) {
+    refuse_scan(project, scans[65536], "is one scan more than a store holds (65 536)");
+  }
   LodBuildResult result;
   result.store = settings.output.empty() ? LodStore::path_for(project.path()) : settings.output;
   result.project_revision = project.revision();
@@ -242,7 +265,7 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   LodHeader header;
   header.project_revision = result.project_revision;
   header.origin = model_origin(scans);
-  header.cube = model_cube(scans, header.origin);
+  header.cube = model_cube(project, scans, header.origin);
   header.octree = settings.octree;
   const OctreeCube& cube = header.cube;
 
@@ -286,39 +309,49 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   std::vector<Chunk> chunks;
   std::vector<NodeKey> top;
   if (!counts.codes.empty()) {
+    // A node above the chunks is an inner node: it must hold more than a
+    // leaf may, or the chunks would cut the tree elsewhere than the model
+    // in memory does.
     const std::uint64_t chunk_points =
-        chunk_points_for(settings, limit, result.threads, counts.total());
+        std::max<std::uint64_t>(chunk_points_for(settings, limit, result.threads, counts.total()),
+                                settings.octree.max_leaf_points);
     ChunkPlanner(counts, chunk_points, chunks, top).plan({}, 0, counts.codes.size());
   }
-  for (const Chunk& chunk : chunks) {
-    core::check_memory_limit(
-        chunk.points * kChunkBytesPerPoint, limit, project.path().string(), "lod",
-        "the densest part of the model (" + std::to_string(chunk.points) + " points in one cell)");
-  }
+  // Points wait in memory when the model takes at most half the limit.
+  const bool in_memory = counts.total() * sizeof(BuildPoint) <= limit / 2;
+  const std::uint64_t waiting = in_memory ? counts.total() * sizeof(BuildPoint) : 0;
+  std::uint64_t largest = 0;
+  for (const Chunk& chunk : chunks) largest = std::max(largest, chunk.points);
+  core::check_memory_limit(
+      waiting + largest * kChunkBytesPerPoint, limit, project.path().string(), "lod",
+      "the densest part of the model (" + std::to_string(largest) + " points in one cell)");
+  // As many chunks at once as the limit holds, at most one a worker.
+  const int chunk_workers = static_cast<int>(std::clamp<std::uint64_t>(
+      (limit - waiting) / std::max<std::uint64_t>(1, largest * kChunkBytesPerPoint), 1,
+      static_cast<std::uint64_t>(result.threads)));
   result.chunks = chunks.size();
 
-  // 3. Distribute, a scan per worker; in memory when the model fits half
-  // the limit.
-  ParkedPoints parked(chunks.size(), counts.total() * sizeof(BuildPoint) <= limit / 2);
+  // 3. Distribute, a scan per worker.
+  ParkedPoints parked(chunks.size(), in_memory);
   for (std::size_t c = 0; c < chunks.size(); ++c) parked.reserve(c, chunks[c].points);
   for_each_scan(project, result.project_revision, scans, result.threads, progress,
                 "lod: distribute", [&](std::size_t s, const store::Project& own_project) {
-                  ChunkSorter sorter(cube, counts, parked, chunks.size());
+                  ChunkRouter router(cube, counts, parked, chunks.size());
                   read_shown_points(
                       own_project, scans[s], lod_scans[s], cube, header.origin, settings.points,
-                      [&](std::span<const BuildPoint> points) { sorter.add(points); });
-                  sorter.finish();
+                      [&](std::span<const BuildPoint> points) { router.add(points); });
+                  router.finish();
                 });
   result.distribute_seconds = lap();
 
   // 4. Chunks, a batch of one per worker at a time; their roots wait.
   LodStoreWriter writer(result.store, header, lod_scans);
-  ParkedPoints roots(chunks.size(), false);
-  const auto workers = static_cast<std::size_t>(result.threads);
+  ParkedPoints roots(chunks.size(), in_memory);
+  const auto workers = static_cast<std::size_t>(chunk_workers);
   for (std::size_t batch = 0; batch < chunks.size(); batch += workers) {
     progress.throw_if_cancelled("lod");
     const std::size_t end = std::min(chunks.size(), batch + workers);
-    core::parallel_for_index(static_cast<int>(end - batch), result.threads, [&](int k) {
+    core::parallel_for_index(static_cast<int>(end - batch), chunk_workers, [&](int k) {
       const std::size_t c = batch + static_cast<std::size_t>(k);
       Subtree root = build_subtree(cube, chunks[c].key, parked.take(c), settings.octree,
                                    [&](BuiltNode&& node) { writer.put(node); });
@@ -331,6 +364,7 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   result.chunk_seconds = lap();
 
   // 5. The nodes above the chunks, and the root.
+  progress.throw_if_cancelled("lod");
   if (!chunks.empty()) {
     TopBuilder builder(cube, chunks, top, roots, writer);
     writer.put(finish_node(cube, builder.build({})));

@@ -2,8 +2,9 @@
 // (octree_sampling.hpp) in an SQLite file beside the project,
 // PROJECT.sbproj.lod. A cache derived from the project: rebuildable at any
 // time, never needed to open the project, and tied to the project revision
-// it reflects. A build writes PROJECT.sbproj.lod.partial and renames it over
-// the store when complete, so a crash leaves the old store or the new one.
+// it reflects. A build writes PROJECT.sbproj.lod.partial-PID and renames it
+// over the store when complete and synced, so a crash leaves the old store
+// or the new one; two builds at once each write their own.
 //
 // One LodStore is one connection, for one thread at a time: a loader thread
 // opens its own.
@@ -81,7 +82,8 @@ class LodStore {
   const std::vector<LodScan>& scans() const { return scans_; }
 
   // Every node, in the order of their locational codes (a node before its
-  // descendants).
+  // descendants); none for a model without shown points. Throws
+  // core::InputError naming the node when a node's description is damaged.
   std::vector<LodNodeInfo> nodes() const;
 
   // The points of `node`, in level order (offsets from its corner). Throws
@@ -96,9 +98,10 @@ class LodStore {
   std::vector<LodScan> scans_;
 };
 
-// Writes a new store: into FILE.partial, renamed over FILE by commit().
-// Destroyed without commit() (an error, a cancel), it removes the partial
-// file and leaves the store at FILE as it was.
+// Writes a new store: into FILE.partial-PID, renamed over FILE by
+// commit(). Destroyed without commit() (an error, a cancel), it removes the
+// partial file and leaves the store at FILE as it was. Partial files of
+// builds whose process is gone are removed when a build starts.
 class LodStoreWriter {
  public:
   // Throws core::RuntimeFailure when the file cannot be made.

@@ -14,11 +14,12 @@
 // every occupied cell of depth d's grids: each is an even subsample of the
 // model at its resolution. Which point lands where depends on the set of
 // points only: not on their order, the threads, or how a build cut the
-// work into chunks; inserting or deleting a point changes only the nodes on
-// its path. Within a node the points are in level order: level L holds one
-// point for each cell of its grid of 2^L cells an edge that no coarser level
-// represents (the last level: points sharing a finest cell with another), so
-// every prefix is an even subsample of the node.
+// work into chunks. Inserting or deleting a point changes only the nodes on
+// its path, and splits or joins a leaf that crosses max_leaf_points.
+// Within a node the points are in level order: level L holds one point for
+// each cell of its grid of 2^L cells an edge that no coarser level
+// represents (the last level: points sharing a finest cell with another),
+// so every prefix is an even subsample of the node.
 #pragma once
 
 #include <array>

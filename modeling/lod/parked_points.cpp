@@ -9,6 +9,7 @@ ParkedPoints::ParkedPoints(std::size_t slots, bool in_memory)
     : in_memory_(in_memory), memory_(in_memory ? slots : 0), extents_(in_memory ? 0 : slots) {}
 
 void ParkedPoints::reserve(std::size_t slot, std::size_t points) {
+  const std::lock_guard lock(mutex_);
   if (in_memory_) core::reserve_mapped(memory_[slot], points);
 }
 

@@ -146,6 +146,56 @@ void visit_band(const Band& band, ScanSurvey& survey, InModel&& in_model, Shown&
   }
 }
 
+// Where a scan's samples go in the cube: quanta from its corner, the same
+// for both passes.
+struct Placement {
+  const store::Project& project;
+  const store::StoredScanSummary& stored;
+  const OctreeCube& cube;
+  const Eigen::Vector3d& origin;
+
+  // Sample (r, c) of band.held. Throws core::InputError naming the scan when
+  // it lies outside the cube (outside the bounds the scan recorded).
+  std::array<std::uint32_t, 3> at(const Band& band, const ScanSplats& directions, int r,
+                                  int c) const {
+    const double range = band.held.range_m[band.held.index(r, c)];
+    const Eigen::Vector3d world = stored.summary.T_world_scan *
+                                  (range * directions.direction(band.held, band.held_first, r, c));
+    const auto q = cube.quantize(world - origin);
+    if (!q)
+      refuse(project, stored, "has a point outside its recorded bounds: run `scanbench check`");
+    return *q;
+  }
+};
+
+// What the store keeps of sample i of `held` besides where it is and
+// whose: its intensity on the scan's spread, its recorded colour and its
+// splat.
+void describe_sample(const acquisition::Scan& held, std::size_t i, const LodScan& scan,
+                     const Splat& splat, LodPoint& p) {
+  const float spread =
+      scan.intensity_high > scan.intensity_low ? scan.intensity_high - scan.intensity_low : 1.0f;
+  const float level =
+      held.has_intensity() && std::isfinite(held.intensity[i])
+          ? std::clamp((held.intensity[i] - scan.intensity_low) / spread, 0.0f, 1.0f)
+          : 0.5f;
+  p.intensity = static_cast<std::uint8_t>(std::lround(255.0f * level));
+  if (held.has_color()) {
+    p.flags |= LodPoint::kHasColor;
+    p.rgb = {held.rgb[3 * i], held.rgb[3 * i + 1], held.rgb[3 * i + 2], 0};
+  }
+  if (!splat.normal.isZero()) {
+    p.flags |= LodPoint::kHasNormal;
+    p.normal = encode_unit(splat.normal);
+  }
+  if (splat.major_axis.isZero()) {
+    p.flags |= LodPoint::kRound;
+  } else {
+    p.major_axis = encode_unit(splat.major_axis);
+  }
+  p.radii = {to_half(splat.radii_m.x()), to_half(splat.radii_m.y())};
+}
+
 }  // namespace
 
 ScanSurvey survey_scan(
@@ -153,6 +203,7 @@ ScanSurvey survey_scan(
     const Eigen::Vector3d& origin, const ShownPointsSettings& settings,
     const std::function<void(std::span<const std::array<std::uint32_t, 3>>)>& visit) {
   ScanSurvey survey;
+  const Placement place{project, stored, cube, origin};
   IntensityHistogram intensities;
   std::vector<std::array<std::uint32_t, 3>> positions;
   std::optional<ScanSplats> directions;
@@ -165,17 +216,7 @@ ScanSurvey survey_scan(
         [&](std::size_t i) {
           if (has_intensity) intensities.add(band.held.intensity[i]);
         },
-        [&](std::size_t, int r, int c) {
-          const double range = band.held.range_m[band.held.index(r, c)];
-          const Eigen::Vector3d world =
-              stored.summary.T_world_scan *
-              (range * directions->direction(band.held, band.held_first, r, c));
-          const auto q = cube.quantize(world - origin);
-          if (!q)
-            refuse(project, stored,
-                   "has a point outside its recorded bounds: run `scanbench check`");
-          positions.push_back(*q);
-        });
+        [&](std::size_t, int r, int c) { positions.push_back(place.at(band, *directions, r, c)); });
     visit(positions);
   });
   if (const auto low = intensities.at(0.02)) {
@@ -190,10 +231,9 @@ void read_shown_points(const store::Project& project, const store::StoredScanSum
                        const ShownPointsSettings& settings,
                        const std::function<void(std::span<const BuildPoint>)>& visit) {
   ScanSurvey counts;
+  const Placement place{project, stored, cube, origin};
   std::vector<BuildPoint> points;
   std::optional<ScanSplats> splats;
-  const float spread =
-      scan.intensity_high > scan.intensity_low ? scan.intensity_high - scan.intensity_low : 1.0f;
   for_each_band(project, stored, Reading::kEverything, settings.band_pixels, [&](const Band& band) {
     const acquisition::Scan& held = band.held;
     if (!splats) {
@@ -206,41 +246,16 @@ void read_shown_points(const store::Project& project, const store::StoredScanSum
         band, counts, [](std::size_t) {},
         [&](std::size_t g, int r, int c) {
           const std::size_t i = held.index(r, c);
-          const Eigen::Vector3d beam = splats->direction(held, band.held_first, r, c);
-          const Eigen::Vector3d world =
-              stored.summary.T_world_scan * (double{held.range_m[i]} * beam);
-          const auto q = cube.quantize(world - origin);
-          if (!q)
-            refuse(project, stored,
-                   "has a point outside its recorded bounds: run `scanbench check`");
           BuildPoint p;
-          p.point.offset = *q;
+          p.point.offset = place.at(band, *splats, r, c);
           p.point.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(band.held_first + r) *
                                                          static_cast<std::size_t>(held.columns) +
                                                      static_cast<std::size_t>(c));
           p.priority = point_priority(stored.id, p.point.pixel);
           p.point.scan = scan.index;
           p.point.object = band.membership ? (*band.membership)[g] : 0;
-          const float level =
-              held.has_intensity() && std::isfinite(held.intensity[i])
-                  ? std::clamp((held.intensity[i] - scan.intensity_low) / spread, 0.0f, 1.0f)
-                  : 0.5f;
-          p.point.intensity = static_cast<std::uint8_t>(std::lround(255.0f * level));
-          if (held.has_color()) {
-            p.point.flags |= LodPoint::kHasColor;
-            p.point.rgb = {held.rgb[3 * i], held.rgb[3 * i + 1], held.rgb[3 * i + 2], 0};
-          }
-          const Splat splat = splats->splat(held, band.held_first, band.geometry, g, r, c);
-          if (!splat.normal.isZero()) {
-            p.point.flags |= LodPoint::kHasNormal;
-            p.point.normal = encode_unit(splat.normal);
-          }
-          if (splat.major_axis.isZero()) {
-            p.point.flags |= LodPoint::kRound;
-          } else {
-            p.point.major_axis = encode_unit(splat.major_axis);
-          }
-          p.point.radii = {to_half(splat.radii_m.x()), to_half(splat.radii_m.y())};
+          describe_sample(held, i, scan,
+                          splats->splat(held, band.held_first, band.geometry, g, r, c), p.point);
           points.push_back(p);
         });
     visit(points);

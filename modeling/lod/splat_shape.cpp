@@ -7,7 +7,7 @@
 namespace scanbench::lod {
 
 ScanSplats::ScanSplats(const acquisition::Scan& description, float max_stretch)
-    : description_(description),
+    : description_(acquisition::without_arrays(description)),
       max_stretch_(max_stretch),
       rotation_(description.T_world_scan.linear().cast<float>()),
       up_(description.T_world_scan.linear().transpose().col(2).cast<float>()),

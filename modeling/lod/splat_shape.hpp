@@ -31,7 +31,8 @@ struct Splat {
 class ScanSplats {
  public:
   // `description`: the scan's grid size, angle model and pose (its arrays
-  // are not read). max_stretch: the largest stretch along the major axis.
+  // are not read; a copy without them is kept). max_stretch: the largest
+  // stretch along the major axis.
   ScanSplats(const acquisition::Scan& description, float max_stretch);
 
   // The unit direction of pixel (row, col) of `held` (rows from grid row
@@ -49,7 +50,7 @@ class ScanSplats {
                                     const Eigen::Vector3f& normal, int row, int col,
                                     float reach) const;
 
-  const acquisition::Scan& description_;
+  acquisition::Scan description_;  // without its arrays
   float max_stretch_;
   std::optional<acquisition::SphericalDirections> spherical_;
   Eigen::Matrix3f rotation_;  // scan frame → world

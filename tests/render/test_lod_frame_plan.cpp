@@ -5,28 +5,14 @@
 
 #include <set>
 
-#include "modeling/lod/build_lod.hpp"
-#include "modeling/room_project.hpp"
 #include "render/lod_frame_plan.hpp"
-#include "support/test_support.hpp"
+#include "render/lod_room_store.hpp"
 
 namespace scanbench::render {
 namespace {
 
-// The room's store, built once for the file's tests.
 const LodHierarchy& room_hierarchy() {
-  static const LodHierarchy hierarchy = [] {
-    const scanbench::test::ScratchDir dir;
-    store::Project project = store::Project::create(dir / "p.sbproj");
-    modeling::store_room(project);
-    core::Progress quiet;
-    lod::LodBuildSettings settings;
-    settings.threads = 1;
-    settings.octree.max_leaf_points = 2000;  // a deep tree of a small room
-    const lod::LodBuildResult built = lod::build_lod(project, settings, quiet);
-    return LodHierarchy::of(lod::LodStore::open(built.store));
-  }();
-  return hierarchy;
+  return lod_room_store().hierarchy;
 }
 
 RenderView room_view(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {

@@ -156,9 +156,25 @@ TEST(LodStore, IsTheSameTreeWhateverTheChunksAndThreads) {
   parked.output = dir / "parked.lod";
   parked.memory_limit_bytes = 8'000'000;
   const LodBuildResult spilled = build_quietly(project, parked);
+  // Chunks smaller than a leaf: the nodes above them still hold more.
+  LodBuildSettings small = whole;
+  small.output = dir / "small.lod";
+  small.octree.max_leaf_points = 12000;
+  small.chunk_points = 5000;
+  const LodBuildResult small_chunks = build_quietly(project, small);
+  small.output = dir / "small_whole.lod";
+  small.chunk_points = std::size_t{1} << 30;
+  const auto small_reference = read_store(LodStore::open(build_quietly(project, small).store));
+  EXPECT_GT(small_chunks.chunks, 2u);
+  EXPECT_EQ(read_store(LodStore::open(small_chunks.store)).size(), small_reference.size());
+  // The chunk size the build chooses itself.
+  LodBuildSettings automatic = whole;
+  automatic.output = dir / "automatic.lod";
+  automatic.chunk_points = 0;
+  const LodBuildResult chosen = build_quietly(project, automatic);
   const auto a = read_store(LodStore::open(one.store));
   ASSERT_GT(a.size(), 10u);
-  for (const LodBuildResult* other_build : {&many, &spilled}) {
+  for (const LodBuildResult* other_build : {&many, &spilled, &chosen}) {
     const auto b = read_store(LodStore::open(other_build->store));
     ASSERT_EQ(a.size(), b.size());
     for (const auto& [code, node] : a) {
@@ -172,9 +188,12 @@ TEST(LodStore, IsTheSameTreeWhateverTheChunksAndThreads) {
   }
 }
 
-class CancelAtOnce : public core::Progress {
+// Cancels once the chunks are built: the new store's partial file exists.
+class CancelAfterTheChunks : public core::Progress {
  public:
-  void update(const core::ProgressStep&) override { request_cancel(); }
+  void update(const core::ProgressStep& step) override {
+    if (step.stage == "lod: build") request_cancel();
+  }
 };
 
 TEST(LodStore, ACancelledBuildLeavesTheStoreItWouldHaveReplaced) {
@@ -183,10 +202,16 @@ TEST(LodStore, ACancelledBuildLeavesTheStoreItWouldHaveReplaced) {
   store_two_rooms(project);
   const LodBuildResult first = build_quietly(project);
   const std::string before = test::read_file_bytes(first.store);
-  CancelAtOnce cancel;
+  CancelAfterTheChunks cancel;
   EXPECT_THROW(build_lod(project, {}, cancel), core::Cancelled);
   EXPECT_EQ(test::read_file_bytes(first.store), before);
-  EXPECT_FALSE(std::filesystem::exists(first.store.string() + ".partial"));
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
+  }
+  // A crashed build's file (a process long gone) is removed by the next build.
+  std::ofstream(first.store.string() + ".partial-999999999") << "half a store";
+  build_quietly(project);
+  EXPECT_FALSE(std::filesystem::exists(first.store.string() + ".partial-999999999"));
   EXPECT_EQ(LodStore::open(first.store).header().points, first.points);
 }
 
@@ -212,6 +237,66 @@ TEST(LodStore, RefusesWhatIsNotAStoreNamingTheFile) {
   core::Progress quiet;
   EXPECT_THROW(build_lod(project, {}, quiet), core::InputError);
   EXPECT_FALSE(std::filesystem::exists(LodStore::path_for(project.path())));
+}
+
+// The room's store with `sql` run on a copy, checks off: what opening it or
+// reading its nodes says.
+std::string refusal_after(const std::string& sql) {
+  const scanbench::test::ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  modeling::store_room(project);
+  const LodBuildResult result = build_quietly(project);
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open(result.store.c_str(), &db), SQLITE_OK);
+  const std::string unchecked = "PRAGMA ignore_check_constraints = 1; " + sql;
+  EXPECT_EQ(sqlite3_exec(db, unchecked.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+  sqlite3_close(db);
+  try {
+    const LodStore store = LodStore::open(result.store);
+    for (const LodNodeInfo& node : store.nodes()) store.read_points(node.key);
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.sbproj.lod"), std::string::npos) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "read after " << sql;
+  return "";
+}
+
+TEST(LodStore, ADamagedDescriptionIsRefusedNamingWhatIsDamaged) {
+  EXPECT_NE(refusal_after("UPDATE lod_header SET format = 99").find("newer"), std::string::npos);
+  EXPECT_NE(refusal_after("UPDATE lod_header SET edge_bits = 40").find("header"),
+            std::string::npos);
+  EXPECT_NE(refusal_after("DELETE FROM lod_header").find("never completed"), std::string::npos);
+  EXPECT_NE(refusal_after("UPDATE lod_scans SET pose = zeroblob(8)").find("scan"),
+            std::string::npos);
+  EXPECT_NE(refusal_after("UPDATE lod_nodes SET code = 4611686018427387904 WHERE code = 1")
+                .find("damaged code"),
+            std::string::npos);
+  EXPECT_NE(refusal_after("UPDATE lod_nodes SET level_ends = zeroblob(36) WHERE code = 1")
+                .find("damaged description"),
+            std::string::npos);
+  EXPECT_NE(refusal_after("UPDATE lod_nodes SET points = 4000000000 WHERE code = 1")
+                .find("node 1 (depth 0)"),
+            std::string::npos);
+}
+
+TEST(LodStore, AModelWithoutShownPointsHasAStoreWithoutNodes) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t id = modeling::store_room(project);
+  store::Project::Edit edit = project.begin_command("segment", "{}");
+  const std::vector<std::uint32_t> deleted(test::shared_room().scan.pixel_count(),
+                                           store::kDeletedPoints);
+  project.put_layer(edit, id,
+                    store::encode_layer<std::uint32_t>(store::layer::kMembership,
+                                                       store::ElementType::kU32, deleted));
+  edit.commit("{}");
+  const LodBuildResult result = build_quietly(project);
+  EXPECT_EQ(result.points, 0u);
+  EXPECT_GT(result.deleted, 0u);
+  const LodStore store = LodStore::open(result.store);
+  EXPECT_TRUE(store.nodes().empty());
+  EXPECT_EQ(store.header().points, 0u);
 }
 
 TEST(LodStore, ADamagedNodeIsReportedByName) {
