@@ -1,0 +1,256 @@
+#include "modeling/lod/octree_edit.hpp"
+
+#include <algorithm>
+#include <cassert>
+
+namespace scanbench::lod {
+namespace {
+
+PointId id_of(const BuildPoint& p) {
+  return {p.point.scan, p.point.pixel};
+}
+
+bool in_region(const OctreeCube& cube, const NodeKey& region, const BuildPoint& p) {
+  return cube.node_of(p.point.offset, region.depth) == region;
+}
+
+bool is_below(const NodeKey& node, const NodeKey& region) {
+  if (node.depth < region.depth) return false;
+  const int up = node.depth - region.depth;
+  for (int a = 0; a < 3; ++a) {
+    if ((node.xyz[a] >> up) != region.xyz[a]) return false;
+  }
+  return true;
+}
+
+// Where the descent of a point at `q` ends: the leaf whose region holds
+// it, or the missing child of an inner node (the root of an empty tree).
+NodeKey anchor_of(const OctreeCube& cube, const EditableTree& tree,
+                  const std::array<std::uint32_t, 3>& q) {
+  NodeKey key;
+  while (true) {
+    const auto found = tree.find(key.code());
+    if (found == tree.end() || found->second.leaf) return key;
+    key = cube.node_of(q, key.depth + 1);
+  }
+}
+
+class Editor {
+ public:
+  Editor(const OctreeCube& cube, const OctreeSettings& settings, EditableTree& tree,
+         std::span<const std::int64_t> scan_ids)
+      : cube_(cube), settings_(settings), tree_(tree), scan_ids_(scan_ids) {}
+
+  OctreeEditResult run(std::span<const BuildPoint> added, std::span<const BuildPoint> removed) {
+    for (const BuildPoint& p : removed) removed_ids_.insert(id_of(p));
+    std::set<std::uint64_t> regions = anchors(added, removed);
+    regions = highest_collapsing(regions, added, removed);
+    regions = outermost(regions);
+    std::set<std::uint64_t> ancestors;
+    for (const std::uint64_t code : regions) {
+      for (NodeKey k = NodeKey::from_code(code); k.depth > 0;) {
+        k = k.parent();
+        ancestors.insert(k.code());
+      }
+    }
+    for (const std::uint64_t code : ancestors) old_sample(NodeKey::from_code(code));
+    for (const std::uint64_t code : regions) rebuild(NodeKey::from_code(code), added);
+    redraw_ancestors(ancestors);
+    return std::move(result_);
+  }
+
+ private:
+  // The nodes each edited point's descent ends at.
+  std::set<std::uint64_t> anchors(std::span<const BuildPoint> added,
+                                  std::span<const BuildPoint> removed) const {
+    std::set<std::uint64_t> codes;
+    for (const auto* points : {&added, &removed}) {
+      for (const BuildPoint& p : *points)
+        codes.insert(anchor_of(cube_, tree_, p.point.offset).code());
+    }
+    return codes;
+  }
+
+  // Each region raised to its highest ancestor that the edit leaves with
+  // few enough points to be a leaf: that ancestor's subtree is rebuilt.
+  std::set<std::uint64_t> highest_collapsing(const std::set<std::uint64_t>& regions,
+                                             std::span<const BuildPoint> added,
+                                             std::span<const BuildPoint> removed) {
+    std::map<std::uint64_t, std::int64_t> delta;
+    const auto count = [&](const BuildPoint& p, std::int64_t by) {
+      for (int depth = 0;; ++depth) {
+        const NodeKey k = cube_.node_of(p.point.offset, depth);
+        const auto found = tree_.find(k.code());
+        if (found == tree_.end() || found->second.leaf) return;
+        delta[k.code()] += by;
+      }
+    };
+    for (const BuildPoint& p : added) count(p, 1);
+    for (const BuildPoint& p : removed) count(p, -1);
+    std::set<std::uint64_t> raised;
+    for (const std::uint64_t code : regions) {
+      NodeKey region = NodeKey::from_code(code);
+      for (NodeKey k = region; k.depth > 0;) {
+        k = k.parent();
+        const EditableNode& node = tree_.at(k.code());
+        const auto after = static_cast<std::int64_t>(node.points_below) + delta[k.code()];
+        if (after <= static_cast<std::int64_t>(settings_.max_leaf_points)) region = k;
+      }
+      raised.insert(region.code());
+    }
+    return raised;
+  }
+
+  // Regions below another region are part of it.
+  static std::set<std::uint64_t> outermost(const std::set<std::uint64_t>& regions) {
+    std::set<std::uint64_t> kept;
+    for (const std::uint64_t code : regions) {
+      bool inside = false;
+      for (NodeKey k = NodeKey::from_code(code); k.depth > 0 && !inside;) {
+        k = k.parent();
+        inside = regions.count(k.code()) > 0;
+      }
+      if (!inside) kept.insert(code);
+    }
+    return kept;
+  }
+
+  // A node's sample before the edit: its points and its ancestors' in its
+  // region (memoized; the tree must not have changed yet).
+  const std::vector<BuildPoint>& old_sample(const NodeKey& key) {
+    const auto found = old_samples_.find(key.code());
+    if (found != old_samples_.end()) return found->second;
+    std::vector<BuildPoint> sample = tree_.at(key.code()).points;
+    if (key.depth > 0) {
+      for (const BuildPoint& p : old_sample(key.parent())) {
+        if (in_region(cube_, key, p)) sample.push_back(p);
+      }
+    }
+    return old_samples_.emplace(key.code(), std::move(sample)).first->second;
+  }
+
+  // Region `region` built again from its points after the edit.
+  void rebuild(const NodeKey& region, std::span<const BuildPoint> added) {
+    std::vector<BuildPoint> points;
+    if (region.depth > 0) {
+      for (const BuildPoint& p : old_sample(region.parent())) {
+        if (in_region(cube_, region, p)) points.push_back(p);
+      }
+    }
+    for (auto at = tree_.begin(); at != tree_.end();) {
+      if (!is_below(at->second.key, region)) {
+        ++at;
+        continue;
+      }
+      points.insert(points.end(), at->second.points.begin(), at->second.points.end());
+      result_.removed.insert(at->first);
+      at = tree_.erase(at);
+    }
+    const std::size_t before = points.size();
+    std::erase_if(points, [&](const BuildPoint& p) { return removed_ids_.count(id_of(p)) > 0; });
+    result_.removed_points += before - points.size();
+    for (const BuildPoint& p : added) {
+      if (in_region(cube_, region, p)) {
+        points.push_back(p);
+        ++result_.added_points;
+      }
+    }
+    if (points.empty()) return;
+    Subtree top = build_subtree(cube_, region, std::move(points), settings_, [&](BuiltNode&& node) {
+      store_node(node.key, node.leaf, node.points_below, {});
+      restore_points(node);
+    });
+    samples_.emplace(region.code(), std::move(top));
+  }
+
+  // The nodes above the rebuilt regions, deepest first: each drawn again
+  // from its children, of which only those on an edited path changed.
+  void redraw_ancestors(const std::set<std::uint64_t>& ancestors) {
+    std::vector<NodeKey> order;
+    for (const std::uint64_t code : ancestors) order.push_back(NodeKey::from_code(code));
+    std::sort(order.begin(), order.end(),
+              [](const NodeKey& a, const NodeKey& b) { return a.depth > b.depth; });
+    for (const NodeKey& key : order) {
+      std::vector<Subtree> children;
+      std::vector<bool> edited;
+      for (int octant = 0; octant < 8; ++octant) {
+        const NodeKey child = key.child(octant);
+        if (const auto found = samples_.find(child.code()); found != samples_.end()) {
+          children.push_back(std::move(found->second));
+          samples_.erase(found);
+          edited.push_back(true);
+        } else if (const auto node = tree_.find(child.code()); node != tree_.end()) {
+          Subtree sibling{child, node->second.leaf, node->second.points_below, node->second.points};
+          for (const BuildPoint& p : old_sample(key)) {
+            if (in_region(cube_, child, p)) sibling.sample.push_back(p);
+          }
+          children.push_back(std::move(sibling));
+          edited.push_back(false);
+        }
+      }
+      Subtree parent;
+      parent.key = key;
+      draw_from_children(cube_, parent, children);
+      for (std::size_t k = 0; k < children.size(); ++k) {
+        if (edited[k])
+          store_node(children[k].key, children[k].leaf, children[k].points_below,
+                     std::move(children[k].sample));
+      }
+      samples_.emplace(key.code(), std::move(parent));
+    }
+    // The root keeps its whole sample.
+    if (const auto root = samples_.find(NodeKey{}.code()); root != samples_.end()) {
+      store_node(root->second.key, root->second.leaf, root->second.points_below,
+                 std::move(root->second.sample));
+    }
+  }
+
+  void store_node(const NodeKey& key, bool leaf, std::uint64_t below,
+                  std::vector<BuildPoint> points) {
+    tree_[key.code()] = {key, leaf, below, std::move(points)};
+    result_.changed.insert(key.code());
+    result_.removed.erase(key.code());
+  }
+
+  // A built node's points back in the cube's frame.
+  void restore_points(const BuiltNode& node) {
+    const std::array<std::uint64_t, 3> corner = cube_.node_corner(node.key);
+    std::vector<BuildPoint>& points = tree_.at(node.key.code()).points;
+    for (const LodPoint& p : node.points) {
+      BuildPoint b;
+      b.point = p;
+      b.priority = point_priority(scan_ids_[p.scan], p.pixel);
+      for (int a = 0; a < 3; ++a)
+        b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
+      points.push_back(b);
+    }
+  }
+
+  const OctreeCube& cube_;
+  const OctreeSettings& settings_;
+  EditableTree& tree_;
+  std::span<const std::int64_t> scan_ids_;
+  std::set<PointId> removed_ids_;
+  std::map<std::uint64_t, std::vector<BuildPoint>> old_samples_;
+  std::map<std::uint64_t, Subtree> samples_;  // new samples of rebuilt regions and redrawn nodes
+  OctreeEditResult result_;
+};
+
+}  // namespace
+
+EditableTree build_editable_tree(const OctreeCube& cube, const std::vector<BuildPoint>& points,
+                                 const OctreeSettings& settings,
+                                 std::span<const std::int64_t> scan_ids) {
+  EditableTree tree;
+  edit_octree(cube, settings, tree, points, {}, scan_ids);
+  return tree;
+}
+
+OctreeEditResult edit_octree(const OctreeCube& cube, const OctreeSettings& settings,
+                             EditableTree& tree, std::span<const BuildPoint> added,
+                             std::span<const BuildPoint> removed,
+                             std::span<const std::int64_t> scan_ids) {
+  return Editor(cube, settings, tree, scan_ids).run(added, removed);
+}
+
+}  // namespace scanbench::lod
