@@ -46,10 +46,6 @@ struct CellCounts {
   std::uint64_t total() const { return below.back(); }
 };
 
-std::uint64_t cell_code(const OctreeCube& cube, const std::array<std::uint32_t, 3>& q, int depth) {
-  return interleave(cube.node_of(q, depth).xyz, depth);
-}
-
 // Splits the cube into chunks from the survey's counts: a node whose
 // region holds at most `chunk_points` points, or is one survey cell, is a
 // chunk; the nodes above them are `top`.
@@ -68,17 +64,9 @@ class ChunkPlanner {
       return;
     }
     top_.push_back(node);
-    const int shift = 3 * (counts_.depth - node.depth - 1);
-    std::size_t start = begin;
-    for (int octant = 0; octant < 8 && start < end; ++octant) {
-      const auto stop = std::partition_point(
-          counts_.codes.begin() + static_cast<std::ptrdiff_t>(start),
-          counts_.codes.begin() + static_cast<std::ptrdiff_t>(end),
-          [&](std::uint64_t code) { return static_cast<int>((code >> shift) & 7u) <= octant; });
-      const auto stop_index = static_cast<std::size_t>(stop - counts_.codes.begin());
-      if (stop_index > start) plan(node.child(octant), start, stop_index);
-      start = stop_index;
-    }
+    for_each_octant_run(
+        counts_.codes, begin, end, 3 * (counts_.depth - node.depth - 1),
+        [&](int octant, std::size_t b, std::size_t e) { plan(node.child(octant), b, e); });
   }
 
  private:
@@ -92,13 +80,6 @@ class ChunkPlanner {
 // model's), so floats relative to it keep sub-millimetre precision.
 Eigen::Vector3d model_origin(const std::vector<store::StoredScanSummary>& scans) {
   return scans.front().summary.T_world_scan.translation().array().round();
-}
-
-[[noreturn]] void refuse_scan(const store::Project& project, const store::StoredScanSummary& s,
-                              const std::string& problem) {
-  core::FilePosition position;
-  position.detail = "scan " + std::to_string(s.id) + " (" + s.summary.name + ")";
-  throw core::InputError(project.path().string(), position, problem);
 }
 
 // The cube on the scans' bounds. Refuses a scan whose bounds are not
@@ -135,7 +116,7 @@ class ChunkRouter {
 
   void add(std::span<const BuildPoint> points) {
     for (const BuildPoint& p : points) {
-      const std::uint64_t code = cell_code(cube_, p.point.offset, counts_.depth);
+      const std::uint64_t code = cube_.morton_of(p.point.offset, counts_.depth);
       const auto at = std::lower_bound(counts_.codes.begin(), counts_.codes.end(), code);
       assert(at != counts_.codes.end() && *at == code && "the survey counted every cell");
       const std::uint32_t chunk =
@@ -282,8 +263,7 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
                     const ScanSurvey survey =
                         survey_scan(own_project, scans[s], cube, header.origin, settings.points,
                                     [&](std::span<const std::array<std::uint32_t, 3>> positions) {
-                                      for (const auto& q : positions)
-                                        ++own[cell_code(cube, q, counts.depth)];
+        for (const auto& q : positions) ++own[cube.morton_of(q, counts.depth)];
                                     });
                     lod_scans[s] = {static_cast<std::uint16_t>(s), scans[s].id,
                                     scans[s].summary.name,         survey.intensity_low,

@@ -14,10 +14,12 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 namespace scanbench::lod {
 
@@ -67,6 +69,11 @@ struct OctreeCube {
   // The node of depth `depth` holding the point at `q` (quanta from the
   // corner).
   NodeKey node_of(const std::array<std::uint32_t, 3>& q, int depth) const;
+  // The same node's Morton code (its coordinates interleaved): in this
+  // order a region's points are one run, its children's consecutive runs.
+  std::uint64_t morton_of(const std::array<std::uint32_t, 3>& q, int depth) const {
+    return interleave(node_of(q, depth).xyz, depth);
+  }
 
   // The edge of a node of depth `depth` [quanta], and its corner [quanta
   // from the root's corner].
@@ -84,5 +91,24 @@ struct OctreeCube {
 
   bool operator==(const OctreeCube&) const = default;
 };
+
+// Splits [begin, end) of `codes`, Morton codes sorted ascending that share
+// the digits above the octant digit at bit `shift`, into the runs of each
+// octant: visit(octant, run_begin, run_end) for every run that is not empty,
+// in octant order.
+template <typename Visit>
+void for_each_octant_run(std::span<const std::uint64_t> codes, std::size_t begin, std::size_t end,
+                         int shift, Visit&& visit) {
+  std::size_t start = begin;
+  for (int octant = 0; octant < 8 && start < end; ++octant) {
+    const auto stop = std::partition_point(
+        codes.begin() + static_cast<std::ptrdiff_t>(start),
+        codes.begin() + static_cast<std::ptrdiff_t>(end),
+        [&](std::uint64_t code) { return static_cast<int>((code >> shift) & 7u) <= octant; });
+    const auto stop_index = static_cast<std::size_t>(stop - codes.begin());
+    if (stop_index > start) visit(octant, start, stop_index);
+    start = stop_index;
+  }
+}
 
 }  // namespace scanbench::lod

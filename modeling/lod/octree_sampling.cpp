@@ -57,10 +57,9 @@ class SubtreeBuilder {
     const int depth = cube_.max_depth();
     std::vector<std::pair<std::uint64_t, std::uint32_t>> order;
     core::reserve_mapped(order, points_.size());
-    for (std::size_t i = 0; i < points_.size(); ++i) {
-      const NodeKey deepest = cube_.node_of(points_[i].point.offset, depth);
-      order.emplace_back(interleave(deepest.xyz, depth), static_cast<std::uint32_t>(i));
-    }
+    for (std::size_t i = 0; i < points_.size(); ++i)
+      order.emplace_back(cube_.morton_of(points_[i].point.offset, depth),
+                         static_cast<std::uint32_t>(i));
     std::sort(order.begin(), order.end());
     std::vector<BuildPoint> sorted;
     core::reserve_mapped(sorted, points_.size());
@@ -85,16 +84,9 @@ class SubtreeBuilder {
     // The octant digit of the children's depth in the deepest codes.
     const int shift = 3 * (cube_.max_depth() - key.depth - 1);
     std::vector<Subtree> children;
-    std::size_t start = begin;
-    for (int octant = 0; octant < 8 && start < end; ++octant) {
-      const auto stop = std::partition_point(
-          codes_.begin() + static_cast<std::ptrdiff_t>(start),
-          codes_.begin() + static_cast<std::ptrdiff_t>(end),
-          [&](std::uint64_t code) { return static_cast<int>((code >> shift) & 7u) <= octant; });
-      const auto stop_index = static_cast<std::size_t>(stop - codes_.begin());
-      if (stop_index > start) children.push_back(build(key.child(octant), start, stop_index));
-      start = stop_index;
-    }
+    for_each_octant_run(codes_, begin, end, shift, [&](int octant, std::size_t b, std::size_t e) {
+      children.push_back(build(key.child(octant), b, e));
+    });
     draw_from_children(cube_, node, children);
     for (Subtree& child : children) emit_(finish_node(cube_, std::move(child)));
     return node;

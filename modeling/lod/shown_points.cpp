@@ -26,13 +26,6 @@ struct Band {
   const std::optional<std::vector<std::uint32_t>>& membership;
 };
 
-[[noreturn]] void refuse(const store::Project& project, const store::StoredScanSummary& stored,
-                         const std::string& problem) {
-  core::FilePosition position;
-  position.detail = "scan " + std::to_string(stored.id) + " (" + stored.summary.name + ")";
-  throw core::InputError(project.path().string(), position, problem);
-}
-
 // What a pass reads: the first, what says where the shown points are and
 // the intensities; the second, everything.
 enum class Reading { kPositions, kEverything };
@@ -55,7 +48,8 @@ void for_each_band(const store::Project& project, const store::StoredScanSummary
     flag_rows = project.open_layer_rows(id, store::layer::kGeometryFlags, store::ElementType::kU8);
   }
   if (!geometry_rows && !flag_rows) {
-    refuse(project, stored, "has no geometry (footprints and normals): run `scanbench geometry`");
+    refuse_scan(project, stored,
+                "has no geometry (footprints and normals): run `scanbench geometry`");
   }
   std::optional<store::LayerRowReader> keep =
       project.open_layer_rows(id, store::layer::kKeep, store::ElementType::kU8);
@@ -163,7 +157,8 @@ struct Placement {
                                   (range * directions.direction(band.held, band.held_first, r, c));
     const auto q = cube.quantize(world - origin);
     if (!q)
-      refuse(project, stored, "has a point outside its recorded bounds: run `scanbench check`");
+      refuse_scan(project, stored,
+                  "has a point outside its recorded bounds: run `scanbench check`");
     return *q;
   }
 };
@@ -197,6 +192,13 @@ void describe_sample(const acquisition::Scan& held, std::size_t i, const LodScan
 }
 
 }  // namespace
+
+void refuse_scan(const store::Project& project, const store::StoredScanSummary& stored,
+                 const std::string& problem) {
+  core::FilePosition position;
+  position.detail = "scan " + std::to_string(stored.id) + " (" + stored.summary.name + ")";
+  throw core::InputError(project.path().string(), position, problem);
+}
 
 ScanSurvey survey_scan(
     const store::Project& project, const store::StoredScanSummary& stored, const OctreeCube& cube,

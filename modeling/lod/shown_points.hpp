@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 
 #include "modeling/lod/lod_store.hpp"
 #include "modeling/lod/octree_cube.hpp"
@@ -24,6 +25,11 @@ struct ShownPointsSettings {
   float max_stretch = 64.0f;
   std::size_t band_pixels = std::size_t{1} << 22;  // rows read at a time, in pixels
 };
+
+// Throws core::InputError naming the project and scan `stored` ("scan ID
+// (NAME)"), with `problem`.
+[[noreturn]] void refuse_scan(const store::Project& project, const store::StoredScanSummary& stored,
+                              const std::string& problem);
 
 // What a first pass over a scan finds.
 struct ScanSurvey {
