@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <vector>
 
 namespace scanbench::acquisition {
 
@@ -33,5 +34,11 @@ Eigen::Isometry3d look_at(const Eigen::Vector3d& position, const Eigen::Vector3d
 // "look_at": [x, y, z] (and optional "up", default [0, 0, 1])}. Throws
 // InputError naming the file, the key and the problem.
 CameraView read_camera_view(const std::filesystem::path& view_json);
+
+// Reads a camera path, a fly-through: a view file's "width", "height" and
+// "vertical_fov_deg", and "frames": an array of poses, each as a view file
+// gives its own ("T_world_camera", or "position" and "look_at" with an
+// optional "up"). Throws InputError naming the file, the frame and the key.
+std::vector<CameraView> read_camera_path(const std::filesystem::path& path_json);
 
 }  // namespace scanbench::acquisition

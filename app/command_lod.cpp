@@ -41,18 +41,22 @@ nlohmann::json result_json(const lod::LodBuildResult& r) {
           {"points_per_second", r.seconds > 0.0 ? static_cast<double>(r.points) / r.seconds : 0.0}};
 }
 
-void run_lod(const LodOptions& options) {
-  // The build allocates and frees arrays of megabytes band after band and
-  // chunk after chunk. By default glibc maps each one anew from the kernel
-  // and gives it back when freed, and on a virtual machine the page faults
-  // of those fresh pages cost a good part of the build (the campus on 2
-  // cores: about 7.1 s without the two lines below, 5.8 s with them; three
-  // runs each). Arrays under 32 MB (the most glibc allows here) now come
-  // from the heap, which keeps up to 256 MB of freed memory for the next
-  // ones. A process-wide setting, so here and not in the library; best
-  // effort (mallopt returns 0 when it declines: the build is then slower).
+// The build allocates and frees arrays of megabytes band after band and
+// chunk after chunk. By default glibc maps each one anew from the kernel and
+// gives it back when freed, and on a virtual machine the page faults of
+// those fresh pages cost a good part of the build (the campus on 2 cores:
+// about 7.1 s without this, 5.8 s with it; three runs each). Arrays under
+// 32 MB (the most glibc allows here) then come from the heap, which keeps up
+// to 256 MB of freed memory for the next ones. A process-wide setting, so
+// here and not in the library; best effort (mallopt returns 0 when it
+// declines: the build is then slower).
+void keep_freed_arrays_for_the_build() {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
+}
+
+void run_lod(const LodOptions& options) {
+  keep_freed_arrays_for_the_build();
   const store::Project project = store::Project::open_for_reading(options.project);
   lod::LodBuildSettings settings;
   settings.threads = options.threads;
@@ -73,6 +77,18 @@ void run_lod(const LodOptions& options) {
 }
 
 }  // namespace
+
+std::filesystem::path current_lod_store(const store::Project& project, double& built_seconds) {
+  built_seconds = 0.0;
+  if (const std::optional<std::filesystem::path> current = lod::current_lod_store(project))
+    return *current;
+  keep_freed_arrays_for_the_build();
+  ProgressBar progress;
+  const lod::LodBuildResult result = naming_project(
+      project.path(), [&] { return lod::build_lod(project, lod::LodBuildSettings{}, progress); });
+  built_seconds = result.seconds;
+  return result.store;
+}
 
 void add_lod_command(CLI::App& app) {
   auto options = std::make_shared<LodOptions>();

@@ -13,6 +13,10 @@
 #include "core/parallel.hpp"
 #include "modeling/command_json.hpp"
 
+namespace scanbench::store {
+class Project;
+}
+
 namespace scanbench::app {
 
 // Exit codes of every subcommand.
@@ -31,6 +35,10 @@ inline constexpr const char* kBenchDescription =
 void add_simulate_command(CLI::App& app);
 void add_geometry_command(CLI::App& app);
 void add_lod_command(CLI::App& app);
+// The project's level-of-detail store (docs/lod.md), built first, with a
+// progress bar, when it is missing or no longer current; `built_seconds`
+// is how long that took (0 when it was current).
+std::filesystem::path current_lod_store(const store::Project& project, double& built_seconds);
 void add_register_command(CLI::App& app);
 void add_merge_command(CLI::App& app);
 // history, undo and redo.

@@ -1,12 +1,24 @@
 #include "bench/bench_lod.hpp"
 
+#include <chrono>
+#include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
+#include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
+#include "bench/campus_views.hpp"
 #include "bench/child_process.hpp"
+#include "bench/image_metrics.hpp"
 #include "bench/scratch_folder.hpp"
 #include "bench/simulated_site.hpp"
+#include "modeling/lod/lod_store.hpp"
+#include "render/device.hpp"
+#include "render/lod_renderer.hpp"
+#include "render/render_model.hpp"
+#include "render/splat_renderer.hpp"
 
 namespace scanbench::bench {
 namespace {
@@ -26,6 +38,115 @@ nlohmann::json timed_build(const std::filesystem::path& project, int threads,
   built["process_seconds"] = run.seconds;
   built["peak_rss_bytes"] = run.peak_rss_bytes;
   return built;
+}
+
+namespace sim = acquisition::sim;
+
+std::vector<std::uint8_t> rgb_of(const render::RenderedImage& image) {
+  std::vector<std::uint8_t> rgb(3 * image.rgba.size() / 4);
+  for (std::size_t i = 0; i < rgb.size() / 3; ++i) {
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image.rgba[4 * i + c];
+  }
+  return rgb;
+}
+
+std::vector<std::uint8_t> covered_of(const render::RenderedImage& image) {
+  std::vector<std::uint8_t> covered(image.rgba.size() / 4);
+  for (std::size_t i = 0; i < covered.size(); ++i) covered[i] = image.rgba[4 * i + 3] != 0;
+  return covered;
+}
+
+// Each view as the streaming renderer draws it once the camera stops,
+// from cold caches (a renderer just opened): the frames until the picture
+// is complete, and that picture against the truth and against the render
+// model's renderer (every point in memory, its own level of detail).
+nlohmann::json measure_views(const std::filesystem::path& project, const SimulatedSite& site,
+                             int width, int height) {
+  const sim::Site scene_site =
+      sim::make_site("campus", kSiteSeed, static_cast<int>(site.scans.size()));
+  const std::unique_ptr<render::RenderDevice> device = render::make_headless_device();
+  const render::RenderModel model = render::build_render_model(store::Project::open(project), {});
+  render::SplatRenderer full(model);
+  render::RenderSettings settings;
+  settings.background = {sim::kSkyRgb[0], sim::kSkyRgb[1], sim::kSkyRgb[2]};
+  nlohmann::json views = nlohmann::json::object();
+  for (const NamedView& view : campus_views(width, height)) {
+    const sim::TruthImage truth = sim::render_truth_view(scene_site.scene, view.camera);
+    const std::vector<std::uint8_t> mask = sampled_mask(truth, view.camera, site);
+    full.draw(render::make_render_view(view.camera, model.origin), settings);
+    const render::RenderedImage full_image = full.read_image();
+    render::LodRenderer streaming(lod::LodStore::path_for(project), {});
+    const render::RenderView camera =
+        render::make_render_view(view.camera, streaming.header().origin);
+    const auto start = std::chrono::steady_clock::now();
+    std::size_t frames = 1;
+    while (!streaming.draw(camera, settings).complete()) {
+      ++frames;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the loader's turn
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const render::RenderedImage image = streaming.read_image();
+    const auto against = [&](const std::vector<std::uint8_t>& rgb,
+                             const std::vector<std::uint8_t>& reference,
+                             const std::vector<std::uint8_t>& where) {
+      return compare_pictures(width, height, rgb, reference, covered_of(image), where).psnr_db;
+    };
+    const std::vector<std::uint8_t> full_covered = covered_of(full_image);
+    views[view.name] = {
+        {"converged_psnr_db", against(rgb_of(image), truth.rgb, mask)},
+        {"full_renderer_psnr_db",
+         compare_pictures(width, height, rgb_of(full_image), truth.rgb, full_covered, mask)
+             .psnr_db},
+        {"against_full_renderer_psnr_db", against(rgb_of(image), rgb_of(full_image), full_covered)},
+        {"converge_seconds", seconds},
+        {"converge_frames", frames}};
+  }
+  return views;
+}
+
+// A fly-through of `frames` frames: along the street at eye height, then
+// up and round to the overview's camera.
+void write_camera_path(const std::filesystem::path& file, int frames, int width, int height) {
+  nlohmann::json poses = nlohmann::json::array();
+  const Eigen::Vector3d walk_from(-22.0, -2.0, 1.7), walk_to(12.0, 5.0, 1.7);
+  const Eigen::Vector3d rise_to(-55.0, -60.0, 55.0);
+  for (int k = 0; k < frames; ++k) {
+    const double t = static_cast<double>(k) / std::max(1, frames - 1);
+    Eigen::Vector3d position, target;
+    if (t < 0.5) {
+      position = walk_from + 2.0 * t * (walk_to - walk_from);
+      target = position + 30.0 * (walk_to - walk_from).normalized() + Eigen::Vector3d(0, 0, 1);
+    } else {
+      const double u = 2.0 * (t - 0.5);
+      position = walk_to + u * (rise_to - walk_to);
+      target = (1.0 - u) * (walk_to + 30.0 * (walk_to - walk_from).normalized());
+    }
+    poses.push_back({{"position", {position.x(), position.y(), position.z()}},
+                     {"look_at", {target.x(), target.y(), target.z()}}});
+  }
+  std::ofstream(file) << nlohmann::json{
+      {"width", width}, {"height", height}, {"vertical_fov_deg", 60.0}, {"frames", poses}};
+}
+
+// `scanbench render --path` in a process of its own: its JSON, with its
+// peak memory.
+nlohmann::json measure_path(const std::filesystem::path& project, const std::filesystem::path& dir,
+                            int frames, int width, int height) {
+  const std::filesystem::path path = dir / "path.json";
+  write_camera_path(path, frames, width, height);
+  const ChildRun run =
+      run_scanbench("render_path",
+                    {"render", project.string(), "--path", path.string(), "--target-ms", "100",
+                     "-o", (dir / "path_last.png").string(), "--json"},
+                    dir);
+  if (run.exit_code != 0) {
+    throw std::runtime_error("bench lod: scanbench render --path exited with " +
+                             std::to_string(run.exit_code) + ": " + run.err);
+  }
+  nlohmann::json out = nlohmann::json::parse(run.out);
+  out["peak_rss_bytes"] = run.peak_rss_bytes;
+  return out;
 }
 
 }  // namespace
@@ -62,14 +183,25 @@ nlohmann::json run_lod_bench(const BenchOptions& options) {
                        {"build_peak_rss_bytes", one["peak_rss_bytes"]},
                        {"seconds", one["seconds"]},
                        {"phase_seconds", one["phase_seconds"]}};
-  // Not built yet: the streaming renderer, edits in place, 3D selection.
-  for (const char* field :
-       {"first_frame_ms", "frame_ms_p50", "frame_ms_p95", "points_per_frame_p50",
-        "render_peak_rss_bytes", "gpu_cache_bytes_peak", "hide_ms", "recolor_ms",
-        "commit_1m_points_ms", "insert_scan_seconds"}) {
-    out[field] = nullptr;
+  const int width = options.smoke ? 240 : 960, height = options.smoke ? 135 : 540;
+  const nlohmann::json path =
+      measure_path(project, scratch.path(), options.smoke ? 30 : 300, width, height);
+  for (const char* field : {"first_frame_ms", "frame_ms_p50", "frame_ms_p95",
+                            "points_per_frame_p50", "gpu_cache_bytes_peak"}) {
+    out[field] = path[field];
   }
-  out["views"] = nlohmann::json::object();
+  out["render_peak_rss_bytes"] = path["peak_rss_bytes"];
+  out["path"] = {{"frames", path["frames"]},
+                 {"target_ms", path["target_ms"]},
+                 {"frame_ms_max", path["frame_ms_max"]},
+                 {"converge_seconds", path["converge_seconds"]},
+                 {"memory_cache_bytes_peak", path["memory_cache_bytes_peak"]},
+                 {"width", width},
+                 {"height", height}};
+  out["views"] = measure_views(project, site, width, height);
+  // Not built yet: edits in place, 3D selection.
+  for (const char* field : {"hide_ms", "recolor_ms", "commit_1m_points_ms", "insert_scan_seconds"})
+    out[field] = nullptr;
   out["selection"] = nlohmann::json::array();
   return out;
 }

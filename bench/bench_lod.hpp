@@ -1,14 +1,29 @@
-// `scanbench bench lod` (issue 29): the level-of-detail store. The campus
-// (seed 1, 4 stations at 3600 × 900; smoke: 2 at 900 × 225) at its true
-// poses with its geometry and merge, as the render bench has it; then
-// `scanbench lod` in a process of its own, on every core and on one:
-// "build_points_per_second" (the store's points over the whole build,
-// reading the project included), "build_points_per_second_per_thread",
-// "threads", "build_peak_rss_bytes" (the kernel's high-water mark of that
-// process), "full_rebuild_seconds", and "one_thread" (the same on one
-// core). "points", "nodes", "store_bytes" and "phase_seconds" describe the
-// build. The figures of the streaming renderer and of edits in place are
-// null until they exist.
+// `scanbench bench lod` (issue 29): the level-of-detail store and the
+// streaming renderer. The campus (seed 1, 4 stations at 3600 × 900; smoke:
+// 2 at 900 × 225) at its true poses with its geometry and merge, as the
+// render bench has it. Then:
+//   - `scanbench lod` in a process of its own, on every core and on one:
+//     "build_points_per_second" (the store's points over the whole build,
+//     reading the project included), "build_points_per_second_per_thread",
+//     "threads", "build_peak_rss_bytes" (the kernel's high-water mark of
+//     that process), "full_rebuild_seconds", and "one_thread" (the same on
+//     one core); "points", "nodes", "store_bytes" and "phase_seconds"
+//     describe the build;
+//   - `scanbench render --path` in a process of its own: a fly-through of
+//     300 frames at 960 × 540 (smoke: 30 at 240 × 135) along the street
+//     and up to the overview, with a 100 ms frame-time target:
+//     "first_frame_ms" (from the start of the command to the first frame
+//     with points), "frame_ms_p50", "frame_ms_p95", "points_per_frame_p50",
+//     "gpu_cache_bytes_peak", "render_peak_rss_bytes", and "path" (its
+//     frame count, the slowest frame, the seconds to complete the last
+//     picture once still);
+//   - "views": for each bench camera, the streaming renderer from cold
+//     caches, frame after frame until the picture is complete
+//     ("converge_seconds", "converge_frames"), that picture's PSNR against
+//     the truth over the pixels some scan sampled ("converged_psnr_db"),
+//     the render model renderer's ("full_renderer_psnr_db"), and the two
+//     pictures against each other ("against_full_renderer_psnr_db").
+// The figures of edits in place and 3D selection are null until they exist.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -40,10 +40,12 @@ LodHierarchy LodHierarchy::of(const lod::LodHeader& header, std::vector<lod::Lod
   for (std::size_t k = 0; k < h.nodes.size(); ++k) index_of.emplace(h.nodes[k].key.code(), k);
   h.children.assign(h.nodes.size(), {-1, -1, -1, -1, -1, -1, -1, -1});
   h.reach.assign(h.nodes.size(), Eigen::AlignedBox3f());
+  h.held.assign(h.nodes.size(), 0);
   // Children after parents in code order: backwards, each reach is whole
   // before its parent takes it in.
   for (std::size_t k = h.nodes.size(); k-- > 0;) {
     const lod::LodNodeInfo& node = h.nodes[k];
+    h.held[k] += node.points;
     if (!node.bounds.isEmpty()) {
       const Eigen::Vector3f grow = Eigen::Vector3f::Constant(node.max_radius_m);
       h.reach[k].extend(Eigen::AlignedBox3f(node.bounds.min() - grow, node.bounds.max() + grow));
@@ -54,6 +56,7 @@ LodHierarchy LodHierarchy::of(const lod::LodHeader& header, std::vector<lod::Lod
     h.children[parent->second][static_cast<std::size_t>(node.key.octant())] =
         static_cast<std::int32_t>(k);
     if (!h.reach[k].isEmpty()) h.reach[parent->second].extend(h.reach[k]);
+    h.held[parent->second] += h.held[k];
   }
   return h;
 }
@@ -73,7 +76,7 @@ LodFramePlan plan_lod_frame(const LodHierarchy& hierarchy, const RenderView& vie
     queue.pop();
     const lod::LodNodeInfo& node = hierarchy.nodes[k];
     const Eigen::AlignedBox3f& box = hierarchy.reach[k];
-    const auto below = static_cast<std::size_t>(node.points_below);
+    const auto below = static_cast<std::size_t>(hierarchy.held[k]);
     if (box.isEmpty()) continue;
     if (settings.clipping.excludes(box)) {
       plan.culled_clip += below;

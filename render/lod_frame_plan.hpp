@@ -28,6 +28,9 @@ struct LodHierarchy {
   // The bounds of each node's points and its descendants', grown by their
   // largest splat radius [m from the origin]; empty when it holds none.
   std::vector<Eigen::AlignedBox3f> reach;
+  // The points each node and its descendants hold (a node's points_below
+  // also counts those of its region its ancestors hold).
+  std::vector<std::uint64_t> held;
 
   // The hierarchy of `store`'s nodes.
   static LodHierarchy of(const lod::LodStore& store);

@@ -55,6 +55,7 @@ class LodNodeCache {
   // Nodes the loader could not read, with the reason (a damaged node, a
   // store gone): never asked for again.
   const std::vector<std::pair<std::size_t, std::string>>& failures() const { return failures_; }
+  bool failed(std::size_t node) const { return failed_[node] != 0; }
   // True while the loader has nodes queued or in hand.
   bool busy() const;
   // Waits until the loader is idle (a picture that must be complete, tests).

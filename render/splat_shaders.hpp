@@ -1,4 +1,4 @@
-// GLSL 4.50 sources of the splat renderer (splat_renderer.hpp): one vertex
+// GLSL 4.50 sources of the splat passes (splat_passes.hpp): one vertex
 // and one fragment stage for every splat pass, and the resolve.
 #pragma once
 
@@ -6,8 +6,11 @@
 
 namespace scanbench::render::shaders {
 
-// The splat vertex stage, with the object palette's GLSL in it.
+// The splat vertex stage, with the object palette's GLSL in it, of the
+// render model's points (one attribute array each), and of a
+// level-of-detail store's (lod_point.hpp, as stored).
 std::string splat_vertex();
+std::string lod_splat_vertex();
 extern const char* const kSplatFragment;
 extern const char* const kResolveVertex;
 extern const char* const kResolveFragment;

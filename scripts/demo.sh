@@ -68,6 +68,13 @@ phase "history"
 "$scanbench" undo "$project"
 "$scanbench" redo "$project"
 
+phase "lod"
+# The level-of-detail store beside the project, which `render` and the
+# workbench draw from: built in parallel from the scans, a band of rows at a
+# time. A colour correction leaves it current; a change to the points or
+# the objects makes `render` build it again.
+"$scanbench" lod "$project"
+
 phase "harmonize"
 # Each scan was taken under its own sun, exposure and white balance; the
 # street view before harmonising, then one correction per scan.

@@ -359,4 +359,19 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   return result;
 }
 
+std::optional<std::filesystem::path> current_lod_store(const store::Project& project) {
+  const std::filesystem::path file = LodStore::path_for(project.path());
+  if (!std::filesystem::exists(file)) return std::nullopt;
+  std::int64_t reflects = 0;
+  try {
+    reflects = LodStore::open(file).header().project_revision;
+  } catch (const core::InputError&) {  // damaged or of another format: built again
+    return std::nullopt;
+  }
+  for (const store::ProjectData data : store::data_in(kLodInputs)) {
+    if (project.changed_at(data) > reflects) return std::nullopt;
+  }
+  return file;
+}
+
 }  // namespace scanbench::lod

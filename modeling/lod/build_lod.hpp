@@ -64,4 +64,15 @@ struct LodBuildResult {
 LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& settings,
                          core::Progress& progress);
 
+// What a store reflects of its project: a command that writes none of
+// these (a recolour of the scans, a measurement) leaves it current.
+inline constexpr store::ProjectDataSet kLodInputs =
+    store::ProjectData::kScans | store::ProjectData::kGeometry | store::ProjectData::kPoses |
+    store::ProjectData::kMerge | store::ProjectData::kObjects;
+
+// The store beside `project` (LodStore::path_for) when it reflects the
+// project as it is now; none when it is missing, unreadable, or older than
+// a change to its inputs.
+std::optional<std::filesystem::path> current_lod_store(const store::Project& project);
+
 }  // namespace scanbench::lod

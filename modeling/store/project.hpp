@@ -49,6 +49,7 @@
 #include "core/memory.hpp"
 #include "core/project_file.hpp"
 #include "modeling/store/color_edit.hpp"
+#include "modeling/store/command_footprint.hpp"
 #include "modeling/store/layer_rows.hpp"
 #include "modeling/store/layer_store.hpp"
 
@@ -208,6 +209,9 @@ class Project {
   // begin_command, which refuses to write when a command since changed data
   // the stage read (command_footprint.hpp).
   std::int64_t revision() const;
+  // The revision at which `data` last changed (by a command, an undo or a
+  // redo); 0 when none has since scanbench began keeping it.
+  std::int64_t changed_at(ProjectData data) const;
 
   // ---- Scans -------------------------------------------------------------
 

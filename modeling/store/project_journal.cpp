@@ -144,6 +144,10 @@ std::int64_t Project::revision() const {
   return read_revision(db(), file_name());
 }
 
+std::int64_t Project::changed_at(ProjectData data) const {
+  return store::changed_at(db(), file_name(), data);
+}
+
 Project::Edit Project::begin_command(std::string_view name, const std::string& settings_json,
                                      std::optional<std::int64_t> based_on_revision) {
   Edit edit(db(), file_name(), 0, Edit::Kind::kCommand, connection_.get());

@@ -93,5 +93,50 @@ INSTANTIATE_TEST_SUITE_P(
                       "T_world_camera": [1, 0, 0, 1e9, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]})",
                   "each element must be a finite number"}));
 
+// A camera path: a view file's optics, then its poses, each refused by its
+// frame's place.
+class BadPathFile : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
+
+TEST(CameraPath, ReadsEveryFrameWithTheSharedOptics) {
+  const ScratchDir dir;
+  const std::filesystem::path file = dir / "path.json";
+  std::ofstream(file) << R"({"width": 64, "height": 48, "vertical_fov_deg": 50, "frames": [
+      {"position": [0, 0, 1], "look_at": [5, 0, 1]},
+      {"T_world_camera": [1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 3, 0, 0, 0, 1]}]})";
+  const std::vector<CameraView> path = read_camera_path(file);
+  ASSERT_EQ(path.size(), 2u);
+  EXPECT_EQ(path[1].width, 64);
+  EXPECT_EQ(path[1].vertical_fov_deg, 50.0);
+  EXPECT_TRUE(path[0].T_world_camera.isApprox(look_at({0, 0, 1}, {5, 0, 1})));
+  EXPECT_EQ(path[1].T_world_camera.translation(), Eigen::Vector3d(2, 0, 3));
+}
+
+TEST_P(BadPathFile, IsRefusedNamingTheFileTheFrameAndTheKey) {
+  const ScratchDir dir;
+  const std::filesystem::path file = dir / "path.json";
+  std::ofstream(file) << GetParam().first;
+  const core::InputError error = refusal([&] { read_camera_path(file); });
+  EXPECT_EQ(error.file(), file.string());
+  EXPECT_THAT(error.what(), HasSubstr(GetParam().second)) << GetParam().first;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    PathFiles, BadPathFile,
+    ::testing::Values(
+        std::pair{R"({"width": 64, "height": 48, "vertical_fov_deg": 60, "frames": []})",
+                  "key \"frames\": must be an array of 1 to 1 000 000 camera poses"},
+        std::pair{R"({"width": 64, "height": 48, "vertical_fov_deg": 60, "frames": [
+                      {"position": [1, 0, 0], "look_at": [0, 0, 0]},
+                      {"position": [1, 0, 0], "look_at": [1, 0, 0]}]})",
+                  "key \"frames[1].look_at\": equals the position"},
+        std::pair{R"({"width": 64, "height": 48, "vertical_fov_deg": 60, "frames": [
+                      {"position": [1, 0, 0], "look": [0, 0, 0]}]})",
+                  "unknown key \"look\""},
+        std::pair{R"({"width": 64, "vertical_fov_deg": 60, "frames": [
+                      {"position": [1, 0, 0], "look_at": [0, 0, 0]}]})",
+                  "key \"height\": is missing"},
+        std::pair{R"({"width": 64, "height": 48, "vertical_fov_deg": 60, "frames": [7]})",
+                  "key \"frames[0]\": must be a JSON object"}));
+
 }  // namespace
 }  // namespace scanbench::acquisition

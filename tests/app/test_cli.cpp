@@ -213,7 +213,11 @@ TEST(Cli, RecolorEditsAnObjectUndoablyAndRefusesWhatItCannotDo) {
 
 TEST(Cli, RenderDrawsTheProjectHeadlessAndRefusesBadViewsAndOutputs) {
   ScratchDir dir;
-  const std::filesystem::path project = segmentable_project(dir);
+  const std::filesystem::path project = dir / "render.sbproj";
+  ASSERT_EQ(run_cli(dir, {"import", project.string(), fixture("good/ptx/tiny_color.ptx").string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(run_cli(dir, {"geometry", project.string()}).exit_code, 0);
   const std::filesystem::path view =
       write_script(dir, "view.json",
                    R"json({"width": 64, "height": 48, "vertical_fov_deg": 60,
@@ -225,10 +229,49 @@ TEST(Cli, RenderDrawsTheProjectHeadlessAndRefusesBadViewsAndOutputs) {
   const nlohmann::json out = nlohmann::json::parse(run.out);
   EXPECT_EQ(out["width"], 64);
   EXPECT_EQ(out["mode"], "blended");
-  for (const char* key : {"points", "points_submitted", "culled_frustum", "culled_backface",
-                          "culled_budget", "frame_ms"})
+  for (const char* key :
+       {"points", "points_submitted", "culled_frustum", "culled_budget", "nodes_drawn", "frame_ms"})
     EXPECT_TRUE(out.contains(key)) << key;
+  EXPECT_GT(out["points_submitted"], 0);
   EXPECT_GT(std::filesystem::file_size(picture), 0u);
+  // The level-of-detail store was built beside the project, and is used as
+  // it is while the project does not change.
+  EXPECT_GT(out["store_build_seconds"], 0.0);
+  const CliResult again = run_cli(dir, {"render", project.string(), "--view", view.string(), "-o",
+                                        picture.string(), "--force", "--json"});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(nlohmann::json::parse(again.out)["store_build_seconds"], 0.0);
+  // A fly-through: every frame drawn as the camera moves, the last one
+  // refined until complete.
+  const std::filesystem::path path = write_script(dir, "path.json",
+                                                  R"json({"width": 64, "height": 48,
+              "vertical_fov_deg": 60, "frames": [
+                {"position": [0, 0, 0], "look_at": [1, 0, 0]},
+                {"position": [0, 0, 0], "look_at": [1, 0.2, 0]},
+                {"position": [0, 0, 0], "look_at": [1, 0.4, 0]}]})json");
+  const CliResult flown = run_cli(dir, {"render", project.string(), "--path", path.string(), "-o",
+                                        (dir / "last.png").string(), "--json"});
+  ASSERT_EQ(flown.exit_code, 0) << flown.err;
+  const nlohmann::json fly = nlohmann::json::parse(flown.out);
+  EXPECT_EQ(fly["frames"], 3);
+  for (const char* key : {"frame_ms_p50", "frame_ms_p95", "points_per_frame_p50",
+                          "converge_seconds", "gpu_cache_bytes_peak", "first_frame_ms"})
+    EXPECT_TRUE(fly.contains(key)) << key;
+  EXPECT_TRUE(std::filesystem::exists(dir / "last.png"));
+  EXPECT_EQ(run_cli(dir, {"render", project.string(), "--path", path.string(), "--view",
+                          view.string(), "-o", (dir / "both.png").string()})
+                .exit_code,
+            2);
+  EXPECT_EQ(run_cli(dir, {"render", project.string(), "-o", (dir / "none.png").string()}).exit_code,
+            2);
+  // Scans in frames hundreds of kilometres apart (one not registered yet)
+  // cannot share a store: refused, naming the scan.
+  const std::filesystem::path apart = segmentable_project(dir);
+  const CliResult far = run_cli(
+      dir, {"render", apart.string(), "--view", view.string(), "-o", (dir / "far.png").string()});
+  EXPECT_EQ(far.exit_code, 2);
+  EXPECT_THAT(far.err, HasSubstr("scan 2 (two_scans-2)"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "far.png"));
   // A view file without its camera, and a picture over the project: exit 2, nothing written.
   const std::filesystem::path bad = write_script(dir, "bad.json", R"json({"width": 64})json");
   const CliResult refused = run_cli(

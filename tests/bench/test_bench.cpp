@@ -255,7 +255,7 @@ TEST(BenchScale, SmokeRunMeasuresEveryStageOfEachCampaignInItsOwnProcess) {
   EXPECT_GT(bench["campaigns"][1]["stages"]["harmonize"]["seconds"].get<double>(), 0.0);
 }
 
-TEST(BenchLod, SmokeRunMeasuresTheBuildInItsOwnProcess) {
+TEST(BenchLod, SmokeRunMeasuresTheBuildAndTheStreamingRenderer) {
   test::ScratchDir dir;
   const test::CliResult result = test::run_cli(dir, {"bench", "lod", "--json", "--smoke"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -268,7 +268,21 @@ TEST(BenchLod, SmokeRunMeasuresTheBuildInItsOwnProcess) {
     EXPECT_GT(bench[field].get<double>(), 0.0) << field;
   }
   EXPECT_GT(bench["one_thread"]["build_points_per_second"].get<double>(), 0.0);
-  EXPECT_TRUE(bench["frame_ms_p95"].is_null());  // the streaming renderer is still to come
+  // The fly-through in its own process, and each view streamed to its
+  // complete picture.
+  for (const char* field :
+       {"first_frame_ms", "frame_ms_p50", "frame_ms_p95", "points_per_frame_p50",
+        "render_peak_rss_bytes", "gpu_cache_bytes_peak"}) {
+    EXPECT_GT(bench[field].get<double>(), 0.0) << field;
+  }
+  EXPECT_EQ(bench["path"]["frames"], 30);
+  for (const char* view : {"closeup", "street", "overview"}) {
+    const nlohmann::json& figures = bench["views"][view];
+    EXPECT_GT(figures["converged_psnr_db"].get<double>(), 15.0) << view;
+    EXPECT_GT(figures["full_renderer_psnr_db"].get<double>(), 15.0) << view;
+    EXPECT_GE(figures["converge_frames"].get<int>(), 1) << view;
+  }
+  EXPECT_TRUE(bench["hide_ms"].is_null());  // edits in place are still to come
 }
 
 }  // namespace

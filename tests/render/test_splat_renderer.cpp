@@ -9,6 +9,7 @@
 #include "render/device.hpp"
 #include "render/object_palette.hpp"
 #include "render/splat_renderer.hpp"
+#include "shared_device.hpp"
 #include "wall_model.hpp"
 
 namespace scanbench::render {
@@ -16,11 +17,8 @@ namespace {
 
 using test::kOrigin;
 
-// One device for the whole executable: creating contexts is slow on llvmpipe.
 RenderDevice& device() {
-  static const std::unique_ptr<RenderDevice> shared = make_headless_device();
-  shared->make_current();
-  return *shared;
+  return test::shared_device();
 }
 
 TEST(SplatRenderer, DevicesComeAndGoWhileAnotherDraws) {

@@ -1,0 +1,361 @@
+#include "render/lod_renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstddef>
+#include <unordered_map>
+
+#include "core/errors.hpp"
+#include "modeling/color_pipeline.hpp"
+#include "modeling/shown_nodes.hpp"
+#include "render/gl_objects.hpp"
+#include "render/lod_node_cache.hpp"
+#include "render/splat_shaders.hpp"
+
+namespace scanbench::render {
+
+namespace {
+
+constexpr std::size_t kPointBytes = sizeof(lod::LodPoint);
+
+// The vertex formats of a stored point (lod_point.hpp), read by the LOD
+// vertex stage (splat_shaders.cpp) from one interleaved buffer.
+void describe_stored_points(GLuint vao) {
+  struct Attribute {
+    GLint size;
+    GLenum type;
+    bool integer;
+    GLboolean normalized;
+    std::size_t offset;
+  };
+  const std::array<Attribute, 9> attributes = {{
+      {3, GL_UNSIGNED_INT, true, GL_FALSE, offsetof(lod::LodPoint, offset)},
+      {1, GL_UNSIGNED_INT, true, GL_FALSE, offsetof(lod::LodPoint, object)},
+      {1, GL_UNSIGNED_SHORT, true, GL_FALSE, offsetof(lod::LodPoint, scan)},
+      {1, GL_UNSIGNED_BYTE, true, GL_FALSE, offsetof(lod::LodPoint, flags)},
+      {1, GL_UNSIGNED_BYTE, false, GL_TRUE, offsetof(lod::LodPoint, intensity)},
+      {2, GL_SHORT, true, GL_FALSE, offsetof(lod::LodPoint, normal)},
+      {2, GL_SHORT, true, GL_FALSE, offsetof(lod::LodPoint, major_axis)},
+      {2, GL_HALF_FLOAT, false, GL_FALSE, offsetof(lod::LodPoint, radii)},
+      {4, GL_UNSIGNED_BYTE, false, GL_TRUE, offsetof(lod::LodPoint, rgb)},
+  }};
+  for (GLuint k = 0; k < attributes.size(); ++k) {
+    const Attribute& a = attributes[k];
+    const auto offset = static_cast<GLuint>(a.offset);
+    if (a.integer) {
+      glVertexArrayAttribIFormat(vao, k, a.size, a.type, offset);
+    } else {
+      glVertexArrayAttribFormat(vao, k, a.size, a.type, a.normalized, offset);
+    }
+    glVertexArrayAttribBinding(vao, k, 0);
+    glEnableVertexArrayAttrib(vao, k);
+  }
+}
+
+// A shader storage buffer holding `values` (at least one vec4: GL refuses
+// empty storage).
+GlBuffer storage_buffer(std::vector<float> values) {
+  if (values.empty()) values.assign(4, 0.0f);
+  GlBuffer buffer = make_buffer();
+  glNamedBufferStorage(buffer.get(), static_cast<GLsizeiptr>(values.size() * sizeof(float)),
+                       values.data(), 0);
+  return buffer;
+}
+
+}  // namespace
+
+struct LodRenderer::Gpu {
+  struct DeviceNode {
+    GlBuffer buffer;
+    std::uint64_t bytes = 0;
+    std::uint64_t last_frame = 0;
+  };
+
+  SplatPasses passes{shaders::lod_splat_vertex()};
+  GlVertexArray points;
+  GlBuffer objects;  // ObjectStates (splat_shaders.cpp)
+  GlBuffer scans;    // ScanCorrections
+  std::unique_ptr<LodNodeCache> memory;
+  std::unordered_map<std::size_t, DeviceNode> device;
+  std::uint64_t device_bytes = 0, device_peak = 0;
+  std::uint64_t frame = 0;
+  std::vector<std::size_t> pending;  // wanted and in memory, not yet uploaded
+
+  // Lets the least recently drawn nodes go until the device holds at most
+  // `limit` bytes, never one this frame drew.
+  void evict(std::uint64_t limit) {
+    if (device_bytes <= limit) return;
+    std::vector<std::pair<std::uint64_t, std::size_t>> by_age;
+    for (const auto& [node, held] : device) {
+      if (held.last_frame < frame) by_age.emplace_back(held.last_frame, node);
+    }
+    std::sort(by_age.begin(), by_age.end());
+    for (const auto& [age, node] : by_age) {
+      if (device_bytes <= limit) break;
+      device_bytes -= device.at(node).bytes;
+      device.erase(node);
+    }
+  }
+};
+
+LodRenderer::LodRenderer(const std::filesystem::path& store_file, const LodRendererLimits& limits)
+    : store_file_(store_file), limits_(limits), gpu_(std::make_unique<Gpu>()) {
+  const lod::LodStore store = lod::LodStore::open(store_file);
+  hierarchy_ = LodHierarchy::of(store);
+  for (const lod::LodScan& scan : store.scans()) scan_of_id_[scan.scan_id] = scan.index;
+  if (!hierarchy_.reach.empty() && !hierarchy_.reach.front().isEmpty())
+    height_range_ = {hierarchy_.reach.front().min().z(), hierarchy_.reach.front().max().z()};
+  std::vector<lod::NodeKey> keys;
+  keys.reserve(hierarchy_.nodes.size());
+  for (const lod::LodNodeInfo& node : hierarchy_.nodes) keys.push_back(node.key);
+  gpu_->memory = std::make_unique<LodNodeCache>(store_file, std::move(keys), limits.memory_bytes);
+  gpu_->points = make_vertex_array();
+  describe_stored_points(gpu_->points.get());
+  set_objects({});
+  set_scan_corrections({});
+}
+
+LodRenderer::~LodRenderer() = default;
+
+void LodRenderer::set_objects(const std::vector<store::ObjectNode>& tree) {
+  std::int64_t largest = 0;
+  for (const store::ObjectNode& node : tree) largest = std::max(largest, node.id);
+  // Id 0 (no object) and every id up to the largest: shown, no edit.
+  std::vector<float> table(16 * static_cast<std::size_t>(largest + 1), 0.0f);
+  const auto neutral = [&](std::size_t id, bool shown, bool known) {
+    float* s = &table[16 * id];
+    s[0] = shown ? 1.0f : 0.0f;
+    s[2] = known ? 1.0f : 0.0f;
+    s[4] = s[5] = s[6] = 1.0f;  // transfer scale
+    s[7] = 1.0f;                // contrast
+    s[11] = 1.0f;               // gamma
+    s[12] = 1.0f;               // cos hue
+    s[14] = 1.0f;               // saturation
+  };
+  for (std::size_t id = 0; id <= static_cast<std::size_t>(largest); ++id)
+    neutral(id, true, id == 0);
+  const std::map<std::int64_t, bool> shown = modeling::shown_nodes(tree);
+  for (const auto& [id, edit] : modeling::resolve_color_edits(tree)) {
+    const auto at = static_cast<std::size_t>(id);
+    neutral(at, shown.at(id), true);
+    if (edit.identity()) continue;
+    float* s = &table[16 * at];
+    s[1] = 1.0f;
+    s[3] = static_cast<float>(edit.brightness);
+    for (int c = 0; c < 3; ++c) {
+      s[4 + c] = static_cast<float>(edit.transfer.scale[c]);
+      s[8 + c] = static_cast<float>(edit.transfer.offset[c]);
+    }
+    s[7] = static_cast<float>(edit.contrast);
+    s[11] = static_cast<float>(edit.gamma);
+    const double angle = edit.hue_deg * 3.14159265358979323846 / 180.0;
+    s[12] = static_cast<float>(std::cos(angle));
+    s[13] = static_cast<float>(std::sin(angle));
+    s[14] = static_cast<float>(edit.saturation);
+  }
+  gpu_->objects = storage_buffer(std::move(table));
+}
+
+void LodRenderer::set_scan_corrections(
+    const std::map<std::int64_t, store::ScanColorCorrection>& corrections) {
+  std::size_t scans = 0;
+  for (const auto& [id, index] : scan_of_id_) scans = std::max<std::size_t>(scans, index + 1u);
+  std::vector<float> table(16 * scans, 0.0f);
+  for (const auto& [id, correction] : corrections) {
+    const auto found = scan_of_id_.find(id);
+    if (found == scan_of_id_.end() || correction.identity()) continue;
+    float* s = &table[16 * static_cast<std::size_t>(found->second)];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) s[4 * r + c] = static_cast<float>(correction.matrix(r, c));
+      s[4 * r + 3] = static_cast<float>(correction.offset[r]);
+    }
+    s[12] = 1.0f;
+  }
+  gpu_->scans = storage_buffer(std::move(table));
+}
+
+void LodRenderer::show_project_state(const store::Project& project) {
+  set_objects(project.object_nodes());
+  set_scan_corrections(project.scan_color_corrections());
+}
+
+LodFramePlan LodRenderer::plan(const RenderView& banded_view,
+                               const RenderSettings& settings) const {
+  const CullSettings& cull = settings.culling;
+  LodPlanSettings plan_settings;
+  plan_settings.clipping = cull.clipping;
+  plan_settings.frustum = cull.frustum;
+  plan_settings.lod_pixels = cull.level_of_detail ? cull.lod_pixels : 0.0f;
+  plan_settings.budget = cull.budget;
+  return plan_lod_frame(hierarchy_, banded_view, plan_settings,
+                        [&](std::size_t k) { return gpu_->device.count(k) > 0; });
+}
+
+std::size_t LodRenderer::upload(const std::vector<std::size_t>& wanted, std::uint64_t byte_limit,
+                                LodFrameResult& result) {
+  Gpu& gpu = *gpu_;
+  std::size_t uploaded = 0;
+  std::uint64_t bytes = 0;
+  for (const std::size_t node : wanted) {
+    if (!gpu.memory->loaded(node) || gpu.device.count(node)) continue;
+    const std::span<const lod::LodPoint> points = gpu.memory->points(node);
+    const std::uint64_t size = points.size() * kPointBytes;
+    if (byte_limit > 0 && uploaded > 0 && bytes + size > byte_limit) break;
+    Gpu::DeviceNode held;
+    held.buffer = make_buffer();
+    held.bytes = std::max<std::uint64_t>(size, kPointBytes);  // GL refuses empty storage
+    const lod::LodPoint none{};
+    glNamedBufferStorage(held.buffer.get(), static_cast<GLsizeiptr>(held.bytes),
+                         points.empty() ? &none : points.data(), 0);
+    held.last_frame = gpu.frame;
+    gpu.device_bytes += held.bytes;
+    gpu.device.emplace(node, std::move(held));
+    bytes += size;
+    ++uploaded;
+  }
+  gpu.device_peak = std::max(gpu.device_peak, gpu.device_bytes);
+  result.uploaded_nodes += uploaded;
+  result.uploaded_bytes += bytes;
+  return uploaded;
+}
+
+double LodRenderer::issue(const RenderView& banded_view, const RenderSettings& settings,
+                          const LodFramePlan& plan) {
+  Gpu& gpu = *gpu_;
+  const lod::OctreeCube& cube = hierarchy_.header.cube;
+  SplatPasses& passes = gpu.passes;
+  for (const LodNodeDraw& draw : plan.draws) gpu.device.at(draw.node).last_frame = gpu.frame;
+  return passes.draw(banded_view, settings, height_range_, [&] {
+    glBindVertexArray(gpu.points.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gpu.objects.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, gpu.scans.get());
+    for (const LodNodeDraw& draw : plan.draws) {
+      const lod::LodNodeInfo& node = hierarchy_.nodes[draw.node];
+      const std::array<std::uint64_t, 3> corner = cube.node_corner(node.key);
+      Eigen::Vector3f corner_m;
+      for (int c = 0; c < 3; ++c) {
+        corner_m[c] = static_cast<float>(
+            static_cast<double>(cube.corner[static_cast<std::size_t>(c)] +
+                                static_cast<std::int64_t>(corner[static_cast<std::size_t>(c)])) *
+            lod::kQuantumM);
+      }
+      // Octants whose points are not all drawn: all of them under a
+      // prefix, else those with a child that is not drawn.
+      std::uint32_t missing = 0;
+      if (draw.count < node.points) {
+        missing = 0xffu;
+      } else {
+        for (int octant = 0; octant < 8; ++octant) {
+          const bool child = hierarchy_.children[draw.node][static_cast<std::size_t>(octant)] >= 0;
+          if (child && !(draw.children_drawn & (1u << octant))) missing |= 1u << octant;
+        }
+      }
+      passes.uniform("u_node_corner", corner_m);
+      passes.uniform("u_half_edge", static_cast<unsigned>(cube.node_edge(node.key.depth) / 2));
+      passes.uniform("u_missing", static_cast<unsigned>(missing));
+      passes.uniform("u_cell", draw.cell_m);
+      glVertexArrayVertexBuffer(gpu.points.get(), 0, gpu.device.at(draw.node).buffer.get(), 0,
+                                static_cast<GLsizei>(kPointBytes));
+      glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(draw.count));
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, 0);
+  });
+}
+
+void LodRenderer::refuse_failed(const std::vector<std::size_t>& wanted) const {
+  for (const std::size_t node : wanted) {
+    if (!gpu_->memory->failed(node)) continue;
+    // The store's own error, naming the file and the node.
+    lod::LodStore::open(store_file_).read_points(hierarchy_.nodes[node].key);
+    const auto& failures = gpu_->memory->failures();
+    const auto reason = std::find_if(failures.begin(), failures.end(),
+                                     [&](const auto& f) { return f.first == node; });
+    throw core::RuntimeFailure(store_file_.string(), {},
+                               "a node could not be read: " + reason->second);
+  }
+}
+
+LodFrameResult LodRenderer::draw(const RenderView& picture_view, const RenderSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  Gpu& gpu = *gpu_;
+  ++gpu.frame;
+  const RenderView view = SplatPasses::banded(picture_view);
+  LodFrameResult result;
+  const auto ms_since = [](std::chrono::steady_clock::time_point from) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - from)
+        .count();
+  };
+  gpu.memory->collect(gpu.pending);
+  auto lap = std::chrono::steady_clock::now();
+  result.plan = plan(view, settings);
+  result.plan_ms = ms_since(lap);
+  refuse_failed(result.plan.wanted);
+  lap = std::chrono::steady_clock::now();
+  const std::size_t uploaded = upload(result.plan.wanted, limits_.upload_bytes_per_frame, result);
+  result.upload_ms = ms_since(lap);
+  if (uploaded > 0) {
+    lap = std::chrono::steady_clock::now();
+    result.plan = plan(view, settings);
+    result.plan_ms += ms_since(lap);
+  }
+  gpu.pending.clear();
+  for (const std::size_t node : result.plan.wanted) {
+    if (gpu.memory->loaded(node)) gpu.pending.push_back(node);
+  }
+  gpu.memory->request(result.plan.wanted);
+  result.gpu_ms = issue(view, settings, result.plan);
+  gpu.evict(limits_.device_bytes);
+  result.frame_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+LodFrameResult LodRenderer::draw_complete(const RenderView& picture_view,
+                                          const RenderSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  Gpu& gpu = *gpu_;
+  ++gpu.frame;
+  const RenderView view = SplatPasses::banded(picture_view);
+  LodFrameResult result;
+  while (true) {
+    gpu.memory->collect(gpu.pending);
+    result.plan = plan(view, settings);
+    if (upload(result.plan.wanted, 0, result) > 0) continue;
+    refuse_failed(result.plan.wanted);
+    std::vector<std::size_t> missing;
+    for (const std::size_t node : result.plan.wanted) {
+      if (!gpu.memory->loaded(node)) missing.push_back(node);
+    }
+    if (result.plan.wanted.empty()) break;
+    gpu.pending = result.plan.wanted;
+    gpu.memory->request(missing);
+    gpu.memory->wait_idle();
+  }
+  gpu.pending.clear();
+  result.gpu_ms = issue(view, settings, result.plan);
+  gpu.evict(limits_.device_bytes);
+  result.frame_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+RenderedImage LodRenderer::read_image() const {
+  return gpu_->passes.read_image();
+}
+
+PictureTexture LodRenderer::picture_texture() const {
+  return gpu_->passes.picture_texture();
+}
+
+std::uint64_t LodRenderer::device_bytes() const {
+  return gpu_->device_bytes;
+}
+std::uint64_t LodRenderer::device_peak_bytes() const {
+  return gpu_->device_peak;
+}
+std::uint64_t LodRenderer::memory_peak_bytes() const {
+  return gpu_->memory->peak_bytes();
+}
+
+}  // namespace scanbench::render

@@ -1,0 +1,112 @@
+// The streaming splat renderer (docs/lod.md; seed 000 §4): draws a
+// level-of-detail store through the splat passes (splat_passes.hpp). Each
+// frame plans the nodes the view wants (lod_frame_plan.hpp); a loader
+// thread reads the missing ones from disk into an LRU cache in main memory
+// (lod_node_cache.hpp), and the renderer uploads them, as stored, into an
+// LRU cache on the device, each with a byte limit. A node not on the device
+// yet is stood in for by its ancestors, whose splats grow to cover it.
+//
+// Visibility and colour edits are tables on the device (per object: shown,
+// its resolved edit; per scan: its colour correction), so hiding or
+// recolouring an object changes the next frame and rewrites no node.
+//
+// Needs the device's context current for its whole life.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "modeling/store/color_edit.hpp"
+#include "modeling/store/project.hpp"
+#include "render/lod_frame_plan.hpp"
+#include "render/splat_passes.hpp"
+
+namespace scanbench::render {
+
+struct LodRendererLimits {
+  std::uint64_t memory_bytes = std::uint64_t{512} << 20;  // points in main memory
+  std::uint64_t device_bytes = std::uint64_t{1} << 30;    // points on the device
+  // Uploaded in one frame at most, so a frame stays short while the camera
+  // moves (draw_complete() has no limit); 0: no limit.
+  std::uint64_t upload_bytes_per_frame = std::uint64_t{64} << 20;
+};
+
+struct LodFrameResult {
+  LodFramePlan plan;
+  double frame_ms = 0.0;   // CPU wall time of the frame, finished on the device
+  double gpu_ms = -1.0;    // the device's own time; negative where it cannot say
+  double plan_ms = 0.0;    // of frame_ms: planning (the walk of the tree)
+  double upload_ms = 0.0;  // of frame_ms: uploading nodes to the device
+  std::size_t uploaded_nodes = 0;
+  std::uint64_t uploaded_bytes = 0;
+  // Every node the view wants is drawn (plan.wanted is empty): the
+  // picture will not refine further.
+  bool complete() const { return plan.wanted.empty(); }
+};
+
+class LodRenderer {
+ public:
+  // Opens the store at `store_file` (throws core::InputError naming it when
+  // it is missing or damaged) and starts its loader.
+  LodRenderer(const std::filesystem::path& store_file, const LodRendererLimits& limits);
+  ~LodRenderer();
+  LodRenderer(const LodRenderer&) = delete;
+  LodRenderer& operator=(const LodRenderer&) = delete;
+
+  const lod::LodHeader& header() const { return hierarchy_.header; }
+  const LodHierarchy& hierarchy() const { return hierarchy_; }
+
+  // What the next frame shows of the objects: each node's visibility (a
+  // node below a hidden group is hidden) and resolved colour edit
+  // (modeling/color_pipeline.hpp). Points of objects not in `tree` show as
+  // no object's.
+  void set_objects(const std::vector<store::ObjectNode>& tree);
+  // Each scan's colour correction, by scan id; scans not in the map show
+  // their recorded colours.
+  void set_scan_corrections(const std::map<std::int64_t, store::ScanColorCorrection>& corrections);
+  // Both, as `project` has them now.
+  void show_project_state(const store::Project& project);
+
+  // Draws a frame through `view` (in the store's frame: metres from
+  // header().origin) with what is on the device, uploading at most the
+  // per-frame limit of what the loader has read and asking it for the
+  // rest. Leaves the context's GL state as it found it. Throws
+  // core::InputError naming the store and the node when a node the view
+  // wants could not be read.
+  LodFrameResult draw(const RenderView& view, const RenderSettings& settings);
+  // Loads everything the view wants first: the converged picture. Throws
+  // as draw().
+  LodFrameResult draw_complete(const RenderView& view, const RenderSettings& settings);
+
+  // The last frame, without its guard band; asserts that one was drawn.
+  RenderedImage read_image() const;
+  PictureTexture picture_texture() const;
+
+  std::uint64_t device_bytes() const;
+  std::uint64_t device_peak_bytes() const;
+  std::uint64_t memory_peak_bytes() const;
+
+ private:
+  struct Gpu;
+  LodFramePlan plan(const RenderView& banded_view, const RenderSettings& settings) const;
+  // Uploads the wanted nodes the memory cache holds, within `byte_limit`
+  // (0: none); returns how many.
+  std::size_t upload(const std::vector<std::size_t>& wanted, std::uint64_t byte_limit,
+                     LodFrameResult& result);
+  // Throws when a node of `wanted` could not be read.
+  void refuse_failed(const std::vector<std::size_t>& wanted) const;
+  double issue(const RenderView& banded_view, const RenderSettings& settings,
+               const LodFramePlan& plan);
+
+  LodHierarchy hierarchy_;
+  std::filesystem::path store_file_;
+  std::map<std::int64_t, std::uint16_t> scan_of_id_;  // project scan id → store index
+  LodRendererLimits limits_;
+  Eigen::Vector2f height_range_{0.0f, 1.0f};
+  std::unique_ptr<Gpu> gpu_;
+};
+
+}  // namespace scanbench::render
