@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <limits>
+#include <numeric>
 #include <unordered_map>
 
 #include "core/errors.hpp"
@@ -10,6 +12,7 @@
 #include "modeling/shown_nodes.hpp"
 #include "render/gl_objects.hpp"
 #include "render/lod_node_cache.hpp"
+#include "render/pick.hpp"
 #include "render/splat_shaders.hpp"
 
 namespace scanbench::render {
@@ -134,10 +137,15 @@ void LodRenderer::set_objects(const std::vector<store::ObjectNode>& tree) {
   };
   for (std::size_t id = 0; id <= static_cast<std::size_t>(largest); ++id)
     neutral(id, true, id == 0);
+  object_shown_.assign(static_cast<std::size_t>(largest) + 1, 1);
+  object_known_.assign(static_cast<std::size_t>(largest) + 1, 0);
+  object_known_[0] = 1;
   const std::map<std::int64_t, bool> shown = modeling::shown_nodes(tree);
   for (const auto& [id, edit] : modeling::resolve_color_edits(tree)) {
     const auto at = static_cast<std::size_t>(id);
     neutral(at, shown.at(id), true);
+    object_shown_[at] = shown.at(id) ? 1 : 0;
+    object_known_[at] = 1;
     if (edit.identity()) continue;
     float* s = &table[16 * at];
     s[1] = 1.0f;
@@ -219,37 +227,44 @@ std::size_t LodRenderer::upload(const std::vector<std::size_t>& wanted, std::uin
   return uploaded;
 }
 
+Eigen::Vector3f LodRenderer::node_corner_m(std::size_t k) const {
+  const lod::OctreeCube& cube = hierarchy_.header.cube;
+  const std::array<std::uint64_t, 3> corner = cube.node_corner(hierarchy_.nodes[k].key);
+  Eigen::Vector3f corner_m;
+  for (std::size_t c = 0; c < 3; ++c) {
+    corner_m[static_cast<int>(c)] = static_cast<float>(
+        static_cast<double>(cube.corner[c] + static_cast<std::int64_t>(corner[c])) *
+        lod::kQuantumM);
+  }
+  return corner_m;
+}
+
+std::uint32_t LodRenderer::missing_octants(const LodNodeDraw& draw) const {
+  // All of them under a prefix, else those with a child that is not drawn.
+  if (draw.count < hierarchy_.nodes[draw.node].points) return 0xffu;
+  std::uint32_t missing = 0;
+  for (int octant = 0; octant < 8; ++octant) {
+    const bool child = hierarchy_.children[draw.node][static_cast<std::size_t>(octant)] >= 0;
+    if (child && !(draw.children_drawn & (1u << octant))) missing |= 1u << octant;
+  }
+  return missing;
+}
+
 double LodRenderer::issue(const RenderView& banded_view, const RenderSettings& settings,
                           const LodFramePlan& plan) {
   Gpu& gpu = *gpu_;
   const lod::OctreeCube& cube = hierarchy_.header.cube;
   SplatPasses& passes = gpu.passes;
   for (const LodNodeDraw& draw : plan.draws) gpu.device.at(draw.node).last_frame = gpu.frame;
+  last_plan_ = plan;
   return passes.draw(banded_view, settings, height_range_, [&] {
     glBindVertexArray(gpu.points.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gpu.objects.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, gpu.scans.get());
     for (const LodNodeDraw& draw : plan.draws) {
       const lod::LodNodeInfo& node = hierarchy_.nodes[draw.node];
-      const std::array<std::uint64_t, 3> corner = cube.node_corner(node.key);
-      Eigen::Vector3f corner_m;
-      for (int c = 0; c < 3; ++c) {
-        corner_m[c] = static_cast<float>(
-            static_cast<double>(cube.corner[static_cast<std::size_t>(c)] +
-                                static_cast<std::int64_t>(corner[static_cast<std::size_t>(c)])) *
-            lod::kQuantumM);
-      }
-      // Octants whose points are not all drawn: all of them under a
-      // prefix, else those with a child that is not drawn.
-      std::uint32_t missing = 0;
-      if (draw.count < node.points) {
-        missing = 0xffu;
-      } else {
-        for (int octant = 0; octant < 8; ++octant) {
-          const bool child = hierarchy_.children[draw.node][static_cast<std::size_t>(octant)] >= 0;
-          if (child && !(draw.children_drawn & (1u << octant))) missing |= 1u << octant;
-        }
-      }
+      const Eigen::Vector3f corner_m = node_corner_m(draw.node);
+      const std::uint32_t missing = missing_octants(draw);
       passes.uniform("u_node_corner", corner_m);
       passes.uniform("u_half_edge", static_cast<unsigned>(cube.node_edge(node.key.depth) / 2));
       passes.uniform("u_missing", static_cast<unsigned>(missing));
@@ -289,6 +304,12 @@ LodFrameResult LodRenderer::draw(const RenderView& picture_view, const RenderSet
   gpu.memory->collect(gpu.pending);
   auto lap = std::chrono::steady_clock::now();
   result.plan = plan(view, settings);
+  if (gpu.device.empty() && !result.plan.wanted.empty()) {
+    // The very first frame: the root is worth the wait of one node.
+    gpu.memory->request({result.plan.wanted.front()});
+    gpu.memory->wait_idle();
+    gpu.memory->collect(result.plan.wanted);
+  }
   result.plan_ms = ms_since(lap);
   refuse_failed(result.plan.wanted);
   lap = std::chrono::steady_clock::now();
@@ -338,6 +359,91 @@ LodFrameResult LodRenderer::draw_complete(const RenderView& picture_view,
   result.frame_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+bool LodRenderer::has_more_to_draw() {
+  gpu_->memory->collect(gpu_->pending);
+  return std::any_of(last_plan_.wanted.begin(), last_plan_.wanted.end(),
+                     [&](std::size_t k) { return gpu_->memory->loaded(k); });
+}
+
+std::vector<lod::LodPoint> LodRenderer::node_points(std::size_t k) {
+  if (gpu_->memory->loaded(k)) {
+    const std::span<const lod::LodPoint> points = gpu_->memory->points(k);
+    return {points.begin(), points.end()};
+  }
+  if (!reader_) reader_.emplace(lod::LodStore::open(store_file_));
+  return reader_->read_points(hierarchy_.nodes[k].key);
+}
+
+std::optional<LodPick> LodRenderer::pick(const Eigen::Vector3f& origin,
+                                         const Eigen::Vector3f& direction,
+                                         const RenderSettings& settings) {
+  const Clipping& clipping = settings.culling.clipping;
+  const float scale = settings.splat_scale;
+  const lod::OctreeCube& cube = hierarchy_.header.cube;
+  std::optional<LodPick> best;
+  for (const LodNodeDraw& draw : last_plan_.draws) {
+    if (!ray_meets_box(
+            hierarchy_.reach[draw.node].isEmpty()
+                ? hierarchy_.reach[draw.node]
+                : Eigen::AlignedBox3f(hierarchy_.reach[draw.node].min().array() - draw.cell_m,
+                                      hierarchy_.reach[draw.node].max().array() + draw.cell_m),
+            origin, direction))
+      continue;
+    const lod::LodNodeInfo& node = hierarchy_.nodes[draw.node];
+    const Eigen::Vector3f corner = node_corner_m(draw.node);
+    const std::uint32_t missing = missing_octants(draw);
+    const std::uint64_t half = cube.node_edge(node.key.depth) / 2;
+    const std::vector<lod::LodPoint> points = node_points(draw.node);
+    for (std::uint32_t i = 0; i < draw.count && i < points.size(); ++i) {
+      const lod::LodPoint& q = points[i];
+      const std::int64_t object =
+          q.object < object_known_.size() && object_known_[q.object] ? q.object : 0;
+      if (!object_shown_[static_cast<std::size_t>(object)]) continue;
+      SplatShape splat;
+      splat.position =
+          corner + Eigen::Vector3f(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
+                                   static_cast<float>(q.offset[2])) *
+                       static_cast<float>(lod::kQuantumM);
+      if (clipping.active() && !clipping.keeps(splat.position)) continue;
+      splat.normal = (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
+                                                           : Eigen::Vector3f::Zero();
+      splat.major_axis = (q.flags & lod::LodPoint::kRound) ? Eigen::Vector3f::Zero()
+                                                           : lod::decode_unit(q.major_axis);
+      splat.radii_m = Eigen::Vector2f(lod::from_half(q.radii[0]), lod::from_half(q.radii[1]));
+      const int octant = (q.offset[0] >= half ? 4 : 0) + (q.offset[1] >= half ? 2 : 0) +
+                         (q.offset[2] >= half ? 1 : 0);
+      if (missing & (1u << octant)) splat.radii_m = splat.radii_m.cwiseMax(draw.cell_m / scale);
+      const std::optional<float> hit =
+          splat_hit(origin, direction, splat, scale, settings.oriented,
+                    best ? best->distance_m : std::numeric_limits<float>::max());
+      if (hit) best = LodPick{q, object, splat.position, *hit};
+    }
+  }
+  return best;
+}
+
+std::vector<LodSample> LodRenderer::sample(std::size_t count) {
+  std::vector<std::size_t> by_depth(hierarchy_.nodes.size());
+  std::iota(by_depth.begin(), by_depth.end(), std::size_t{0});
+  std::stable_sort(by_depth.begin(), by_depth.end(), [&](std::size_t a, std::size_t b) {
+    return hierarchy_.nodes[a].key.depth < hierarchy_.nodes[b].key.depth;
+  });
+  std::vector<LodSample> out;
+  for (const std::size_t k : by_depth) {
+    if (out.size() >= count) break;
+    const Eigen::Vector3f corner = node_corner_m(k);
+    for (const lod::LodPoint& q : node_points(k)) {
+      const Eigen::Vector3f offset(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
+                                   static_cast<float>(q.offset[2]));
+      out.push_back({corner + offset * static_cast<float>(lod::kQuantumM),
+                     (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
+                                                           : Eigen::Vector3f::Zero(),
+                     q.object});
+    }
+  }
+  return out;
 }
 
 RenderedImage LodRenderer::read_image() const {

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "modeling/store/color_edit.hpp"
@@ -45,6 +46,21 @@ struct LodFrameResult {
   // Every node the view wants is drawn (plan.wanted is empty): the
   // picture will not refine further.
   bool complete() const { return plan.wanted.empty(); }
+};
+
+// A point of the store under a ray, as the last frame drew it.
+struct LodPick {
+  lod::LodPoint point;       // as stored: its scan, pixel and object
+  std::int64_t object = 0;   // its object as the view shows it (0: none, or one not in the tree)
+  Eigen::Vector3f position;  // model frame (metres from the store's origin)
+  float distance_m = 0.0f;   // along the ray
+};
+
+// A point of a sample of the whole model.
+struct LodSample {
+  Eigen::Vector3f position;  // model frame
+  Eigen::Vector3f normal;    // zero: unknown
+  std::int64_t object = 0;   // as stored
 };
 
 class LodRenderer {
@@ -81,6 +97,24 @@ class LodRenderer {
   // as draw().
   LodFrameResult draw_complete(const RenderView& view, const RenderSettings& settings);
 
+  // Whether a frame through the last frame's view would draw more: nodes it
+  // wanted have been read since.
+  bool has_more_to_draw();
+
+  // The point whose splat the ray from `origin` along unit `direction`
+  // (model frame) meets first among those the last frame drew, as it drew
+  // them with `settings` (its clipping, splat scale and orientation; the
+  // splats of a node standing in for its children grown as drawn). Hidden
+  // objects' points are not hit. Reads nodes the memory cache let go from
+  // the store again.
+  std::optional<LodPick> pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                              const RenderSettings& settings);
+
+  // A sample spread over the whole model: the points of its shallowest
+  // nodes (each an even subsample of its region), at least `count` where
+  // the store holds as many. Read from the store.
+  std::vector<LodSample> sample(std::size_t count);
+
   // The last frame, without its guard band; asserts that one was drawn.
   RenderedImage read_image() const;
   PictureTexture picture_texture() const;
@@ -96,12 +130,23 @@ class LodRenderer {
   // (0: none); returns how many.
   std::size_t upload(const std::vector<std::size_t>& wanted, std::uint64_t byte_limit,
                      LodFrameResult& result);
+  // Node `k`'s corner, model frame [m].
+  Eigen::Vector3f node_corner_m(std::size_t k) const;
+  // The octants of a drawn node whose points are not all drawn (bit k:
+  // octant k): its splats there grow to cover them.
+  std::uint32_t missing_octants(const LodNodeDraw& draw) const;
+  // Node `k`'s points from the memory cache, or read from the store.
+  std::vector<lod::LodPoint> node_points(std::size_t k);
   // Throws when a node of `wanted` could not be read.
   void refuse_failed(const std::vector<std::size_t>& wanted) const;
   double issue(const RenderView& banded_view, const RenderSettings& settings,
                const LodFramePlan& plan);
 
   LodHierarchy hierarchy_;
+  LodFramePlan last_plan_;
+  std::optional<lod::LodStore> reader_;  // for pick() and sample(), opened when first needed
+  // Per object id (as the tables on the device): shown, and in the tree.
+  std::vector<std::uint8_t> object_shown_, object_known_;
   std::filesystem::path store_file_;
   std::map<std::int64_t, std::uint16_t> scan_of_id_;  // project scan id → store index
   LodRendererLimits limits_;

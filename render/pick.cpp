@@ -41,6 +41,50 @@ Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y) {
   return (eye_to_model * in_eye).normalized();
 }
 
+std::optional<float> splat_hit(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                               const SplatShape& splat, float splat_scale, bool oriented,
+                               float nearer_than) {
+  const Eigen::Vector3f& p = splat.position;
+  const Eigen::Vector3f to = p - origin;
+  const float along = to.dot(direction);
+  const float radius = splat.radii_m.maxCoeff() * splat_scale;
+  // Cheap rejections first: behind the eye, farther than the best hit by
+  // more than the splat's reach, or off the ray beyond it.
+  if (along + radius <= 0.0f || along - radius >= nearer_than) return std::nullopt;
+  if ((to - along * direction).squaredNorm() > radius * radius) return std::nullopt;
+  const Eigen::Vector3f& normal = splat.normal;
+  const bool has_normal = normal.squaredNorm() > 0.25f;
+  if (has_normal && normal.dot(-to) < 0.0f) return std::nullopt;  // faces away
+  // Where the ray meets the splat as the view draws it: the ellipse in the
+  // plane of its normal, or a disk facing the eye (unoriented, no normal,
+  // or seen edge on).
+  bool in_plane = oriented && has_normal;
+  Eigen::Vector3f n = in_plane ? normal : Eigen::Vector3f(-to.normalized());
+  if (in_plane && std::abs(direction.dot(n)) < 0.05f) {
+    in_plane = false;
+    n = -to.normalized();
+  }
+  const float hit = to.dot(n) / direction.dot(n);
+  if (!(hit > 0.0f) || hit >= nearer_than) return std::nullopt;
+  const Eigen::Vector3f offset = origin + hit * direction - p;
+  const Eigen::Vector2f r = splat.radii_m * splat_scale;
+  const Eigen::Vector3f& major = splat.major_axis;
+  float d2 = 0.0f;
+  if (in_plane && major.squaredNorm() > 0.25f) {
+    const Eigen::Vector2f e(offset.dot(n.cross(major)) / r.x(), offset.dot(major) / r.y());
+    d2 = e.squaredNorm();
+  } else {
+    d2 = offset.squaredNorm() / (in_plane ? r.x() * r.x() : r.x() * r.y());
+  }
+  if (d2 > 1.0f) return std::nullopt;
+  return hit;
+}
+
+bool ray_meets_box(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& origin,
+                   const Eigen::Vector3f& direction) {
+  return ray_meets(box, 0.0f, origin, direction);
+}
+
 std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
                                const Eigen::Vector3f& direction, const Clipping& clipping,
                                float splat_scale, bool oriented) {
@@ -54,40 +98,12 @@ std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& 
       if (clipping.excludes(tile.box) || !ray_meets(tile.box, reach, origin, direction)) continue;
       for (std::uint32_t k = tile.first; k < tile.first + tile.count; ++k) {
         const Eigen::Vector3f& p = points.position[k];
-        const Eigen::Vector3f to = p - origin;
-        const float along = to.dot(direction);
-        const float radius = points.radii_m[k].maxCoeff() * splat_scale;
-        // Cheap rejections first: behind the eye, farther than the best
-        // hit by more than the splat's reach, or off the ray beyond it.
-        if (along + radius <= 0.0f || (best && along - radius >= best->distance_m)) continue;
-        if ((to - along * direction).squaredNorm() > radius * radius) continue;
-        const Eigen::Vector3f& normal = points.normal[k];
-        const bool has_normal = normal.squaredNorm() > 0.25f;
-        if (has_normal && normal.dot(-to) < 0.0f) continue;  // faces away
         if (clipping.active() && !clipping.keeps(p)) continue;
-        // Where the ray meets the splat as the view draws it: the ellipse
-        // in the plane of its normal, or a disk facing the eye (unoriented,
-        // no normal, or seen edge on).
-        bool in_plane = oriented && has_normal;
-        Eigen::Vector3f n = in_plane ? normal : Eigen::Vector3f(-to.normalized());
-        if (in_plane && std::abs(direction.dot(n)) < 0.05f) {
-          in_plane = false;
-          n = -to.normalized();
-        }
-        const float hit = to.dot(n) / direction.dot(n);
-        if (!(hit > 0.0f) || (best && hit >= best->distance_m)) continue;
-        const Eigen::Vector3f offset = origin + hit * direction - p;
-        const Eigen::Vector2f r = points.radii_m[k] * splat_scale;
-        const Eigen::Vector3f& major = points.major_axis[k];
-        float d2 = 0.0f;
-        if (in_plane && major.squaredNorm() > 0.25f) {
-          const Eigen::Vector2f e(offset.dot(n.cross(major)) / r.x(), offset.dot(major) / r.y());
-          d2 = e.squaredNorm();
-        } else {
-          d2 = offset.squaredNorm() / (in_plane ? r.x() * r.x() : r.x() * r.y());
-        }
-        if (d2 > 1.0f) continue;
-        best = Pick{k, hit, p};
+        const SplatShape splat{p, points.normal[k], points.major_axis[k], points.radii_m[k]};
+        const std::optional<float> hit =
+            splat_hit(origin, direction, splat, splat_scale, oriented,
+                      best ? best->distance_m : std::numeric_limits<float>::max());
+        if (hit) best = Pick{k, *hit, p};
       }
     }
   }

@@ -24,6 +24,27 @@ struct Pick {
 // the top left; pixel centres at +0.5) as a unit direction, model frame.
 Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y);
 
+// A splat as the view draws it, model frame: zero normal: unknown (a disk
+// facing the eye); zero major axis: round.
+struct SplatShape {
+  Eigen::Vector3f position;
+  Eigen::Vector3f normal;
+  Eigen::Vector3f major_axis;
+  Eigen::Vector2f radii_m;  // (across, along the major axis)
+};
+
+// Where the ray from `origin` along unit `direction` meets `splat` (radii ×
+// splat_scale; its ellipse in the plane of its normal when `oriented`,
+// else a disk facing the eye): the distance along the ray, when it does at
+// less than `nearer_than` and the splat faces the ray.
+std::optional<float> splat_hit(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                               const SplatShape& splat, float splat_scale, bool oriented,
+                               float nearer_than);
+
+// Whether the ray meets `box` at a distance ≥ 0.
+bool ray_meets_box(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& origin,
+                   const Eigen::Vector3f& direction);
+
 // The point whose splat the ray from `origin` along unit `direction` meets
 // first, the splat as the view draws it (splat_shaders.cpp): its ellipse
 // (radii × splat_scale) in the plane of its normal when `oriented`, else a

@@ -11,6 +11,7 @@
 #include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
 #include "modeling/export_command.hpp"
+#include "modeling/lod/build_lod.hpp"
 #include "modeling/store/layer_store.hpp"
 #include "modeling/store/typed_layers.hpp"
 
@@ -42,6 +43,10 @@ Session::Session(const std::filesystem::path& project, bool read_only)
     : project_(read_only ? store::Project::open_read_only(project) : store::Project::open(project)),
       read_only_(read_only) {
   show_first_scan();
+  if (store_current()) {  // drawn at once; else the workbench builds it in the background
+    store_ = lod::LodStore::path_for(project_.path());
+    store_generation_ = 1;
+  }
   if (read_only_)
     status_ =
         "read-only: you can look, grow selections, select nodes and frame them; nothing is "
@@ -84,7 +89,7 @@ std::string Session::missing() const {
 }
 
 template <typename Action>
-bool Session::act(const std::string& what, Action&& action, bool changes_model) {
+bool Session::act(const std::string& what, Action&& action) {
   if (read_only_) {
     status_ = "refused: the project is open read-only (nothing is written)";
     return false;
@@ -101,7 +106,6 @@ bool Session::act(const std::string& what, Action&& action, bool changes_model) 
     return false;
   }
   tools_.command_ran();
-  if (changes_model) ++model_changes_;
   reload();
   return true;
 }
@@ -279,9 +283,7 @@ std::optional<std::int64_t> Session::propose() {
 bool Session::keep_selections(bool at_close) {
   if (read_only_) return true;
   modeling::SelectionTools::Kept kept;
-  if (!act(
-          "", [&] { kept = tools_.keep(project_, at_close); }, false))
-    return false;
+  if (!act("", [&] { kept = tools_.keep(project_, at_close); })) return false;
   if (kept.held_back) {
     status_ = "the selection is not kept: keeping it would end the redo chain";
   } else if (kept.command_id != 0) {
@@ -294,9 +296,8 @@ bool Session::keep_selections(bool at_close) {
 
 bool Session::save_measurements(const std::vector<modeling::Measurement>& list,
                                 const std::string& what) {
-  return act(
-      what, [&] { modeling::save_measurements(project_, list, what, measurements_revision_); },
-      false);
+  return act(what,
+             [&] { modeling::save_measurements(project_, list, what, measurements_revision_); });
 }
 
 bool Session::export_measurements(const std::filesystem::path& file) {
@@ -399,7 +400,6 @@ void Session::show_first_scan_again() {
   } else {
     show_first_scan();
   }
-  ++model_changes_;
   status_ = said;
 }
 
@@ -431,7 +431,20 @@ std::optional<Eigen::Vector2d> Session::image_point(const Eigen::Vector3d& p) co
 }
 
 void Session::prepare_views() {
-  render_model();
+  if (!store_current()) {
+    view_problem_.clear();
+    try {
+      core::Progress quiet;  // the window shows the command running
+      store_ = lod::build_lod(project_, {}, quiet).store;
+    } catch (const core::FileError& e) {
+      // A scan without geometry, a store that cannot be written: the 3D
+      // view says so and stays empty.
+      store_.clear();
+      const std::string& where = e.position().detail;
+      view_problem_ = (where.empty() ? "" : where + " ") + e.problem();
+    }
+    ++store_generation_;
+  }
   if (!nodes_.empty()) coverage();
 }
 
@@ -452,21 +465,8 @@ render::Picture Session::panorama(render::PanoramaChannel channel, std::int64_t 
       scan_, {normal_, membership_, selection_, static_cast<std::uint32_t>(highlight)}, channel);
 }
 
-const render::RenderModel& Session::render_model() {
-  if (!model_ || model_revision_ != model_changes_) {
-    model_problem_.clear();
-    try {
-      model_ = render::build_render_model(project_, {});
-    } catch (const core::InputError& e) {
-      // A scan without geometry: the 3D view says so and stays empty.
-      model_ = render::RenderModel{};
-      const std::string& where = e.position().detail;
-      model_problem_ = (where.empty() ? "" : where + " ") + e.problem();
-    }
-    model_revision_ = model_changes_;
-    ++model_generation_;
-  }
-  return *model_;
+bool Session::store_current() const {
+  return lod::current_lod_store(project_).has_value();
 }
 
 }  // namespace scanbench::app::workbench

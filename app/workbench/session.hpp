@@ -20,7 +20,6 @@
 #include "modeling/selection_tools.hpp"
 #include "modeling/store/project.hpp"
 #include "render/panorama_picture.hpp"
-#include "render/render_model.hpp"
 #include "segmentation/constraints.hpp"
 #include "segmentation/segmentation_grid.hpp"
 
@@ -140,31 +139,30 @@ class Session {
   // The scan's channel with the objects and the selection laid over it,
   // node `highlight` (0: none) standing out.
   render::Picture panorama(render::PanoramaChannel channel, std::int64_t highlight) const;
-  // The model as the 3D view draws it, rebuilt after changes to it (not
-  // after a selection, which it does not show).
-  const render::RenderModel& render_model();
-  bool render_model_stale() const { return !model_ || model_revision_ != model_changes_; }
-  // Changes each time render_model() builds the model anew: a renderer built
-  // from another generation draws buffers of a model that is gone.
-  std::int64_t render_model_generation() const { return model_generation_; }
-  // The model's origin without building it (the 3D view builds it), for
-  // drawing over the view.
-  bool has_render_model() const { return model_.has_value(); }
-  Eigen::Vector3d render_model_origin() const {
-    return model_ ? model_->origin : Eigen::Vector3d::Zero();
-  }
-  // Builds what the views show after a change (the render model and the
-  // nodes' coverage), where it is stale; a background command calls it so
-  // that the window's thread does not.
+  // What the 3D view draws: the project's level-of-detail store
+  // (docs/lod.md). prepare_views() builds it anew when a command changed
+  // what it reflects (the points and which objects own them); a hide, a
+  // recolour or a harmonisation leaves it as it is, and the view shows them
+  // from the tree. Empty while there is none.
+  const std::filesystem::path& store() const { return store_; }
+  // Changes each time the store is built anew: a renderer of another
+  // generation draws a file that was replaced.
+  std::int64_t store_generation() const { return store_generation_; }
+  // Whether the store reflects the project as it is (reads the store's
+  // header and the project's change marks: after a command, not each frame).
+  bool store_current() const;
+  // Builds what the views show after a change (the store and the nodes'
+  // coverage), where it is stale; a background command calls it so that the
+  // window's thread does not.
   void prepare_views();
   // Why the 3D view is empty (a scan without geometry); empty when it is not.
-  const std::string& render_model_problem() const { return model_problem_; }
+  const std::string& view_problem() const { return view_problem_; }
 
  private:
   // Runs a command; a refusal becomes status() and false. After it, the
   // layers and the tree are read again.
   template <typename Action>
-  bool act(const std::string& what, Action&& action, bool changes_model = true);
+  bool act(const std::string& what, Action&& action);
   void reload();
   // The selection of the scan shown, from tools_, as the panorama draws it.
   void show_selection();
@@ -188,11 +186,9 @@ class Session {
   std::vector<modeling::Measurement> measurements_;
   std::string status_;
   std::int64_t revision_ = 0;
-  std::optional<render::RenderModel> model_;
-  std::int64_t model_revision_ = -1;
-  std::int64_t model_changes_ = 0;  // commands that changed what the 3D view shows
-  std::string model_problem_;
-  std::int64_t model_generation_ = 0;       // models built so far
+  std::filesystem::path store_;
+  std::int64_t store_generation_ = 0;  // stores built or found so far
+  std::string view_problem_;
   std::int64_t measurements_revision_ = 0;  // the project's revision they were read at
 };
 

@@ -10,7 +10,7 @@ void status_panel(WorkbenchState& s) {
   place_window(0, size.y - s.px(kStatusHeight), size.x, s.px(kStatusHeight));
   ImGui::Begin("Status", nullptr,
                kFixedWindow | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoScrollbar);
-  const render::FramePlan& plan = s.last_plan;
+  const render::LodFramePlan& plan = s.last_plan;
   // The device's time where it reports one, beside the wall time; the rate
   // once two frames have passed.
   const std::string gpu =
@@ -27,11 +27,11 @@ void status_panel(WorkbenchState& s) {
   if (!s.command_status.empty() && s.command_status == s.session.status())
     std::snprintf(took, sizeof took, " (%.1f s)", s.command.seconds());
   ImGui::Text(
-      "%s%s | selection %zu px | 3D %zu of %zu points (culled: clip %zu, frustum %zu, back %zu, "
-      "detail %zu) | draw %s%.0f ms wall | %s frames/s",
+      "%s%s | selection %zu px | 3D %zu of %zu points in %zu nodes (left out: clip %zu, frustum "
+      "%zu, budget %zu; %zu nodes loading) | draw %s%.0f ms wall | %s frames/s",
       s.session.status().empty() ? "ready" : s.session.status().c_str(), took,
-      s.session.selected_pixels(), plan.submitted, plan.points, plan.culled_clip,
-      plan.culled_frustum, plan.culled_backface, plan.culled_budget, gpu.c_str(), s.last_draw_ms,
+      s.session.selected_pixels(), plan.submitted, plan.points, plan.draws.size(), plan.culled_clip,
+      plan.culled_frustum, plan.stopped_by_budget, plan.wanted.size(), gpu.c_str(), s.last_draw_ms,
       rate);
   ImGui::End();
 }

@@ -10,21 +10,54 @@ namespace scanbench::app::workbench {
 
 namespace {
 
-// Draws the model into the renderer's picture when the view or the model
-// changed.
+// A renderer for the session's store, when it has a new one.
+void follow_the_store(WorkbenchState& s) {
+  Session& session = s.session;
+  if (s.renderer_generation == session.store_generation()) return;
+  s.renderer.reset();
+  s.renderer_generation = session.store_generation();
+  s.shown_revision = -1;
+  s.shown_objects.clear();
+  s.view_dirty = true;
+  if (!session.store().empty())
+    s.renderer =
+        std::make_unique<render::LodRenderer>(session.store(), render::LodRendererLimits{});
+}
+
+// The objects' visibility and colours, and the scans' corrections, into
+// the renderer when a command changed them: the next frame shows them.
+void follow_the_objects(WorkbenchState& s) {
+  Session& session = s.session;
+  if (s.shown_revision == session.revision()) return;
+  s.shown_revision = session.revision();
+  decltype(s.shown_objects) objects;
+  for (const store::ObjectNode& n : session.nodes())
+    objects.emplace_back(n.id, n.parent, n.hidden, n.color);
+  const std::int64_t corrections =
+      session.project().changed_at(store::ProjectData::kColorCorrections);
+  if (objects == s.shown_objects && corrections == s.shown_corrections) return;
+  s.renderer->show_project_state(session.project());
+  s.shown_objects = std::move(objects);
+  s.shown_corrections = corrections;
+  s.view_dirty = true;
+}
+
+// Draws a frame into the renderer's picture when the view changed (a
+// moving frame, within the budget) or the last one is not complete yet (a
+// refining frame, without one).
 void redraw(WorkbenchState& s, int width, int height) {
-  const render::RenderModel& model = s.session.render_model();  // built anew when stale
-  if (!s.renderer || s.renderer_generation != s.session.render_model_generation()) {
-    s.renderer.reset();
-    s.renderer = std::make_unique<render::SplatRenderer>(model);
-    s.renderer_generation = s.session.render_model_generation();
-    s.view_dirty = true;
-  }
+  follow_the_store(s);
+  if (!s.renderer) return;
+  follow_the_objects(s);
   s.apply_clipping();
-  if (!s.view_dirty) return;
+  const bool moving = s.view_dirty;
+  if (!moving && s.last_plan.stopped_by_budget == 0 && !s.renderer->has_more_to_draw()) return;
+  render::RenderSettings settings = s.settings;
+  settings.culling.budget = s.budget.next(moving);
   const render::RenderView view =
-      render::make_render_view(s.navigation.camera(width, height), s.session.render_model().origin);
-  const render::FrameResult frame = s.renderer->draw(view, s.settings);
+      render::make_render_view(s.navigation.camera(width, height), s.renderer->header().origin);
+  const render::LodFrameResult frame = s.renderer->draw(view, settings);
+  if (moving) s.budget.record(frame.frame_ms, frame.plan.submitted);
   s.last_plan = frame.plan;
   s.last_draw_ms = frame.frame_ms;  // the renderer gives ImGui its GL state back
   s.last_gpu_ms = frame.gpu_ms;
@@ -37,13 +70,15 @@ void view_3d(WorkbenchState& s) {
   const int w = static_cast<int>(s.view3d.w), h = static_cast<int>(s.view3d.h);
   if (w <= 0 || h <= 0) return;
   redraw(s, w, h);
-  const render::SplatRenderer::PictureTexture picture = s.renderer->picture_texture();
   ImDrawList* draw = ImGui::GetBackgroundDrawList();
   const Rect& r = s.view3d;
-  // The texture's bottom row first: flipped.
-  draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(picture.texture)),
-                 ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h),
-                 ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
+  if (s.renderer) {  // redraw() drew a first frame
+    const render::PictureTexture picture = s.renderer->picture_texture();
+    // The texture's bottom row first: flipped.
+    draw->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(picture.texture)),
+                   ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h),
+                   ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
+  }
   draw->AddText(ImVec2(r.x + s.px(8), r.y + s.px(6)), IM_COL32(255, 255, 255, 200),
                 s.fly ? "walk/fly: W A S D Q E, drag to look"
                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
@@ -52,9 +87,10 @@ void view_3d(WorkbenchState& s) {
       s, draw, [&s](const Eigen::Vector3d& p) { return s.screen_of(p); },
       std::numeric_limits<float>::infinity());
   draw->PopClipRect();
-  const std::string& problem = s.session.render_model_problem();
-  if (!problem.empty()) {
-    const std::string text = "nothing to draw: " + problem;
+  const std::string& problem = s.session.view_problem();
+  if (!problem.empty() || !s.renderer) {
+    const std::string text = problem.empty() ? std::string("no level-of-detail store yet")
+                                             : "nothing to draw: " + problem;
     draw->AddText(ImVec2(r.x + s.px(8), r.y + s.px(26)), IM_COL32(255, 200, 120, 255),
                   text.c_str());
   }

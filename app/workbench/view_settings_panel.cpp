@@ -14,9 +14,11 @@ void view_settings_panel(WorkbenchState& s) {
   bool blended = settings.mode == render::DrawMode::kBlended;
   changed |= ImGui::Checkbox("two-pass blending", &blended);
   settings.mode = blended ? render::DrawMode::kBlended : render::DrawMode::kSplats;
-  int budget = static_cast<int>(settings.culling.budget / 1000);
-  changed |= ImGui::SliderInt("budget (k)", &budget, 50, 8000);
-  settings.culling.budget = static_cast<std::size_t>(budget) * 1000;
+  // Moving frames keep to this time; a still view refines to every point.
+  if (ImGui::SliderFloat("frame target (ms)", &s.frame_target_ms, 20.0f, 1000.0f, "%.0f")) {
+    s.budget = render::FrameBudget(s.frame_target_ms);
+    changed = true;
+  }
   int color = static_cast<int>(settings.color);
   changed |= ImGui::Combo("colour", &color, "colour\0intensity\0height\0normal\0object\0");
   settings.color = static_cast<render::ColorMode>(color);

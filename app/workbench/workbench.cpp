@@ -70,6 +70,9 @@ class Workbench {
 
   // Whether a background command runs: the frames show it, not the panels.
   bool busy() const { return state_.command.running(); }
+  // No command runs or waits to, and the 3D view shows all it will: what a
+  // screenshot waits for, as a user waits for the picture to settle.
+  bool settled() const { return !busy() && !state_.command.asked() && state_.view_settled(); }
 
   // The session ends, once the command running has: the selections are
   // kept in the project (Session::keep_selections). Throws
@@ -293,6 +296,16 @@ std::string describe(const ReplayPlace& place) {
   return "the place is not in the window";
 }
 
+// Frames until the workbench settles (Workbench::settled), at most a
+// minute of them: a store built in the background, the 3D view refined.
+void settle(Workbench& bench, render::WindowDevice& window) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (!bench.settled() && std::chrono::steady_clock::now() < give_up) {
+    window.swap_buffers();
+    bench.frame(kReplayFrameSeconds);
+  }
+}
+
 // Feeds the events, a frame each, to `input` (the workbench's, or a
 // recorder in front of it), then takes the screenshot and layout asked for.
 // The places a pointer event names are found in the frame before it is
@@ -338,7 +351,10 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
         bench.frame(kReplayFrameSeconds);
       }
       if (recorder) recorder->next_frame();
-      if (e.kind == ReplayEvent::Kind::kScreenshot) bench.screenshot(e.file);
+      if (e.kind == ReplayEvent::Kind::kScreenshot) {
+        settle(bench, window);
+        bench.screenshot(e.file);
+      }
       if (e.kind == ReplayEvent::Kind::kLayout) bench.write_layout(e.file);
       window.swap_buffers();
     }
@@ -346,11 +362,15 @@ void replay(Workbench& bench, render::WindowDevice& window, const WorkbenchOptio
   do {
     bench.frame(kReplayFrameSeconds);
   } while (bench.busy());
-  if (!options.screenshot.empty()) bench.screenshot(options.screenshot);
+  if (!options.screenshot.empty()) {
+    settle(bench, window);
+    bench.screenshot(options.screenshot);
+  }
   if (!options.layout.empty()) bench.write_layout(options.layout);
 }
 
-// Frames until the window closes (or, with a screenshot asked for, one).
+// Frames until the window closes (or, with a screenshot asked for, until
+// the opened project is drawn).
 void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions& options,
           ReplayRecorder* recorder) {
   auto last = std::chrono::steady_clock::now();
@@ -366,6 +386,7 @@ void live(Workbench& bench, render::WindowDevice& window, const WorkbenchOptions
       layout_written = true;
     }
     if (!options.screenshot.empty()) {
+      settle(bench, window);
       bench.screenshot(options.screenshot);
       return;  // a screenshot of the opened project is all that was asked for
     }

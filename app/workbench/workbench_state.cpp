@@ -16,7 +16,9 @@ WorkbenchState::WorkbenchState(const WorkbenchOptions& options, render::WindowDe
     : options(options),
       window(window),
       session(options.project, options.read_only || Session::cannot_write(options.project)) {
-  settings.culling.budget = 1'500'000;
+  // A store to build first: in the background, the window showing it.
+  if (!session.store_current())
+    command.ask("Building the 3D view (level of detail)", [this] { session.prepare_views(); });
   // Proposals left in their group by an earlier session are still to review.
   const std::string proposals = modeling::ProposeSettings{}.group_name;
   for (const store::ObjectNode& n : session.nodes()) {
@@ -186,20 +188,19 @@ void WorkbenchState::group() {
 }
 
 void WorkbenchState::frame_whole_model() {
-  const render::RenderModel& model = session.render_model();
-  const std::size_t n = model.points.size();
-  if (n == 0) return;
-  const std::size_t step = std::max<std::size_t>(1, n / 20000);
+  if (!renderer) return;
+  const std::vector<render::LodSample> sample = renderer->sample(20000);
+  if (sample.empty()) return;
   std::array<std::vector<float>, 3> axes;
-  for (std::size_t k = 0; k < n; k += step)
-    for (int a = 0; a < 3; ++a)
-      axes[static_cast<std::size_t>(a)].push_back(model.points.position[k][a]);
+  for (const render::LodSample& p : sample)
+    for (int a = 0; a < 3; ++a) axes[static_cast<std::size_t>(a)].push_back(p.position[a]);
+  const Eigen::Vector3d origin = model_origin();
   Eigen::AlignedBox3d box;
   for (int a = 0; a < 3; ++a) {
     std::vector<float>& v = axes[static_cast<std::size_t>(a)];
     std::sort(v.begin(), v.end());
-    box.min()[a] = v[v.size() / 50] + model.origin[a];
-    box.max()[a] = v[v.size() - 1 - v.size() / 50] + model.origin[a];
+    box.min()[a] = v[v.size() / 50] + origin[a];
+    box.max()[a] = v[v.size() - 1 - v.size() / 50] + origin[a];
   }
   navigation.frame(box);
   view_dirty = true;
@@ -208,18 +209,16 @@ void WorkbenchState::frame_whole_model() {
 void WorkbenchState::frame_selection() {
   const auto p = primary();
   const std::optional<store::ObjectNode> n = p ? node(*p) : std::nullopt;
-  if (!n || !n->bbox_world) {
+  if (!n || !n->bbox_world || !renderer) {
     frame_whole_model();
     return;
   }
   // The side the node's points were seen from: their normals point towards
   // their scanners, so their sum points out of its visible side.
   const std::set<std::int64_t> inside = subtree(n->id);
-  const render::RenderPoints& points = session.render_model().points;
   Eigen::Vector3d facing = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    if (points.node[k] != 0 && inside.count(points.node[k]))
-      facing += points.normal[k].cast<double>();
+  for (const render::LodSample& point : renderer->sample(200000)) {
+    if (point.object != 0 && inside.count(point.object)) facing += point.normal.cast<double>();
   }
   navigation.frame(*n->bbox_world, facing);
   view_dirty = true;
@@ -238,8 +237,17 @@ void WorkbenchState::clip_to_selection() {
   view_dirty = true;
 }
 
+bool WorkbenchState::view_settled() const {
+  if (!renderer) return renderer_generation == session.store_generation();
+  return !view_dirty && last_plan.wanted.empty() && last_plan.stopped_by_budget == 0;
+}
+
+Eigen::Vector3d WorkbenchState::model_origin() const {
+  return renderer ? renderer->header().origin : Eigen::Vector3d::Zero();
+}
+
 void WorkbenchState::apply_clipping() {
-  const Eigen::Vector3d origin = session.render_model().origin;
+  const Eigen::Vector3d origin = model_origin();
   render::Clipping clipping;
   if (clip_on) {
     // Corners dragged past each other still make a box.
@@ -264,17 +272,16 @@ void WorkbenchState::apply_clipping() {
   view_dirty = true;
 }
 
-std::optional<render::Pick> WorkbenchState::point_under(double x, double y) {
+std::optional<render::LodPick> WorkbenchState::point_under(double x, double y) {
   const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
-  const render::RenderModel& model = session.render_model();
-  const render::RenderView view = render::make_render_view(navigation.camera(w, h), model.origin);
-  return render::pick_point(model, view.eye, render::pixel_ray(view, x - view3d.x, y - view3d.y),
-                            settings.culling.clipping, settings.splat_scale, settings.oriented);
+  if (!renderer || w <= 0 || h <= 0) return std::nullopt;
+  const render::RenderView view = render::make_render_view(navigation.camera(w, h), model_origin());
+  return renderer->pick(view.eye, render::pixel_ray(view, x - view3d.x, y - view3d.y), settings);
 }
 
 void WorkbenchState::select_in_3d(double x, double y, bool toggle) {
-  const std::optional<render::Pick> pick = point_under(x, y);
-  const std::int64_t id = pick ? session.render_model().points.node[pick->point] : 0;
+  const std::optional<render::LodPick> pick = point_under(x, y);
+  const std::int64_t id = pick ? pick->object : 0;
   if (toggle) {
     if (id == 0) return;
     if (!selected.erase(id)) selected.insert(id);
@@ -289,8 +296,8 @@ void WorkbenchState::select_in_3d(double x, double y, bool toggle) {
 }
 
 void WorkbenchState::pick_at(double x, double y) {
-  const std::optional<render::Pick> pick = point_under(x, y);
-  if (pick) add_pick(session.render_model().origin + pick->position.cast<double>());
+  const std::optional<render::LodPick> pick = point_under(x, y);
+  if (pick) add_pick(model_origin() + pick->position.cast<double>());
 }
 
 void WorkbenchState::pick_in_panorama(double x, double y) {
@@ -326,10 +333,9 @@ void WorkbenchState::finish_measurement() {
 
 std::optional<ImVec2> WorkbenchState::screen_of(const Eigen::Vector3d& p) const {
   const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
-  if (w <= 0 || h <= 0 || !session.has_render_model()) return std::nullopt;
-  const render::RenderView view =
-      render::make_render_view(navigation.camera(w, h), session.render_model_origin());
-  const Eigen::Vector4f model((p - session.render_model_origin()).cast<float>().homogeneous());
+  if (w <= 0 || h <= 0 || !renderer) return std::nullopt;
+  const render::RenderView view = render::make_render_view(navigation.camera(w, h), model_origin());
+  const Eigen::Vector4f model((p - model_origin()).cast<float>().homogeneous());
   const Eigen::Vector4f clip = view.projection * view.view * model;
   if (clip.w() <= 1e-6f) return std::nullopt;
   const float nx = clip.x() / clip.w(), ny = clip.y() / clip.w();

@@ -19,6 +19,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -26,8 +27,9 @@
 #include "app/workbench/navigation.hpp"
 #include "app/workbench/session.hpp"
 #include "app/workbench/workbench.hpp"
+#include "render/frame_budget.hpp"
+#include "render/lod_renderer.hpp"
 #include "render/pick.hpp"
-#include "render/splat_renderer.hpp"
 #include "render/window/window_device.hpp"
 
 namespace scanbench::app::workbench {
@@ -74,12 +76,23 @@ struct WorkbenchState {
   // ---- The 3D view --------------------------------------------------------
   Navigation navigation;
   render::RenderSettings settings;
-  std::unique_ptr<render::SplatRenderer> renderer;
-  std::int64_t renderer_generation = -1;  // of the model it was built from
-  render::FramePlan last_plan;
+  // The store the session names, drawn streaming (render/lod_renderer.hpp):
+  // moving frames keep to a time target through the point budget, then the
+  // frames refine until the picture is complete.
+  std::unique_ptr<render::LodRenderer> renderer;
+  std::int64_t renderer_generation = -1;  // of the store it draws
+  std::int64_t shown_revision = -1;       // the session's revision it was last told of
+  // What it shows of the tree (ids, parents, visibility, colour edits) and
+  // when the scans' corrections last changed.
+  std::vector<std::tuple<std::int64_t, std::optional<std::int64_t>, bool, store::ColorEdit>>
+      shown_objects;
+  std::int64_t shown_corrections = -1;
+  render::LodFramePlan last_plan;
+  float frame_target_ms = 100.0f;
+  render::FrameBudget budget{100.0};
   double last_draw_ms = 0.0;  // the last 3D draw: wall time, finished on the device
   double last_gpu_ms = -1.0;  // ... and the device's own time (negative: unknown)
-  bool view_dirty = true;
+  bool view_dirty = true;     // the camera or what the view shows changed
   bool fly = false;
 
   // ---- What the 3D view draws: a clipping box and a slice (world [m]) ----
@@ -219,7 +232,12 @@ struct WorkbenchState {
   // What the view does not draw (hidden, clipped, sliced away) is not hit.
   void select_in_3d(double x, double y, bool toggle);
   // The point of the model drawn under window point (x, y) of the 3D view.
-  std::optional<render::Pick> point_under(double x, double y);
+  std::optional<render::LodPick> point_under(double x, double y);
+  // The 3D view shows all it will until something changes: no frame is
+  // due (a move, a refinement, nodes loading), or there is nothing to draw.
+  bool view_settled() const;
+  // World = this + model frame: the store's origin (zero without one).
+  Eigen::Vector3d model_origin() const;
   // Window point of world point `p` in the 3D view; none behind the eye.
   std::optional<ImVec2> screen_of(const Eigen::Vector3d& p) const;
 

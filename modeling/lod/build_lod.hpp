@@ -65,10 +65,11 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
                          core::Progress& progress);
 
 // What a store reflects of its project: a command that writes none of
-// these (a recolour of the scans, a measurement) leaves it current.
+// these (a harmonisation, a hide, a recolour, a measurement) leaves it
+// current.
 inline constexpr store::ProjectDataSet kLodInputs =
     store::ProjectData::kScans | store::ProjectData::kGeometry | store::ProjectData::kPoses |
-    store::ProjectData::kMerge | store::ProjectData::kObjects;
+    store::ProjectData::kMerge | store::ProjectData::kMembership;
 
 // The store beside `project` (LodStore::path_for) when it reflects the
 // project as it is now; none when it is missing, unreadable, or older than

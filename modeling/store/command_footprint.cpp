@@ -13,7 +13,10 @@ using D = ProjectData;
 
 // Everything a command on the object tree computes from: the points and
 // where they are (an object's figures and its growth into other scans).
-constexpr ProjectDataSet kObjectInputs = D::kScans | D::kGeometry | D::kPoses | D::kObjects;
+constexpr ProjectDataSet kObjectInputs =
+    D::kScans | D::kGeometry | D::kPoses | D::kObjects | D::kMembership;
+// What a command that moves points between objects writes.
+constexpr ProjectDataSet kObjectsAndPoints = D::kObjects | D::kMembership;
 
 constexpr ProjectDataSet only(ProjectData data) {
   return static_cast<ProjectDataSet>(data);
@@ -22,20 +25,20 @@ constexpr ProjectDataSet only(ProjectData data) {
 constexpr std::array<std::pair<std::string_view, CommandFootprint>, 18> kFootprints = {{
     {"import", {0, D::kScans | D::kPoses | D::kMerge}},
     {"geometry", {only(D::kScans), D::kGeometry | D::kMerge}},
-    {"register", {kObjectInputs, D::kPoses | D::kMerge | D::kObjects}},
+    {"register", {kObjectInputs, D::kPoses | D::kMerge | kObjectsAndPoints}},
     {"merge", {D::kScans | D::kGeometry | D::kPoses, only(D::kMerge)}},
     {"harmonize",
      {D::kScans | D::kGeometry | D::kPoses | D::kColorCorrections, only(D::kColorCorrections)}},
     {"select", {kObjectInputs, only(D::kSelections)}},  // in older journals
     {"keep_selection", {0, only(D::kSelections)}},
-    {"commit", {kObjectInputs, D::kObjects | D::kSelections}},  // it removes a kept selection
-    {"separate", {kObjectInputs, only(D::kObjects)}},
-    {"propose", {kObjectInputs, only(D::kObjects)}},
-    {"delete", {kObjectInputs, only(D::kObjects)}},
+    {"commit", {kObjectInputs, kObjectsAndPoints | D::kSelections}},  // it removes a kept selection
+    {"separate", {kObjectInputs, kObjectsAndPoints}},
+    {"propose", {kObjectInputs, kObjectsAndPoints}},
+    {"delete", {kObjectInputs, kObjectsAndPoints}},
     {"group", {kObjectInputs, only(D::kObjects)}},
     {"edit", {kObjectInputs, only(D::kObjects)}},
     {"ungroup", {kObjectInputs, only(D::kObjects)}},
-    {"merge_objects", {kObjectInputs, only(D::kObjects)}},
+    {"merge_objects", {kObjectInputs, kObjectsAndPoints}},
     {"recolor", {only(D::kObjects), only(D::kObjects)}},
     // A clone measures the source's colours as shown: corrections included.
     {"clone", {kObjectInputs | D::kColorCorrections, only(D::kObjects)}},
@@ -59,7 +62,7 @@ struct DataNames {
   const char* name;  // in messages
 };
 
-constexpr std::array<DataNames, 8> kDataNames = {{
+constexpr std::array<DataNames, 9> kDataNames = {{
     {D::kScans, "scans", "scans"},
     {D::kGeometry, "geometry", "geometry"},
     {D::kPoses, "poses", "poses"},
@@ -68,6 +71,7 @@ constexpr std::array<DataNames, 8> kDataNames = {{
     {D::kObjects, "objects", "objects"},
     {D::kMeasurements, "measurements", "measurements"},
     {D::kSelections, "selections", "kept selections"},
+    {D::kMembership, "membership", "objects' points"},
 }};
 
 const DataNames& names_of(ProjectData data) {

@@ -22,10 +22,13 @@ enum class ProjectData : std::uint32_t {
   kObjects = 1u << 5,           // the object tree, memberships, object colours
   kMeasurements = 1u << 6,      // the measurements list
   kSelections = 1u << 7,        // selections kept for the next session (no command reads them)
+  // Which object owns each point (the membership layers): a part of the
+  // objects that a hide, a rename or a recolour leaves as it was.
+  kMembership = 1u << 8,
 };
 
 using ProjectDataSet = std::uint32_t;
-inline constexpr ProjectDataSet kAllProjectData = (1u << 8) - 1;
+inline constexpr ProjectDataSet kAllProjectData = (1u << 9) - 1;
 
 constexpr ProjectDataSet operator|(ProjectData a, ProjectData b) {
   return static_cast<ProjectDataSet>(a) | static_cast<ProjectDataSet>(b);

@@ -123,7 +123,7 @@ TEST(LodRenderer, DrawsTheStoreAsTheRenderModelDrawsItsProject) {
   // Hidden: the next frame leaves the wall out, from the nodes on the
   // device (the store is as it was; no node is read or uploaded again).
   modeling::edit_node(project, {wall.node_id, std::nullopt, true, std::nullopt, {}});
-  EXPECT_FALSE(lod::current_lod_store(project));  // the tree changed; the points did not
+  EXPECT_EQ(lod::current_lod_store(project), store);  // the tree changed, not its points
   renderer.show_project_state(project);
   const LodFrameResult hidden_frame = renderer.draw_complete(view, every_point());
   EXPECT_EQ(hidden_frame.uploaded_nodes, 0u);
@@ -139,6 +139,14 @@ TEST(LodRenderer, DrawsTheStoreAsTheRenderModelDrawsItsProject) {
   objects.color = ColorMode::kObject;
   renderer.draw_complete(view, objects);
   EXPECT_GT(compare(renderer.read_image(), render_model(project, objects)).psnr_db, 35.0);
+
+  // Points that change hands make it out of date, and undoing that does
+  // not make it current again (the project changed after it was built).
+  static_cast<void>(tools.select(project, modeling::select_at(scan, 0, -45)));
+  tools.commit(project, {scan, "floor", std::nullopt});
+  EXPECT_FALSE(lod::current_lod_store(project));
+  project.undo();
+  EXPECT_FALSE(lod::current_lod_store(project));
 }
 
 TEST(LodRenderer, RefinesFrameByFrameToTheCompletePicture) {
@@ -154,7 +162,9 @@ TEST(LodRenderer, RefinesFrameByFrameToTheCompletePicture) {
   for (const lod::LodNodeInfo& node : room.hierarchy.nodes)
     largest_node = std::max<std::uint64_t>(largest_node, node.points * sizeof(lod::LodPoint));
   LodFrameResult frame = streaming.draw(view, settings);
-  EXPECT_EQ(frame.plan.submitted, 0u);  // nothing on the device yet
+  // The first frame waits for the root alone.
+  EXPECT_EQ(frame.plan.draws.size(), 1u);
+  EXPECT_EQ(frame.plan.draws.front().node, 0u);
   EXPECT_FALSE(frame.complete());
   std::size_t frames = 1, previous = 0;
   bool grew = true;
