@@ -9,7 +9,6 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <thread>
 
 #include "acquisition/camera_view.hpp"
 #include "acquisition/formats/picture_file.hpp"
@@ -163,10 +162,10 @@ void render_path(RenderOptions& options) {
   settings.culling.budget = options.settings.culling.budget;
   const render::RenderView last = render::make_render_view(cameras.back(), origin);
   std::size_t refining_frames = 0;
-  while (!renderer.draw(last, settings).complete()) {
+  // As the workbench refines a still view: each frame waits up to 250 ms
+  // for the nodes being read.
+  while (!renderer.draw(last, settings, std::chrono::milliseconds(250)).complete())
     ++refining_frames;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the loader's turn
-  }
   const double converge_seconds = since(still);
   write_picture(renderer, options.output);
   nlohmann::json out = settings_json(options, session);

@@ -5,7 +5,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
@@ -17,8 +16,6 @@
 #include "modeling/lod/lod_store.hpp"
 #include "render/device.hpp"
 #include "render/lod_renderer.hpp"
-#include "render/render_model.hpp"
-#include "render/splat_renderer.hpp"
 
 namespace scanbench::bench {
 namespace {
@@ -58,32 +55,33 @@ std::vector<std::uint8_t> covered_of(const render::RenderedImage& image) {
 
 // Each view as the streaming renderer draws it once the camera stops,
 // from cold caches (a renderer just opened): the frames until the picture
-// is complete, and that picture against the truth and against the render
-// model's renderer (every point in memory, its own level of detail).
+// is complete, and that picture against the truth and against the full
+// picture (every point of the store drawn, no level of detail).
 nlohmann::json measure_views(const std::filesystem::path& project, const SimulatedSite& site,
                              int width, int height) {
   const sim::Site scene_site =
       sim::make_site("campus", kSiteSeed, static_cast<int>(site.scans.size()));
   const std::unique_ptr<render::RenderDevice> device = render::make_headless_device();
-  const render::RenderModel model = render::build_render_model(store::Project::open(project), {});
-  render::SplatRenderer full(model);
+  const std::filesystem::path store = lod::LodStore::path_for(project);
+  render::LodRenderer full(store, {});
   render::RenderSettings settings;
   settings.background = {sim::kSkyRgb[0], sim::kSkyRgb[1], sim::kSkyRgb[2]};
+  render::RenderSettings every_point = settings;
+  every_point.culling.level_of_detail = false;
   nlohmann::json views = nlohmann::json::object();
   for (const NamedView& view : campus_views(width, height)) {
     const sim::TruthImage truth = sim::render_truth_view(scene_site.scene, view.camera);
     const std::vector<std::uint8_t> mask = sampled_mask(truth, view.camera, site);
-    full.draw(render::make_render_view(view.camera, model.origin), settings);
+    full.draw_complete(render::make_render_view(view.camera, full.header().origin), every_point);
     const render::RenderedImage full_image = full.read_image();
-    render::LodRenderer streaming(lod::LodStore::path_for(project), {});
+    render::LodRenderer streaming(store, {});
     const render::RenderView camera =
         render::make_render_view(view.camera, streaming.header().origin);
     const auto start = std::chrono::steady_clock::now();
     std::size_t frames = 1;
-    while (!streaming.draw(camera, settings).complete()) {
-      ++frames;
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the loader's turn
-    }
+    // As the workbench refines a still view: each frame waits up to 250 ms
+    // for the nodes being read.
+    while (!streaming.draw(camera, settings, std::chrono::milliseconds(250)).complete()) ++frames;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const render::RenderedImage image = streaming.read_image();

@@ -18,11 +18,13 @@
 //     frame count, the slowest frame, the seconds to complete the last
 //     picture once still);
 //   - "views": for each bench camera, the streaming renderer from cold
-//     caches, frame after frame until the picture is complete
+//     caches, frame after frame (each waiting up to 250 ms for the nodes
+//     being read, as the workbench refines) until the picture is complete
 //     ("converge_seconds", "converge_frames"), that picture's PSNR against
 //     the truth over the pixels some scan sampled ("converged_psnr_db"),
-//     the render model renderer's ("full_renderer_psnr_db"), and the two
-//     pictures against each other ("against_full_renderer_psnr_db").
+//     the full picture's (every point of the store drawn, no level of
+//     detail: "full_renderer_psnr_db"), and the two pictures against each
+//     other ("against_full_renderer_psnr_db").
 // The figures of edits in place and 3D selection are null until they exist.
 #pragma once
 

@@ -1,6 +1,6 @@
 // The protocol: the campus at seed 1, 4 scans at their true poses, lit as
-// the truth pictures are, their geometry and merge; the render model of the
-// merged points. For three
+// the truth pictures are, their geometry and merge; the level-of-detail
+// store of the merged points, drawn complete. For three
 // cameras ("closeup": Keller Hall's west façade from 9 m, scanned from
 // 20–35 m; "street": eye height across the quad; "overview": from 90 m up
 // and away) the simulator ray-casts the truth picture (reference lighting,
@@ -8,7 +8,7 @@
 // truth's surface was sampled by some scan (sampled_mask): a roof no scanner
 // saw, or ground so far off that the scans' rows are more than 8 footprints
 // apart, is not a hole of the renderer. Frame times: the street view, blended, the median
-// of 5 frames after a warm-up, culling (frustum, normal cones, level of
+// of 5 frames after a warm-up, culling (frustum, facing away, level of
 // detail) on and off.
 #include "bench/bench_render.hpp"
 
@@ -26,13 +26,13 @@
 #include "bench/image_metrics.hpp"
 #include "bench/scratch_folder.hpp"
 #include "bench/simulated_site.hpp"
+#include "modeling/lod/build_lod.hpp"
 #include "modeling/store/layer_store.hpp"
 #include "modeling/store/typed_layers.hpp"
 #include "registration/merge.hpp"
 #include "registration/prepared_scan.hpp"
 #include "render/device.hpp"
-#include "render/render_model.hpp"
-#include "render/splat_renderer.hpp"
+#include "render/lod_renderer.hpp"
 
 namespace scanbench::bench {
 
@@ -41,11 +41,12 @@ namespace {
 namespace sim = acquisition::sim;
 
 // The campaign in a project (true poses, geometry, the merge's keep masks)
-// and its render model: the path `scanbench render` takes.
-render::RenderModel campus_model(const SimulatedSite& site, const ScratchFolder& scratch) {
+// and its level-of-detail store: the path `scanbench render` takes.
+std::filesystem::path campus_store(const SimulatedSite& site, const ScratchFolder& scratch) {
   const std::filesystem::path file = scratch.path() / "render.sbproj";
   store_site_project(site, file);
-  return render::build_render_model(store::Project::open(file), {});
+  core::Progress quiet;
+  return lod::build_lod(store::Project::open(file), {}, quiet).store;
 }
 
 struct ViewFigures {
@@ -53,8 +54,8 @@ struct ViewFigures {
   double blended_minus_points_db = 0.0;
 };
 
-ViewFigures measure_view(render::SplatRenderer& renderer, const render::RenderModel& model,
-                         const sim::Scene& scene, const NamedView& view, const SimulatedSite& site,
+ViewFigures measure_view(render::LodRenderer& renderer, const sim::Scene& scene,
+                         const NamedView& view, const SimulatedSite& site,
                          const std::filesystem::path& pictures) {
   const sim::TruthImage truth = sim::render_truth_view(scene, view.camera);
   const std::vector<std::uint8_t> mask = sampled_mask(truth, view.camera, site);
@@ -65,7 +66,7 @@ ViewFigures measure_view(render::SplatRenderer& renderer, const render::RenderMo
                                    truth.width, truth.height, rgb);
   };
   picture("truth", truth.rgb);
-  const render::RenderView camera = render::make_render_view(view.camera, model.origin);
+  const render::RenderView camera = render::make_render_view(view.camera, renderer.header().origin);
   ViewFigures out;
   double points_db = 0.0;
   for (const render::DrawMode mode :
@@ -73,7 +74,7 @@ ViewFigures measure_view(render::SplatRenderer& renderer, const render::RenderMo
     render::RenderSettings settings;
     settings.mode = mode;
     settings.background = {sim::kSkyRgb[0], sim::kSkyRgb[1], sim::kSkyRgb[2]};
-    const render::FrameResult frame = renderer.draw(camera, settings);
+    const render::LodFrameResult frame = renderer.draw_complete(camera, settings);
     const render::RenderedImage image = renderer.read_image();
     std::vector<std::uint8_t> rgb(truth.rgb.size()), covered(mask.size());
     for (std::size_t i = 0; i < covered.size(); ++i) {
@@ -100,7 +101,7 @@ ViewFigures measure_view(render::SplatRenderer& renderer, const render::RenderMo
     out.modes["sampled_pixels"] = c.pixels;
     if (mode == render::DrawMode::kBlended) {  // what the splats alone leave open
       settings.fill_reach_px = 0;
-      renderer.draw(camera, settings);
+      renderer.draw_complete(camera, settings);
       const render::RenderedImage unfilled = renderer.read_image();
       std::size_t open = 0;
       for (std::size_t i = 0; i < mask.size(); ++i)
@@ -114,13 +115,14 @@ ViewFigures measure_view(render::SplatRenderer& renderer, const render::RenderMo
   return out;
 }
 
-// The median frame time of `frames` frames after one to warm up.
-double median_frame_ms(render::SplatRenderer& renderer, const render::RenderView& view,
+// The median frame time of `frames` frames after one to warm up (and to
+// load what the view wants).
+double median_frame_ms(render::LodRenderer& renderer, const render::RenderView& view,
                        const render::RenderSettings& settings, int frames,
-                       render::FramePlan* plan) {
-  *plan = renderer.draw(view, settings).plan;
+                       render::LodFramePlan* plan) {
+  *plan = renderer.draw_complete(view, settings).plan;
   std::vector<double> times;
-  for (int k = 0; k < frames; ++k) times.push_back(renderer.draw(view, settings).frame_ms);
+  for (int k = 0; k < frames; ++k) times.push_back(renderer.draw_complete(view, settings).frame_ms);
   std::nth_element(times.begin(), times.begin() + frames / 2, times.end());
   return times[static_cast<std::size_t>(frames / 2)];
 }
@@ -128,7 +130,7 @@ double median_frame_ms(render::SplatRenderer& renderer, const render::RenderView
 }  // namespace
 
 // Longer than 60 lines, but flat: the suite's cameras and measurements in
-// order, sharing the simulated site and its render model.
+// order, sharing the simulated site and its store.
 nlohmann::json run_render_bench(const BenchOptions& options) {
   sim::ScannerModel scanner;
   if (options.smoke) {
@@ -143,28 +145,29 @@ nlohmann::json run_render_bench(const BenchOptions& options) {
   const sim::Site scene_site = sim::make_site("campus", kSiteSeed, scan_count);
   const ScratchFolder scratch("render");
   const auto build_start = std::chrono::steady_clock::now();
-  const render::RenderModel model = campus_model(site, scratch);
+  const std::filesystem::path store = campus_store(site, scratch);
   const double build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 
   const std::unique_ptr<render::RenderDevice> device = render::make_headless_device();
-  render::SplatRenderer renderer(model);
+  render::LodRenderer renderer(store, {});
   nlohmann::json views = nlohmann::json::object();
   double closeup_gain_db = 0.0, worst_hole = 0.0;
   for (const NamedView& view : campus_views(width, height)) {
     const ViewFigures figures =
-        measure_view(renderer, model, scene_site.scene, view, site, options.pictures);
+        measure_view(renderer, scene_site.scene, view, site, options.pictures);
     views[view.name] = figures.modes;
     worst_hole = std::max(worst_hole, figures.modes["blended"]["hole_fraction"].get<double>());
     if (std::string(view.name) == "closeup") closeup_gain_db = figures.blended_minus_points_db;
   }
 
   const NamedView street = campus_views(width, height)[1];
-  const render::RenderView street_view = render::make_render_view(street.camera, model.origin);
+  const render::RenderView street_view =
+      render::make_render_view(street.camera, renderer.header().origin);
   render::RenderSettings culled, unculled;
   unculled.culling.frustum = unculled.culling.backface = unculled.culling.level_of_detail = false;
   const int frames = options.smoke ? 1 : 5;
-  render::FramePlan plan_on, plan_off;
+  render::LodFramePlan plan_on, plan_off;
   const double on_ms = median_frame_ms(renderer, street_view, culled, frames, &plan_on);
   const double off_ms = median_frame_ms(renderer, street_view, unculled, frames, &plan_off);
   const double culled_share =
@@ -173,9 +176,9 @@ nlohmann::json run_render_bench(const BenchOptions& options) {
   return {{"suite", "render"},
           {"site", "campus"},
           {"scans", scan_count},
-          {"points", model.points.size()},
-          {"tiles", model.tiles.size()},
-          {"model_build_seconds", build_seconds},
+          {"points", renderer.header().points},
+          {"nodes", renderer.hierarchy().nodes.size()},
+          {"store_build_seconds", build_seconds},
           {"width", width},
           {"height", height},
           {"device", device->describe()},
@@ -186,8 +189,8 @@ nlohmann::json run_render_bench(const BenchOptions& options) {
           {"culled_share", culled_share},
           {"street_culled",
            {{"frustum", plan_on.culled_frustum},
-            {"backface", plan_on.culled_backface},
-            {"level_of_detail", plan_on.culled_budget},
+            {"level_of_detail",
+             plan_on.points - plan_on.submitted - plan_on.culled_frustum - plan_on.culled_clip},
             {"submitted", plan_on.submitted}}},
           {"closeup_blended_minus_points_db", closeup_gain_db},
           {"blended_hole_fraction_worst", worst_hole},

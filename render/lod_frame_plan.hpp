@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "modeling/lod/lod_store.hpp"
-#include "render/frame_plan.hpp"
+#include "render/clipping.hpp"
 #include "render/render_view.hpp"
 
 namespace scanbench::render {

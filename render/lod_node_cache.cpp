@@ -91,6 +91,12 @@ void LodNodeCache::wait_idle() {
   idle_.wait(lock, [this] { return queue_.empty() && loading_ == SIZE_MAX; });
 }
 
+bool LodNodeCache::wait_idle_until(std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  return idle_.wait_until(lock, deadline,
+                          [this] { return queue_.empty() && loading_ == SIZE_MAX; });
+}
+
 void LodNodeCache::load_loop() {
   std::optional<lod::LodStore> store;
   std::unique_lock lock(mutex_);

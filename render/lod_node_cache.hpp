@@ -9,6 +9,7 @@
 // thread's; the spans points() gives stay valid until the next collect().
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
@@ -60,6 +61,8 @@ class LodNodeCache {
   bool busy() const;
   // Waits until the loader is idle (a picture that must be complete, tests).
   void wait_idle();
+  // The same, giving up at `deadline`; whether it is idle.
+  bool wait_idle_until(std::chrono::steady_clock::time_point deadline);
 
  private:
   struct Resident {

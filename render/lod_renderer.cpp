@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <limits>
 #include <numeric>
+#include <queue>
 #include <unordered_map>
 
 #include "core/errors.hpp"
@@ -74,7 +75,7 @@ struct LodRenderer::Gpu {
     std::uint64_t last_frame = 0;
   };
 
-  SplatPasses passes{shaders::lod_splat_vertex()};
+  SplatPasses passes{shaders::splat_vertex()};
   GlVertexArray points;
   GlBuffer objects;  // ObjectStates (splat_shaders.cpp)
   GlBuffer scans;    // ScanCorrections
@@ -106,6 +107,17 @@ LodRenderer::LodRenderer(const std::filesystem::path& store_file, const LodRende
   const lod::LodStore store = lod::LodStore::open(store_file);
   hierarchy_ = LodHierarchy::of(store);
   for (const lod::LodScan& scan : store.scans()) scan_of_id_[scan.scan_id] = scan.index;
+  // Children after parents: backwards, each subtree's radius is whole
+  // before its parent takes it in.
+  subtree_radius_.resize(hierarchy_.nodes.size());
+  for (std::size_t k = hierarchy_.nodes.size(); k-- > 0;) {
+    subtree_radius_[k] = std::max(subtree_radius_[k], hierarchy_.nodes[k].max_radius_m);
+    for (const std::int32_t child : hierarchy_.children[k]) {
+      if (child >= 0)
+        subtree_radius_[k] =
+            std::max(subtree_radius_[k], subtree_radius_[static_cast<std::size_t>(child)]);
+    }
+  }
   if (!hierarchy_.reach.empty() && !hierarchy_.reach.front().isEmpty())
     height_range_ = {hierarchy_.reach.front().min().z(), hierarchy_.reach.front().max().z()};
   std::vector<lod::NodeKey> keys;
@@ -291,73 +303,69 @@ void LodRenderer::refuse_failed(const std::vector<std::size_t>& wanted) const {
   }
 }
 
-LodFrameResult LodRenderer::draw(const RenderView& picture_view, const RenderSettings& settings) {
+LodFrameResult LodRenderer::draw(const RenderView& picture_view, const RenderSettings& settings,
+                                 std::chrono::milliseconds wait_for_nodes) {
   const auto start = std::chrono::steady_clock::now();
-  Gpu& gpu = *gpu_;
-  ++gpu.frame;
-  const RenderView view = SplatPasses::banded(picture_view);
-  LodFrameResult result;
-  const auto ms_since = [](std::chrono::steady_clock::time_point from) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - from)
-        .count();
-  };
-  gpu.memory->collect(gpu.pending);
-  auto lap = std::chrono::steady_clock::now();
-  result.plan = plan(view, settings);
-  if (gpu.device.empty() && !result.plan.wanted.empty()) {
-    // The very first frame: the root is worth the wait of one node.
-    gpu.memory->request({result.plan.wanted.front()});
-    gpu.memory->wait_idle();
-    gpu.memory->collect(result.plan.wanted);
-  }
-  result.plan_ms = ms_since(lap);
-  refuse_failed(result.plan.wanted);
-  lap = std::chrono::steady_clock::now();
-  const std::size_t uploaded = upload(result.plan.wanted, limits_.upload_bytes_per_frame, result);
-  result.upload_ms = ms_since(lap);
-  if (uploaded > 0) {
-    lap = std::chrono::steady_clock::now();
-    result.plan = plan(view, settings);
-    result.plan_ms += ms_since(lap);
-  }
-  gpu.pending.clear();
-  for (const std::size_t node : result.plan.wanted) {
-    if (gpu.memory->loaded(node)) gpu.pending.push_back(node);
-  }
-  gpu.memory->request(result.plan.wanted);
-  result.gpu_ms = issue(view, settings, result.plan);
-  gpu.evict(limits_.device_bytes);
-  result.frame_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return result;
+  return frame(picture_view, settings, start + wait_for_nodes, limits_.upload_bytes_per_frame);
 }
 
 LodFrameResult LodRenderer::draw_complete(const RenderView& picture_view,
                                           const RenderSettings& settings) {
-  const auto start = std::chrono::steady_clock::now();
+  return frame(picture_view, settings, std::nullopt, 0);
+}
+
+LodFrameResult LodRenderer::frame(const RenderView& picture_view, const RenderSettings& settings,
+                                  std::optional<std::chrono::steady_clock::time_point> until,
+                                  std::uint64_t upload_limit) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const auto ms_since = [](Clock::time_point from) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - from).count();
+  };
   Gpu& gpu = *gpu_;
   ++gpu.frame;
   const RenderView view = SplatPasses::banded(picture_view);
   LodFrameResult result;
+  // The very first frame waits for the root: one node is worth the wait.
+  const bool first = gpu.device.empty();
   while (true) {
     gpu.memory->collect(gpu.pending);
+    auto lap = Clock::now();
     result.plan = plan(view, settings);
-    if (upload(result.plan.wanted, 0, result) > 0) continue;
+    result.plan_ms += ms_since(lap);
     refuse_failed(result.plan.wanted);
+    lap = Clock::now();
+    const std::size_t uploaded = upload(result.plan.wanted, upload_limit, result);
+    result.upload_ms += ms_since(lap);
+    if (uploaded > 0) {
+      lap = Clock::now();
+      result.plan = plan(view, settings);
+      result.plan_ms += ms_since(lap);
+    }
+    gpu.pending.clear();
     std::vector<std::size_t> missing;
     for (const std::size_t node : result.plan.wanted) {
-      if (!gpu.memory->loaded(node)) missing.push_back(node);
+      (gpu.memory->loaded(node) ? gpu.pending : missing).push_back(node);
     }
-    if (result.plan.wanted.empty()) break;
-    gpu.pending = result.plan.wanted;
     gpu.memory->request(missing);
-    gpu.memory->wait_idle();
+    if (result.plan.wanted.empty()) break;
+    if (first && gpu.device.empty()) {
+      gpu.memory->wait_idle();
+      continue;
+    }
+    // Nodes read since could be drawn now: another round while time is left.
+    if (until && Clock::now() >= *until) break;
+    if (upload_limit > 0 && result.uploaded_bytes >= upload_limit) break;
+    if (missing.empty()) continue;  // in memory, waiting for the upload limit of a later round
+    if (until) {
+      if (!gpu.memory->wait_idle_until(*until)) break;
+    } else {
+      gpu.memory->wait_idle();
+    }
   }
-  gpu.pending.clear();
   result.gpu_ms = issue(view, settings, result.plan);
   gpu.evict(limits_.device_bytes);
-  result.frame_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.frame_ms = ms_since(start);
   return result;
 }
 
@@ -367,13 +375,14 @@ bool LodRenderer::has_more_to_draw() {
                      [&](std::size_t k) { return gpu_->memory->loaded(k); });
 }
 
-std::vector<lod::LodPoint> LodRenderer::node_points(std::size_t k) {
+void LodRenderer::with_node_points(std::size_t k,
+                                   const std::function<void(std::span<const lod::LodPoint>)>& use) {
   if (gpu_->memory->loaded(k)) {
-    const std::span<const lod::LodPoint> points = gpu_->memory->points(k);
-    return {points.begin(), points.end()};
+    use(gpu_->memory->points(k));
+    return;
   }
   if (!reader_) reader_.emplace(lod::LodStore::open(store_file_));
-  return reader_->read_points(hierarchy_.nodes[k].key);
+  use(reader_->read_points(hierarchy_.nodes[k].key));
 }
 
 std::optional<LodPick> LodRenderer::pick(const Eigen::Vector3f& origin,
@@ -381,45 +390,58 @@ std::optional<LodPick> LodRenderer::pick(const Eigen::Vector3f& origin,
                                          const RenderSettings& settings) {
   const Clipping& clipping = settings.culling.clipping;
   const float scale = settings.splat_scale;
-  const lod::OctreeCube& cube = hierarchy_.header.cube;
+  // Reach boxes hold each splat's own radius once; drawn, it is scale ×.
+  const float grow_factor = std::max(0.0f, scale - 1.0f);
+  // Where the ray enters node k's bounds (grown to the drawn splats), when
+  // it does and the clipping keeps some of it.
+  const auto entry_of = [&](std::size_t k) -> std::optional<float> {
+    const Eigen::AlignedBox3f& reach = hierarchy_.reach[k];
+    if (reach.isEmpty() || clipping.excludes(reach)) return std::nullopt;
+    const float grow = grow_factor * subtree_radius_[k];
+    return ray_box_entry(
+        Eigen::AlignedBox3f(reach.min().array() - grow, reach.max().array() + grow), origin,
+        direction);
+  };
   std::optional<LodPick> best;
-  for (const LodNodeDraw& draw : last_plan_.draws) {
-    if (!ray_meets_box(
-            hierarchy_.reach[draw.node].isEmpty()
-                ? hierarchy_.reach[draw.node]
-                : Eigen::AlignedBox3f(hierarchy_.reach[draw.node].min().array() - draw.cell_m,
-                                      hierarchy_.reach[draw.node].max().array() + draw.cell_m),
-            origin, direction))
-      continue;
-    const lod::LodNodeInfo& node = hierarchy_.nodes[draw.node];
-    const Eigen::Vector3f corner = node_corner_m(draw.node);
-    const std::uint32_t missing = missing_octants(draw);
-    const std::uint64_t half = cube.node_edge(node.key.depth) / 2;
-    const std::vector<lod::LodPoint> points = node_points(draw.node);
-    for (std::uint32_t i = 0; i < draw.count && i < points.size(); ++i) {
-      const lod::LodPoint& q = points[i];
-      const std::int64_t object =
-          q.object < object_known_.size() && object_known_[q.object] ? q.object : 0;
-      if (!object_shown_[static_cast<std::size_t>(object)]) continue;
-      SplatShape splat;
-      splat.position =
-          corner + Eigen::Vector3f(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
-                                   static_cast<float>(q.offset[2])) *
-                       static_cast<float>(lod::kQuantumM);
-      if (clipping.active() && !clipping.keeps(splat.position)) continue;
-      splat.normal = (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
-                                                           : Eigen::Vector3f::Zero();
-      splat.major_axis = (q.flags & lod::LodPoint::kRound) ? Eigen::Vector3f::Zero()
-                                                           : lod::decode_unit(q.major_axis);
-      splat.radii_m = Eigen::Vector2f(lod::from_half(q.radii[0]), lod::from_half(q.radii[1]));
-      const int octant = (q.offset[0] >= half ? 4 : 0) + (q.offset[1] >= half ? 2 : 0) +
-                         (q.offset[2] >= half ? 1 : 0);
-      if (missing & (1u << octant)) splat.radii_m = splat.radii_m.cwiseMax(draw.cell_m / scale);
-      const std::optional<float> hit =
-          splat_hit(origin, direction, splat, scale, settings.oriented,
-                    best ? best->distance_m : std::numeric_limits<float>::max());
-      if (hit) best = LodPick{q, object, splat.position, *hit};
+  // Nodes nearest along the ray first: once a hit is nearer than where the
+  // ray enters the next node, no farther node can hold a nearer one.
+  using Entry = std::pair<float, std::size_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  if (!hierarchy_.nodes.empty() && hierarchy_.nodes.front().key.depth == 0) {
+    if (const auto entry = entry_of(0)) queue.emplace(*entry, 0);
+  }
+  while (!queue.empty()) {
+    const auto [entry, k] = queue.top();
+    queue.pop();
+    if (best && entry >= best->distance_m) break;
+    for (const std::int32_t child : hierarchy_.children[k]) {
+      if (child < 0) continue;
+      if (const auto at = entry_of(static_cast<std::size_t>(child)))
+        queue.emplace(*at, static_cast<std::size_t>(child));
     }
+    const Eigen::Vector3f corner = node_corner_m(k);
+    with_node_points(k, [&](std::span<const lod::LodPoint> points) {
+      for (const lod::LodPoint& q : points) {
+        const std::int64_t object =
+            q.object < object_known_.size() && object_known_[q.object] ? q.object : 0;
+        if (!object_shown_[static_cast<std::size_t>(object)]) continue;
+        SplatShape splat;
+        splat.position = corner + Eigen::Vector3f(static_cast<float>(q.offset[0]),
+                                                  static_cast<float>(q.offset[1]),
+                                                  static_cast<float>(q.offset[2])) *
+                                      static_cast<float>(lod::kQuantumM);
+        if (clipping.active() && !clipping.keeps(splat.position)) continue;
+        splat.normal = (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
+                                                             : Eigen::Vector3f::Zero();
+        splat.major_axis = (q.flags & lod::LodPoint::kRound) ? Eigen::Vector3f::Zero()
+                                                             : lod::decode_unit(q.major_axis);
+        splat.radii_m = Eigen::Vector2f(lod::from_half(q.radii[0]), lod::from_half(q.radii[1]));
+        const std::optional<float> hit =
+            splat_hit(origin, direction, splat, scale, settings.oriented,
+                      best ? best->distance_m : std::numeric_limits<float>::max());
+        if (hit) best = LodPick{q, object, splat.position, *hit};
+      }
+    });
   }
   return best;
 }
@@ -434,14 +456,17 @@ std::vector<LodSample> LodRenderer::sample(std::size_t count) {
   for (const std::size_t k : by_depth) {
     if (out.size() >= count) break;
     const Eigen::Vector3f corner = node_corner_m(k);
-    for (const lod::LodPoint& q : node_points(k)) {
-      const Eigen::Vector3f offset(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
-                                   static_cast<float>(q.offset[2]));
-      out.push_back({corner + offset * static_cast<float>(lod::kQuantumM),
-                     (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
-                                                           : Eigen::Vector3f::Zero(),
-                     q.object});
-    }
+    with_node_points(k, [&](std::span<const lod::LodPoint> points) {
+      for (const lod::LodPoint& q : points) {
+        const Eigen::Vector3f offset(static_cast<float>(q.offset[0]),
+                                     static_cast<float>(q.offset[1]),
+                                     static_cast<float>(q.offset[2]));
+        out.push_back({corner + offset * static_cast<float>(lod::kQuantumM),
+                       (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
+                                                             : Eigen::Vector3f::Zero(),
+                       q.object});
+      }
+    });
   }
   return out;
 }

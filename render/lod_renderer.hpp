@@ -13,11 +13,14 @@
 // Needs the device's context current for its whole life.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "modeling/store/color_edit.hpp"
@@ -89,10 +92,13 @@ class LodRenderer {
   // Draws a frame through `view` (in the store's frame: metres from
   // header().origin) with what is on the device, uploading at most the
   // per-frame limit of what the loader has read and asking it for the
-  // rest. Leaves the context's GL state as it found it. Throws
+  // rest; for up to `wait_for_nodes` it waits for the loader and takes in
+  // what it reads (a still camera refining: fewer frames, each drawing
+  // more). Leaves the context's GL state as it found it. Throws
   // core::InputError naming the store and the node when a node the view
   // wants could not be read.
-  LodFrameResult draw(const RenderView& view, const RenderSettings& settings);
+  LodFrameResult draw(const RenderView& view, const RenderSettings& settings,
+                      std::chrono::milliseconds wait_for_nodes = std::chrono::milliseconds(0));
   // Loads everything the view wants first: the converged picture. Throws
   // as draw().
   LodFrameResult draw_complete(const RenderView& view, const RenderSettings& settings);
@@ -102,11 +108,12 @@ class LodRenderer {
   bool has_more_to_draw();
 
   // The point whose splat the ray from `origin` along unit `direction`
-  // (model frame) meets first among those the last frame drew, as it drew
-  // them with `settings` (its clipping, splat scale and orientation; the
-  // splats of a node standing in for its children grown as drawn). Hidden
-  // objects' points are not hit. Reads nodes the memory cache let go from
-  // the store again.
+  // (model frame) meets first among every point of the store, drawn as
+  // `settings` draws them (its clipping, splat scale and orientation):
+  // the points a full picture shows, whatever level of detail the last
+  // frame drew. Hidden objects' points and points facing away are not hit.
+  // Walks the nodes whose bounds the ray crosses; reads those the memory
+  // cache does not hold from the store.
   std::optional<LodPick> pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                               const RenderSettings& settings);
 
@@ -126,6 +133,12 @@ class LodRenderer {
  private:
   struct Gpu;
   LodFramePlan plan(const RenderView& banded_view, const RenderSettings& settings) const;
+  // A frame: plans, uploads (at most `upload_limit` bytes; 0: no limit)
+  // and waits for the loader until `until` (none: until the view has
+  // every node it wants), then draws.
+  LodFrameResult frame(const RenderView& picture_view, const RenderSettings& settings,
+                       std::optional<std::chrono::steady_clock::time_point> until,
+                       std::uint64_t upload_limit);
   // Uploads the wanted nodes the memory cache holds, within `byte_limit`
   // (0: none); returns how many.
   std::size_t upload(const std::vector<std::size_t>& wanted, std::uint64_t byte_limit,
@@ -135,8 +148,9 @@ class LodRenderer {
   // The octants of a drawn node whose points are not all drawn (bit k:
   // octant k): its splats there grow to cover them.
   std::uint32_t missing_octants(const LodNodeDraw& draw) const;
-  // Node `k`'s points from the memory cache, or read from the store.
-  std::vector<lod::LodPoint> node_points(std::size_t k);
+  // Node `k`'s points, from the memory cache or read from the store.
+  void with_node_points(std::size_t k,
+                        const std::function<void(std::span<const lod::LodPoint>)>& use);
   // Throws when a node of `wanted` could not be read.
   void refuse_failed(const std::vector<std::size_t>& wanted) const;
   double issue(const RenderView& banded_view, const RenderSettings& settings,
@@ -144,6 +158,7 @@ class LodRenderer {
 
   LodHierarchy hierarchy_;
   LodFramePlan last_plan_;
+  std::vector<float> subtree_radius_;    // each node's largest splat radius, its descendants' too
   std::optional<lod::LodStore> reader_;  // for pick() and sample(), opened when first needed
   // Per object id (as the tables on the device): shown, and in the tree.
   std::vector<std::uint8_t> object_shown_, object_known_;

@@ -6,30 +6,6 @@
 
 namespace scanbench::render {
 
-namespace {
-
-// Whether the ray meets `box` (grown by `margin`) at a distance ≥ 0 (slab test).
-bool ray_meets(const Eigen::AlignedBox3f& box, float margin, const Eigen::Vector3f& origin,
-               const Eigen::Vector3f& direction) {
-  if (box.isEmpty()) return false;
-  float near = 0.0f, far = std::numeric_limits<float>::max();
-  for (int a = 0; a < 3; ++a) {
-    const float low = box.min()[a] - margin, high = box.max()[a] + margin;
-    if (std::abs(direction[a]) < 1e-12f) {
-      if (origin[a] < low || origin[a] > high) return false;
-      continue;
-    }
-    float t0 = (low - origin[a]) / direction[a], t1 = (high - origin[a]) / direction[a];
-    if (t0 > t1) std::swap(t0, t1);
-    near = std::max(near, t0);
-    far = std::min(far, t1);
-    if (near > far) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
 Eigen::Vector3f pixel_ray(const RenderView& view, double x, double y) {
   // Normalised device coordinates, then back through the projection and the view.
   const float ndc_x = static_cast<float>(2.0 * x / view.width - 1.0);
@@ -80,34 +56,23 @@ std::optional<float> splat_hit(const Eigen::Vector3f& origin, const Eigen::Vecto
   return hit;
 }
 
-bool ray_meets_box(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& origin,
-                   const Eigen::Vector3f& direction) {
-  return ray_meets(box, 0.0f, origin, direction);
-}
-
-std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
-                               const Eigen::Vector3f& direction, const Clipping& clipping,
-                               float splat_scale, bool oriented) {
-  const RenderPoints& points = model.points;
-  std::optional<Pick> best;
-  for (const RenderNode& node : model.nodes) {
-    if (!node.shown) continue;
-    for (const std::size_t t : node.tiles) {
-      const RenderTile& tile = model.tiles[t];
-      const float reach = tile.max_radius_m * splat_scale;
-      if (clipping.excludes(tile.box) || !ray_meets(tile.box, reach, origin, direction)) continue;
-      for (std::uint32_t k = tile.first; k < tile.first + tile.count; ++k) {
-        const Eigen::Vector3f& p = points.position[k];
-        if (clipping.active() && !clipping.keeps(p)) continue;
-        const SplatShape splat{p, points.normal[k], points.major_axis[k], points.radii_m[k]};
-        const std::optional<float> hit =
-            splat_hit(origin, direction, splat, splat_scale, oriented,
-                      best ? best->distance_m : std::numeric_limits<float>::max());
-        if (hit) best = Pick{k, *hit, p};
-      }
+std::optional<float> ray_box_entry(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& origin,
+                                   const Eigen::Vector3f& direction) {
+  if (box.isEmpty()) return std::nullopt;
+  float near = 0.0f, far = std::numeric_limits<float>::max();
+  for (int a = 0; a < 3; ++a) {
+    const float low = box.min()[a], high = box.max()[a];
+    if (std::abs(direction[a]) < 1e-12f) {
+      if (origin[a] < low || origin[a] > high) return std::nullopt;
+      continue;
     }
+    float t0 = (low - origin[a]) / direction[a], t1 = (high - origin[a]) / direction[a];
+    if (t0 > t1) std::swap(t0, t1);
+    near = std::max(near, t0);
+    far = std::min(far, t1);
+    if (near > far) return std::nullopt;
   }
-  return best;
+  return near;
 }
 
 }  // namespace scanbench::render

@@ -1,24 +1,17 @@
-// Picking in the 3D view: the point a ray through a pixel meets first, as
-// the view draws the model. What the view does not draw is not picked:
-// hidden objects, points outside the clipping box or slice, and points
-// facing away (the view culls them).
+// Picking in the 3D view: where a ray through a pixel meets a splat as the
+// view draws it. The store's renderer walks the nodes the ray crosses
+// (lod_renderer.hpp); what the view does not draw is not picked: hidden
+// objects, points outside the clipping box or slice, and points facing
+// away.
 #pragma once
 
 #include <Eigen/Core>
-#include <cstddef>
+#include <Eigen/Geometry>
 #include <optional>
 
-#include "render/frame_plan.hpp"
-#include "render/render_model.hpp"
 #include "render/render_view.hpp"
 
 namespace scanbench::render {
-
-struct Pick {
-  std::size_t point = 0;     // into RenderModel::points
-  float distance_m = 0.0f;   // from the ray's origin, along it, to where it meets the splat
-  Eigen::Vector3f position;  // the point's own position, model frame
-};
 
 // The ray from the eye of `view` through pixel (x, y) (window pixels from
 // the top left; pixel centres at +0.5) as a unit direction, model frame.
@@ -36,23 +29,16 @@ struct SplatShape {
 // Where the ray from `origin` along unit `direction` meets `splat` (radii ×
 // splat_scale; its ellipse in the plane of its normal when `oriented`,
 // else a disk facing the eye): the distance along the ray, when it does at
-// less than `nearer_than` and the splat faces the ray.
+// less than `nearer_than` and the splat faces the ray. (A sphere of the
+// larger radius would let the long thin splats of distant ground catch
+// rays that pass metres above them.)
 std::optional<float> splat_hit(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                                const SplatShape& splat, float splat_scale, bool oriented,
                                float nearer_than);
 
-// Whether the ray meets `box` at a distance ≥ 0.
-bool ray_meets_box(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& origin,
-                   const Eigen::Vector3f& direction);
-
-// The point whose splat the ray from `origin` along unit `direction` meets
-// first, the splat as the view draws it (splat_shaders.cpp): its ellipse
-// (radii × splat_scale) in the plane of its normal when `oriented`, else a
-// disk facing the eye. None when it meets none. Walks only the tiles whose
-// box the ray crosses. (A sphere of the larger radius would let the long
-// thin splats of distant ground catch rays that pass metres above them.)
-std::optional<Pick> pick_point(const RenderModel& model, const Eigen::Vector3f& origin,
-                               const Eigen::Vector3f& direction, const Clipping& clipping,
-                               float splat_scale, bool oriented = true);
+// Where the ray enters `box` (0 when it starts inside); none when it
+// misses it.
+std::optional<float> ray_box_entry(const Eigen::AlignedBox3f& box, const Eigen::Vector3f& origin,
+                                   const Eigen::Vector3f& direction);
 
 }  // namespace scanbench::render

@@ -30,7 +30,7 @@
 #include <string_view>
 #include <vector>
 
-#include "render/frame_plan.hpp"
+#include "render/clipping.hpp"
 #include "render/render_view.hpp"
 
 namespace scanbench::render {

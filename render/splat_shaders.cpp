@@ -4,7 +4,7 @@
 
 namespace scanbench::render::shaders {
 
-// The vertex stage is a reader of the renderer's points (its attributes and
+// The vertex stage is a reader of the points (their attributes and
 // load_point(), which fills the p_ variables), then the common part: per
 // point its centre, normal, major axis and radii in eye space for the
 // fragment stage, its colour by the colour mode, and a sprite wide enough
@@ -51,31 +51,6 @@ vec3 ramp(float t) {  // blue, cyan, green, yellow, red
                0.0, 1.0);
 }
 
-)glsl";
-
-// The render model's points: one attribute array each.
-const char* const kModelPointReader = R"glsl(#version 450 core
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_radii;
-layout(location = 3) in vec4 a_color;
-layout(location = 4) in float a_intensity;
-layout(location = 5) in uint a_node;
-layout(location = 6) in vec3 a_major;
-
-uniform float u_min_radius;
-
-void load_point() {
-  p_position = a_position;
-  p_normal = dot(a_normal, a_normal) > 0.25 ? a_normal : vec3(0.0);
-  p_major = dot(a_major, a_major) > 0.25 ? a_major : vec3(0.0);
-  p_radii = a_radii;
-  p_color = a_color.rgb;
-  p_intensity = a_intensity;
-  p_node = a_node;
-  p_min_radius = u_min_radius;
-  p_hidden = false;
-}
 )glsl";
 
 // A level-of-detail node's points as the store keeps them (lod_point.hpp),
@@ -242,21 +217,13 @@ void main() {
 }
 )glsl";
 
-std::string splat_vertex_stage(const char* point_reader) {
+std::string splat_vertex() {
   // The reader's #version line first; its load_point() after the p_
   // variables it fills.
-  const std::string reader(point_reader);
+  const std::string reader(kLodPointReader);
   const std::size_t first_line = reader.find('\n') + 1;
   return reader.substr(0, first_line) + kSplatVertexCommon + reader.substr(first_line) +
          object_color_glsl() + kSplatVertexBody;
-}
-
-std::string splat_vertex() {
-  return splat_vertex_stage(kModelPointReader);
-}
-
-std::string lod_splat_vertex() {
-  return splat_vertex_stage(kLodPointReader);
 }
 
 // The fragment's view ray meets the splat's plane (its normal, or facing the

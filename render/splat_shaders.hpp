@@ -6,11 +6,9 @@
 
 namespace scanbench::render::shaders {
 
-// The splat vertex stage, with the object palette's GLSL in it, of the
-// render model's points (one attribute array each), and of a
-// level-of-detail store's (lod_point.hpp, as stored).
+// The splat vertex stage, with the object palette's GLSL in it, reading a
+// level-of-detail store's points as stored (lod_point.hpp).
 std::string splat_vertex();
-std::string lod_splat_vertex();
 extern const char* const kSplatFragment;
 extern const char* const kResolveVertex;
 extern const char* const kResolveFragment;

@@ -1,3 +1,4 @@
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -56,7 +57,10 @@ void redraw(WorkbenchState& s, int width, int height) {
   settings.culling.budget = s.budget.next(moving);
   const render::RenderView view =
       render::make_render_view(s.navigation.camera(width, height), s.renderer->header().origin);
-  const render::LodFrameResult frame = s.renderer->draw(view, settings);
+  // Refining, each frame draws the whole picture again: it waits a little
+  // for the nodes being read, so that fewer frames draw more each.
+  const render::LodFrameResult frame = s.renderer->draw(
+      view, settings, moving ? std::chrono::milliseconds(0) : std::chrono::milliseconds(250));
   if (moving) s.budget.record(frame.frame_ms, frame.plan.submitted);
   s.last_plan = frame.plan;
   s.last_draw_ms = frame.frame_ms;  // the renderer gives ImGui its GL state back

@@ -9,17 +9,19 @@
 #include <string>
 
 #include "acquisition/color_space.hpp"
+#include "acquisition/formats/ptx_reader.hpp"
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "core/errors.hpp"
 #include "core/progress.hpp"
-#include "acquisition/formats/ptx_reader.hpp"
 #include "modeling/color_commands.hpp"
+#include "modeling/color_pipeline.hpp"
 #include "modeling/export_command.hpp"
 #include "modeling/harmonize_command.hpp"
 #include "modeling/merge_command.hpp"
 #include "modeling/register_command.hpp"
 #include "modeling/selection_tools.hpp"
+#include "modeling/store/typed_layers.hpp"
 #include "modeling/tree_commands.hpp"
-#include "render/render_model.hpp"
 #include "room_project.hpp"
 #include "support/test_support.hpp"
 
@@ -49,17 +51,44 @@ RoomObjects segment_room(store::Project& project) {
   return out;
 }
 
-render::RenderModel model_of(const store::Project& project) {
-  render::RenderModelSettings settings;
-  settings.merged_only = false;
-  return render::build_render_model(project, settings);
+// The model's colours as it shows them, point by point, scan after scan
+// in pixel order (the same project state gives the same order): each
+// scan's in-model points but those the segmentation deleted, through the
+// CPU's colour pipeline (modeling/color_pipeline.hpp), which the
+// renderer's shaders follow, with each point's owner.
+using Colours = std::vector<std::array<std::uint8_t, 4>>;
+struct ShownModel {
+  struct Points {
+    Colours rgba;
+    std::vector<std::uint32_t> node;
+    std::size_t size() const { return rgba.size(); }
+  } points;
+};
+
+ShownModel model_of(const store::Project& project) {
+  const modeling::ColorPipeline pipeline(project.scan_color_corrections(),
+                                         modeling::resolve_color_edits(project.object_nodes()));
+  ShownModel model;
+  for (const store::StoredScanSummary& stored : project.scans()) {
+    const acquisition::Scan scan = project.load_scan(stored.id);
+    const std::optional<acquisition::ScanGeometry> geometry =
+        store::load_geometry(project, stored.id);
+    const auto membership = project.load_layer<std::uint32_t>(stored.id, store::layer::kMembership,
+                                                              store::ElementType::kU32);
+    for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+      if (!geometry || !acquisition::in_model(scan, *geometry, i)) continue;
+      const std::uint32_t owner = membership ? (*membership)[i] : 0;
+      if (owner == store::kDeletedPoints) continue;
+      const std::array<std::uint8_t, 3> rgb = pipeline.shown(
+          stored.id, owner, {scan.rgb[3 * i], scan.rgb[3 * i + 1], scan.rgb[3 * i + 2]});
+      model.points.rgba.push_back({rgb[0], rgb[1], rgb[2], 255});
+      model.points.node.push_back(owner);
+    }
+  }
+  return model;
 }
 
-// The render model's colours point by point, in its order (the same
-// project state gives the same order).
-using Colours = std::vector<std::array<std::uint8_t, 4>>;
-
-Eigen::Vector3d mean_lab(const render::RenderModel& model, std::uint32_t node) {
+Eigen::Vector3d mean_lab(const ShownModel& model, std::uint32_t node) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   std::size_t n = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {
@@ -75,7 +104,7 @@ TEST(Recolor, AnEditChangesOnlyItsObjectAndUndoRestoresItBitExactly) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const RoomObjects room = segment_room(project);
-  const render::RenderModel before = model_of(project);
+  const ShownModel before = model_of(project);
   const acquisition::Scan scan_before = project.load_scan(room.scan);
 
   RecolorSettings settings;
@@ -83,7 +112,7 @@ TEST(Recolor, AnEditChangesOnlyItsObjectAndUndoRestoresItBitExactly) {
   settings.set.hue_deg = 120.0;
   settings.set.brightness = -10.0;
   recolor_object(project, settings);
-  const render::RenderModel after = model_of(project);
+  const ShownModel after = model_of(project);
   ASSERT_EQ(after.points.size(), before.points.size());
   std::size_t changed = 0, wall = 0;
   for (std::size_t k = 0; k < after.points.size(); ++k) {
@@ -110,7 +139,7 @@ TEST(Recolor, AGroupsEditReachesChildrenThatDoNotOverrideIt) {
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const RoomObjects room = segment_room(project);
-  const render::RenderModel before = model_of(project);
+  const ShownModel before = model_of(project);
   RecolorSettings group;
   group.node = room.room;
   group.set.brightness = 10.0;
@@ -119,7 +148,7 @@ TEST(Recolor, AGroupsEditReachesChildrenThatDoNotOverrideIt) {
   floor.node = room.floor;
   floor.set.brightness = 0.0;  // the floor keeps its lightness
   recolor_object(project, floor);
-  const render::RenderModel after = model_of(project);
+  const ShownModel after = model_of(project);
   const auto wall = static_cast<std::uint32_t>(room.wall);
   const auto floor_id = static_cast<std::uint32_t>(room.floor);
   EXPECT_NEAR(mean_lab(after, wall).x(), mean_lab(before, wall).x() + 10.0, 0.5);
@@ -222,7 +251,7 @@ TEST(Export, WritesWhatTheModelShowsUnlessAskedForTheRecording) {
   const std::size_t deleted = tools.select(project, select_at(room.scan, 90, 0)).selected_pixels;
   const NodeCommandResult far = tools.commit(project, {room.scan, "far wall", std::nullopt});
   delete_node(project, {far.node_id, DeletedPoints::kDeleted, {}});
-  const render::RenderModel model = model_of(project);  // without the deleted points
+  const ShownModel model = model_of(project);  // without the deleted points
   std::vector<std::array<int, 3>> shown;
   std::size_t floor = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {
@@ -287,7 +316,7 @@ TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
   const CloneResult out = clone_color(project, clone);
   EXPECT_GT(out.source_points, 1000u);
   EXPECT_GT(out.target_points, 1000u);
-  const render::RenderModel model = model_of(project);
+  const ShownModel model = model_of(project);
   const Eigen::Vector3d floor = mean_lab(model, static_cast<std::uint32_t>(room.floor));
   const Eigen::Vector3d wall = mean_lab(model, static_cast<std::uint32_t>(room.wall));
   EXPECT_LT(acquisition::delta_e(floor, wall), 1.0)
@@ -307,7 +336,7 @@ TEST(Clone, TheTargetTakesTheSourcesColoursAsShown) {
 }
 
 // Mean and standard deviation of the shown L* of a node's points.
-std::pair<double, double> lightness(const render::RenderModel& model, std::uint32_t node) {
+std::pair<double, double> lightness(const ShownModel& model, std::uint32_t node) {
   double sum = 0.0, squares = 0.0;
   std::size_t n = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {
@@ -401,7 +430,7 @@ TEST(Harmonize, RecoversGainsAppliedToACopyOfAScanAndUndoRemovesThem) {
   ASSERT_EQ(stored.size(), 2u);
   EXPECT_TRUE(stored.begin()->second.identity());
   // The copy now shows the first scan's colours.
-  const render::RenderModel model = model_of(project);
+  const ShownModel model = model_of(project);
   ASSERT_EQ(model.points.size(), 2 * first_scan.size());
   std::size_t off = 0;
   for (std::size_t k = 0; k < model.points.size(); ++k) {

@@ -1,9 +1,8 @@
-// The streaming renderer draws a level-of-detail store as the render model's
-// renderer draws the project: the same picture from the stored points, the
-// object tree's visibility and colour edits and the scans' corrections
-// applied on the device (a hide or a recolour uploads no node), and a
-// picture that refines frame by frame within the upload limit to the
-// complete one.
+// The streaming renderer draws a level-of-detail store: the object tree's
+// visibility and colour edits and the scans' corrections applied on the
+// device as the CPU's colour pipeline applies them (a hide or a recolour
+// uploads no node), and a picture that refines frame by frame within the
+// upload limit to the complete one.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -11,14 +10,15 @@
 #include <thread>
 
 #include "modeling/color_commands.hpp"
+#include "modeling/color_pipeline.hpp"
 #include "modeling/lod/build_lod.hpp"
 #include "modeling/room_project.hpp"
 #include "modeling/selection_tools.hpp"
 #include "modeling/tree_commands.hpp"
 #include "render/lod_renderer.hpp"
 #include "render/lod_room_store.hpp"
-#include "render/render_model.hpp"
-#include "render/splat_renderer.hpp"
+#include "render/object_palette.hpp"
+#include "render/pick.hpp"
 #include "shared_device.hpp"
 #include "support/test_support.hpp"
 
@@ -36,48 +36,40 @@ acquisition::CameraView room_camera() {
   return view;
 }
 
-struct Agreement {
-  double covered_apart = 0.0;  // share of pixels covered in one picture only
-  double psnr_db = 0.0;        // over pixels covered in both
-  std::size_t covered = 0;     // in the first
-};
-
-Agreement compare(const RenderedImage& a, const RenderedImage& b) {
-  std::size_t apart = 0, both = 0, covered = 0;
-  double squared = 0.0;
-  for (int y = 0; y < a.height; ++y) {
-    for (int x = 0; x < a.width; ++x) {
-      covered += a.covered(x, y);
-      if (a.covered(x, y) != b.covered(x, y)) ++apart;
-      if (!a.covered(x, y) || !b.covered(x, y)) continue;
-      ++both;
-      const std::size_t at = 4 * (static_cast<std::size_t>(y) * a.width + x);
-      for (int c = 0; c < 3; ++c) {
-        const double d = double(a.rgba[at + c]) - double(b.rgba[at + c]);
-        squared += d * d;
-      }
-    }
-  }
-  const double pixels = static_cast<double>(a.width) * a.height;
-  const double mse = both ? squared / (3.0 * static_cast<double>(both)) : 0.0;
-  return {static_cast<double>(apart) / pixels,
-          mse > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : 99.0, covered};
-}
-
 RenderSettings every_point() {
   RenderSettings settings;
-  settings.culling.level_of_detail = false;  // the two trees thin differently
+  settings.culling.level_of_detail = false;
   return settings;
 }
 
-RenderedImage render_model(const store::Project& project, const RenderSettings& settings) {
-  const RenderModel model = build_render_model(project, {});
-  SplatRenderer renderer(model);
-  renderer.draw(make_render_view(room_camera(), model.origin), settings);
-  return renderer.read_image();
+// Every 12th pixel of the picture (each way) whose centre the pick finds
+// on a point, with what was picked there.
+std::vector<std::pair<std::array<int, 2>, LodPick>> picked_pixels(LodRenderer& renderer,
+                                                                  const RenderView& view,
+                                                                  const RenderSettings& settings) {
+  std::vector<std::pair<std::array<int, 2>, LodPick>> out;
+  for (int y = 6; y < view.height; y += 12) {
+    for (int x = 6; x < view.width; x += 12) {
+      const std::optional<LodPick> pick =
+          renderer.pick(view.eye, pixel_ray(view, x + 0.5, y + 0.5), settings);
+      if (pick) out.push_back({{x, y}, *pick});
+    }
+  }
+  return out;
 }
 
-TEST(LodRenderer, DrawsTheStoreAsTheRenderModelDrawsItsProject) {
+std::array<int, 3> pixel(const RenderedImage& image, int x, int y) {
+  const std::uint8_t* p = &image.rgba[4 * (static_cast<std::size_t>(y) * image.width + x)];
+  return {p[0], p[1], p[2]};
+}
+
+// The shaders show each point in the colour the CPU's pipeline gives it
+// (modeling/color_pipeline.hpp): the scan's correction, then the owning
+// object's edit; hiding an object takes it out of the next frame without
+// uploading a node; the palette colours objects as the panorama does. The
+// room's surfaces are of one colour each, so a pixel inside one is that
+// colour whatever blends there.
+TEST(LodRenderer, ShowsThePipelinesColoursHidesAndRecoloursWithoutUploads) {
   test::shared_device();
   modeling::SelectionTools tools;
   const scanbench::test::ScratchDir dir;
@@ -113,32 +105,54 @@ TEST(LodRenderer, DrawsTheStoreAsTheRenderModelDrawsItsProject) {
   EXPECT_TRUE(frame.complete());
   EXPECT_GT(frame.plan.culled_frustum, 0u);  // the wall behind the camera
   EXPECT_EQ(frame.plan.submitted + frame.plan.culled_frustum, frame.plan.points);
-  const RenderedImage stored = renderer.read_image();
-  const Agreement shown = compare(stored, render_model(project, every_point()));
-  EXPECT_GT(shown.covered, stored.rgba.size() / 4 / 2);  // the room fills the view
-  EXPECT_LT(shown.covered_apart, 0.005);
-  EXPECT_GT(shown.psnr_db, 35.0);
-  std::printf("shown: %.4f apart, %.1f dB\n", shown.covered_apart, shown.psnr_db);
+  const RenderedImage shown = renderer.read_image();
+  const modeling::ColorPipeline pipeline(project.scan_color_corrections(),
+                                         modeling::resolve_color_edits(project.object_nodes()));
+  const auto picks = picked_pixels(renderer, view, every_point());
+  std::size_t on_wall = 0, agree = 0;
+  for (const auto& [at, pick] : picks) {
+    on_wall += pick.object == wall.node_id;
+    const auto& rgb = pick.point.rgb;
+    const std::array<std::uint8_t, 3> expected =
+        pipeline.shown(scan, pick.object, {rgb[0], rgb[1], rgb[2]});
+    const std::array<int, 3> drawn = pixel(shown, at[0], at[1]);
+    bool same = true;
+    for (int c = 0; c < 3; ++c) same = same && std::abs(drawn[c] - expected[c]) <= 2;
+    agree += same;
+  }
+  EXPECT_GT(picks.size(), 300u);  // the room fills most of the view
+  EXPECT_GT(on_wall, 30u);
+  EXPECT_GT(static_cast<double>(agree), 0.97 * static_cast<double>(picks.size()));
 
   // Hidden: the next frame leaves the wall out, from the nodes on the
-  // device (the store is as it was; no node is read or uploaded again).
+  // device (the store is current still: its points did not change).
   modeling::edit_node(project, {wall.node_id, std::nullopt, true, std::nullopt, {}});
-  EXPECT_EQ(lod::current_lod_store(project), store);  // the tree changed, not its points
+  EXPECT_EQ(lod::current_lod_store(project), store);
   renderer.show_project_state(project);
   const LodFrameResult hidden_frame = renderer.draw_complete(view, every_point());
   EXPECT_EQ(hidden_frame.uploaded_nodes, 0u);
   const RenderedImage hidden = renderer.read_image();
-  const Agreement after = compare(hidden, render_model(project, every_point()));
-  EXPECT_LT(after.covered, shown.covered - shown.covered / 10);  // the wall is gone
-  EXPECT_LT(after.covered_apart, 0.005);
-  EXPECT_GT(after.psnr_db, 35.0);
-  std::printf("hidden: %.4f apart, %.1f dB\n", after.covered_apart, after.psnr_db);
+  std::size_t gone = 0;
+  for (const auto& [at, pick] : picks) {
+    if (pick.object == wall.node_id) gone += !hidden.covered(at[0], at[1]);  // nothing behind it
+  }
+  EXPECT_GT(static_cast<double>(gone), 0.95 * static_cast<double>(on_wall));
 
-  // Colour by object: the palette's colours, the wall's now hidden.
+  // Colour by object: the palette's colour of each object picked.
   RenderSettings objects = every_point();
   objects.color = ColorMode::kObject;
   renderer.draw_complete(view, objects);
-  EXPECT_GT(compare(renderer.read_image(), render_model(project, objects)).psnr_db, 35.0);
+  const RenderedImage by_object = renderer.read_image();
+  std::size_t palette = 0, visible = 0;
+  for (const auto& [at, pick] : picked_pixels(renderer, view, objects)) {
+    const std::array<std::uint8_t, 3> expected =
+        object_color(static_cast<std::uint32_t>(pick.object));
+    const std::array<int, 3> drawn = pixel(by_object, at[0], at[1]);
+    ++visible;
+    palette += std::abs(drawn[0] - expected[0]) <= 1 && std::abs(drawn[1] - expected[1]) <= 1 &&
+               std::abs(drawn[2] - expected[2]) <= 1;
+  }
+  EXPECT_GT(static_cast<double>(palette), 0.97 * static_cast<double>(visible));
 
   // Points that change hands make it out of date, and undoing that does
   // not make it current again (the project changed after it was built).

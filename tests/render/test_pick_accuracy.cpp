@@ -13,38 +13,51 @@
 #include <vector>
 
 #include "acquisition/range_noise.hpp"
+#include "modeling/lod/memory_store.hpp"
 #include "registration/simulated_campus.hpp"
+#include "render/lod_renderer.hpp"
 #include "render/pick.hpp"
+#include "shared_device.hpp"
+#include "support/test_support.hpp"
 
 namespace scanbench::render {
 namespace {
 
 using registration::test::campus;
 
-// Scan 0's in-model points as a render model of round splats, origin at
-// the scanner. The model orders its points by tile, so each carries its
-// pixel's index in `intensity` (exact: the reduced scan has 202 500 pixels,
-// under 2^24).
-RenderModel scan_model() {
-  const auto& site = campus(1);
-  const acquisition::Scan& scan = site.scans[0];
-  const registration::PreparedScan& prepared = site.prepared[0];
-  const Eigen::Isometry3d& T = site.true_poses[0];
-  RenderPoints p;
-  for (std::size_t i = 0; i < prepared.in_model.size(); ++i) {
-    if (!prepared.in_model[i]) continue;
-    p.position.push_back((T.linear() * prepared.points[i].cast<double>()).cast<float>());
-    const Eigen::Vector3f n = site.geometry[0].normal[i];
-    p.normal.push_back((T.linear().cast<float>() * n));
-    const float r = site.geometry[0].footprint_m[i];
-    p.radii_m.emplace_back(r, r);
-    p.major_axis.push_back(Eigen::Vector3f::Zero());
-    p.rgba.push_back({128, 128, 128, 255});
-    p.intensity.push_back(static_cast<float>(i));
-    p.node.push_back(0);
-  }
-  EXPECT_LT(scan.pixel_count(), std::size_t{1} << 24);
-  return assemble_render_model(std::move(p), T.translation(), {}, {});
+// Scan 0's in-model points in a store of round splats, origin at the
+// scanner (positions kept to 0.1 mm), each point knowing its pixel; and the
+// positions of those points, model frame, to aim at.
+struct ScanStore {
+  scanbench::test::ScratchDir dir;
+  std::filesystem::path file;
+  std::vector<Eigen::Vector3f> targets;
+};
+
+const ScanStore& scan_store() {
+  static ScanStore s;  // its folder goes when the executable exits
+  static const bool built = [] {
+    const auto& site = campus(1);
+    const registration::PreparedScan& prepared = site.prepared[0];
+    const Eigen::Isometry3d& T = site.true_poses[0];
+    std::vector<lod::PointToStore> points;
+    for (std::size_t i = 0; i < prepared.in_model.size(); ++i) {
+      if (!prepared.in_model[i]) continue;
+      lod::PointToStore p;
+      p.position = T * prepared.points[i].cast<double>();
+      p.normal = T.linear().cast<float>() * site.geometry[0].normal[i];
+      const float r = site.geometry[0].footprint_m[i];
+      p.radii_m = Eigen::Vector2f(r, r);
+      p.pixel = static_cast<std::uint32_t>(i);
+      points.push_back(p);
+      s.targets.push_back((p.position - T.translation()).cast<float>());
+    }
+    s.file = s.dir / "scan.sbproj.lod";
+    lod::write_lod_store(s.file, T.translation(), {{0, 1, "scan", 0.0f, 1.0f, T}}, points);
+    return true;
+  }();
+  static_cast<void>(built);
+  return s;
 }
 
 // The true position (model frame) of the sample `pixel`: on its beam, at the
@@ -57,26 +70,31 @@ Eigen::Vector3d true_point(std::size_t pixel) {
 }
 
 TEST(PickAccuracy, PickedPointsAndDistancesAreWithinTheScannersNoise) {
-  const RenderModel model = scan_model();
+  const ScanStore& store = scan_store();
+  test::shared_device();
+  LodRenderer renderer(store.file, {});
+  RenderSettings settings;
+  settings.splat_scale = 1.0f;
   const acquisition::RangeNoise noise;
   // Rays from 2 m above the scanner towards 300 random samples.
   std::mt19937 random(7);
-  std::uniform_int_distribution<std::size_t> any(0, model.points.size() - 1);
+  std::uniform_int_distribution<std::size_t> any(0, store.targets.size() - 1);
   const Eigen::Vector3f eye(0.0f, 0.0f, 2.0f);
   std::vector<double> point_sigmas, distance_sigmas;
   std::optional<Eigen::Vector3d> last_measured, last_true;
   double last_sigma = 0.0;
   for (int k = 0; k < 300; ++k) {
-    const Eigen::Vector3f target = model.points.position[any(random)];
-    const std::optional<Pick> pick = pick_point(model, eye, (target - eye).normalized(), {}, 1.0f);
+    const Eigen::Vector3f target = store.targets[any(random)];
+    const std::optional<LodPick> pick = renderer.pick(eye, (target - eye).normalized(), settings);
     if (!pick) continue;
     // Where the ray was aimed, or in front of it, and on the ray.
     const float aimed = (target - eye).norm();
-    const float radius = model.points.radii_m[pick->point].maxCoeff();
+    const float radius =
+        std::max(lod::from_half(pick->point.radii[0]), lod::from_half(pick->point.radii[1]));
     EXPECT_LE(pick->distance_m, aimed + 4.0f * noise.sigma(aimed));
     EXPECT_LE((pick->position - eye - pick->distance_m * (target - eye).normalized()).norm(),
               radius + 1e-4f);
-    const auto pixel = static_cast<std::size_t>(model.points.intensity[pick->point]);
+    const std::size_t pixel = pick->point.pixel;
     if (campus(1).truth[0].mixed[pixel]) continue;  // a blend of two surfaces: no single truth
     const Eigen::Vector3d measured = pick->position.cast<double>();
     const Eigen::Vector3d truth = true_point(pixel);

@@ -1,14 +1,15 @@
-// The splat renderer on the headless device (llvmpipe in CI): raw points
-// leave holes that splats close, each half of the wall keeps its colour,
-// hidden objects are not drawn, and every kernel and colour mode draws.
+// The splat passes on the headless device (llvmpipe in CI), drawing the
+// wall's store: raw points leave holes that splats close, each half of the
+// wall keeps its colour, hidden objects are not drawn, and every kernel and
+// colour mode draws.
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <memory>
 
 #include "render/device.hpp"
+#include "render/lod_renderer.hpp"
 #include "render/object_palette.hpp"
-#include "render/splat_renderer.hpp"
 #include "shared_device.hpp"
 #include "wall_model.hpp"
 
@@ -24,10 +25,10 @@ RenderDevice& device() {
 TEST(SplatRenderer, DevicesComeAndGoWhileAnotherDraws) {
   device();
   { const std::unique_ptr<RenderDevice> second = make_headless_device(); }
-  const RenderModel model = test::wall_model();
   device();
-  SplatRenderer renderer(model);
-  renderer.draw(make_render_view(test::camera_at({1000.0, 2000.0, 1.5}), kOrigin), {});
+  LodRenderer renderer(test::wall_store(), {});
+  renderer.draw_complete(
+      make_render_view(test::camera_at({1000.0, 2000.0, 1.5}), renderer.header().origin), {});
   EXPECT_TRUE(renderer.read_image().covered(80, 60));
 }
 
@@ -62,20 +63,21 @@ Inside inside_the_wall(const RenderedImage& image) {
   return out;
 }
 
-RenderedImage render(const RenderModel& model, const RenderSettings& settings,
-                     const Eigen::Vector3d& eye = {1000.0, 2000.0, 1.5}) {
+// The wall drawn complete through a 640 × 480 camera at `eye`.
+RenderedImage render(const RenderSettings& settings,
+                     const Eigen::Vector3d& eye = {1000.0, 2000.0, 1.5}, bool hide_right = false) {
   device();
-  SplatRenderer renderer(model);
-  renderer.draw(make_render_view(test::camera_at(eye, 640, 480), kOrigin), settings);
+  LodRenderer renderer(test::wall_store(), {});
+  renderer.set_objects(test::wall_tree(hide_right));
+  renderer.draw_complete(make_render_view(test::camera_at(eye, 640, 480), kOrigin), settings);
   return renderer.read_image();
 }
 
 TEST(SplatRenderer, ADrawLeavesTheGlStateAsItFoundIt) {
   device();
-  const RenderModel model = test::wall_model();  // the renderer keeps a reference
-  SplatRenderer renderer(model);
+  LodRenderer renderer(test::wall_store(), {});
   const RenderView view = make_render_view(test::camera_at({1000.0, 2000.0, 1.5}, 64, 48), kOrigin);
-  renderer.draw(view, {});
+  renderer.draw_complete(view, {});
   const RenderedImage clean = renderer.read_image();
   // A host's state, ImGui's for instance: none of what drawing splats needs.
   glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
@@ -89,7 +91,7 @@ TEST(SplatRenderer, ADrawLeavesTheGlStateAsItFoundIt) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glUseProgram(0);
   glViewport(1, 2, 3, 4);
-  renderer.draw(view, {});
+  renderer.draw_complete(view, {});
   // The same picture: the passes set their own state.
   EXPECT_EQ(renderer.read_image().rgba, clean.rgba);
   GLint origin = 0, framebuffer = -1, program = -1, source = 0;
@@ -121,17 +123,16 @@ TEST(SplatRenderer, TheHeadlessDeviceIsOpenGl45) {
 }
 
 TEST(SplatRenderer, RawPointsLeaveHolesThatBlendedSplatsClose) {
-  const RenderModel model = test::wall_model();
   RenderSettings points;
   points.mode = DrawMode::kPoints;
-  const Inside raw = inside_the_wall(render(model, points));
+  const Inside raw = inside_the_wall(render(points));
   EXPECT_GT(raw.covered, 0.03);  // a pixel every 4.5 pixels each way
   EXPECT_LT(raw.covered, 0.1);
   EXPECT_GT(raw.red_left, 0.99);
   for (const DrawMode mode : {DrawMode::kSplats, DrawMode::kBlended}) {
     RenderSettings splats;
     splats.mode = mode;
-    const Inside closed = inside_the_wall(render(model, splats));
+    const Inside closed = inside_the_wall(render(splats));
     EXPECT_EQ(closed.covered, 1.0) << draw_mode_name(mode);
     EXPECT_GT(closed.red_left, 0.99) << draw_mode_name(mode);
     EXPECT_GT(closed.blue_right, 0.99) << draw_mode_name(mode);
@@ -139,12 +140,11 @@ TEST(SplatRenderer, RawPointsLeaveHolesThatBlendedSplatsClose) {
 }
 
 TEST(SplatRenderer, EveryKernelClosesTheWallAndTheBackgroundStaysEmpty) {
-  const RenderModel model = test::wall_model();
   for (const Kernel kernel : {Kernel::kDisk, Kernel::kGaussian, Kernel::kCosine}) {
     RenderSettings settings;
     settings.kernel = kernel;
     settings.background = {10, 20, 30};
-    const RenderedImage image = render(model, settings);
+    const RenderedImage image = render(settings);
     EXPECT_EQ(inside_the_wall(image).covered, 1.0) << kernel_name(kernel);
     EXPECT_FALSE(image.covered(5, 5));
     EXPECT_EQ(image.rgba[0], 10);
@@ -156,14 +156,13 @@ TEST(SplatRenderer, EveryKernelClosesTheWallAndTheBackgroundStaysEmpty) {
 // resolve fills each from the splats round it, and nothing beyond the
 // wall's edges, where background lies on one side.
 TEST(SplatRenderer, PinholesRingedBySplatsAreFilledAndTheSilhouetteStays) {
-  const RenderModel model = test::wall_model();
   RenderSettings thin;
   thin.splat_scale = 0.8f;
   thin.fill_reach_px = 0;
-  const RenderedImage open = render(model, thin);
+  const RenderedImage open = render(thin);
   EXPECT_LT(inside_the_wall(open).covered, 0.995);
   thin.fill_reach_px = 3;
-  const RenderedImage filled = render(model, thin);
+  const RenderedImage filled = render(thin);
   const Inside inside = inside_the_wall(filled);
   EXPECT_EQ(inside.covered, 1.0);
   EXPECT_GT(inside.red_left, 0.99);
@@ -177,7 +176,7 @@ TEST(SplatRenderer, PinholesRingedBySplatsAreFilledAndTheSilhouetteStays) {
 }
 
 TEST(SplatRenderer, HiddenObjectsAreNotDrawn) {
-  const RenderedImage image = render(test::wall_model(true), {});
+  const RenderedImage image = render({}, {1000.0, 2000.0, 1.5}, true);
   std::size_t right = 0;
   for (int y = 116; y < 364; ++y) {
     for (int x = 340; x < 489; ++x) right += image.covered(x, y);
@@ -190,11 +189,10 @@ TEST(SplatRenderer, HiddenObjectsAreNotDrawn) {
 // through the wall's middle draws only that band (the wall spans 3 m, rows
 // 106…374: the band lies within rows 150…330).
 TEST(SplatRenderer, AClippingBoxAndASliceLimitWhatIsDrawn) {
-  const RenderModel model = test::wall_model();
   RenderSettings boxed;
   boxed.culling.clipping.box = Eigen::AlignedBox3f(Eigen::Vector3f(9.0f, 0.0f, -1.0f),
                                                    Eigen::Vector3f(11.0f, 3.0f, 4.0f));
-  const RenderedImage left = render(model, boxed);
+  const RenderedImage left = render(boxed);
   std::size_t right = 0;
   for (int y = 116; y < 364; ++y) {
     for (int x = 340; x < 489; ++x) right += left.covered(x, y);
@@ -206,7 +204,7 @@ TEST(SplatRenderer, AClippingBoxAndASliceLimitWhatIsDrawn) {
   sliced.culling.clipping.section_normal = Eigen::Vector3f::UnitZ();
   sliced.culling.clipping.section_offset = 1.5f;
   sliced.culling.clipping.section_half_width = 0.5f;
-  const RenderedImage band = render(model, sliced);
+  const RenderedImage band = render(sliced);
   std::size_t outside = 0, inside = 0, pixels = 0;
   for (int x = 151; x < 489; ++x) {
     for (int y = 116; y < 140; ++y) outside += band.covered(x, y);
@@ -218,23 +216,21 @@ TEST(SplatRenderer, AClippingBoxAndASliceLimitWhatIsDrawn) {
 }
 
 TEST(SplatRenderer, TheBackOfTheWallIsCulledUnlessAskedFor) {
-  const RenderModel model = test::wall_model();
   const Eigen::Vector3d behind(1020.0, 2000.0, 1.5);
   std::size_t drawn = 0;
-  const RenderedImage culled = render(model, {}, behind);
+  const RenderedImage culled = render({}, behind);
   for (std::size_t i = 3; i < culled.rgba.size(); i += 4) drawn += culled.rgba[i] != 0;
   EXPECT_EQ(drawn, 0u);
   RenderSettings both_sides;
   both_sides.culling.backface = false;
-  const RenderedImage seen = render(model, both_sides, behind);
+  const RenderedImage seen = render(both_sides, behind);
   EXPECT_TRUE(seen.covered(320, 240));
 }
 
 TEST(SplatRenderer, ColourModesDrawWhatTheyName) {
-  const RenderModel model = test::wall_model();
   RenderSettings settings;
   settings.color = ColorMode::kObject;
-  const RenderedImage objects = render(model, settings);
+  const RenderedImage objects = render(settings);
   const auto pixel = [&](const RenderedImage& image, int x, int y) {
     const std::uint8_t* p = &image.rgba[4 * (static_cast<std::size_t>(y) * image.width + x)];
     return Eigen::Vector3i(p[0], p[1], p[2]);
@@ -245,14 +241,14 @@ TEST(SplatRenderer, ColourModesDrawWhatTheyName) {
   for (int c = 0; c < 3; ++c)
     EXPECT_NEAR(pixel(objects, 200, 240)[c], one[static_cast<std::size_t>(c)], 1);
   settings.color = ColorMode::kIntensity;
-  EXPECT_EQ(pixel(render(model, settings), 200, 240), Eigen::Vector3i(128, 128, 128));
+  EXPECT_EQ(pixel(render(settings), 200, 240), Eigen::Vector3i(128, 128, 128));
   settings.color = ColorMode::kNormal;  // (−1, 0, 0) → (0, 0.5, 0.5)
-  EXPECT_EQ(pixel(render(model, settings), 200, 240), Eigen::Vector3i(0, 128, 128));
+  EXPECT_EQ(pixel(render(settings), 200, 240), Eigen::Vector3i(0, 128, 128));
   for (const ColorMode mode : {ColorMode::kHeight, ColorMode::kColor}) {
     settings.color = mode;
     settings.lighting = true;
     settings.eye_dome = true;
-    EXPECT_EQ(inside_the_wall(render(model, settings)).covered, 1.0) << color_mode_name(mode);
+    EXPECT_EQ(inside_the_wall(render(settings)).covered, 1.0) << color_mode_name(mode);
   }
 }
 

@@ -1,0 +1,36 @@
+// What the user limits a frame to (a clipping box and a slice) and how a
+// frame may be culled and thinned: settings the frame plan
+// (lod_frame_plan.hpp) and the shaders share. No OpenGL here.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+
+namespace scanbench::render {
+
+// What the user limits the drawing to, in the model's frame (metres from
+// its origin): a clipping box, and a section plane with a thickness (a
+// slice). A point is drawn when it lies in both.
+struct Clipping {
+  Eigen::AlignedBox3f box;                                    // empty (the default): no box
+  Eigen::Vector3f section_normal = Eigen::Vector3f::UnitZ();  // unit
+  float section_offset = 0.0f;                                // the plane: normal · p = offset
+  float section_half_width = 0.0f;  // the slice's half thickness; 0: no plane
+
+  bool active() const { return !box.isEmpty() || section_half_width > 0.0f; }
+  bool keeps(const Eigen::Vector3f& p) const;
+  // No point of `b` can be kept.
+  bool excludes(const Eigen::AlignedBox3f& b) const;
+};
+
+struct CullSettings {
+  Clipping clipping;
+  bool frustum = true;          // nodes outside the view's frustum are left out
+  bool backface = true;         // points facing away are left out (in the shaders)
+  bool level_of_detail = true;  // nodes drawn as the prefix whose cells are lod_pixels wide
+  float lod_pixels = 1.0f;      // [pixels] on screen
+  std::size_t budget = 0;       // points per frame; 0: no budget
+};
+
+}  // namespace scanbench::render
