@@ -51,7 +51,7 @@ struct LodFrameResult {
   bool complete() const { return plan.wanted.empty(); }
 };
 
-// A point of the store under a ray, as the last frame drew it.
+// A point of the store under a ray, as a complete picture draws it.
 struct LodPick {
   lod::LodPoint point;       // as stored: its scan, pixel and object
   std::int64_t object = 0;   // its object as the view shows it (0: none, or one not in the tree)

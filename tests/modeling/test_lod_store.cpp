@@ -2,11 +2,17 @@
 // point for point, the same tree whatever the chunks and threads, and a
 // build that fails leaves the store it would have replaced.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <fstream>
 #include <map>
+#include <random>
 #include <set>
+#include <thread>
 
 #include "core/errors.hpp"
 #include "modeling/lod/build_lod.hpp"
@@ -213,6 +219,82 @@ TEST(LodStore, ACancelledBuildLeavesTheStoreItWouldHaveReplaced) {
   build_quietly(project);
   EXPECT_FALSE(std::filesystem::exists(first.store.string() + ".partial-999999999"));
   EXPECT_EQ(LodStore::open(first.store).header().points, first.points);
+}
+
+// A build killed at any moment (SIGKILL: no destructor runs) leaves the
+// store it would have replaced, byte for byte, or the new one whole; never
+// a mix. The next build clears what the dead ones left.
+TEST(LodStore, ABuildKilledAtAnyMomentLeavesTheOldStoreOrTheNew) {
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const LodRoomProject room = store_two_rooms(project);
+  const LodBuildResult old_build = build_quietly(project);
+  const std::string old_bytes = test::read_file_bytes(old_build.store);
+  {  // the project moves on: a new store would hold other points
+    std::vector<std::uint8_t> keep = room.keep;
+    for (std::size_t i = 0; i < keep.size(); i += 2) keep[i] = 1;
+    store::Project::Edit edit = project.begin_command("merge", "{}");
+    project.put_layer(
+        edit, room.second,
+        store::encode_layer<std::uint8_t>(store::layer::kKeep, store::ElementType::kU8, keep));
+    edit.commit("{}");
+  }
+  LodBuildSettings to_the_side;
+  to_the_side.output = dir / "new.lod";
+  const auto start = std::chrono::steady_clock::now();
+  const LodBuildResult new_build = build_quietly(project, to_the_side);
+  const double build_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_NE(new_build.points, old_build.points);
+  const auto new_nodes = read_store(LodStore::open(new_build.store));
+  std::mt19937 random(29);
+  std::uniform_real_distribution<double> moment(0.0, 2.0 * build_s);
+  std::size_t old_seen = 0, new_seen = 0;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    if (attempt > 0 && test::read_file_bytes(old_build.store) != old_bytes) {
+      // The last kill came after the rename: put the old store back.
+      std::ofstream(old_build.store, std::ios::binary | std::ios::trunc) << old_bytes;
+    }
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      try {
+        build_quietly(store::Project::open_for_reading(dir / "p.sbproj"));
+      } catch (...) {
+        ::_exit(3);
+      }
+      ::_exit(0);
+    }
+    // The last one is let finish: the new store, before the next build.
+    if (attempt < 7) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(moment(random)));
+      ::kill(child, SIGKILL);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    const std::string bytes = test::read_file_bytes(old_build.store);
+    if (bytes == old_bytes) {
+      ++old_seen;
+      continue;
+    }
+    const LodStore now = LodStore::open(old_build.store);  // whole, or this throws
+    EXPECT_EQ(now.header().points, new_build.points);
+    const auto nodes = read_store(now);
+    ASSERT_EQ(nodes.size(), new_nodes.size());
+    for (const auto& [code, node] : nodes) {
+      ASSERT_TRUE(new_nodes.count(code)) << code;
+      EXPECT_EQ(node.first.level_ends, new_nodes.at(code).first.level_ends);
+      EXPECT_TRUE(node.second == new_nodes.at(code).second) << "node " << code;
+    }
+    ++new_seen;
+  }
+  EXPECT_GT(old_seen, 0u);
+  EXPECT_GT(new_seen, 0u);
+  std::printf("killed builds: %zu left the old store, %zu the new one\n", old_seen, new_seen);
+  build_quietly(project);
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
+  }
 }
 
 TEST(LodStore, RefusesWhatIsNotAStoreNamingTheFile) {
