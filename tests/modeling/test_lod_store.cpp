@@ -250,7 +250,8 @@ TEST(LodStore, ABuildKilledAtAnyMomentLeavesTheOldStoreOrTheNew) {
   std::mt19937 random(29);
   std::uniform_real_distribution<double> moment(0.0, 2.0 * build_s);
   std::size_t old_seen = 0, new_seen = 0;
-  for (int attempt = 0; attempt < 8; ++attempt) {
+  constexpr int kAttempts = 5;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
     if (attempt > 0 && test::read_file_bytes(old_build.store) != old_bytes) {
       // The last kill came after the rename: put the old store back.
       std::ofstream(old_build.store, std::ios::binary | std::ios::trunc) << old_bytes;
@@ -266,7 +267,7 @@ TEST(LodStore, ABuildKilledAtAnyMomentLeavesTheOldStoreOrTheNew) {
       ::_exit(0);
     }
     // The last one is let finish: the new store, before the next build.
-    if (attempt < 7) {
+    if (attempt + 1 < kAttempts) {
       std::this_thread::sleep_for(std::chrono::duration<double>(moment(random)));
       ::kill(child, SIGKILL);
     }
