@@ -78,11 +78,7 @@ RenderSession open_render_session(RenderOptions& options) {
 
 void write_picture(const render::LodRenderer& renderer, const std::string& output) {
   const render::RenderedImage image = renderer.read_image();
-  std::vector<std::uint8_t> rgb(3 * static_cast<std::size_t>(image.width) * image.height);
-  for (std::size_t i = 0; i < rgb.size() / 3; ++i) {
-    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image.rgba[4 * i + c];
-  }
-  acquisition::write_rgb_picture(output, image.width, image.height, rgb);
+  acquisition::write_rgb_picture(output, image.width, image.height, image.rgb());
 }
 
 nlohmann::json settings_json(const RenderOptions& options, const RenderSession& session) {

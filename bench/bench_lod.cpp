@@ -39,20 +39,6 @@ nlohmann::json timed_build(const std::filesystem::path& project, int threads,
 
 namespace sim = acquisition::sim;
 
-std::vector<std::uint8_t> rgb_of(const render::RenderedImage& image) {
-  std::vector<std::uint8_t> rgb(3 * image.rgba.size() / 4);
-  for (std::size_t i = 0; i < rgb.size() / 3; ++i) {
-    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image.rgba[4 * i + c];
-  }
-  return rgb;
-}
-
-std::vector<std::uint8_t> covered_of(const render::RenderedImage& image) {
-  std::vector<std::uint8_t> covered(image.rgba.size() / 4);
-  for (std::size_t i = 0; i < covered.size(); ++i) covered[i] = image.rgba[4 * i + 3] != 0;
-  return covered;
-}
-
 // Each view as the streaming renderer draws it once the camera stops,
 // from cold caches (a renderer just opened): the frames until the picture
 // is complete, and that picture against the truth and against the full
@@ -88,15 +74,14 @@ nlohmann::json measure_views(const std::filesystem::path& project, const Simulat
     const auto against = [&](const std::vector<std::uint8_t>& rgb,
                              const std::vector<std::uint8_t>& reference,
                              const std::vector<std::uint8_t>& where) {
-      return compare_pictures(width, height, rgb, reference, covered_of(image), where).psnr_db;
+      return compare_pictures(width, height, rgb, reference, image.coverage(), where).psnr_db;
     };
-    const std::vector<std::uint8_t> full_covered = covered_of(full_image);
+    const std::vector<std::uint8_t> full_covered = full_image.coverage();
     views[view.name] = {
-        {"converged_psnr_db", against(rgb_of(image), truth.rgb, mask)},
+        {"converged_psnr_db", against(image.rgb(), truth.rgb, mask)},
         {"full_renderer_psnr_db",
-         compare_pictures(width, height, rgb_of(full_image), truth.rgb, full_covered, mask)
-             .psnr_db},
-        {"against_full_renderer_psnr_db", against(rgb_of(image), rgb_of(full_image), full_covered)},
+         compare_pictures(width, height, full_image.rgb(), truth.rgb, full_covered, mask).psnr_db},
+        {"against_full_renderer_psnr_db", against(image.rgb(), full_image.rgb(), full_covered)},
         {"converge_seconds", seconds},
         {"converge_frames", frames}};
   }

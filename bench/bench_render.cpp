@@ -76,11 +76,7 @@ ViewFigures measure_view(render::LodRenderer& renderer, const sim::Scene& scene,
     settings.background = {sim::kSkyRgb[0], sim::kSkyRgb[1], sim::kSkyRgb[2]};
     const render::LodFrameResult frame = renderer.draw_complete(camera, settings);
     const render::RenderedImage image = renderer.read_image();
-    std::vector<std::uint8_t> rgb(truth.rgb.size()), covered(mask.size());
-    for (std::size_t i = 0; i < covered.size(); ++i) {
-      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image.rgba[4 * i + c];
-      covered[i] = image.rgba[4 * i + 3] != 0;
-    }
+    const std::vector<std::uint8_t> rgb = image.rgb(), covered = image.coverage();
     picture(std::string(render::draw_mode_name(mode)), rgb);
     if (mode == render::DrawMode::kBlended) {  // the holes, magenta on the truth
       std::vector<std::uint8_t> holes = truth.rgb;

@@ -44,6 +44,20 @@ std::optional<ColorMode> color_mode_from_name(std::string_view name) {
   return from_name<ColorMode>(kColorModeNames, name);
 }
 
+std::vector<std::uint8_t> RenderedImage::rgb() const {
+  std::vector<std::uint8_t> out(3 * (rgba.size() / 4));
+  for (std::size_t i = 0; i < rgba.size() / 4; ++i) {
+    for (std::size_t c = 0; c < 3; ++c) out[3 * i + c] = rgba[4 * i + c];
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> RenderedImage::coverage() const {
+  std::vector<std::uint8_t> out(rgba.size() / 4);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = rgba[4 * i + 3] != 0;
+  return out;
+}
+
 struct SplatPasses::Gpu {
   GlVertexArray empty;  // the resolve's triangle needs no attributes
   GlProgram splat;

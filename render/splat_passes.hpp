@@ -75,6 +75,10 @@ struct RenderedImage {
   bool covered(int x, int y) const {
     return rgba[4 * (static_cast<std::size_t>(y) * width + x) + 3] != 0;
   }
+  // The picture without alpha: RGB, 3 bytes a pixel, top row first.
+  std::vector<std::uint8_t> rgb() const;
+  // 1 where something was drawn, a byte a pixel.
+  std::vector<std::uint8_t> coverage() const;
 };
 
 // The last frame on the device, for a window to show without reading it
