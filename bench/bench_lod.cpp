@@ -2,10 +2,13 @@
 
 #include <chrono>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
+#include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/simulation/sites.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
 #include "bench/campus_views.hpp"
@@ -13,20 +16,25 @@
 #include "bench/image_metrics.hpp"
 #include "bench/scratch_folder.hpp"
 #include "bench/simulated_site.hpp"
+#include "modeling/color_commands.hpp"
+#include "modeling/lod/build_lod.hpp"
 #include "modeling/lod/lod_store.hpp"
+#include "modeling/selection_commands.hpp"
+#include "modeling/tree_commands.hpp"
 #include "render/device.hpp"
 #include "render/lod_renderer.hpp"
 
 namespace scanbench::bench {
 namespace {
 
-// `scanbench lod` on `project` with `threads` (0: every core), its JSON
-// with the process's wall time and peak memory.
-nlohmann::json timed_build(const std::filesystem::path& project, int threads,
-                           const std::filesystem::path& dir) {
-  const std::string stage = "lod_" + std::to_string(threads);
-  const ChildRun run = run_scanbench(
-      stage, {"lod", project.string(), "--json", "--threads", std::to_string(threads)}, dir);
+// `scanbench lod` on `project` with `threads` (0: every core; --rebuild
+// when `rebuild`), its JSON with the process's wall time and peak memory.
+nlohmann::json timed_lod(const std::filesystem::path& project, int threads,
+                         const std::filesystem::path& dir, bool rebuild, const std::string& stage) {
+  std::vector<std::string> arguments = {"lod", project.string(), "--json", "--threads",
+                                        std::to_string(threads)};
+  if (rebuild) arguments.push_back("--rebuild");
+  const ChildRun run = run_scanbench(stage, arguments, dir);
   if (run.exit_code != 0) {
     throw std::runtime_error("bench lod: scanbench lod exited with " +
                              std::to_string(run.exit_code) + ": " + run.err);
@@ -37,16 +45,140 @@ nlohmann::json timed_build(const std::filesystem::path& project, int threads,
   return built;
 }
 
+nlohmann::json timed_build(const std::filesystem::path& project, int threads,
+                           const std::filesystem::path& dir) {
+  return timed_lod(project, threads, dir, true, "lod_" + std::to_string(threads));
+}
+
+// `scanbench lod` updating the store in place after a command; refuses a
+// rebuild (the bench measures updates).
+nlohmann::json timed_update(const std::filesystem::path& project, const std::filesystem::path& dir,
+                            const std::string& stage) {
+  nlohmann::json update = timed_lod(project, 0, dir, false, stage);
+  if (!update["updated"].get<bool>()) {
+    throw std::runtime_error("bench lod: the store was built again after " + stage + ": " +
+                             update["why_built"].get<std::string>());
+  }
+  return update;
+}
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// The truth object of `site`'s first scan whose pixels there come nearest
+// a million points over the whole campaign (a scan of 3600 × 900 holds
+// 3.24 M pixels; the other scans carry about as many again): its id and
+// its in-model pixels.
+std::pair<std::uint32_t, std::vector<std::uint32_t>> object_of_a_million(
+    const SimulatedSite& site) {
+  const acquisition::Scan& scan = site.scans.front();
+  const double target = 0.5e6 * static_cast<double>(scan.pixel_count()) / (3600.0 * 900.0);
+  std::map<std::uint32_t, std::vector<std::uint32_t>> pixels;
+  for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
+    const std::uint32_t id = site.truth.front().object_id[i];
+    if (id != 0 && acquisition::in_model(scan, site.geometry.front(), i))
+      pixels[id].push_back(static_cast<std::uint32_t>(i));
+  }
+  auto best = pixels.begin();
+  for (auto at = pixels.begin(); at != pixels.end(); ++at) {
+    if (std::abs(static_cast<double>(at->second.size()) - target) <
+        std::abs(static_cast<double>(best->second.size()) - target))
+      best = at;
+  }
+  return *best;
+}
+
+// Edits as a user makes them, the store updated in place (`scanbench lod`
+// in a process of its own after each command): a truth object committed
+// from the first scan and carried into the others; its hide and recolour,
+// each shown by the next frame of the street view without a node
+// uploaded or the store rewritten; its delete; then the undo of that.
+nlohmann::json measure_edits(const std::filesystem::path& file, const SimulatedSite& site,
+                             const std::filesystem::path& dir, int width, int height) {
+  store::Project project = store::Project::open(file);
+  const std::int64_t scan_id = project.scans().front().id;
+  nlohmann::json out;
+  const auto [truth_id, selection] = object_of_a_million(site);
+  auto start = std::chrono::steady_clock::now();
+  modeling::CommitSettings commit;
+  commit.scan_id = scan_id;
+  commit.name = "bench object";
+  const std::int64_t node = modeling::commit_selection(project, commit, selection).node_id;
+  out["commit_command_ms"] = ms_since(start);
+  const nlohmann::json committed = timed_update(file, dir, "lod_commit");
+  out["commit_points"] = committed["points_relabelled"];
+  out["commit_store_ms"] = 1000.0 * committed["seconds"].get<double>();
+  out["commit_nodes_written"] = committed["nodes_written"];
+  out["commit_truth_object"] = truth_id;
+
+  const std::unique_ptr<render::RenderDevice> device = render::make_headless_device();
+  render::LodRenderer renderer(lod::LodStore::path_for(file), {});
+  render::RenderSettings settings;
+  const NamedView street = campus_views(width, height).at(1);
+  const render::RenderView camera =
+      render::make_render_view(street.camera, renderer.header().origin);
+  renderer.show_project_state(project);
+  renderer.draw_complete(camera, settings);
+  // A command, then the next frame: what it costs to see it.
+  const auto next_frame = [&](const std::function<void()>& command, const char* name) {
+    const auto begin = std::chrono::steady_clock::now();
+    command();
+    const double command_ms = ms_since(begin);
+    renderer.show_project_state(project);
+    const render::LodFrameResult frame = renderer.draw(camera, settings);
+    out[std::string(name) + "_ms"] = ms_since(begin);
+    out[name] = {{"command_ms", command_ms},
+                 {"frame_ms", frame.frame_ms},
+                 {"frames", 1},
+                 {"uploaded_nodes", frame.uploaded_nodes},
+                 {"store_current", lod::current_lod_store(project).has_value()}};
+  };
+  // Hides or shows the object.
+  const auto show = [&](bool shown) {
+    modeling::NodeEdit edit;
+    edit.node = node;
+    edit.hidden = !shown;
+    modeling::edit_node(project, edit);
+  };
+  next_frame([&] { show(false); }, "hide");
+  show(true);
+  next_frame(
+      [&] {
+        modeling::RecolorSettings recolor;
+        recolor.node = node;
+        recolor.set.hue_deg = 120.0;
+        recolor.set.saturation = 1.5;
+        modeling::recolor_object(project, recolor);
+      },
+      "recolor");
+  start = std::chrono::steady_clock::now();
+  modeling::DeleteSettings removal;
+  removal.node = node;
+  removal.points = modeling::DeletedPoints::kDeleted;
+  modeling::delete_node(project, removal);
+  out["delete_command_ms"] = ms_since(start);
+  const nlohmann::json deleted = timed_update(file, dir, "lod_delete");
+  out["delete_store_ms"] = 1000.0 * deleted["seconds"].get<double>();
+  out["delete_points"] = deleted["points_removed"];
+  project.undo();
+  const nlohmann::json undone = timed_update(file, dir, "lod_undo_delete");
+  out["undo_delete_store_ms"] = 1000.0 * undone["seconds"].get<double>();
+  out["undo_delete_points"] = undone["points_added"];
+  return out;
+}
+
 namespace sim = acquisition::sim;
 
-// Each view as the streaming renderer draws it once the camera stops,
+// Each view of the project of the site's first `stations` scans as the
+// streaming renderer draws it once the camera stops,
 // from cold caches (a renderer just opened): the frames until the picture
 // is complete, and that picture against the truth and against the full
 // picture (every point of the store drawn, no level of detail).
 nlohmann::json measure_views(const std::filesystem::path& project, const SimulatedSite& site,
-                             int width, int height) {
-  const sim::Site scene_site =
-      sim::make_site("campus", kSiteSeed, static_cast<int>(site.scans.size()));
+                             std::size_t stations, int width, int height) {
+  const sim::Site scene_site = sim::make_site("campus", kSiteSeed, static_cast<int>(stations));
   const std::unique_ptr<render::RenderDevice> device = render::make_headless_device();
   const std::filesystem::path store = lod::LodStore::path_for(project);
   render::LodRenderer full(store, {});
@@ -57,7 +189,7 @@ nlohmann::json measure_views(const std::filesystem::path& project, const Simulat
   nlohmann::json views = nlohmann::json::object();
   for (const NamedView& view : campus_views(width, height)) {
     const sim::TruthImage truth = sim::render_truth_view(scene_site.scene, view.camera);
-    const std::vector<std::uint8_t> mask = sampled_mask(truth, view.camera, site);
+    const std::vector<std::uint8_t> mask = sampled_mask(truth, view.camera, site, stations);
     full.draw_complete(render::make_render_view(view.camera, full.header().origin), every_point);
     const render::RenderedImage full_image = full.read_image();
     render::LodRenderer streaming(store, {});
@@ -140,11 +272,13 @@ nlohmann::json run_lod_bench(const BenchOptions& options) {
     scanner.columns = 900;
     scanner.rows = 225;
   }
+  // One scan more than the project holds at first: the one inserted.
+  const std::size_t stations = options.smoke ? 2 : 4;
   const SimulatedSite site =
-      simulate_site("campus", scanner, options.smoke ? 2 : 4, SiteLighting::kReference);
+      simulate_site("campus", scanner, static_cast<int>(stations) + 1, SiteLighting::kReference);
   const ScratchFolder scratch("lod");
   const std::filesystem::path project = scratch.path() / "campus.sbproj";
-  store_site_project(site, project);
+  store_site_project(site, project, stations);
 
   const nlohmann::json all = timed_build(project, 0, scratch.path());
   const nlohmann::json one = timed_build(project, 1, scratch.path());
@@ -161,7 +295,6 @@ nlohmann::json run_lod_bench(const BenchOptions& options) {
   out["build_points_per_second"] = points / seconds;
   out["build_points_per_second_per_thread"] = points / seconds / threads;
   out["build_peak_rss_bytes"] = all["peak_rss_bytes"];
-  out["full_rebuild_seconds"] = seconds;
   out["one_thread"] = {{"build_points_per_second", points / one["seconds"].get<double>()},
                        {"build_peak_rss_bytes", one["peak_rss_bytes"]},
                        {"seconds", one["seconds"]},
@@ -181,11 +314,30 @@ nlohmann::json run_lod_bench(const BenchOptions& options) {
                  {"memory_cache_bytes_peak", path["memory_cache_bytes_peak"]},
                  {"width", width},
                  {"height", height}};
-  out["views"] = measure_views(project, site, width, height);
-  // Not built yet: edits in place, 3D selection.
-  for (const char* field : {"hide_ms", "recolor_ms", "commit_1m_points_ms", "insert_scan_seconds"})
-    out[field] = nullptr;
-  out["selection"] = nlohmann::json::array();
+  out["views"] = measure_views(project, site, stations, width, height);
+  const nlohmann::json edits = measure_edits(project, site, scratch.path(), width, height);
+  out["edits"] = edits;
+  out["hide_ms"] = edits["hide_ms"];
+  out["recolor_ms"] = edits["recolor_ms"];
+  out["commit_1m_points_ms"] = edits["commit_store_ms"];
+  // A new scan: imported, the campaign merged again, the store updated in
+  // place; against building the store of the grown campaign anew.
+  {
+    store::Project grown = store::Project::open(project);
+    add_site_scan(site, stations, grown);
+  }
+  const nlohmann::json inserted = timed_update(project, scratch.path(), "lod_insert");
+  out["insert_scan_seconds"] = inserted["seconds"];
+  const nlohmann::json rebuilt = timed_build(project, 0, scratch.path());
+  out["full_rebuild_seconds"] = rebuilt["seconds"];
+  out["full_rebuild"] = {{"points", rebuilt["points"]},
+                         {"nodes", rebuilt["nodes"]},
+                         {"peak_rss_bytes", rebuilt["peak_rss_bytes"]}};
+  out["insert"] = {
+      {"points_added", inserted["points_added"]},   {"points_removed", inserted["points_removed"]},
+      {"nodes_written", inserted["nodes_written"]}, {"nodes", inserted["nodes"]},
+      {"phase_seconds", inserted["phase_seconds"]}, {"peak_rss_bytes", inserted["peak_rss_bytes"]}};
+  out["selection"] = nlohmann::json::array();  // 3D selection: still to come
   return out;
 }
 

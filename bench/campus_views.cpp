@@ -1,5 +1,8 @@
 #include "bench/campus_views.hpp"
 
+#include <algorithm>
+#include <span>
+
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/spherical_grid.hpp"
 
@@ -23,8 +26,10 @@ std::vector<NamedView> campus_views(int width, int height) {
 
 std::vector<std::uint8_t> sampled_mask(const acquisition::sim::TruthImage& truth,
                                        const acquisition::CameraView& camera,
-                                       const SimulatedSite& site) {
-  const std::vector<acquisition::Scan>& scans = site.scans;
+                                       const SimulatedSite& site,
+                                       std::optional<std::size_t> first_scans) {
+  const std::span<const acquisition::Scan> scans(
+      site.scans.data(), std::min(site.scans.size(), first_scans.value_or(site.scans.size())));
   std::vector<acquisition::SphericalGrid> grids;
   for (const acquisition::Scan& scan : scans) grids.emplace_back(scan);
   const double focal = camera.focal_px();

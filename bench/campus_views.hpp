@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "acquisition/camera_view.hpp"
@@ -25,12 +26,13 @@ acquisition::CameraView look(const Eigen::Vector3d& position, const Eigen::Vecto
 // across the quad) and "overview" (from 90 m up and away).
 std::vector<NamedView> campus_views(int width, int height);
 
-// 1 where the truth's surface was sampled by one of the scans: the beam
-// through it has an in-model return (not a mixed pixel) within two
-// footprints (the geometry stage's, stretched by at most 4 at grazing
-// incidence) and 2 cm of it.
+// 1 where the truth's surface was sampled by one of the scans (the first
+// `scans` of them; none: all): the beam through it has an in-model return
+// (not a mixed pixel) within two footprints (the geometry stage's,
+// stretched by at most 4 at grazing incidence) and 2 cm of it.
 std::vector<std::uint8_t> sampled_mask(const acquisition::sim::TruthImage& truth,
                                        const acquisition::CameraView& camera,
-                                       const SimulatedSite& site);
+                                       const SimulatedSite& site,
+                                       std::optional<std::size_t> scans = std::nullopt);
 
 }  // namespace scanbench::bench

@@ -5,11 +5,13 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/simulation/virtual_scanner.hpp"
+#include "modeling/store/project.hpp"
 
 namespace scanbench::bench {
 
@@ -49,6 +51,14 @@ SimulatedSite simulate_site(const std::string& name, const acquisition::sim::Sca
 // The campaign stored in a new project `file` at its true poses, with its
 // geometry and the keep masks of a merge at those poses: the model
 // `scanbench render` and `scanbench lod` read.
-void store_site_project(const SimulatedSite& site, const std::filesystem::path& file);
+// `scans`: only the first so many (none: all).
+void store_site_project(const SimulatedSite& site, const std::filesystem::path& file,
+                        std::optional<std::size_t> scans = std::nullopt);
+
+// Scan k of `site` added to `project` (holding scans 0…k − 1 of it, as
+// store_site_project stored them) as a campaign grows: imported with its
+// geometry in one command, then the first k + 1 scans merged again in
+// another (their keep masks).
+void add_site_scan(const SimulatedSite& site, std::size_t k, store::Project& project);
 
 }  // namespace scanbench::bench

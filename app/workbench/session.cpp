@@ -11,7 +11,7 @@
 #include "acquisition/formats/output_file.hpp"
 #include "core/errors.hpp"
 #include "modeling/export_command.hpp"
-#include "modeling/lod/build_lod.hpp"
+#include "modeling/lod/update_lod.hpp"
 #include "modeling/store/layer_store.hpp"
 #include "modeling/store/typed_layers.hpp"
 
@@ -435,7 +435,7 @@ void Session::prepare_views() {
     view_problem_.clear();
     try {
       core::Progress quiet;  // the window shows the command running
-      store_ = lod::build_lod(project_, {}, quiet).store;
+      store_ = lod::refresh_lod(project_, {}, quiet).store();
     } catch (const core::FileError& e) {
       // A scan without geometry, a store that cannot be written: the 3D
       // view says so and stays empty.

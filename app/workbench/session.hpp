@@ -140,13 +140,14 @@ class Session {
   // node `highlight` (0: none) standing out.
   render::Picture panorama(render::PanoramaChannel channel, std::int64_t highlight) const;
   // What the 3D view draws: the project's level-of-detail store
-  // (docs/lod.md). prepare_views() builds it anew when a command changed
-  // what it reflects (the points and which objects own them); a hide, a
+  // (docs/lod.md). prepare_views() updates it in place (or builds it anew
+  // when it cannot) when a command changed what it reflects (the points
+  // and which objects own them); a hide, a
   // recolour or a harmonisation leaves it as it is, and the view shows them
   // from the tree. Empty while there is none.
   const std::filesystem::path& store() const { return store_; }
-  // Changes each time the store is built anew: a renderer of another
-  // generation draws a file that was replaced.
+  // Changes each time the store is updated or built anew: a renderer of
+  // another generation draws nodes that changed.
   std::int64_t store_generation() const { return store_generation_; }
   // Whether the store reflects the project as it is (reads the store's
   // header and the project's change marks: after a command, not each frame).

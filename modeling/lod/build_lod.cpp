@@ -82,7 +82,8 @@ Eigen::Vector3d model_origin(const std::vector<store::StoredScanSummary>& scans)
   return scans.front().summary.T_world_scan.translation().array().round();
 }
 
-// The cube on the scans' bounds. Refuses a scan whose bounds are not
+// The cube on the scans' bounds, grown by their extent on every side.
+// Refuses a scan whose bounds are not
 // finite or lie so far that the cube would pass 2^32 quanta (429 km): a
 // wrong pose or range, which the store's 32-bit positions cannot hold.
 OctreeCube model_cube(const store::Project& project,
@@ -102,6 +103,17 @@ OctreeCube model_cube(const store::Project& project,
                   "(`scanbench info`)");
     }
     box.extend(own);
+  }
+  // Room for the campaign to grow: a scan added later whose bounds reach
+  // at most the model's extent beyond them is inserted in place
+  // (update_lod.hpp). It costs the tree a level or two above the model.
+  if (!box.isEmpty()) {
+    constexpr double kLargestEdgeM = 4e5;  // within the 2^32 quanta of a position
+    const Eigen::Vector3d extent = box.sizes();
+    const double room = std::max(0.0, (kLargestEdgeM - extent.maxCoeff()) / 2.0);
+    const Eigen::Vector3d grow = extent.cwiseMin(room);
+    box.extend(box.min() - grow);
+    box.extend(box.max() + grow);
   }
   return OctreeCube::enclosing(box);
 }
@@ -265,9 +277,18 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
                                     [&](std::span<const std::array<std::uint32_t, 3>> positions) {
         for (const auto& q : positions) ++own[cube.morton_of(q, counts.depth)];
                                     });
-                    lod_scans[s] = {static_cast<std::uint16_t>(s), scans[s].id,
-                                    scans[s].summary.name,         survey.intensity_low,
-                                    survey.intensity_high,         scans[s].summary.T_world_scan};
+                    const ScanSources sources = scan_sources(own_project, scans[s].id);
+                    lod_scans[s] = {static_cast<std::uint16_t>(s),
+                                    scans[s].id,
+                                    scans[s].summary.name,
+                                    survey.intensity_low,
+                                    survey.intensity_high,
+                                    scans[s].summary.T_world_scan,
+                                    sources.points,
+                                    sources.owners,
+                                    survey.band_rows,
+                                    scans[s].summary.columns,
+                                    scan_points_content(own_project, scans[s].id)};
                     const std::lock_guard lock(merging);
                     for (const auto& [code, n] : own) cells[code] += n;
                     result.in_model += survey.in_model;
@@ -311,21 +332,34 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
       static_cast<std::uint64_t>(result.threads)));
   result.chunks = chunks.size();
 
-  // 3. Distribute, a scan per worker.
+  // 3. Distribute, a scan per worker, storing each band's owners.
+  LodStoreWriter writer(result.store, header, lod_scans);
   ParkedPoints parked(chunks.size(), in_memory);
   for (std::size_t c = 0; c < chunks.size(); ++c) parked.reserve(c, chunks[c].points);
   for_each_scan(project, result.project_revision, scans, result.threads, progress,
                 "lod: distribute", [&](std::size_t s, const store::Project& own_project) {
                   ChunkRouter router(cube, counts, parked, chunks.size());
-                  read_shown_points(
-                      own_project, scans[s], lod_scans[s], cube, header.origin, settings.points,
-                      [&](std::span<const BuildPoint> points) { router.add(points); });
+                  const LodScan& scan = lod_scans[s];
+                  std::vector<BuildPoint> points;
+                  read_shown_bands(own_project, scans[s], scan, cube, header.origin,
+                                   settings.points, [&](const ShownBand& band) {
+                                     if (points.capacity() < band.owners.size())
+                                       core::reserve_mapped(points, band.owners.size());
+                                     points.clear();
+                                     for (std::size_t g = 0; g < band.owners.size(); ++g) {
+                                       if (in_store(band.owners[g]))
+                                         points.push_back(band.point(g));
+                                     }
+                                     router.add(points);
+                                     writer.put_owners(scan.index,
+                                                       band.first_row / scan.digest_rows,
+                                                       band.owners);
+                                   });
                   router.finish();
                 });
   result.distribute_seconds = lap();
 
   // 4. Chunks, a batch of one per worker at a time; their roots wait.
-  LodStoreWriter writer(result.store, header, lod_scans);
   ParkedPoints roots(chunks.size(), in_memory);
   const auto workers = static_cast<std::size_t>(chunk_workers);
   for (std::size_t batch = 0; batch < chunks.size(); batch += workers) {

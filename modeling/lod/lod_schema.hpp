@@ -11,7 +11,9 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "modeling/lod/lod_store.hpp"
 #include "modeling/lod/octree_cube.hpp"
+#include "modeling/lod/octree_sampling.hpp"
 #include "modeling/store/sqlite_statement.hpp"
 
 namespace scanbench::lod::schema {
@@ -40,7 +42,17 @@ CREATE TABLE lod_scans (
   name TEXT NOT NULL,
   intensity_low REAL NOT NULL,
   intensity_high REAL NOT NULL,
-  pose BLOB NOT NULL CHECK (length(pose) = 128));
+  pose BLOB NOT NULL CHECK (length(pose) = 128),
+  source TEXT NOT NULL,
+  owners_source TEXT NOT NULL,
+  content TEXT NOT NULL,
+  digest_rows INTEGER NOT NULL CHECK (digest_rows >= 1),
+  columns INTEGER NOT NULL CHECK (columns >= 0));
+CREATE TABLE lod_pixels (
+  point_scan INTEGER NOT NULL REFERENCES lod_scans (point_scan),
+  band INTEGER NOT NULL CHECK (band >= 0),
+  owners BLOB NOT NULL,
+  PRIMARY KEY (point_scan, band));
 CREATE TABLE lod_nodes (
   code INTEGER PRIMARY KEY CHECK (code >= 1),
   leaf INTEGER NOT NULL CHECK (leaf IN (0, 1)),
@@ -50,6 +62,10 @@ CREATE TABLE lod_nodes (
   bounds BLOB NOT NULL CHECK (length(bounds) = 24),
   max_radius REAL NOT NULL,
   data BLOB NOT NULL);
+CREATE TABLE lod_node_tiles (
+  code INTEGER PRIMARY KEY REFERENCES lod_nodes (code),
+  count INTEGER NOT NULL CHECK (count >= 0),
+  tiles BLOB NOT NULL);
 )sql";
 
 template <typename T>
@@ -66,9 +82,35 @@ std::span<const std::uint8_t> bytes_of(const T* data, std::size_t count) {
   throw core::InputError(file.string(), position, problem);
 }
 
+// A connection that waits up to 30 s for another's write (an update) to end.
 inline sqlite3* connect(const std::filesystem::path& file, int flags) {
-  return store::sqlite::open_connection(file.string(), flags, "opening the level-of-detail store");
+  sqlite3* db =
+      store::sqlite::open_connection(file.string(), flags, "opening the level-of-detail store");
+  sqlite3_busy_timeout(db, 30000);
+  return db;
 }
+
+// Writes `node` (finished: offsets from its corner, in level order) with its
+// bounds, largest radius and the scan tiles its points come from
+// (tile_of), replacing the rows of its code. `name` names the file in
+// errors.
+void put_node(sqlite3* db, const std::string& name, const OctreeCube& cube,
+              const std::vector<LodScan>& scans, const BuiltNode& node);
+
+// Writes the owners of band `band` of the store's scan `scan` (one a
+// pixel, as LodStore::owners gives them), replacing
+// the band's row.
+void put_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
+                std::span<const std::uint32_t> owners);
+
+// The owners of a band as the store keeps them: one zstd frame.
+std::vector<std::uint8_t> compress_owners(std::span<const std::uint32_t> owners);
+// put_owners of owners compress_owners compressed.
+void put_compressed_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
+                           std::span<const std::uint8_t> compressed);
+
+// Writes scan `scan`'s row, replacing it.
+void put_scan(sqlite3* db, const std::string& name, const LodScan& scan);
 
 inline std::string node_name(const NodeKey& key) {
   return "node " + std::to_string(key.code()) + " (depth " + std::to_string(key.depth) + ")";

@@ -39,6 +39,11 @@ LodHeader read_header(sqlite3* db, const std::filesystem::path& file) {
                 ", newer than this scanbench reads (" + std::to_string(kLodFormatVersion) +
                 "): run `scanbench lod` to rebuild it");
   }
+  if (s.column_int(0) >= 1 && s.column_int(0) < kLodFormatVersion) {
+    damaged(file, "its header",
+            "is of format " + std::to_string(s.column_int(0)) +
+                ", older than this scanbench writes: run `scanbench lod` to rebuild it");
+  }
   if (s.column_int(0) < 1 || s.column_int(8) < kCellBits || s.column_int(8) > 32 ||
       s.column_int(9) < 1 || s.column_int(10) < 0 || s.column_int(11) < 0) {
     damaged(file, "its header", "is damaged: run `scanbench lod` to rebuild the store");
@@ -55,11 +60,10 @@ LodHeader read_header(sqlite3* db, const std::filesystem::path& file) {
 }
 
 std::vector<LodScan> read_scans(sqlite3* db, const std::filesystem::path& file) {
-  Statement s(
-      db,
-      "SELECT point_scan, scan_id, name, intensity_low, intensity_high, pose FROM lod_scans "
-      "ORDER BY point_scan",
-      file.string());
+  Statement s(db,
+              "SELECT point_scan, scan_id, name, intensity_low, intensity_high, pose, source, "
+              "owners_source, digest_rows, columns, content FROM lod_scans ORDER BY point_scan",
+              file.string());
   std::vector<LodScan> scans;
   while (s.step()) {
     LodScan scan;
@@ -68,7 +72,12 @@ std::vector<LodScan> read_scans(sqlite3* db, const std::filesystem::path& file) 
     scan.name = s.column_text(2);
     scan.intensity_low = static_cast<float>(s.column_double(3));
     scan.intensity_high = static_cast<float>(s.column_double(4));
-    if (!read_blob(s, 5, scan.T_world_scan.matrix().data(), 16) ||
+    scan.source = s.column_text(6);
+    scan.owners_source = s.column_text(7);
+    scan.digest_rows = static_cast<int>(std::clamp<std::int64_t>(s.column_int(8), 0, 1 << 30));
+    scan.columns = static_cast<int>(std::clamp<std::int64_t>(s.column_int(9), 0, 1 << 30));
+    scan.content = s.column_text(10);
+    if (!read_blob(s, 5, scan.T_world_scan.matrix().data(), 16) || scan.digest_rows < 1 ||
         !scan.T_world_scan.matrix().allFinite() ||
         scan.index != static_cast<std::uint16_t>(scans.size())) {
       damaged(file, "scan " + std::to_string(scan.scan_id) + " (" + scan.name + ")",
@@ -113,7 +122,15 @@ LodStore LodStore::open(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file, error)) {
     damaged(file, "", "is not there: run `scanbench lod` on the project to build it");
   }
-  LodStore store(file, schema::connect(file, SQLITE_OPEN_READONLY));
+  // Read-write where it may, though it only reads: the first read then
+  // rolls back what an update that crashed left in the journal.
+  sqlite3* db = nullptr;
+  try {
+    db = schema::connect(file, SQLITE_OPEN_READWRITE);
+  } catch (const core::RuntimeFailure&) {
+    db = schema::connect(file, SQLITE_OPEN_READONLY);
+  }
+  LodStore store(file, db);
   const std::string name = file.string();
   const auto id = static_cast<std::uint32_t>(pragma_int(store.db_, "PRAGMA application_id", name));
   if (id != schema::kLodApplicationId) {
@@ -181,6 +198,46 @@ std::vector<LodPoint> LodStore::read_points(const NodeKey& node) const {
     }
   }
   return points;
+}
+
+std::vector<std::uint32_t> LodStore::owners(const LodScan& scan, int band,
+                                            std::size_t pixels) const {
+  Statement s(db_, "SELECT owners FROM lod_pixels WHERE point_scan = ?1 AND band = ?2",
+              file_.string());
+  s.bind_int(1, scan.index).bind_int(2, band);
+  const std::string where = "scan " + std::to_string(scan.scan_id) + " (" + scan.name +
+                            "), the owners of band " + std::to_string(band);
+  if (!s.step()) damaged(file_, where, "are missing: run `scanbench lod --rebuild`");
+  const store::BlobContext context{file_.string(), where};
+  store::check_blob_size(s.column_blob(0), pixels * sizeof(std::uint32_t), context);
+  std::vector<std::uint32_t> owners(pixels);
+  store::decompress_into(s.column_blob(0), std::as_writable_bytes(std::span<std::uint32_t>(owners)),
+                         context);
+  return owners;
+}
+
+std::set<std::uint64_t> LodStore::nodes_in_tiles(const std::set<std::uint64_t>& tiles) const {
+  std::set<std::uint64_t> codes;
+  if (tiles.empty()) return codes;
+  Statement s(db_, "SELECT code, count, tiles FROM lod_node_tiles", file_.string());
+  std::vector<std::uint64_t> held;
+  while (s.step()) {
+    const auto code = static_cast<std::uint64_t>(s.column_int(0));
+    const auto count = static_cast<std::uint64_t>(std::max<std::int64_t>(0, s.column_int(1)));
+    const std::span<const std::uint8_t> blob = s.column_blob(2);
+    const store::BlobContext context{file_.string(),
+                                     node_name(NodeKey::from_code(code)) + ", its tiles"};
+    store::check_blob_size(blob, count * sizeof(std::uint64_t), context);
+    held.resize(count);
+    store::decompress_into(blob, std::as_writable_bytes(std::span<std::uint64_t>(held)), context);
+    for (const std::uint64_t tile : held) {
+      if (tiles.count(tile)) {
+        codes.insert(code);
+        break;
+      }
+    }
+  }
+  return codes;
 }
 
 }  // namespace scanbench::lod

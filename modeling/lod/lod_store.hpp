@@ -12,11 +12,14 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -28,7 +31,18 @@ struct sqlite3;
 
 namespace scanbench::lod {
 
-inline constexpr int kLodFormatVersion = 1;
+// 2: the owners of every pixel (the digest edits compare with) and what
+// each scan's points were read from.
+inline constexpr int kLodFormatVersion = 2;
+
+// A pixel's owner in the store's digest (LodStore::owners) is the object
+// of its point when the store holds it (0: none), else one of these:
+inline constexpr std::uint32_t kNotInModel = 0xffffffffu;  // no point: no return, or mixed
+inline constexpr std::uint32_t kNotShown = 0xfffffffeu;    // merged away or deleted
+// Whether the store holds the point of a pixel whose owner is `owner`.
+inline bool in_store(std::uint32_t owner) {
+  return owner < kNotShown;
+}
 
 struct LodHeader {
   std::int64_t project_revision = 0;  // the project's revision the store reflects
@@ -50,7 +64,27 @@ struct LodScan {
   float intensity_low = 0.0f;
   float intensity_high = 1.0f;
   Eigen::Isometry3d T_world_scan = Eigen::Isometry3d::Identity();  // the pose its points have
+  // The commands whose layers its points were read from (scan_sources):
+  // the layers that place and describe a point, and those that say whether
+  // it is shown and whose it is.
+  std::string source{}, owners_source{};
+  // The rows of a band of its pixel digest (LodStore::owners).
+  int digest_rows = 1;
+  int columns = 0;        // of its grid (0: unknown, a store written from points in memory)
+  std::string content{};  // the values of the layers `source` names (scan_points_content)
 };
+
+// Which tile of its scan's grid (64 × 64 pixels) the point of `pixel`
+// lies in, with the store's index of its scan: what the store records of
+// each node, so that an update finds the nodes holding changed pixels.
+inline std::uint64_t tile_of(const LodScan& scan, std::uint32_t pixel) {
+  constexpr int kTileBits = 6;
+  const auto columns = static_cast<std::uint32_t>(std::max(scan.columns, 1));
+  const std::uint32_t across = (columns + (1u << kTileBits) - 1) >> kTileBits;
+  const std::uint32_t tile =
+      (pixel / columns >> kTileBits) * across + (pixel % columns >> kTileBits);
+  return (std::uint64_t{scan.index} << 32) | tile;
+}
 
 // A node without its points.
 struct LodNodeInfo {
@@ -90,6 +124,16 @@ class LodStore {
   // core::InputError naming the node when its data is missing or damaged.
   std::vector<LodPoint> read_points(const NodeKey& node) const;
 
+  // The owner of every pixel of band `band` of scan `scan` (rows
+  // [band · digest_rows, …)): the object of its point, kNotShown or
+  // kNotInModel.
+  // Throws core::InputError naming the scan and band when it is missing or
+  // damaged.
+  std::vector<std::uint32_t> owners(const LodScan& scan, int band, std::size_t pixels) const;
+
+  // The nodes holding points of any of `tiles` (tile_of), by code.
+  std::set<std::uint64_t> nodes_in_tiles(const std::set<std::uint64_t>& tiles) const;
+
  private:
   LodStore(std::filesystem::path file, sqlite3* db);
   std::filesystem::path file_;
@@ -115,6 +159,10 @@ class LodStoreWriter {
   // compresses its node on its own, and they take turns to store.
   void put(const BuiltNode& node);
 
+  // Stores the owners of band `band` of scan `scan` (LodStore::owners).
+  // Safe from several threads.
+  void put_owners(std::uint16_t scan, int band, std::span<const std::uint32_t> owners);
+
   // The points and nodes put so far.
   std::uint64_t points() const { return points_; }
   std::uint64_t nodes() const { return nodes_; }
@@ -126,6 +174,7 @@ class LodStoreWriter {
   std::filesystem::path file_, partial_;
   sqlite3* db_ = nullptr;
   LodHeader header_;
+  std::vector<LodScan> scans_;
   std::mutex mutex_;  // over db_ and the counts while building
   std::uint64_t points_ = 0, nodes_ = 0;
   bool committed_ = false;

@@ -43,11 +43,96 @@ void sync_folder(const std::filesystem::path& file) {
 
 }  // namespace
 
+namespace schema {
+
+void put_node(sqlite3* db, const std::string& name, const OctreeCube& cube,
+              const std::vector<LodScan>& scans, const BuiltNode& node) {
+  // Bounds and the largest radius, from the points' quanta.
+  const Eigen::AlignedBox3d box = cube.node_box(node.key);
+  Eigen::AlignedBox3f bounds;
+  float max_radius = 0.0f;
+  for (const LodPoint& p : node.points) {
+    const Eigen::Vector3d offset(p.offset[0], p.offset[1], p.offset[2]);
+    bounds.extend((box.min() + offset * kQuantumM).cast<float>());
+    max_radius = std::max({max_radius, from_half(p.radii[0]), from_half(p.radii[1])});
+  }
+  const std::array<float, 6> corners =
+      bounds.isEmpty() ? std::array<float, 6>{}
+                       : std::array<float, 6>{bounds.min().x(), bounds.min().y(), bounds.min().z(),
+                                              bounds.max().x(), bounds.max().y(), bounds.max().z()};
+  const std::vector<std::uint8_t> data =
+      store::compress(std::as_bytes(std::span<const LodPoint>(node.points)), kNodeCompressionLevel);
+  Statement insert(db,
+                   "INSERT OR REPLACE INTO lod_nodes (code, leaf, points_below, points, "
+                   "level_ends, bounds, max_radius, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+                   name);
+  insert.bind_int(1, static_cast<std::int64_t>(node.key.code()))
+      .bind_int(2, node.leaf ? 1 : 0)
+      .bind_int(3, static_cast<std::int64_t>(node.points_below))
+      .bind_int(4, static_cast<std::int64_t>(node.points.size()))
+      .bind_blob(5, bytes_of(node.level_ends.data(), node.level_ends.size()))
+      .bind_blob(6, bytes_of(corners.data(), corners.size()))
+      .bind_double(7, max_radius)
+      .bind_blob(8, data)
+      .run();
+  std::vector<std::uint64_t> tiles;
+  tiles.reserve(node.points.size());
+  for (const LodPoint& p : node.points) tiles.push_back(tile_of(scans.at(p.scan), p.pixel));
+  std::sort(tiles.begin(), tiles.end());
+  tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
+  Statement tiled(
+      db, "INSERT OR REPLACE INTO lod_node_tiles (code, count, tiles) VALUES (?1, ?2, ?3)", name);
+  tiled.bind_int(1, static_cast<std::int64_t>(node.key.code()))
+      .bind_int(2, static_cast<std::int64_t>(tiles.size()))
+      .bind_blob(3, store::compress(std::as_bytes(std::span<const std::uint64_t>(tiles)),
+                                    kNodeCompressionLevel))
+      .run();
+}
+
+std::vector<std::uint8_t> compress_owners(std::span<const std::uint32_t> owners) {
+  return store::compress(std::as_bytes(owners), kNodeCompressionLevel);
+}
+
+void put_compressed_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
+                           std::span<const std::uint8_t> compressed) {
+  Statement insert(
+      db, "INSERT OR REPLACE INTO lod_pixels (point_scan, band, owners) VALUES (?1, ?2, ?3)", name);
+  insert.bind_int(1, scan).bind_int(2, band).bind_blob(3, compressed).run();
+}
+
+void put_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
+                std::span<const std::uint32_t> owners) {
+  put_compressed_owners(db, name, scan, band, compress_owners(owners));
+}
+
+void put_scan(sqlite3* db, const std::string& name, const LodScan& scan) {
+  Statement insert(db,
+                   "INSERT OR REPLACE INTO lod_scans (point_scan, scan_id, name, intensity_low, "
+                   "intensity_high, pose, source, owners_source, digest_rows, columns, content) "
+                   "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)",
+                   name);
+  insert.bind_int(1, scan.index)
+      .bind_int(2, scan.scan_id)
+      .bind_text(3, scan.name)
+      .bind_double(4, scan.intensity_low)
+      .bind_double(5, scan.intensity_high)
+      .bind_blob(6, bytes_of(scan.T_world_scan.matrix().data(), 16))
+      .bind_text(7, scan.source)
+      .bind_text(8, scan.owners_source)
+      .bind_int(9, scan.digest_rows)
+      .bind_int(10, scan.columns)
+      .bind_text(11, scan.content)
+      .run();
+}
+
+}  // namespace schema
+
 LodStoreWriter::LodStoreWriter(const std::filesystem::path& file, const LodHeader& header,
                                const std::vector<LodScan>& scans)
     : file_(file),
       partial_(file.string() + ".partial-" + std::to_string(::getpid())),
-      header_(header) {
+      header_(header),
+      scans_(scans) {
   remove_stale_partials(file);
   db_ = schema::connect(partial_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
   try {
@@ -59,19 +144,7 @@ LodStoreWriter::LodStoreWriter(const std::filesystem::path& file, const LodHeade
         db_, ("PRAGMA application_id = " + std::to_string(schema::kLodApplicationId)).c_str(),
         name);
     store::sqlite::execute(db_, "BEGIN", name);
-    for (const LodScan& scan : scans) {
-      Statement insert(db_,
-                       "INSERT INTO lod_scans (point_scan, scan_id, name, intensity_low, "
-                       "intensity_high, pose) VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
-                       name);
-      insert.bind_int(1, scan.index)
-          .bind_int(2, scan.scan_id)
-          .bind_text(3, scan.name)
-          .bind_double(4, scan.intensity_low)
-          .bind_double(5, scan.intensity_high)
-          .bind_blob(6, bytes_of(scan.T_world_scan.matrix().data(), 16))
-          .run();
-    }
+    for (const LodScan& scan : scans) schema::put_scan(db_, name, scan);
   } catch (...) {
     sqlite3_close(db_);
     std::error_code ignored_too;
@@ -89,38 +162,17 @@ LodStoreWriter::~LodStoreWriter() {
 
 void LodStoreWriter::put(const BuiltNode& node) {
   assert(!committed_ && "put before commit");
-  const std::string name = partial_.string();
-  // Bounds and the largest radius, from the points' quanta.
-  const Eigen::AlignedBox3d box = header_.cube.node_box(node.key);
-  Eigen::AlignedBox3f bounds;
-  float max_radius = 0.0f;
-  for (const LodPoint& p : node.points) {
-    const Eigen::Vector3d offset(p.offset[0], p.offset[1], p.offset[2]);
-    bounds.extend((box.min() + offset * kQuantumM).cast<float>());
-    max_radius = std::max({max_radius, from_half(p.radii[0]), from_half(p.radii[1])});
-  }
-  const std::array<float, 6> corners =
-      bounds.isEmpty() ? std::array<float, 6>{}
-                       : std::array<float, 6>{bounds.min().x(), bounds.min().y(), bounds.min().z(),
-                                              bounds.max().x(), bounds.max().y(), bounds.max().z()};
-  const std::vector<std::uint8_t> data = store::compress(
-      std::as_bytes(std::span<const LodPoint>(node.points)), schema::kNodeCompressionLevel);
   const std::lock_guard lock(mutex_);
-  Statement insert(db_,
-                   "INSERT INTO lod_nodes (code, leaf, points_below, points, level_ends, bounds, "
-                   "max_radius, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
-                   name);
-  insert.bind_int(1, static_cast<std::int64_t>(node.key.code()))
-      .bind_int(2, node.leaf ? 1 : 0)
-      .bind_int(3, static_cast<std::int64_t>(node.points_below))
-      .bind_int(4, static_cast<std::int64_t>(node.points.size()))
-      .bind_blob(5, bytes_of(node.level_ends.data(), node.level_ends.size()))
-      .bind_blob(6, bytes_of(corners.data(), corners.size()))
-      .bind_double(7, max_radius)
-      .bind_blob(8, data)
-      .run();
+  schema::put_node(db_, partial_.string(), header_.cube, scans_, node);
   points_ += node.points.size();
   ++nodes_;
+}
+
+void LodStoreWriter::put_owners(std::uint16_t scan, int band,
+                                std::span<const std::uint32_t> owners) {
+  assert(!committed_ && "put_owners before commit");
+  const std::lock_guard lock(mutex_);
+  schema::put_owners(db_, partial_.string(), scan, band, owners);
 }
 
 void LodStoreWriter::commit() {

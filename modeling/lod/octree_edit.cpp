@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <optional>
 
 namespace scanbench::lod {
 namespace {
@@ -35,17 +36,18 @@ NodeKey anchor_of(const OctreeCube& cube, const EditableTree& tree,
   }
 }
 
-class Editor {
+// Which regions an edit rebuilds and which nodes above them it draws
+// again: from the nodes' descriptions alone, not their points.
+class EditPlanner {
  public:
-  Editor(const OctreeCube& cube, const OctreeSettings& settings, EditableTree& tree,
-         std::span<const std::int64_t> scan_ids)
-      : cube_(cube), settings_(settings), tree_(tree), scan_ids_(scan_ids) {}
+  EditPlanner(const OctreeCube& cube, const OctreeSettings& settings, const EditableTree& tree)
+      : cube_(cube), settings_(settings), tree_(tree) {}
 
-  OctreeEditResult run(std::span<const BuildPoint> added, std::span<const BuildPoint> removed) {
-    for (const BuildPoint& p : removed) removed_ids_.insert(id_of(p));
-    std::set<std::uint64_t> regions = anchors(added, removed);
-    regions = highest_collapsing(regions, added, removed);
-    regions = outermost(regions);
+  // The regions, and the nodes above them.
+  std::pair<std::set<std::uint64_t>, std::set<std::uint64_t>> plan(
+      std::span<const BuildPoint> added, std::span<const BuildPoint> removed) const {
+    const std::map<std::uint64_t, std::int64_t> gains = anchor_gains(added, removed);
+    std::set<std::uint64_t> regions = outermost(highest_collapsing(gains));
     std::set<std::uint64_t> ancestors;
     for (const std::uint64_t code : regions) {
       for (NodeKey k = NodeKey::from_code(code); k.depth > 0;) {
@@ -53,42 +55,44 @@ class Editor {
         ancestors.insert(k.code());
       }
     }
-    for (const std::uint64_t code : ancestors) old_sample(NodeKey::from_code(code));
-    for (const std::uint64_t code : regions) rebuild(NodeKey::from_code(code), added);
-    redraw_ancestors(ancestors);
-    return std::move(result_);
+    return {std::move(regions), std::move(ancestors)};
   }
 
  private:
-  // The nodes each edited point's descent ends at.
-  std::set<std::uint64_t> anchors(std::span<const BuildPoint> added,
-                                  std::span<const BuildPoint> removed) const {
-    std::set<std::uint64_t> codes;
-    for (const auto* points : {&added, &removed}) {
-      for (const BuildPoint& p : *points)
-        codes.insert(anchor_of(cube_, tree_, p.point.offset).code());
-    }
-    return codes;
-  }
-
-  // Each region raised to its highest ancestor that the edit leaves with
-  // few enough points to be a leaf: that ancestor's subtree is rebuilt.
-  std::set<std::uint64_t> highest_collapsing(const std::set<std::uint64_t>& regions,
-                                             std::span<const BuildPoint> added,
-                                             std::span<const BuildPoint> removed) {
-    std::map<std::uint64_t, std::int64_t> delta;
+  // The nodes the edited points' descents end at, each with the points it
+  // gains (added less removed). Points come in runs that share a leaf: a
+  // point in the last one's anchor ends there too.
+  std::map<std::uint64_t, std::int64_t> anchor_gains(std::span<const BuildPoint> added,
+                                                     std::span<const BuildPoint> removed) const {
+    std::map<std::uint64_t, std::int64_t> gains;
+    std::optional<NodeKey> last;
+    std::int64_t* gain = nullptr;
     const auto count = [&](const BuildPoint& p, std::int64_t by) {
-      for (int depth = 0;; ++depth) {
-        const NodeKey k = cube_.node_of(p.point.offset, depth);
-        const auto found = tree_.find(k.code());
-        if (found == tree_.end() || found->second.leaf) return;
-        delta[k.code()] += by;
+      if (!last || cube_.node_of(p.point.offset, last->depth) != *last) {
+        last = anchor_of(cube_, tree_, p.point.offset);
+        gain = &gains[last->code()];
       }
+      *gain += by;
     };
     for (const BuildPoint& p : added) count(p, 1);
     for (const BuildPoint& p : removed) count(p, -1);
+    return gains;
+  }
+
+  // Each anchor raised to its highest ancestor that the edit leaves with
+  // few enough points to be a leaf: that ancestor's subtree is rebuilt.
+  std::set<std::uint64_t> highest_collapsing(
+      const std::map<std::uint64_t, std::int64_t>& gains) const {
+    // What each inner node gains: what the anchors below it do.
+    std::map<std::uint64_t, std::int64_t> delta;
+    for (const auto& [code, gain] : gains) {
+      for (NodeKey k = NodeKey::from_code(code); k.depth > 0;) {
+        k = k.parent();
+        delta[k.code()] += gain;
+      }
+    }
     std::set<std::uint64_t> raised;
-    for (const std::uint64_t code : regions) {
+    for (const auto& [code, gain] : gains) {
       NodeKey region = NodeKey::from_code(code);
       for (NodeKey k = region; k.depth > 0;) {
         k = k.parent();
@@ -115,6 +119,44 @@ class Editor {
     return kept;
   }
 
+  const OctreeCube& cube_;
+  const OctreeSettings& settings_;
+  const EditableTree& tree_;
+};
+
+class Editor {
+ public:
+  Editor(const OctreeCube& cube, const OctreeSettings& settings, EditableTree& tree,
+         std::span<const std::int64_t> scan_ids)
+      : cube_(cube), settings_(settings), tree_(tree), scan_ids_(scan_ids) {}
+
+  OctreeEditResult run(std::span<const BuildPoint> added, std::span<const BuildPoint> removed) {
+    for (const BuildPoint& p : removed) removed_ids_.insert(id_of(p));
+    const auto [regions, ancestors] = EditPlanner(cube_, settings_, tree_).plan(added, removed);
+    for (const std::uint64_t code : ancestors) old_sample(NodeKey::from_code(code));
+    // The added points by the region they fall in (the regions are
+    // disjoint, and each added point's descent ends in one).
+    std::map<std::uint64_t, std::vector<BuildPoint>> added_to;
+    std::optional<NodeKey> last;  // as the anchors, in runs
+    std::vector<BuildPoint>* to = nullptr;
+    for (const BuildPoint& p : added) {
+      if (!last || cube_.node_of(p.point.offset, last->depth) != *last) {
+        int depth = 0;
+        while (!regions.count(cube_.node_of(p.point.offset, depth).code())) {
+          ++depth;
+          assert(depth <= cube_.max_depth() && "an added point in no region");
+        }
+        last = cube_.node_of(p.point.offset, depth);
+        to = &added_to[last->code()];
+      }
+      to->push_back(p);
+    }
+    for (const std::uint64_t code : regions) rebuild(NodeKey::from_code(code), added_to[code]);
+    redraw_ancestors(ancestors);
+    return std::move(result_);
+  }
+
+ private:
   // A node's sample before the edit: its points and its ancestors' in its
   // region (memoized; the tree must not have changed yet).
   const std::vector<BuildPoint>& old_sample(const NodeKey& key) {
@@ -129,7 +171,8 @@ class Editor {
     return old_samples_.emplace(key.code(), std::move(sample)).first->second;
   }
 
-  // Region `region` built again from its points after the edit.
+  // Region `region` built again from its points after the edit, `added`
+  // (those of the added points inside it) among them.
   void rebuild(const NodeKey& region, std::span<const BuildPoint> added) {
     std::vector<BuildPoint> points;
     if (region.depth > 0) {
@@ -149,12 +192,8 @@ class Editor {
     const std::size_t before = points.size();
     std::erase_if(points, [&](const BuildPoint& p) { return removed_ids_.count(id_of(p)) > 0; });
     result_.removed_points += before - points.size();
-    for (const BuildPoint& p : added) {
-      if (in_region(cube_, region, p)) {
-        points.push_back(p);
-        ++result_.added_points;
-      }
-    }
+    points.insert(points.end(), added.begin(), added.end());
+    result_.added_points += added.size();
     if (points.empty()) return;
     Subtree top = build_subtree(cube_, region, std::move(points), settings_, [&](BuiltNode&& node) {
       store_node(node.key, node.leaf, node.points_below, {});
@@ -244,6 +283,29 @@ EditableTree build_editable_tree(const OctreeCube& cube, const std::vector<Build
   EditableTree tree;
   edit_octree(cube, settings, tree, points, {}, scan_ids);
   return tree;
+}
+
+std::set<std::uint64_t> edit_reads(const OctreeCube& cube, const OctreeSettings& settings,
+                                   const EditableTree& skeleton, std::span<const BuildPoint> added,
+                                   std::span<const BuildPoint> removed) {
+  const auto [regions, ancestors] = EditPlanner(cube, settings, skeleton).plan(added, removed);
+  std::set<std::uint64_t> reads = ancestors;
+  for (const std::uint64_t code : ancestors) {
+    const NodeKey key = NodeKey::from_code(code);
+    for (int octant = 0; octant < 8; ++octant) {
+      const std::uint64_t child = key.child(octant).code();
+      if (skeleton.count(child)) reads.insert(child);
+    }
+  }
+  for (const auto& [code, node] : skeleton) {
+    for (const std::uint64_t region : regions) {
+      if (is_below(node.key, NodeKey::from_code(region))) {
+        reads.insert(code);
+        break;
+      }
+    }
+  }
+  return reads;
 }
 
 OctreeEditResult edit_octree(const OctreeCube& cube, const OctreeSettings& settings,

@@ -66,4 +66,12 @@ OctreeEditResult edit_octree(const OctreeCube& cube, const OctreeSettings& setti
                              std::span<const BuildPoint> removed,
                              std::span<const std::int64_t> scan_ids);
 
+// The nodes whose points edit_octree(cube, settings, tree, added, removed)
+// reads, from `skeleton`: the tree's nodes without their points. An edit
+// on a tree holding only these nodes (and any others) gives the nodes a
+// whole tree would: how a store is edited without reading it whole.
+std::set<std::uint64_t> edit_reads(const OctreeCube& cube, const OctreeSettings& settings,
+                                   const EditableTree& skeleton, std::span<const BuildPoint> added,
+                                   std::span<const BuildPoint> removed);
+
 }  // namespace scanbench::lod

@@ -1,6 +1,7 @@
 #include "modeling/lod/shown_points.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <optional>
@@ -31,8 +32,9 @@ struct Band {
 enum class Reading { kPositions, kEverything };
 
 // Reads scan `stored` band by band.
+// Bands of `rows_per_band` rows, or of about `band_pixels` pixels when 0.
 void for_each_band(const store::Project& project, const store::StoredScanSummary& stored,
-                   Reading reading, std::size_t band_pixels,
+                   Reading reading, std::size_t band_pixels, int rows_per_band,
                    const std::function<void(const Band&)>& visit) {
   const std::int64_t id = stored.id;
   const bool everything = reading == Reading::kEverything;
@@ -55,7 +57,8 @@ void for_each_band(const store::Project& project, const store::StoredScanSummary
       project.open_layer_rows(id, store::layer::kKeep, store::ElementType::kU8);
   std::optional<store::LayerRowReader> membership =
       project.open_layer_rows(id, store::layer::kMembership, store::ElementType::kU32);
-  const int band = store::band_rows(band_pixels, description.columns);
+  const int band =
+      rows_per_band > 0 ? rows_per_band : store::band_rows(band_pixels, description.columns);
   for (int first = 0; first < description.rows; first += band) {
     const int end = std::min(description.rows, first + band);
     const int held_first = std::max(0, first - 1);
@@ -116,7 +119,8 @@ class IntensityHistogram {
 
 // Calls `shown(g, r, c)` for every shown pixel of the band (g: its index
 // in the band's arrays, r: its row in held, c: its column), counting into
-// `survey`; `in_model(i)` first for every in-model pixel (i: in held).
+// `survey`; `in_model(i, g)` first for every in-model pixel (i: its index
+// in held).
 template <typename InModel, typename Shown>
 void visit_band(const Band& band, ScanSurvey& survey, InModel&& in_model, Shown&& shown) {
   const int columns = band.held.columns;
@@ -127,7 +131,7 @@ void visit_band(const Band& band, ScanSurvey& survey, InModel&& in_model, Shown&
       const std::size_t g = static_cast<std::size_t>(row - band.first) * columns + c;
       if (!band.held.valid[i] || band.geometry.is_mixed(g)) continue;
       ++survey.in_model;
-      in_model(i);
+      in_model(i, g);
       if (band.keep && (*band.keep)[g] == 0) {
         ++survey.merged_away;
       } else if (band.membership && (*band.membership)[g] == store::kDeletedPoints) {
@@ -209,18 +213,24 @@ ScanSurvey survey_scan(
   IntensityHistogram intensities;
   std::vector<std::array<std::uint32_t, 3>> positions;
   std::optional<ScanSplats> directions;
-  for_each_band(project, stored, Reading::kPositions, settings.band_pixels, [&](const Band& band) {
-    if (!directions) directions.emplace(band.description, settings.max_stretch);
-    positions.clear();
-    const bool has_intensity = band.held.has_intensity();
-    visit_band(
-        band, survey,
-        [&](std::size_t i) {
-          if (has_intensity) intensities.add(band.held.intensity[i]);
-        },
-        [&](std::size_t, int r, int c) { positions.push_back(place.at(band, *directions, r, c)); });
-    visit(positions);
-  });
+  for_each_band(project, stored, Reading::kPositions, settings.band_pixels, 0,
+                [&](const Band& band) {
+                  if (!directions) {
+                    directions.emplace(band.description, settings.max_stretch);
+                    survey.band_rows = band.end - band.first;
+                  }
+                  positions.clear();
+                  const bool has_intensity = band.held.has_intensity();
+                  visit_band(
+                      band, survey,
+                      [&](std::size_t i, std::size_t) {
+                        if (has_intensity) intensities.add(band.held.intensity[i]);
+                      },
+                      [&](std::size_t, int r, int c) {
+                        positions.push_back(place.at(band, *directions, r, c));
+                      });
+                  visit(positions);
+                });
   if (const auto low = intensities.at(0.02)) {
     survey.intensity_low = *low;
     survey.intensity_high = *intensities.at(0.98);
@@ -228,40 +238,101 @@ ScanSurvey survey_scan(
   return survey;
 }
 
-void read_shown_points(const store::Project& project, const store::StoredScanSummary& stored,
-                       const LodScan& scan, const OctreeCube& cube, const Eigen::Vector3d& origin,
-                       const ShownPointsSettings& settings,
-                       const std::function<void(std::span<const BuildPoint>)>& visit) {
+void read_shown_bands(const store::Project& project, const store::StoredScanSummary& stored,
+                      const LodScan& scan, const OctreeCube& cube, const Eigen::Vector3d& origin,
+                      const ShownPointsSettings& settings,
+                      const std::function<void(const ShownBand&)>& visit) {
   ScanSurvey counts;
   const Placement place{project, stored, cube, origin};
-  std::vector<BuildPoint> points;
+  std::vector<std::uint32_t> owners;
   std::optional<ScanSplats> splats;
-  for_each_band(project, stored, Reading::kEverything, settings.band_pixels, [&](const Band& band) {
+  for_each_band(project, stored, Reading::kEverything, 0, scan.digest_rows, [&](const Band& band) {
     const acquisition::Scan& held = band.held;
-    if (!splats) {
-      splats.emplace(band.description, settings.max_stretch);
-      core::reserve_mapped(points, static_cast<std::size_t>(band.end - band.first) *
-                                       static_cast<std::size_t>(held.columns));
-    }
-    points.clear();
+    const int columns = held.columns;
+    if (!splats) splats.emplace(band.description, settings.max_stretch);
+    owners.assign(static_cast<std::size_t>(band.end - band.first) * columns, kNotInModel);
     visit_band(
-        band, counts, [](std::size_t) {},
-        [&](std::size_t g, int r, int c) {
-          const std::size_t i = held.index(r, c);
-          BuildPoint p;
-          p.point.offset = place.at(band, *splats, r, c);
-          p.point.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(band.held_first + r) *
-                                                         static_cast<std::size_t>(held.columns) +
-                                                     static_cast<std::size_t>(c));
-          p.priority = point_priority(stored.id, p.point.pixel);
-          p.point.scan = scan.index;
-          p.point.object = band.membership ? (*band.membership)[g] : 0;
-          describe_sample(held, i, scan,
-                          splats->splat(held, band.held_first, band.geometry, g, r, c), p.point);
-          points.push_back(p);
-        });
-    visit(points);
+        band, counts,
+        [&](std::size_t, std::size_t g) { owners[g] = shown_owner(band.keep, band.membership, g); },
+        [](std::size_t, int, int) {});
+    const auto point = [&](std::size_t g) {
+      const int r = band.first + static_cast<int>(g / columns) - band.held_first;
+      const int c = static_cast<int>(g % columns);
+      const std::size_t i = held.index(r, c);
+      BuildPoint p;
+      p.point.offset = place.at(band, *splats, r, c);
+      p.point.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(band.held_first + r) *
+                                                     static_cast<std::size_t>(columns) +
+                                                 static_cast<std::size_t>(c));
+      p.priority = point_priority(stored.id, p.point.pixel);
+      p.point.scan = scan.index;
+      p.point.object = owners[g];
+      describe_sample(held, i, scan, splats->splat(held, band.held_first, band.geometry, g, r, c),
+                      p.point);
+      return p;
+    };
+    visit({band.first, band.end, columns, owners, point});
   });
+}
+
+void read_owner_layers(
+    const store::Project& project, const store::StoredScanSummary& stored, int rows_per_band,
+    const std::function<void(int, int, const std::optional<std::vector<std::uint8_t>>&,
+                             const std::optional<std::vector<std::uint32_t>>&)>& visit) {
+  std::optional<store::LayerRowReader> keep =
+      project.open_layer_rows(stored.id, store::layer::kKeep, store::ElementType::kU8);
+  std::optional<store::LayerRowReader> membership =
+      project.open_layer_rows(stored.id, store::layer::kMembership, store::ElementType::kU32);
+  const int rows = stored.summary.rows;
+  for (int first = 0; first < rows; first += rows_per_band) {
+    const int end = std::min(rows, first + rows_per_band);
+    visit(first, end, store::read_rows<std::uint8_t>(keep, end - first),
+          store::read_rows<std::uint32_t>(membership, end - first));
+  }
+}
+
+namespace {
+
+// The layers that place and describe a point; and those that say whether
+// it is shown and whose it is.
+constexpr std::array<const char*, 10> kPointLayers = {store::layer::kRange,
+                                                      store::layer::kValid,
+                                                      store::layer::kIntensity,
+                                                      store::layer::kRgb,
+                                                      store::layer::kDirections,
+                                                      store::layer::kRecordedNormal,
+                                                      store::layer::kRecordedFootprint,
+                                                      store::layer::kFootprint,
+                                                      store::layer::kNormal,
+                                                      store::layer::kGeometryFlags};
+constexpr std::array<const char*, 2> kOwnerLayers = {store::layer::kKeep,
+                                                     store::layer::kMembership};
+
+// "NAME=WHAT;" for each layer, WHAT from `describe` ("-" for none).
+template <std::size_t N>
+std::string describe_layers(
+    const std::array<const char*, N>& names,
+    const std::function<std::optional<std::string>(const char*)>& describe) {
+  std::string out;
+  for (const char* name : names)
+    out += std::string(name) + "=" + describe(name).value_or("-") + ";";
+  return out;
+}
+
+}  // namespace
+
+ScanSources scan_sources(const store::Project& project, std::int64_t scan_id) {
+  const auto writer = [&](const char* name) -> std::optional<std::string> {
+    const std::optional<store::CommandRecord> record = project.layer_writer(scan_id, name);
+    if (!record) return std::nullopt;
+    return std::to_string(record->id);
+  };
+  return {describe_layers(kPointLayers, writer), describe_layers(kOwnerLayers, writer)};
+}
+
+std::string scan_points_content(const store::Project& project, std::int64_t scan_id) {
+  return describe_layers(
+      kPointLayers, [&](const char* name) { return project.layer_fingerprint(scan_id, name); });
 }
 
 }  // namespace scanbench::lod

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cassert>
+#include <memory>
 
 #include "core/errors.hpp"
 #include "core/memory.hpp"
@@ -294,6 +295,36 @@ void Project::verify_current_layer(std::int64_t id, std::string_view name) const
   // A band at a time: a layer may be larger than memory.
   if (std::optional<LayerRowReader> rows = open_layer_rows(id, name, std::nullopt))
     rows->read_rest();
+}
+
+std::optional<std::string> Project::layer_fingerprint(std::int64_t id,
+                                                      std::string_view name) const {
+  sqlite::Statement select(db(), kSelectCurrentPlace.c_str(), file_name());
+  select.bind_int(1, id).bind_text(2, name);
+  if (!select.step()) return std::nullopt;
+  const LayerFields fields = verified(select, file_name());
+  if (fields.codec == "removed") return std::nullopt;
+  const std::string where = "scan " + std::to_string(id) + ", layer " + std::string(name);
+  sqlite3_blob* blob = nullptr;
+  const int code = sqlite3_blob_open(db(), "main", "scan_layers", select.column_text(8).c_str(),
+                                     select.column_int(7), 0, &blob);
+  if (code != SQLITE_OK) sqlite::throw_error(db(), code, file_name(), where);
+  const std::unique_ptr<sqlite3_blob, decltype(&sqlite3_blob_close)> closing(blob,
+                                                                             &sqlite3_blob_close);
+  const int bytes = sqlite3_blob_bytes(blob);
+  std::array<std::uint8_t, 4> checksum{};
+  if (bytes >= 4) {
+    const int read = sqlite3_blob_read(blob, checksum.data(), 4, bytes - 4);
+    if (read != SQLITE_OK) sqlite::throw_error(db(), read, file_name(), where);
+  }
+  std::string hex;
+  for (const std::uint8_t b : checksum) {
+    constexpr const char* kDigits = "0123456789abcdef";
+    hex += kDigits[b >> 4];
+    hex += kDigits[b & 15];
+  }
+  return fields.element_type + "/" + std::to_string(fields.element_count) + "/" +
+         std::to_string(bytes) + "/" + hex;
 }
 
 std::vector<std::string> Project::layer_names(std::int64_t id) const {

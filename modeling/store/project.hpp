@@ -431,6 +431,14 @@ class Project {
   // layer `name` of scan `id` (verified), or none when no done command did.
   std::optional<CommandRecord> layer_writer(std::int64_t id, std::string_view name) const;
 
+  // A fingerprint of the values of the current version of layer `name` of
+  // scan `id`: its type, element count, frame size and the frame's content
+  // checksum (zstd's XXH64 of the values, its low 32 bits). Equal values
+  // written by another command, as a stage run again writes them, give the
+  // same one; none when the scan has no such layer. Reads the frame's end,
+  // not its values.
+  std::optional<std::string> layer_fingerprint(std::int64_t id, std::string_view name) const;
+
   // ---- Integrity ---------------------------------------------------------
 
   // Checks the whole file (`scanbench check`): SQLite's integrity and

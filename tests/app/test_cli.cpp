@@ -729,9 +729,15 @@ TEST(Cli, MergedExportWritesTheKeptPointsOnly) {
   EXPECT_EQ(built["points"].get<std::size_t>(), kept);
   EXPECT_EQ(built["scans"].get<std::size_t>(), 2u);
   EXPECT_TRUE(std::filesystem::exists(dir / "p.sbproj.lod"));
-  // Refused in too little memory, the store built before stays.
+  // A current store is left as it is; a build refused in too little
+  // memory leaves the store built before.
   const std::string before = scanbench::test::read_file_bytes(dir / "p.sbproj.lod");
-  EXPECT_EQ(run_cli(dir, {"lod", project.string(), "--memory-limit", "1kB"}).exit_code, 1);
+  const CliResult again = run_cli(dir, {"lod", project.string(), "--json"});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_TRUE(nlohmann::json::parse(again.out)["updated"].get<bool>());
+  EXPECT_EQ(nlohmann::json::parse(again.out)["nodes_written"], 0);
+  EXPECT_EQ(run_cli(dir, {"lod", project.string(), "--rebuild", "--memory-limit", "1kB"}).exit_code,
+            1);
   EXPECT_EQ(scanbench::test::read_file_bytes(dir / "p.sbproj.lod"), before);
 }
 

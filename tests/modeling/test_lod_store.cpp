@@ -2,21 +2,18 @@
 // point for point, the same tree whatever the chunks and threads, and a
 // build that fails leaves the store it would have replaced.
 #include <gtest/gtest.h>
-#include <signal.h>
 #include <sqlite3.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <fstream>
 #include <map>
 #include <random>
 #include <set>
-#include <thread>
 
 #include "core/errors.hpp"
 #include "modeling/lod/build_lod.hpp"
 #include "modeling/lod/lod_store.hpp"
+#include "modeling/lod_room_project.hpp"
 #include "modeling/room_project.hpp"
 #include "modeling/store/layer_store.hpp"
 #include "support/test_support.hpp"
@@ -25,58 +22,6 @@ namespace scanbench::lod {
 namespace {
 
 using scanbench::test::ScratchDir;
-
-// The room twice: as scanned, and from a second station 0.4 m away whose
-// merge kept two pixels in three; in the first, objects own some pixels and
-// a band of them is deleted.
-struct LodRoomProject {
-  std::int64_t first = 0, second = 0;
-  std::vector<std::uint32_t> membership;
-  std::vector<std::uint8_t> keep;
-};
-
-LodRoomProject store_two_rooms(store::Project& project) {
-  LodRoomProject room;
-  room.first = modeling::store_room(project);
-  acquisition::Scan moved = test::shared_room().scan;
-  moved.T_world_scan.translation() += Eigen::Vector3d(0.4, -0.1, 0.0);
-  moved.T_world_scan.rotate(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()));
-  room.second = test::insert_committed(project, moved);
-  const std::size_t n = moved.pixel_count();
-  room.membership.assign(n, 0);
-  room.keep.assign(n, 1);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (i % 7 == 0) room.membership[i] = 5;
-    if (i / 720 == 100) room.membership[i] = store::kDeletedPoints;
-    if (i % 3 == 0) room.keep[i] = 0;
-  }
-  store::Project::Edit edit = project.begin_command("geometry", "{}");
-  for (const store::EncodedLayer& layer : store::encode_geometry(test::shared_room().geometry))
-    project.put_layer(edit, room.second, layer);
-  project.put_layer(edit, room.first,
-                    store::encode_layer<std::uint32_t>(store::layer::kMembership,
-                                                       store::ElementType::kU32, room.membership));
-  project.put_layer(
-      edit, room.second,
-      store::encode_layer<std::uint8_t>(store::layer::kKeep, store::ElementType::kU8, room.keep));
-  edit.commit("{}");
-  return room;
-}
-
-LodBuildResult build_quietly(const store::Project& project, LodBuildSettings settings = {}) {
-  core::Progress quiet;
-  if (settings.threads == 0) settings.threads = 1;
-  return build_lod(project, settings, quiet);
-}
-
-// Every node's description and points, by code.
-std::map<std::uint64_t, std::pair<LodNodeInfo, std::vector<LodPoint>>> read_store(
-    const LodStore& store) {
-  std::map<std::uint64_t, std::pair<LodNodeInfo, std::vector<LodPoint>>> nodes;
-  for (const LodNodeInfo& info : store.nodes())
-    nodes[info.key.code()] = {info, store.read_points(info.key)};
-  return nodes;
-}
 
 TEST(LodStore, HoldsTheShownModelPointForPoint) {
   const ScratchDir dir;
@@ -256,23 +201,9 @@ TEST(LodStore, ABuildKilledAtAnyMomentLeavesTheOldStoreOrTheNew) {
       // The last kill came after the rename: put the old store back.
       std::ofstream(old_build.store, std::ios::binary | std::ios::trunc) << old_bytes;
     }
-    const pid_t child = ::fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
-      try {
-        build_quietly(store::Project::open_for_reading(dir / "p.sbproj"));
-      } catch (...) {
-        ::_exit(3);
-      }
-      ::_exit(0);
-    }
     // The last one is let finish: the new store, before the next build.
-    if (attempt + 1 < kAttempts) {
-      std::this_thread::sleep_for(std::chrono::duration<double>(moment(random)));
-      ::kill(child, SIGKILL);
-    }
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    run_in_child([&] { build_quietly(store::Project::open_for_reading(dir / "p.sbproj")); },
+                 attempt + 1 < kAttempts ? std::optional(moment(random)) : std::nullopt);
     const std::string bytes = test::read_file_bytes(old_build.store);
     if (bytes == old_bytes) {
       ++old_seen;

@@ -1,0 +1,420 @@
+#include "modeling/lod/update_lod.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <optional>
+#include <set>
+#include <unordered_map>
+
+#include "core/errors.hpp"
+#include "modeling/lod/lod_schema.hpp"
+#include "modeling/lod/lod_store.hpp"
+#include "modeling/lod/octree_edit.hpp"
+#include "modeling/lod/shown_points.hpp"
+#include "modeling/scan_cache.hpp"
+
+namespace scanbench::lod {
+namespace {
+
+using store::sqlite::Statement;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// What changed between the store's digest and the project's pixels: as
+// large as the change, not as the scans.
+struct PixelChanges {
+  // Per store scan, the new owner of each pixel whose point the store holds
+  // and now relabels (an object) or removes (kNotShown).
+  std::vector<std::unordered_map<std::uint32_t, std::uint32_t>> owners;
+  // Per store scan, the pixels whose points the store must now hold.
+  std::vector<std::vector<std::uint32_t>> added_pixels;
+  std::set<std::uint64_t> tiles;  // where points were relabelled or removed (tile_of)
+  std::uint64_t relabelled = 0, removed = 0;
+  struct Band {
+    std::uint16_t scan = 0;
+    int band = 0;
+    std::vector<std::uint8_t> owners;  // compressed (schema::compress_owners)
+  };
+  std::vector<Band> bands;  // the digest's bands that changed, as they are now
+};
+
+// Compares the owners of scan `scan`'s pixels now (the merge's keep mask and
+// the membership read, not the points) with the store's digest, into
+// `changes`. A scan new to the store (`store` none) is read whole, its
+// points into `added`.
+void compare_owners(const store::Project& project, const store::StoredScanSummary& stored,
+                    const LodScan& scan, const LodStore* store, const LodHeader& header,
+                    const ShownPointsSettings& settings, PixelChanges& changes,
+                    std::vector<BuildPoint>& new_points) {
+  const auto columns = static_cast<std::size_t>(stored.summary.columns);
+  auto& owners = changes.owners[scan.index];
+  std::vector<std::uint32_t>& added = changes.added_pixels[scan.index];
+  const auto compare = [&](int first, std::span<const std::uint32_t> before,
+                           std::span<const std::uint32_t> now) {
+    const std::size_t offset = static_cast<std::size_t>(first) * columns;
+    bool differs = false;
+    for (std::size_t g = 0; g < now.size(); ++g) {
+      if (before[g] == now[g]) continue;
+      differs = true;
+      const auto pixel = static_cast<std::uint32_t>(offset + g);
+      if (!in_store(before[g]) && in_store(now[g])) {
+        added.push_back(pixel);
+      } else if (in_store(before[g])) {
+        owners.emplace(pixel, in_store(now[g]) ? now[g] : kNotShown);
+        changes.tiles.insert(tile_of(scan, pixel));
+        ++(in_store(now[g]) ? changes.relabelled : changes.removed);
+      }
+    }
+    if (differs)
+      changes.bands.push_back({scan.index, first / scan.digest_rows, schema::compress_owners(now)});
+  };
+  if (!store) {  // every point new: their owners need the points' validity
+    read_shown_bands(project, stored, scan, header.cube, header.origin, settings,
+                     [&](const ShownBand& band) {
+                       const std::vector<std::uint32_t> none(band.owners.size(), kNotInModel);
+                       compare(band.first_row, none, band.owners);
+                       for (std::size_t g = 0; g < band.owners.size(); ++g) {
+                         if (in_store(band.owners[g])) new_points.push_back(band.point(g));
+                       }
+                     });
+    added.clear();
+    return;
+  }
+  std::vector<std::uint32_t> now;
+  read_owner_layers(project, stored, scan.digest_rows,
+                    [&](int first, int end, const auto& keep, const auto& membership) {
+                      const std::vector<std::uint32_t> before =
+                          store->owners(scan, first / scan.digest_rows,
+                                        static_cast<std::size_t>(end - first) * columns);
+                      now = before;
+                      for (std::size_t g = 0; g < now.size(); ++g) {
+                        if (now[g] != kNotInModel) now[g] = shown_owner(keep, membership, g);
+                      }
+                      compare(first, before, now);
+                    });
+}
+
+// Every point the store holds of scan `scan` (one that moved) to be
+// removed: the tiles they lie in and their count, from its digest.
+void remove_scan(const LodStore& store, const LodScan& scan, const store::StoredScanSummary& stored,
+                 PixelChanges& changes) {
+  const auto columns = static_cast<std::size_t>(stored.summary.columns);
+  for (int first = 0; first < stored.summary.rows; first += scan.digest_rows) {
+    const int end = std::min(stored.summary.rows, first + scan.digest_rows);
+    const std::vector<std::uint32_t> held = store.owners(
+        scan, first / scan.digest_rows, static_cast<std::size_t>(end - first) * columns);
+    for (std::size_t g = 0; g < held.size(); ++g) {
+      if (!in_store(held[g])) continue;
+      changes.tiles.insert(
+          tile_of(scan, static_cast<std::uint32_t>(static_cast<std::size_t>(first) * columns + g)));
+      ++changes.removed;
+    }
+  }
+}
+
+// The points of scan `scan` the store must now hold (changes.added_pixels),
+// read with everything the store keeps of them.
+void read_added(const store::Project& project, const store::StoredScanSummary& stored,
+                const LodScan& scan, const LodHeader& header, const ShownPointsSettings& settings,
+                const std::vector<std::uint32_t>& pixels, std::vector<BuildPoint>& added) {
+  auto next = pixels.begin();
+  read_shown_bands(
+      project, stored, scan, header.cube, header.origin, settings, [&](const ShownBand& band) {
+        const auto first =
+            static_cast<std::uint32_t>(band.first_row) * static_cast<std::uint32_t>(band.columns);
+        const auto end = first + static_cast<std::uint32_t>(band.owners.size());
+        for (; next != pixels.end() && *next < end; ++next)
+          added.push_back(band.point(*next - first));
+      });
+}
+
+// Whether scan `scan` of the store has a new pose in `now`.
+bool has_moved(const LodScan& scan, const store::StoredScanSummary& now) {
+  return !now.summary.T_world_scan.matrix().isApprox(scan.T_world_scan.matrix(), 0.0);
+}
+
+// Why the store's scans cannot be updated into `scans`; empty when they
+// can: the scans it holds are still there, in order, with the points it
+// read (a new pose is followed: the scan's points move), and the scans
+// that are new or moved lie inside its cube.
+std::string why_not_in_place(const store::Project& project,
+                             const std::vector<store::StoredScanSummary>& scans,
+                             const LodStore& store) {
+  const std::vector<LodScan>& held = store.scans();
+  if (held.size() > scans.size()) return "a scan left the project";
+  const LodHeader& header = store.header();
+  std::uint64_t moving = 0;
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    const store::StoredScanSummary& now = scans[k];
+    const std::string name = "scan " + std::to_string(now.id) + " (" + now.summary.name + ")";
+    if (k < held.size()) {
+      if (now.id != held[k].scan_id) return name + " left the project";
+      // Another command wrote its layers: the same values (a stage run
+      // again on every scan) or new ones.
+      if (scan_sources(project, now.id).points != held[k].source &&
+          scan_points_content(project, now.id) != held[k].content)
+        return name + " has new points or geometry";
+      if (!has_moved(held[k], now)) continue;
+      moving += now.summary.valid_points;
+    }
+    const auto& bounds = now.summary.bbox_world;
+    if (!bounds || !header.cube.quantize(bounds->min() - header.origin) ||
+        !header.cube.quantize(bounds->max() - header.origin)) {
+      return name + " reaches outside the store's cube";
+    }
+  }
+  // Moving most of the model point by point costs more than a build.
+  if (2 * moving > header.points) return "most scans have new poses";
+  if (scans.size() > std::size_t{65536}) return "the project has more scans than a store holds";
+  return {};
+}
+
+// Node `info` with `points` (as stored) as an edit holds it: offsets
+// from the cube's corner.
+EditableNode editable_node(const OctreeCube& cube, const LodNodeInfo& info,
+                           const std::vector<LodPoint>& points,
+                           const std::vector<std::int64_t>& scan_ids) {
+  EditableNode node{info.key, info.leaf, info.points_below, {}};
+  const std::array<std::uint64_t, 3> corner = cube.node_corner(info.key);
+  node.points.reserve(points.size());
+  for (const LodPoint& p : points) {
+    BuildPoint b;
+    b.point = p;
+    for (int a = 0; a < 3; ++a)
+      b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
+    b.priority = point_priority(scan_ids[p.scan], p.pixel);
+    node.points.push_back(b);
+  }
+  return node;
+}
+
+[[noreturn]] void disagrees(const std::filesystem::path& file, const std::string& problem) {
+  schema::damaged(file, "its pixel digest", problem + ": run `scanbench lod --rebuild`");
+}
+
+}  // namespace
+
+// Longer than 60 lines, but flat: check, compare, edit, write.
+std::optional<LodUpdateResult> update_lod(const store::Project& project,
+                                          const LodBuildSettings& settings,
+                                          core::Progress& progress, std::string& why_not) {
+  const auto start = std::chrono::steady_clock::now();
+  LodUpdateResult result;
+  result.store = settings.output.empty() ? LodStore::path_for(project.path()) : settings.output;
+  if (!std::filesystem::exists(result.store)) {
+    why_not = "there is no store yet";
+    return std::nullopt;
+  }
+  const store::Project::ReadSnapshot snapshot = project.read_snapshot();
+  std::optional<LodStore> opened;
+  try {
+    opened.emplace(LodStore::open(result.store));
+  } catch (const core::InputError& error) {
+    why_not = error.what();
+    return std::nullopt;
+  }
+  const LodStore& store = *opened;
+  const LodHeader& header = store.header();
+  if (header.octree.max_leaf_points != settings.octree.max_leaf_points) {
+    why_not = "the store was built with another leaf size";
+    return std::nullopt;
+  }
+  const std::vector<store::StoredScanSummary> scans = modeling::scans_with_geometry(project);
+  why_not = why_not_in_place(project, scans, store);
+  if (!why_not.empty()) return std::nullopt;
+  result.from_revision = header.project_revision;
+  result.project_revision = project.revision();
+
+  // The scans, the new ones surveyed for their intensity spread.
+  std::vector<LodScan> lod_scans = store.scans();
+  std::vector<std::int64_t> scan_ids;
+  // Scans whose points move: all deleted, then inserted at their new pose.
+  std::vector<bool> moved(scans.size(), false);
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    scan_ids.push_back(scans[k].id);
+    if (k < lod_scans.size()) {
+      moved[k] = has_moved(lod_scans[k], scans[k]);
+      lod_scans[k].T_world_scan = scans[k].summary.T_world_scan;
+      lod_scans[k].source = scan_sources(project, scans[k].id).points;
+      continue;
+    }
+    const ScanSurvey survey = survey_scan(project, scans[k], header.cube, header.origin,
+                                          settings.points, [](const auto&) {});
+    lod_scans.push_back({static_cast<std::uint16_t>(k), scans[k].id, scans[k].summary.name,
+                         survey.intensity_low, survey.intensity_high, scans[k].summary.T_world_scan,
+                         scan_sources(project, scans[k].id).points, "", survey.band_rows,
+                         scans[k].summary.columns, scan_points_content(project, scans[k].id)});
+    ++result.scans_added;
+  }
+
+  // The pixels that changed, from the scans whose owners were written
+  // since: their owners alone first, then the points to insert.
+  PixelChanges changes;
+  changes.owners.resize(scans.size());
+  changes.added_pixels.resize(scans.size());
+  std::vector<BuildPoint> added;
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    progress.throw_if_cancelled("lod");
+    const std::string owners = scan_sources(project, scans[k].id).owners;
+    if (owners == lod_scans[k].owners_source && !moved[k]) continue;
+    lod_scans[k].owners_source = owners;
+    ++result.scans_read;
+    const bool held = k < store.scans().size() && !moved[k];
+    if (moved[k]) remove_scan(store, lod_scans[k], scans[k], changes);
+    compare_owners(project, scans[k], lod_scans[k], held ? &store : nullptr, header,
+                   settings.points, changes, added);
+    if (!changes.added_pixels[k].empty()) {
+      read_added(project, scans[k], lod_scans[k], header, settings.points, changes.added_pixels[k],
+                 added);
+    }
+    progress.update({"lod: compare", k + 1, scans.size(), scans[k].summary.name});
+  }
+  result.read_seconds = seconds_since(start);
+
+  // The nodes holding points of the changed tiles, relabelled as read, and
+  // the points they hold that the store must no longer.
+  std::map<std::uint64_t, LodNodeInfo> infos;
+  EditableTree skeleton;
+  for (const LodNodeInfo& info : store.nodes()) {
+    infos.emplace(info.key.code(), info);
+    skeleton.emplace(info.key.code(), EditableNode{info.key, info.leaf, info.points_below, {}});
+  }
+  std::map<std::uint64_t, std::vector<LodPoint>> points;
+  std::set<std::uint64_t> relabelled;
+  std::vector<BuildPoint> removed;
+  const auto read_node = [&](std::uint64_t code) {
+    if (points.count(code)) return;
+    const LodNodeInfo& info = infos.at(code);
+    std::vector<LodPoint>& read = points[code] = store.read_points(info.key);
+    const std::array<std::uint64_t, 3> corner = header.cube.node_corner(info.key);
+    for (LodPoint& p : read) {
+      std::optional<std::uint32_t> now;
+      if (const auto& scan = changes.owners.at(p.scan); !scan.empty()) {
+        if (const auto found = scan.find(p.pixel); found != scan.end()) now = found->second;
+      }
+      if (!moved[p.scan] && !now) continue;
+      if (moved[p.scan] || !in_store(*now)) {
+        BuildPoint b;
+        b.point = p;
+        for (int a = 0; a < 3; ++a)
+          b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
+        b.priority = point_priority(scan_ids[p.scan], p.pixel);
+        removed.push_back(b);
+        continue;
+      }
+      p.object = *now;
+      ++result.points_relabelled;
+      relabelled.insert(code);
+    }
+  };
+  for (const std::uint64_t code : store.nodes_in_tiles(changes.tiles)) read_node(code);
+  if (result.points_relabelled != changes.relabelled || removed.size() != changes.removed)
+    disagrees(result.store, "names points the store does not hold");
+  // And the nodes an edit of the octree reads.
+  for (const std::uint64_t code :
+       edit_reads(header.cube, header.octree, skeleton, added, removed)) {
+    read_node(code);
+  }
+  result.nodes_read = points.size();
+  // Inserts and deletes edit the octree.
+  EditableTree tree;
+  OctreeEditResult edit;
+  if (!added.empty() || !removed.empty()) {
+    for (const auto& [code, held] : points)
+      tree.emplace(code, editable_node(header.cube, infos.at(code), held, scan_ids));
+    edit = edit_octree(header.cube, header.octree, tree, added, removed, scan_ids);
+    if (edit.removed_points != removed.size())
+      disagrees(result.store, "says the store holds points it does not");
+  }
+  progress.throw_if_cancelled("lod");
+  result.edit_seconds = seconds_since(start) - result.read_seconds;
+
+  // Written in one transaction.
+  sqlite3* db = schema::connect(result.store, SQLITE_OPEN_READWRITE);
+  const std::unique_ptr<sqlite3, decltype(&sqlite3_close)> closing(db, &sqlite3_close);
+  const std::string name = result.store.string();
+  store::sqlite::execute(db, "BEGIN IMMEDIATE", name);
+  try {
+    {
+      Statement revision(db, "SELECT project_revision FROM lod_header", name);
+      if (!revision.step() || revision.column_int(0) != header.project_revision) {
+        store::sqlite::execute(db, "ROLLBACK", name);
+        why_not = "another process updated the store meanwhile";
+        return std::nullopt;
+      }
+    }
+    for (const std::uint64_t code : edit.removed) {
+      for (const char* sql : {"DELETE FROM lod_node_tiles WHERE code = ?1",
+                              "DELETE FROM lod_nodes WHERE code = ?1"}) {
+        Statement remove(db, sql, name);
+        remove.bind_int(1, static_cast<std::int64_t>(code)).run();
+      }
+    }
+    for (const std::uint64_t code : edit.changed) {
+      const EditableNode& node = tree.at(code);
+      schema::put_node(
+          db, name, header.cube, lod_scans,
+          finish_node(header.cube, Subtree{node.key, node.leaf, node.points_below, node.points}));
+    }
+    // Nodes only relabelled keep their order.
+    for (const std::uint64_t code : relabelled) {
+      if (edit.changed.count(code) || edit.removed.count(code)) continue;
+      const LodNodeInfo& info = infos.at(code);
+      schema::put_node(db, name, header.cube, lod_scans,
+                       BuiltNode{info.key, info.leaf, info.points_below, std::move(points.at(code)),
+                                 info.level_ends});
+      ++result.nodes_written;
+    }
+    for (const LodScan& scan : lod_scans) schema::put_scan(db, name, scan);
+    for (const PixelChanges::Band& band : changes.bands)
+      schema::put_compressed_owners(db, name, band.scan, band.band, band.owners);
+    result.points = header.points + added.size() - removed.size();
+    result.nodes = header.nodes + edit.changed.size() - edit.removed.size();
+    for (const std::uint64_t code : edit.changed) result.nodes -= infos.count(code);
+    Statement update(db, "UPDATE lod_header SET project_revision = ?1, points = ?2, nodes = ?3",
+                     name);
+    update.bind_int(1, result.project_revision)
+        .bind_int(2, static_cast<std::int64_t>(result.points))
+        .bind_int(3, static_cast<std::int64_t>(result.nodes))
+        .run();
+  } catch (...) {
+    sqlite3_exec(db, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+  store::sqlite::execute(db, "COMMIT", name);
+  result.points_added = added.size();
+  result.points_removed = removed.size();
+  result.nodes_written += edit.changed.size();
+  result.nodes_removed = edit.removed.size();
+  result.seconds = seconds_since(start);
+  result.write_seconds = result.seconds - result.read_seconds - result.edit_seconds;
+  return result;
+}
+
+LodRefreshResult refresh_lod(const store::Project& project, const LodBuildSettings& settings,
+                             core::Progress& progress) {
+  LodRefreshResult refresh;
+  if (settings.output.empty()) {
+    if (const std::optional<std::filesystem::path> current = current_lod_store(project)) {
+      const LodHeader header = LodStore::open(*current).header();
+      refresh.updated = LodUpdateResult{};
+      refresh.updated->store = *current;
+      refresh.updated->from_revision = refresh.updated->project_revision = header.project_revision;
+      refresh.updated->points = header.points;
+      refresh.updated->nodes = header.nodes;
+      return refresh;
+    }
+  }
+  std::string why_not;
+  refresh.updated = update_lod(project, settings, progress, why_not);
+  if (!refresh.updated) {
+    refresh.why_built = why_not;
+    refresh.built = build_lod(project, settings, progress);
+  }
+  return refresh;
+}
+
+}  // namespace scanbench::lod
