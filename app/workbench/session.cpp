@@ -435,7 +435,12 @@ void Session::prepare_views() {
     view_problem_.clear();
     try {
       core::Progress quiet;  // the window shows the command running
-      store_ = lod::refresh_lod(project_, {}, quiet).store();
+      const lod::LodRefreshResult refreshed = lod::refresh_lod(project_, {}, quiet);
+      store_ = refreshed.store();
+      if (refreshed.built) ++store_builds_;
+      if (refreshed.updated &&
+          refreshed.updated->nodes_written + refreshed.updated->nodes_removed > 0)
+        ++store_updates_;
     } catch (const core::FileError& e) {
       // A scan without geometry, a store that cannot be written: the 3D
       // view says so and stays empty.

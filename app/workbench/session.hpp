@@ -158,6 +158,10 @@ class Session {
   void prepare_views();
   // Why the 3D view is empty (a scan without geometry); empty when it is not.
   const std::string& view_problem() const { return view_problem_; }
+  // How prepare_views() brought the store up to date so far: builds from
+  // scratch, and updates in place that rewrote nodes.
+  int store_builds() const { return store_builds_; }
+  int store_updates() const { return store_updates_; }
 
  private:
   // Runs a command; a refusal becomes status() and false. After it, the
@@ -190,6 +194,7 @@ class Session {
   std::filesystem::path store_;
   std::int64_t store_generation_ = 0;  // stores built or found so far
   std::string view_problem_;
+  int store_builds_ = 0, store_updates_ = 0;
   std::int64_t measurements_revision_ = 0;  // the project's revision they were read at
 };
 

@@ -193,18 +193,20 @@ class Workbench {
     const WorkbenchState& s = state_;
     nlohmann::json widgets = nlohmann::json::object();
     for (const auto& [name, at] : s.probes) widgets[name] = {at[0], at[1]};
-    const nlohmann::json out = {{"widgets", widgets},
-                                {"scan", s.session.scan_id()},
-                                {"status", s.session.status()},
-                                {"ui_scale", s.ui_scale},
-                                {"selected", s.selected},
-                                {"panorama",
-                                 {{"x", s.panorama.x + s.pan[0]},
-                                  {"y", s.panorama.y + s.pan[1]},
-                                  {"scale", s.panorama_scale()},
-                                  {"columns", s.session.scan().columns},
-                                  {"rows", s.session.scan().rows}}},
-                                {"view3d", {s.view3d.x, s.view3d.y, s.view3d.w, s.view3d.h}}};
+    const nlohmann::json out = {
+        {"widgets", widgets},
+        {"scan", s.session.scan_id()},
+        {"status", s.session.status()},
+        {"ui_scale", s.ui_scale},
+        {"selected", s.selected},
+        {"panorama",
+         {{"x", s.panorama.x + s.pan[0]},
+          {"y", s.panorama.y + s.pan[1]},
+          {"scale", s.panorama_scale()},
+          {"columns", s.session.scan().columns},
+          {"rows", s.session.scan().rows}}},
+        {"view3d", {s.view3d.x, s.view3d.y, s.view3d.w, s.view3d.h}},
+        {"store", {{"builds", s.session.store_builds()}, {"updates", s.session.store_updates()}}}};
     std::ofstream stream(file);
     stream << out.dump(1) << "\n";
     if (!stream.flush()) throw core::RuntimeFailure(file.string(), {}, "cannot write the layout");

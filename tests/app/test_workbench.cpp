@@ -21,6 +21,7 @@
 
 #include "acquisition/formats/image_decoder.hpp"
 #include "cli_runner.hpp"
+#include "modeling/lod/lod_store.hpp"
 #include "support/test_support.hpp"
 
 namespace scanbench::test {
@@ -153,6 +154,28 @@ json commands(const ScratchDir& dir, const std::filesystem::path& project) {
   return json::parse(run_cli(dir, {"history", project.string(), "--json"}).out)["commands"];
 }
 
+// The level-of-detail store beside `project` holds what `scanbench lod
+// --rebuild` of a copy of the project gives, node for node.
+void expect_store_as_built(const ScratchDir& dir, const std::filesystem::path& project) {
+  const std::filesystem::path copy = dir / "rebuilt" / project.filename();
+  std::filesystem::create_directories(copy.parent_path());
+  std::filesystem::copy_file(project, copy);
+  ASSERT_EQ(run_cli(dir, {"lod", copy.string(), "--rebuild"}).exit_code, 0);
+  const lod::LodStore updated = lod::LodStore::open(lod::LodStore::path_for(project));
+  const lod::LodStore built = lod::LodStore::open(lod::LodStore::path_for(copy));
+  EXPECT_EQ(updated.header().project_revision, built.header().project_revision);
+  EXPECT_EQ(updated.header().points, built.header().points);
+  const std::vector<lod::LodNodeInfo> nodes = updated.nodes();
+  const std::vector<lod::LodNodeInfo> expected = built.nodes();
+  ASSERT_EQ(nodes.size(), expected.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    ASSERT_EQ(nodes[k].key.code(), expected[k].key.code());
+    EXPECT_EQ(nodes[k].level_ends, expected[k].level_ends);
+    EXPECT_TRUE(updated.read_points(nodes[k].key) == built.read_points(expected[k].key))
+        << "node " << nodes[k].key.code();
+  }
+}
+
 TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   const ScratchDir dir;
   const std::filesystem::path project = campus_project(dir);
@@ -185,8 +208,13 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
                {{"move", view3d(0.5, 0.5)}},
                {{"key", "V"}},
                {{"hold", "W"}, {"frames", 12}},
-               {{"drag", {view3d(0.5, 0.5), view3d(0.5, 0.5, 120.0, 0.0)}}, {"steps", 4}}}});
+               {{"drag", {view3d(0.5, 0.5), view3d(0.5, 0.5, 120.0, 0.0)}}, {"steps", 4}},
+               {{"layout", "layout_flown.json"}}}});
   run_stage(dir, project, "fly", session);
+  // The 3D view's store: built once when the project opened without one,
+  // then updated in place by each commit, not built again.
+  EXPECT_EQ(read_json(dir / "layout_flown.json")["store"]["builds"], 1);
+  EXPECT_GE(read_json(dir / "layout_flown.json")["store"]["updates"].get<int>(), 2);
   for (const char* shot : {"workbench_open.png", "workbench_segment.png", "workbench_group.png",
                            "workbench_recolored.png"})
     keep_screenshot(dir / shot);
@@ -239,7 +267,13 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   arrange.insert(arrange.end(), ask.begin(), ask.end());
   arrange.push_back({{"click", "question yes"}});
   arrange.push_back({{"wait", 2}});
+  arrange.push_back({{"layout", "layout_arranged.json"}});
   run_stage(dir, project, "arrange", arrange);
+  // Opened with a current store; the delete updated it in place, and it
+  // holds what a build from scratch of the project gives, node for node.
+  EXPECT_EQ(read_json(dir / "layout_arranged.json")["store"]["builds"], 0);
+  EXPECT_GE(read_json(dir / "layout_arranged.json")["store"]["updates"].get<int>(), 1);
+  expect_store_as_built(dir, project);
   EXPECT_TRUE(Layout{read_json(dir / "layout_reparent_out.json")}.draws("node wall south"));
   const Layout cancelled{read_json(dir / "layout_delete_cancelled.json")};
   EXPECT_TRUE(cancelled.draws("node keller hall") && cancelled.draws("node wall west"));
