@@ -106,7 +106,10 @@ LodRenderer::LodRenderer(const std::filesystem::path& store_file, const LodRende
     : store_file_(store_file), limits_(limits), gpu_(std::make_unique<Gpu>()) {
   const lod::LodStore store = lod::LodStore::open(store_file);
   hierarchy_ = LodHierarchy::of(store);
-  for (const lod::LodScan& scan : store.scans()) scan_of_id_[scan.scan_id] = scan.index;
+  for (const lod::LodScan& scan : store.scans()) {
+    scan_of_id_[scan.scan_id] = scan.index;
+    scan_ids_.push_back(scan.scan_id);
+  }
   // Children after parents: backwards, each subtree's radius is whole
   // before its parent takes it in.
   subtree_radius_.resize(hierarchy_.nodes.size());
@@ -419,31 +422,74 @@ std::optional<LodPick> LodRenderer::pick(const Eigen::Vector3f& origin,
       if (const auto at = entry_of(static_cast<std::size_t>(child)))
         queue.emplace(*at, static_cast<std::size_t>(child));
     }
-    const Eigen::Vector3f corner = node_corner_m(k);
-    with_node_points(k, [&](std::span<const lod::LodPoint> points) {
-      for (const lod::LodPoint& q : points) {
-        const std::int64_t object =
-            q.object < object_known_.size() && object_known_[q.object] ? q.object : 0;
-        if (!object_shown_[static_cast<std::size_t>(object)]) continue;
-        SplatShape splat;
-        splat.position = corner + Eigen::Vector3f(static_cast<float>(q.offset[0]),
-                                                  static_cast<float>(q.offset[1]),
-                                                  static_cast<float>(q.offset[2])) *
-                                      static_cast<float>(lod::kQuantumM);
-        if (clipping.active() && !clipping.keeps(splat.position)) continue;
-        splat.normal = (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
-                                                             : Eigen::Vector3f::Zero();
-        splat.major_axis = (q.flags & lod::LodPoint::kRound) ? Eigen::Vector3f::Zero()
-                                                             : lod::decode_unit(q.major_axis);
-        splat.radii_m = Eigen::Vector2f(lod::from_half(q.radii[0]), lod::from_half(q.radii[1]));
-        const std::optional<float> hit =
-            splat_hit(origin, direction, splat, scale, settings.oriented,
-                      best ? best->distance_m : std::numeric_limits<float>::max());
-        if (hit) best = LodPick{q, object, splat.position, *hit};
-      }
-    });
+    for_each_shown_point(
+        k, clipping,
+        [&](const lod::LodPoint& q, std::int64_t object, const Eigen::Vector3f& position) {
+          SplatShape splat;
+          splat.position = position;
+          splat.normal = (q.flags & lod::LodPoint::kHasNormal) ? lod::decode_unit(q.normal)
+                                                               : Eigen::Vector3f::Zero();
+          splat.major_axis = (q.flags & lod::LodPoint::kRound) ? Eigen::Vector3f::Zero()
+                                                               : lod::decode_unit(q.major_axis);
+          splat.radii_m = Eigen::Vector2f(lod::from_half(q.radii[0]), lod::from_half(q.radii[1]));
+          const std::optional<float> hit =
+              splat_hit(origin, direction, splat, scale, settings.oriented,
+                        best ? best->distance_m : std::numeric_limits<float>::max());
+          if (hit) best = LodPick{q, object, splat.position, *hit};
+        });
   }
   return best;
+}
+
+std::map<std::int64_t, std::vector<std::uint32_t>> LodRenderer::select(
+    const RenderView& view, const Lasso& lasso, const RenderSettings& settings) {
+  const Clipping& clipping = settings.culling.clipping;
+  std::map<std::int64_t, std::vector<std::uint32_t>> selected;
+  if (lasso.empty() || hierarchy_.nodes.empty() || hierarchy_.nodes.front().key.depth != 0)
+    return selected;
+  std::vector<std::size_t> stack = {0};
+  while (!stack.empty()) {
+    const std::size_t k = stack.back();
+    stack.pop_back();
+    const Eigen::AlignedBox3f& reach = hierarchy_.reach[k];
+    if (reach.isEmpty() || clipping.excludes(reach)) continue;
+    // A box reaching behind the eye may cover any of the picture.
+    if (const auto on_picture = project_box(view, reach);
+        on_picture && !lasso.may_meet(*on_picture))
+      continue;
+    for (const std::int32_t child : hierarchy_.children[k]) {
+      if (child >= 0) stack.push_back(static_cast<std::size_t>(child));
+    }
+    for_each_shown_point(
+        k, clipping, [&](const lod::LodPoint& q, std::int64_t, const Eigen::Vector3f& position) {
+          const std::optional<Eigen::Vector2f> at = project_to_picture(view, position);
+          if (at && lasso.encloses(*at)) selected[scan_ids_.at(q.scan)].push_back(q.pixel);
+        });
+  }
+  for (auto& [scan, pixels] : selected) {
+    std::sort(pixels.begin(), pixels.end());
+    pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
+  }
+  return selected;
+}
+
+void LodRenderer::for_each_shown_point(
+    std::size_t k, const Clipping& clipping,
+    const std::function<void(const lod::LodPoint&, std::int64_t, const Eigen::Vector3f&)>& use) {
+  const Eigen::Vector3f corner = node_corner_m(k);
+  with_node_points(k, [&](std::span<const lod::LodPoint> points) {
+    for (const lod::LodPoint& q : points) {
+      const std::int64_t object =
+          q.object < object_known_.size() && object_known_[q.object] ? q.object : 0;
+      if (!object_shown_[static_cast<std::size_t>(object)]) continue;
+      const Eigen::Vector3f position =
+          corner + Eigen::Vector3f(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
+                                   static_cast<float>(q.offset[2])) *
+                       static_cast<float>(lod::kQuantumM);
+      if (clipping.active() && !clipping.keeps(position)) continue;
+      use(q, object, position);
+    }
+  });
 }
 
 std::vector<LodSample> LodRenderer::sample(std::size_t count) {

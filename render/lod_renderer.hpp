@@ -25,6 +25,7 @@
 
 #include "modeling/store/color_edit.hpp"
 #include "modeling/store/project.hpp"
+#include "render/lasso.hpp"
 #include "render/lod_frame_plan.hpp"
 #include "render/splat_passes.hpp"
 
@@ -117,6 +118,17 @@ class LodRenderer {
   std::optional<LodPick> pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                               const RenderSettings& settings);
 
+  // The points whose centres `lasso` (picture pixels of `view`) encloses,
+  // through every depth, among those the view would draw (shown objects,
+  // within the clipping box and slice): by scan id, each scan's pixels
+  // ascending, the per-scan pixel selections the segmentation's commands
+  // take. Every point of the store counts, whatever level of detail the
+  // last frame drew. Walks the nodes whose bounds may project into the
+  // lasso; reads those the memory cache does not hold from the store.
+  std::map<std::int64_t, std::vector<std::uint32_t>> select(const RenderView& view,
+                                                            const Lasso& lasso,
+                                                            const RenderSettings& settings);
+
   // A sample spread over the whole model: the points of its shallowest
   // nodes (each an even subsample of its region), at least `count` where
   // the store holds as many. Read from the store.
@@ -151,6 +163,11 @@ class LodRenderer {
   // Node `k`'s points, from the memory cache or read from the store.
   void with_node_points(std::size_t k,
                         const std::function<void(std::span<const lod::LodPoint>)>& use);
+  // Node `k`'s points the view would draw (of shown objects, kept by
+  // `clipping`): use(point, its object as the view shows it, its position).
+  void for_each_shown_point(
+      std::size_t k, const Clipping& clipping,
+      const std::function<void(const lod::LodPoint&, std::int64_t, const Eigen::Vector3f&)>& use);
   // Throws when a node of `wanted` could not be read.
   void refuse_failed(const std::vector<std::size_t>& wanted) const;
   double issue(const RenderView& banded_view, const RenderSettings& settings,
@@ -164,6 +181,7 @@ class LodRenderer {
   std::vector<std::uint8_t> object_shown_, object_known_;
   std::filesystem::path store_file_;
   std::map<std::int64_t, std::uint16_t> scan_of_id_;  // project scan id → store index
+  std::vector<std::int64_t> scan_ids_;                // store index → project scan id
   LodRendererLimits limits_;
   Eigen::Vector2f height_range_{0.0f, 1.0f};
   std::unique_ptr<Gpu> gpu_;
