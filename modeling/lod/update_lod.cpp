@@ -1,11 +1,15 @@
 #include "modeling/lod/update_lod.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
+#include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "modeling/lod/lod_schema.hpp"

@@ -1,21 +1,25 @@
 // Updating a project's level-of-detail store in place (docs/lod.md, seed
 // 002): after a commit, a delete, a separate, a merge of objects, a merge of
-// scans, a newly registered scan, or an undo or redo of any of them, only the
+// scans, a new or moved scan, or an undo or redo of any of them, only the
 // nodes holding the pixels that changed are written, in one SQLite
 // transaction, so a crash leaves the old store or the new one.
 //
-// The store keeps a digest of every pixel of every scan: the object owning
-// its point, or kNotInStore. An update reads again only the scans whose
-// keep mask or membership was written by another command since, compares
-// their pixels with the digest, and edits the octree (octree_edit.hpp):
-// points shown now and not before are inserted, points shown before and
-// not now are deleted, points whose owner changed are relabelled in the
-// nodes on their paths. The result is the store a build from scratch with
-// the same cube gives, node for node.
+// The store keeps a digest of every pixel of every scan (its point's
+// object, kNotShown or kNotInModel) and the scan tiles of each node. An
+// update reads again only the scans whose keep mask or membership was
+// written by another command since, and of those only these two layers,
+// and compares them with the digest. It reads the nodes of the changed
+// tiles, relabelling their points as it reads them, and edits the octree
+// (octree_edit.hpp): points shown now and not before are inserted (only
+// they need their scan read whole), points shown before and not now are
+// deleted. A moved scan's points are deleted and inserted again. The
+// result is the store a build from scratch with the same cube gives, node
+// for node.
 //
 // It cannot update (and says why) when a scan's points themselves changed
-// (a new pose, new geometry, a new import), a scan went, or a new scan lies
-// outside the store's cube: then the store is built again.
+// (new geometry values, a new import), a scan went, a new or moved scan
+// reaches outside the store's cube, or most of the model moved: then the
+// store is built again.
 #pragma once
 
 #include <cstdint>
