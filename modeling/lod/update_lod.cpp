@@ -137,10 +137,11 @@ bool has_moved(const LodScan& scan, const store::StoredScanSummary& now) {
 // Why the store's scans cannot be updated into `scans`; empty when they
 // can: the scans it holds are still there, in order, with the points it
 // read (a new pose is followed: the scan's points move), and the scans
-// that are new or moved lie inside its cube.
+// that are new or moved lie inside its cube. `sources[k]`: scan k's
+// (scan_sources).
 std::string why_not_in_place(const store::Project& project,
                              const std::vector<store::StoredScanSummary>& scans,
-                             const LodStore& store) {
+                             const std::vector<ScanSources>& sources, const LodStore& store) {
   const std::vector<LodScan>& held = store.scans();
   if (held.size() > scans.size()) return "a scan left the project";
   const LodHeader& header = store.header();
@@ -152,7 +153,7 @@ std::string why_not_in_place(const store::Project& project,
       if (now.id != held[k].scan_id) return name + " left the project";
       // Another command wrote its layers: the same values (a stage run
       // again on every scan) or new ones.
-      if (scan_sources(project, now.id).points != held[k].source &&
+      if (sources[k].points != held[k].source &&
           scan_points_content(project, now.id) != held[k].content)
         return name + " has new points or geometry";
       if (!has_moved(held[k], now)) continue;
@@ -221,7 +222,11 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
     return std::nullopt;
   }
   const std::vector<store::StoredScanSummary> scans = modeling::scans_with_geometry(project);
-  why_not = why_not_in_place(project, scans, store);
+  // Which commands wrote each scan's layers: read once, used throughout.
+  std::vector<ScanSources> sources;
+  for (const store::StoredScanSummary& scan : scans)
+    sources.push_back(scan_sources(project, scan.id));
+  why_not = why_not_in_place(project, scans, sources, store);
   if (!why_not.empty()) return std::nullopt;
   result.from_revision = header.project_revision;
   result.project_revision = project.revision();
@@ -236,15 +241,15 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
     if (k < lod_scans.size()) {
       moved[k] = has_moved(lod_scans[k], scans[k]);
       lod_scans[k].T_world_scan = scans[k].summary.T_world_scan;
-      lod_scans[k].source = scan_sources(project, scans[k].id).points;
+      lod_scans[k].source = sources[k].points;
       continue;
     }
     const ScanSurvey survey = survey_scan(project, scans[k], header.cube, header.origin,
                                           settings.points, [](const auto&) {});
     lod_scans.push_back({static_cast<std::uint16_t>(k), scans[k].id, scans[k].summary.name,
                          survey.intensity_low, survey.intensity_high, scans[k].summary.T_world_scan,
-                         scan_sources(project, scans[k].id).points, "", survey.band_rows,
-                         scans[k].summary.columns, scan_points_content(project, scans[k].id)});
+                         sources[k].points, "", survey.band_rows, scans[k].summary.columns,
+                         scan_points_content(project, scans[k].id)});
     ++result.scans_added;
   }
 
@@ -256,9 +261,8 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
   std::vector<ScanChanges> changes(scans.size());
   for (std::size_t k = 0; k < scans.size(); ++k) {
     progress.throw_if_cancelled("lod");
-    const std::string owners = scan_sources(project, scans[k].id).owners;
-    if (owners == lod_scans[k].owners_source && !moved[k]) continue;
-    lod_scans[k].owners_source = owners;
+    if (sources[k].owners == lod_scans[k].owners_source && !moved[k]) continue;
+    lod_scans[k].owners_source = sources[k].owners;
     ++result.scans_read;
     ScanChanges& scan = changes[k];
     if (moved[k]) remove_scan(store, lod_scans[k], scans[k], scan);
