@@ -10,6 +10,7 @@
 #include "modeling/command_json.hpp"
 #include "modeling/node_tree.hpp"
 #include "modeling/object_carry.hpp"
+#include "modeling/scan_cache.hpp"
 #include "modeling/scan_overlaps.hpp"
 #include "modeling/store/typed_layers.hpp"
 #include "registration/prepared_scan.hpp"
@@ -311,117 +312,212 @@ std::int64_t keep_selections(store::Project& project,
   return command_id;
 }
 
-// The membership and carried layers of the other scans with geometry, each
-// with its points that sample the surface of object `node` (its pixels in
-// `membership` of scan `drawn`), and with `grow` those it grows to there,
-// added where they were still to be segmented (object_carry.hpp); scans
-// gaining none are left out. One other scan is decoded at a time, and only
-// the scans whose stored bounds reach the object's are.
-CarriedAgain carried_into_other_scans(const store::Project& project, std::int64_t drawn,
-                                      const std::vector<std::uint32_t>& membership,
-                                      std::uint32_t node,
-                                      const std::optional<segmentation::GrowSettings>& grow,
-                                      const std::optional<acquisition::RangeNoise>& noise) {
-  CarriedAgain out;
-  const std::optional<acquisition::ScanGeometry> drawn_geometry =
-      store::load_geometry(project, drawn);
-  if (!drawn_geometry) return out;
-  const acquisition::Scan drawn_scan = project.load_scan(drawn);
-  const registration::PreparedScan source =
-      registration::prepare_scan(drawn_scan, *drawn_geometry, 0);
-  std::vector<std::uint32_t> labels(membership.size(), 0);
-  for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = membership[i] == node ? 1 : 0;
-  CarrySettings settings;
-  settings.transfer.noise = noise;
-  settings.grow = grow;
-  const DrawnObject object{&source, drawn_scan.T_world_scan, labels};
-  // Only scans whose bounds reach the object's can take any of it.
-  Eigen::AlignedBox3d object_bounds;
-  for (std::size_t i = 0; i < labels.size(); ++i) {
-    if (labels[i] && source.in_model[i])
-      object_bounds.extend(drawn_scan.T_world_scan * source.points[i].cast<double>());
+namespace {
+
+// What a commit carries into scans besides where it was drawn: their
+// changed carried layers, and how many points joined.
+struct CarriedInto {
+  std::map<std::int64_t, std::vector<std::uint8_t>> carried;
+  std::size_t points = 0;
+};
+
+bool has_geometry(const store::Project& project, std::int64_t scan_id) {
+  const std::vector<std::string> layers = project.layer_names(scan_id);
+  return std::find(layers.begin(), layers.end(), store::layer::kNormal) != layers.end();
+}
+
+// The scans with geometry, by id, whose stored bounds reach the world box
+// of object `node` as drawn in `drawn` (scan id → its membership with the
+// object's pixels taken; each has geometry).
+std::vector<std::int64_t> scans_reaching(
+    const store::Project& project, const std::map<std::int64_t, std::vector<std::uint32_t>>& drawn,
+    std::uint32_t node, ScanCache& cache) {
+  std::vector<std::int64_t> drawn_ids;
+  for (const auto& [scan_id, membership] : drawn) drawn_ids.push_back(scan_id);
+  cache.plan(drawn_ids);
+  Eigen::AlignedBox3d bounds;
+  for (const auto& [scan_id, membership] : drawn) {
+    const std::shared_ptr<const LoadedScan> loaded = cache.get(scan_id);
+    const registration::PreparedScan& source = loaded->prepared;
+    for (std::size_t i = 0; i < membership.size(); ++i) {
+      if (membership[i] == node && source.in_model[i])
+        bounds.extend(loaded->scan.T_world_scan * source.points[i].cast<double>());
+    }
   }
+  std::vector<std::int64_t> out;
   for (const store::StoredScanSummary& stored : project.scans()) {
-    if (stored.id == drawn || !bounds_reach(stored, object_bounds)) continue;
-    const std::optional<acquisition::ScanGeometry> geometry =
-        store::load_geometry(project, stored.id);
-    if (!geometry) continue;
-    const acquisition::Scan scan = project.load_scan(stored.id);
-    const registration::PreparedScan target = registration::prepare_scan(scan, *geometry, 0);
-    std::optional<segmentation::SegmentationGrid> grid;
-    if (grow && !scan.is_scattered()) {  // a scattered scan has no grid to grow on
-      segmentation::GridSettings grid_settings;
-      grid_settings.range_noise = noise.value_or(geometry->range_noise);
-      grid = segmentation::prepare_grid(scan, *geometry, grid_settings);
-    }
-    std::vector<std::uint32_t> other = load_membership(project, stored.id, scan.pixel_count());
-    std::vector<std::uint8_t> open = taken_mask(other);
-    for (std::uint8_t& o : open) o = !o;
-    const segmentation::PixelSet joins =
-        carry_object(object, {&target, scan.T_world_scan, grid ? &*grid : nullptr, open}, settings);
-    if (joins.empty()) continue;
-    std::vector<std::uint8_t> carried = load_carried(project, stored.id, scan.pixel_count());
-    for (const std::uint32_t q : joins) {
-      other[q] = node;
-      carried[q] = 1;
-    }
-    out.carried_points += joins.size();
-    out.memberships.emplace(stored.id, std::move(other));
-    out.carried.emplace(stored.id, std::move(carried));
+    if (drawn.count(stored.id) != 0 ||
+        (bounds_reach(stored, bounds) && has_geometry(project, stored.id)))
+      out.push_back(stored.id);
   }
   return out;
 }
 
-NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings,
-                                   const segmentation::PixelSet& selection) {
+// Carries object `node`, drawn in the scans of `memberships` (scan id → its
+// membership with the object's pixels taken), into every scan with
+// geometry whose bounds reach the object's: each takes, where its points
+// are still to be segmented, those that sample the surface the object
+// covers in the other drawn scans, and with `grow` those it grows to there
+// (object_carry.hpp). `memberships` gains the scans that take some;
+// `carried` holds each changed scan's carried layer, starting from
+// `drawn_carried` for the drawn scans. Scans come through a ScanCache
+// within the memory limit: each target with the drawn scans it takes from.
+CarriedInto carry_into_scans(const store::Project& project, std::uint32_t node,
+                             std::map<std::int64_t, std::vector<std::uint32_t>>& memberships,
+                             std::map<std::int64_t, std::vector<std::uint8_t>> drawn_carried,
+                             const CommitSettings& settings) {
+  CarriedInto out;
+  core::Progress quiet;
+  ScanCache cache(project, memory_limit_or_default(std::nullopt), 0, "commit", quiet);
+  // The drawn scans with geometry are the sources (a scan without has no
+  // surfaces to carry from).
+  std::map<std::int64_t, std::vector<std::uint32_t>> drawn;
+  for (const auto& [scan_id, membership] : memberships) {
+    if (has_geometry(project, scan_id)) drawn.emplace(scan_id, membership);
+  }
+  if (drawn.empty()) {
+    out.carried = std::move(drawn_carried);
+    return out;
+  }
+  std::vector<std::int64_t> targets;
+  std::vector<std::int64_t> order;
+  for (const std::int64_t t : scans_reaching(project, drawn, node, cache)) {
+    if (drawn.size() == 1 && drawn.count(t) != 0) continue;  // nothing to take from
+    targets.push_back(t);
+    order.push_back(t);
+    for (const auto& [from, membership] : drawn) {
+      if (from != t) order.push_back(from);
+    }
+  }
+  cache.plan(order);
+  CarrySettings carry;
+  carry.transfer.noise = settings.range_noise;
+  carry.grow = settings.grow;
+  for (const std::int64_t t : targets) {
+    const std::shared_ptr<const LoadedScan> target = cache.get(t);
+    const std::size_t pixels = target->scan.pixel_count();
+    const auto own = drawn.find(t);
+    std::vector<std::uint32_t> membership =
+        own != drawn.end() ? own->second : load_membership(project, t, pixels);
+    const auto kept_carried = drawn_carried.find(t);
+    std::vector<std::uint8_t> carried = kept_carried != drawn_carried.end()
+                                            ? kept_carried->second
+                                            : load_carried(project, t, pixels);
+    std::vector<std::uint8_t> open = taken_mask(membership);
+    for (std::uint8_t& o : open) o = !o;
+    std::optional<segmentation::SegmentationGrid> grid;
+    if (settings.grow && !target->scan.is_scattered()) {  // a scattered scan has no grid
+      segmentation::GridSettings grid_settings;
+      grid_settings.range_noise = settings.range_noise.value_or(target->geometry.range_noise);
+      grid = segmentation::prepare_grid(target->scan, target->geometry, grid_settings);
+    }
+    std::size_t joined = 0;
+    for (const auto& [from, source_membership] : drawn) {
+      if (from == t) continue;
+      const std::shared_ptr<const LoadedScan> source = cache.get(from);
+      std::vector<std::uint32_t> labels(source_membership.size(), 0);
+      for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = source_membership[i] == node;
+      const segmentation::PixelSet joins = carry_object(
+          {&source->prepared, source->scan.T_world_scan, labels},
+          {&target->prepared, target->scan.T_world_scan, grid ? &*grid : nullptr, open}, carry);
+      for (const std::uint32_t q : joins) {
+        membership[q] = node;
+        carried[q] = 1;
+        open[q] = 0;
+      }
+      joined += joins.size();
+    }
+    out.points += joined;
+    if (joined != 0) {
+      out.carried.emplace(t, std::move(carried));
+      memberships[t] = std::move(membership);
+    }
+  }
+  // The drawn scans that took nothing keep their carried layers as drawn.
+  for (auto& [scan_id, carried] : drawn_carried) out.carried.emplace(scan_id, std::move(carried));
+  return out;
+}
+
+}  // namespace
+
+NodeCommandResult commit_selections(
+    store::Project& project, const CommitSettings& settings,
+    const std::map<std::int64_t, segmentation::PixelSet>& selections) {
   const std::int64_t revision = project.revision();
-  const std::string where = "scan " + std::to_string(settings.scan_id);
   require_name(settings.name);
   Tree tree = load_tree(project);
   require_group(tree, settings.parent);
-  // The grid's size from the summary: compute_figures decodes the scan itself.
-  const store::StoredScanSummary stored = require_scan(project, settings.scan_id);
-  std::vector<std::uint32_t> membership =
-      load_membership(project, settings.scan_id,
-                      static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns);
   store::ObjectNode node;
   node.id = fresh_ids(project, 1);
   node.name = settings.name;
   node.parent = settings.parent;
-  segmentation::PixelSet taken;
-  for (const std::uint32_t p : selection) {
-    if (p >= membership.size())
-      refuse(where, "the selection has a pixel outside the grid: it was grown on another scan");
-    if (membership[p] != 0) continue;  // another object's since the selection grew
-    membership[p] = static_cast<std::uint32_t>(node.id);
-    taken.push_back(p);
+  const auto owner = static_cast<std::uint32_t>(node.id);
+  // Per drawn scan: its membership with the selection taken, and its
+  // carried layer with those pixels marked drawn (none without one).
+  std::map<std::int64_t, std::vector<std::uint32_t>> changed;
+  std::map<std::int64_t, std::vector<std::uint8_t>> drawn_carried;
+  std::size_t taken_points = 0;
+  for (const auto& [scan_id, selection] : selections) {
+    if (selection.empty()) continue;
+    const std::string where = "scan " + std::to_string(scan_id);
+    // The grid's size from the summary: compute_figures decodes the scan itself.
+    const store::StoredScanSummary stored = require_scan(project, scan_id);
+    std::vector<std::uint32_t> membership = load_membership(
+        project, scan_id, static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns);
+    segmentation::PixelSet taken;
+    for (const std::uint32_t p : selection) {
+      if (p >= membership.size())
+        refuse(where, "the selection has a pixel outside the grid: it was grown on another scan");
+      if (membership[p] != 0) continue;  // another object's since the selection grew
+      membership[p] = owner;
+      taken.push_back(p);
+    }
+    if (taken.empty()) continue;
+    taken_points += taken.size();
+    changed.emplace(scan_id, std::move(membership));
+    if (auto drawn = drawn_there(project, scan_id, taken))
+      drawn_carried.emplace(scan_id, std::move(*drawn));
   }
-  if (taken.empty()) refuse(where, "the selection is empty: grow a region first");
+  if (changed.empty()) {
+    const std::string where = selections.size() == 1
+                                  ? "scan " + std::to_string(selections.begin()->first)
+                                  : "the selection";
+    refuse(where, "the selection is empty: grow a region first");
+  }
   tree.emplace(node.id, node);
-  CarriedAgain others = settings.other_scans
-                            ? carried_into_other_scans(project, settings.scan_id, membership,
-                                                       static_cast<std::uint32_t>(node.id),
-                                                       settings.grow, settings.range_noise)
-                            : CarriedAgain{};
-  std::map<std::int64_t, std::vector<std::uint32_t>>& changed = others.memberships;
-  changed[settings.scan_id] = std::move(membership);
-  const std::optional<std::vector<std::uint8_t>> drawn =
-      drawn_there(project, settings.scan_id, taken);
+  std::vector<std::int64_t> drawn_scans;
+  for (const auto& [scan_id, membership] : changed) drawn_scans.push_back(scan_id);
+  CarriedInto others;
+  if (settings.other_scans) {
+    others = carry_into_scans(project, owner, changed, std::move(drawn_carried), settings);
+  } else {
+    others.carried = std::move(drawn_carried);
+  }
   const auto figures = compute_figures(project, tree, changed);
-  store::Project::Edit edit = project.begin_command("commit", settings_to_json(settings), revision);
+  // The journal names the first drawn scan; re-carrying after a
+  // registration reads only the channel and noise (carried_objects.hpp).
+  CommitSettings recorded = settings;
+  recorded.scan_id = drawn_scans.front();
+  store::Project::Edit edit = project.begin_command("commit", settings_to_json(recorded), revision);
   project.put_node(edit, node);
   for (const auto& [scan_id, scan_membership] : changed)
     put_membership(project, edit, scan_id, scan_membership);
   for (const auto& [scan_id, carried] : others.carried)
     put_carried(project, edit, scan_id, carried);
-  if (drawn) put_carried(project, edit, settings.scan_id, *drawn);
-  project.remove_layer(edit, settings.scan_id, store::layer::kSelection);
+  for (const auto& [scan_id, selection] : selections)
+    project.remove_layer(edit, scan_id, store::layer::kSelection);
   refresh_figures(project, edit, tree, figures);
   const std::int64_t command_id = edit.command_id();
   edit.commit(dump({{"node", node.id},
-                    {"points", taken.size()},
-                    {"other_scans_points", others.carried_points}}));
+                    {"points", taken_points},
+                    {"scans", drawn_scans},
+                    {"other_scans_points", others.points}}));
   return {command_id, node.id};
+}
+
+NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings,
+                                   const segmentation::PixelSet& selection) {
+  return commit_selections(project, settings, {{settings.scan_id, selection}});
 }
 
 }  // namespace scanbench::modeling

@@ -102,6 +102,20 @@ struct CommitSettings {
 NodeCommandResult commit_selection(store::Project& project, const CommitSettings& settings,
                                    const segmentation::PixelSet& selection);
 
+// Makes the selections of several scans (scan id → its selection; a 3D
+// selection spans every scan it reaches) one new object, as
+// commit_selection does for one; settings.scan_id is not read. With
+// other_scans, each scan with geometry that the object's box reaches
+// takes, where still to be segmented, its points on the surfaces the other
+// scans' selections cover (the points the merge left out of the model
+// where another scan sampled the surface more finely), and with grow those
+// it grows to. Scans are read through a ScanCache within the memory limit
+// (scan_cache.hpp). Refused when no selection has a pixel still to be
+// segmented.
+NodeCommandResult commit_selections(
+    store::Project& project, const CommitSettings& settings,
+    const std::map<std::int64_t, segmentation::PixelSet>& selections);
+
 struct SeparateSettings {
   std::int64_t node = 0;     // an object
   std::int64_t scan_id = 0;  // the scan whose pixels are split

@@ -1,8 +1,11 @@
 #include "modeling/selection_tools.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <set>
 #include <utility>
+
+#include "core/errors.hpp"
 
 namespace scanbench::modeling {
 
@@ -103,18 +106,92 @@ void SelectionTools::open_scan(const store::Project& project, std::int64_t scan_
   static_cast<void>(selection_of(project, scan_id));
 }
 
+void SelectionTools::record(Step step) {
+  for (const ScanChange& change : step) touched_.insert(change.scan_id);
+  done_.push_back(std::move(step));
+  if (done_.size() > kMaxSelectionSteps) done_.pop_front();
+  undone_.clear();
+}
+
 SelectResult SelectionTools::select(const store::Project& project, const SelectSettings& settings) {
   segmentation::PixelSet& selection = selection_of(project, settings.scan_id);
   const segmentation::PixelSet before = selection;
   const SelectResult result = select_region(project, settings, selection);
   if (!result.seed_open) return result;
   if (settings.mode != SelectMode::kSubtract) grown_with_[settings.scan_id] = settings.grow;
-  touched_.insert(settings.scan_id);
-  done_.push_back({settings.scan_id, segmentation::subtract(selection, before),
-                   segmentation::subtract(before, selection)});
-  if (done_.size() > kMaxSelectionSteps) done_.pop_front();
-  undone_.clear();
+  record({{settings.scan_id, segmentation::subtract(selection, before),
+           segmentation::subtract(before, selection)}});
   return result;
+}
+
+std::size_t SelectionTools::select_pixels(
+    const store::Project& project, const std::map<std::int64_t, segmentation::PixelSet>& region,
+    SelectMode mode) {
+  std::map<std::int64_t, std::size_t> grid_pixels;
+  for (const store::StoredScanSummary& stored : project.scans())
+    grid_pixels[stored.id] = static_cast<std::size_t>(stored.summary.rows) * stored.summary.columns;
+  for (const auto& [scan_id, pixels] : region) {
+    const auto grid = grid_pixels.find(scan_id);
+    if (grid == grid_pixels.end())
+      throw core::InputError(project.path().string(), {},
+                             "scan " + std::to_string(scan_id) + ": no such scan");
+    if (!pixels.empty() && pixels.back() >= grid->second)
+      throw core::InputError(
+          project.path().string(), {},
+          "scan " + std::to_string(scan_id) + ": the selection has a pixel outside the grid");
+  }
+  static const segmentation::PixelSet kNone;
+  const auto region_of = [&](std::int64_t scan_id) -> const segmentation::PixelSet& {
+    const auto found = region.find(scan_id);
+    return found == region.end() ? kNone : found->second;
+  };
+  Step step;
+  std::size_t selected = 0;
+  for (const auto& [scan_id, pixels] : grid_pixels) {
+    if (mode != SelectMode::kReplace && region.count(scan_id) == 0) {
+      selected += selection(scan_id).size();
+      continue;
+    }
+    segmentation::PixelSet& now = selection_of(project, scan_id);
+    const segmentation::PixelSet before = now;
+    switch (mode) {
+      case SelectMode::kReplace:
+        now = region_of(scan_id);
+        break;
+      case SelectMode::kAdd:
+        now = segmentation::unite(now, region_of(scan_id));
+        break;
+      case SelectMode::kSubtract:
+        now = segmentation::subtract(now, region_of(scan_id));
+        break;
+    }
+    selected += now.size();
+    if (now != before)
+      step.push_back(
+          {scan_id, segmentation::subtract(now, before), segmentation::subtract(before, now)});
+  }
+  if (!step.empty()) record(std::move(step));
+  return selected;
+}
+
+std::map<std::int64_t, segmentation::PixelSet> SelectionTools::selections() const {
+  std::map<std::int64_t, segmentation::PixelSet> out;
+  for (const auto& [scan_id, selection] : selections_) {
+    if (!selection.empty()) out.emplace(scan_id, selection);
+  }
+  return out;
+}
+
+std::size_t SelectionTools::selected_pixels() const {
+  std::size_t total = 0;
+  for (const auto& [scan_id, selection] : selections_) total += selection.size();
+  return total;
+}
+
+std::size_t SelectionTools::selected_scans() const {
+  return static_cast<std::size_t>(
+      std::count_if(selections_.begin(), selections_.end(),
+                    [](const auto& entry) { return !entry.second.empty(); }));
 }
 
 CommitSettings SelectionTools::commit_of(std::int64_t scan_id, std::string name,
@@ -128,22 +205,43 @@ CommitSettings SelectionTools::commit_of(std::int64_t scan_id, std::string name,
   return settings;
 }
 
-NodeCommandResult SelectionTools::commit(store::Project& project, const CommitSettings& settings) {
-  segmentation::PixelSet& selection = selection_of(project, settings.scan_id);
-  const NodeCommandResult result = commit_selection(project, settings, selection);
+void SelectionTools::committed(std::int64_t command_id, const std::vector<std::int64_t>& scans) {
   command_ran();
-  committed_[result.command_id] = {settings.scan_id, std::move(selection)};
+  std::map<std::int64_t, segmentation::PixelSet>& taken = committed_[command_id];
+  for (const std::int64_t scan_id : scans) {
+    taken[scan_id] = std::move(selections_[scan_id]);
+    selections_[scan_id].clear();
+    touched_.insert(scan_id);
+  }
   if (committed_.size() > kMaxCommitsRemembered) committed_.erase(committed_.begin());
-  selection.clear();
-  touched_.insert(settings.scan_id);
+}
+
+NodeCommandResult SelectionTools::commit(store::Project& project, const CommitSettings& settings) {
+  const NodeCommandResult result =
+      commit_selection(project, settings, selection_of(project, settings.scan_id));
+  committed(result.command_id, {settings.scan_id});
+  return result;
+}
+
+NodeCommandResult SelectionTools::commit_all(store::Project& project, std::int64_t shown_scan,
+                                             std::string name, std::optional<std::int64_t> parent) {
+  const std::map<std::int64_t, segmentation::PixelSet> all = selections();
+  CommitSettings settings = commit_of(shown_scan, std::move(name), parent);
+  if (all.count(shown_scan) == 0) settings.grow.reset();
+  const NodeCommandResult result = commit_selections(project, settings, all);
+  std::vector<std::int64_t> scans;
+  for (const auto& [scan_id, selection] : all) scans.push_back(scan_id);
+  committed(result.command_id, scans);
   return result;
 }
 
 bool SelectionTools::undo_selection() {
   if (done_.empty()) return false;
-  const Step& step = done_.back();
-  segmentation::PixelSet& selection = selections_[step.scan_id];
-  selection = segmentation::unite(segmentation::subtract(selection, step.added), step.removed);
+  for (const ScanChange& change : done_.back()) {
+    segmentation::PixelSet& selection = selections_[change.scan_id];
+    selection =
+        segmentation::unite(segmentation::subtract(selection, change.added), change.removed);
+  }
   undone_.push_back(std::move(done_.back()));
   done_.pop_back();
   return true;
@@ -151,9 +249,11 @@ bool SelectionTools::undo_selection() {
 
 bool SelectionTools::redo_selection() {
   if (undone_.empty()) return false;
-  const Step& step = undone_.back();
-  segmentation::PixelSet& selection = selections_[step.scan_id];
-  selection = segmentation::unite(segmentation::subtract(selection, step.removed), step.added);
+  for (const ScanChange& change : undone_.back()) {
+    segmentation::PixelSet& selection = selections_[change.scan_id];
+    selection =
+        segmentation::unite(segmentation::subtract(selection, change.removed), change.added);
+  }
   done_.push_back(std::move(undone_.back()));
   undone_.pop_back();
   return true;
@@ -177,14 +277,16 @@ void SelectionTools::command_undone(const store::Project& project, std::int64_t 
   command_ran();
   reread_untouched(project);
   const auto commit = committed_.find(command_id);
-  if (commit != committed_.end()) selections_[commit->second.first] = commit->second.second;
+  if (commit == committed_.end()) return;
+  for (const auto& [scan_id, selection] : commit->second) selections_[scan_id] = selection;
 }
 
 void SelectionTools::command_redone(const store::Project& project, std::int64_t command_id) {
   command_ran();
   reread_untouched(project);
   const auto commit = committed_.find(command_id);
-  if (commit != committed_.end()) selections_[commit->second.first].clear();
+  if (commit == committed_.end()) return;
+  for (const auto& [scan_id, selection] : commit->second) selections_[scan_id].clear();
 }
 
 std::map<std::int64_t, segmentation::PixelSet> SelectionTools::unkept(

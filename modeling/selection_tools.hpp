@@ -80,6 +80,23 @@ class SelectionTools {
   // the scan's commit.
   SelectResult select(const store::Project& project, const SelectSettings& settings);
 
+  // Combines `region` (scan id → pixels, ascending: a selection drawn in
+  // the 3D view spans every scan it reaches) with the selections by `mode`,
+  // as one step undo_selection takes back: replace makes it the selection
+  // of every scan of the project (others' become empty), add and subtract
+  // change only the scans it names. Pixels outside a scan's grid are
+  // refused (core::InputError) before anything changes. Returns the
+  // pixels selected in all scans afterwards.
+  std::size_t select_pixels(const store::Project& project,
+                            const std::map<std::int64_t, segmentation::PixelSet>& region,
+                            SelectMode mode);
+  // Every scan's selection that is not empty, by scan id (those this
+  // session has read: open_scan, select, select_pixels).
+  std::map<std::int64_t, segmentation::PixelSet> selections() const;
+  // Their pixels in all, and the scans they are in.
+  std::size_t selected_pixels() const;
+  std::size_t selected_scans() const;
+
   // commit_selection's settings for the selection of scan `scan_id`: it
   // grows on in the other scans with the settings of the last grow that
   // replaced or added to it in this session (none before any).
@@ -88,6 +105,12 @@ class SelectionTools {
   // Commits the selection of settings.scan_id (commit_selection); it is
   // then empty, until the command is undone (command_undone).
   NodeCommandResult commit(store::Project& project, const CommitSettings& settings);
+  // Commits every scan's selection (selections()) as one object
+  // (commit_selections), growing on as the grows of the shown scan
+  // `shown_scan` did when it has a selection (none: only the surfaces the
+  // selections cover); they are then empty, until the command is undone.
+  NodeCommandResult commit_all(store::Project& project, std::int64_t shown_scan, std::string name,
+                               std::optional<std::int64_t> parent);
 
   // ---- Undo and redo ------------------------------------------------------
   // Takes back the newest grow since the last command, or makes the newest
@@ -131,11 +154,16 @@ class SelectionTools {
   void reread_untouched(const store::Project& project);
 
   // One change of a scan's selection: the pixels it added and removed.
-  struct Step {
+  struct ScanChange {
     std::int64_t scan_id = 0;
     segmentation::PixelSet added;
     segmentation::PixelSet removed;
   };
+  // One step: a grow changes one scan, a 3D selection several.
+  using Step = std::vector<ScanChange>;
+  void record(Step step);
+  // Remembers the selections commit `command_id` took, and empties them.
+  void committed(std::int64_t command_id, const std::vector<std::int64_t>& scans);
 
   std::optional<std::int64_t> scan_;
   segmentation::Polyline lasso_;
@@ -148,9 +176,9 @@ class SelectionTools {
   std::set<std::int64_t> touched_;  // scans whose selection this session changed
   std::deque<Step> done_;           // grows since the last command, oldest first
   std::vector<Step> undone_;
-  // By commit command, the newest kMaxCommitsRemembered: the scan and the
-  // selection it took.
-  std::map<std::int64_t, std::pair<std::int64_t, segmentation::PixelSet>> committed_;
+  // By commit command, the newest kMaxCommitsRemembered: the selections it
+  // took, by scan.
+  std::map<std::int64_t, std::map<std::int64_t, segmentation::PixelSet>> committed_;
 };
 
 }  // namespace scanbench::modeling

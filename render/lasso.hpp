@@ -28,11 +28,36 @@ class Lasso {
   // polygon's bounds.
   bool may_meet(const Eigen::AlignedBox2f& box) const;
   bool empty() const { return vertices_.size() < 3; }
+  const Eigen::AlignedBox2f& bounds() const { return bounds_; }
 
  private:
   std::vector<Eigen::Vector2f> vertices_;
   Eigen::AlignedBox2f bounds_;
 };
+
+// The nearest surface over a rectangle of the picture, from splats drawn
+// as discs at their centre's depth: which of the points a lasso encloses
+// a person sees in front, rather than what lies behind them.
+class DepthRaster {
+ public:
+  // Pixels [x0, x1) × [y0, y1) of the picture; empty ones hold nothing.
+  DepthRaster(int x0, int y0, int x1, int y1);
+
+  // A splat centred at picture point `at`, `depth` [m] ahead of the eye,
+  // covering a disc of `radius_px` (at least the pixel it falls in).
+  void splat(const Eigen::Vector2f& at, float depth, float radius_px);
+  // Whether a point at `at`, `depth` ahead lies on the nearest surface
+  // there: no splat in front of it by more than `tolerance` [m]. Outside
+  // the rectangle, true.
+  bool in_front(const Eigen::Vector2f& at, float depth, float tolerance) const;
+
+ private:
+  int x0_, y0_, width_, height_;
+  std::vector<float> nearest_;  // per pixel, +∞ where nothing was drawn
+};
+
+// How far ahead of the eye model point `p` lies along the view axis [m].
+float view_depth(const RenderView& view, const Eigen::Vector3f& p);
 
 // Where model point `p` lands on `view`'s picture (pixels from the top
 // left); none when it lies behind the near plane.

@@ -60,6 +60,29 @@ struct LodPick {
   float distance_m = 0.0f;   // along the ray
 };
 
+// How a selection in the 3D view takes points.
+struct LodSelectOptions {
+  // A lasso takes only the points a person sees inside it, on the nearest
+  // surface (within a tolerance of 2 drawn splat radii and 0.5 % of the
+  // distance), as the view draws them (back faces left out when it culls
+  // them); false: every point inside it, through every depth.
+  bool visible_only = true;
+  // Only points still to be segmented (in no object): those a selection
+  // may hold. Points of objects still hide what lies behind them.
+  bool open_only = true;
+  // At most this many of the selected points' positions, spread evenly
+  // over them, for the view to mark the selection with.
+  std::size_t sample = 0;
+};
+
+struct LodSelection {
+  // By scan id, each scan's pixels ascending: the per-scan pixel
+  // selections the segmentation's commands take.
+  std::map<std::int64_t, std::vector<std::uint32_t>> pixels;
+  std::size_t points = 0;
+  std::vector<Eigen::Vector3f> sample;  // model frame
+};
+
 // A point of a sample of the whole model.
 struct LodSample {
   Eigen::Vector3f position;  // model frame
@@ -119,15 +142,20 @@ class LodRenderer {
                               const RenderSettings& settings);
 
   // The points whose centres `lasso` (picture pixels of `view`) encloses,
-  // through every depth, among those the view would draw (shown objects,
-  // within the clipping box and slice): by scan id, each scan's pixels
-  // ascending, the per-scan pixel selections the segmentation's commands
-  // take. Every point of the store counts, whatever level of detail the
-  // last frame drew. Walks the nodes whose bounds may project into the
-  // lasso; reads those the memory cache does not hold from the store.
-  std::map<std::int64_t, std::vector<std::uint32_t>> select(const RenderView& view,
-                                                            const Lasso& lasso,
-                                                            const RenderSettings& settings);
+  // among those the view would draw (shown objects, within the clipping box
+  // and slice), taken as `options` says. Every point of the store counts,
+  // whatever level of detail the last frame drew. Walks the nodes whose
+  // bounds may project into the lasso (and, seeing which points are in
+  // front, those whose splats may cover it); reads those the memory cache
+  // does not hold from the store.
+  LodSelection select(const RenderView& view, const Lasso& lasso, const RenderSettings& settings,
+                      const LodSelectOptions& options = {});
+  // The volumetric brush (seed 002): the points within `radius_m` of
+  // `centre` (model frame) among those the view would draw, taken as
+  // `options` says (visible_only does not apply). Walks the nodes whose
+  // bounds meet the sphere.
+  LodSelection select_sphere(const Eigen::Vector3f& centre, float radius_m,
+                             const RenderSettings& settings, const LodSelectOptions& options = {});
 
   // A sample spread over the whole model: the points of its shallowest
   // nodes (each an even subsample of its region), at least `count` where

@@ -52,6 +52,10 @@ void WorkbenchInput::cursor_moved(double x, double y) {
   } else if (s.drag == Drag::kPanPanorama) {
     s.pan[0] += static_cast<float>(dx);
     s.pan[1] += static_cast<float>(dy);
+  } else if (s.drag == Drag::kLasso3d) {
+    s.extend_lasso_3d(x, y);
+  } else if (s.drag == Drag::kBrush3d && s.view3d.contains(x, y)) {
+    s.brush_at(x, y);
   }
 }
 
@@ -70,6 +74,16 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
   set_mods(pressed ? mods : 0);
   if (button >= 0 && button < 5) io.MouseDown[button] = pressed;
   if (!pressed) {
+    if (s.drag == Drag::kLasso3d || s.drag == Drag::kBrush3d) {
+      const Drag ended = s.drag;
+      s.drag = Drag::kNone;
+      if (ended == Drag::kLasso3d) {
+        s.finish_lasso_3d();
+      } else {
+        s.finish_brush();
+      }
+      return;
+    }
     // Measuring, a left click that did not drag picks a point.
     const bool clicked =
         s.drag == Drag::kOrbit && button == 0 &&
@@ -103,8 +117,21 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
       s.drag = Drag::kPanPanorama;
     }
   } else if (s.view3d.contains(x, y)) {
-    s.drag = button == 0 ? Drag::kOrbit : Drag::kPan3d;
     s.press_at = s.cursor;
+    // The lasso and the brush select with the left button; the right one
+    // still pans.
+    const bool selecting = button == 0 && !s.measuring && !s.fly;
+    if (selecting && s.session.tool == Tool::kLasso) {
+      s.drag = Drag::kLasso3d;
+      s.start_lasso_3d(x, y, (mods & keys::kModShift) != 0);
+    } else if (selecting && s.session.tool == Tool::kBrush) {
+      s.drag = Drag::kBrush3d;
+      s.brushed.clear();
+      s.selection_marks.clear();
+      s.brush_at(x, y);
+    } else {
+      s.drag = button == 0 ? Drag::kOrbit : Drag::kPan3d;
+    }
   }
 }
 
@@ -171,6 +198,9 @@ void WorkbenchInput::shortcut(int key, int mods) {
       break;
     case 'B':
       s.session.tool = Tool::kBarrier;
+      break;
+    case 'R':
+      s.session.tool = Tool::kBrush;
       break;
     case keys::kEnter:
       if (s.measuring) s.finish_measurement();

@@ -141,8 +141,24 @@ void Session::show_selection() {
   const segmentation::PixelSet& selection = tools_.selection(scan_id_);
   if (has_scan() && !selection.empty())
     selection_ = segmentation::to_mask({scan_.rows, scan_.columns, false}, selection);
-  selected_ = selection.size();
+  selected_ = tools_.selected_pixels();
+  selected_scans_ = tools_.selected_scans();
   ++revision_;
+}
+
+void Session::select_pixels(const std::map<std::int64_t, std::vector<std::uint32_t>>& region,
+                            const std::string& what) {
+  std::size_t taken = 0;
+  for (const auto& [scan_id, pixels] : region) taken += pixels.size();
+  // The selection is session state: selecting writes nothing, read-only too.
+  try {
+    const std::size_t selected = tools_.select_pixels(project_, region, mode);
+    status_ = what + ": " + std::to_string(taken) + " points in " + std::to_string(region.size()) +
+              " scan(s); selection " + std::to_string(selected);
+  } catch (const core::InputError& e) {
+    status_ = "refused: " + e.problem();
+  }
+  show_selection();
 }
 
 void Session::click(double x, double y) {
@@ -163,6 +179,9 @@ void Session::click(double x, double y) {
       tools_.add_barrier_vertex(scan_id_, xy);
       status_ = "barrier: " + std::to_string(tools_.barriers().back().size()) +
                 " vertices (Enter ends it)";
+      return;
+    case Tool::kBrush:
+      status_ = "the brush selects in the 3D view: drag over the surfaces there";
       return;
     case Tool::kSeed:
       break;
@@ -200,7 +219,7 @@ void Session::clear_constraints() {
 
 bool Session::commit(const std::string& name, std::optional<std::int64_t> parent) {
   return act("committed \"" + name + "\"",
-             [&] { tools_.commit(project_, tools_.commit_of(scan_id_, name, parent)); });
+             [&] { tools_.commit_all(project_, scan_id_, name, parent); });
 }
 
 bool Session::group(const std::string& name, const std::vector<std::int64_t>& children) {

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,7 +26,8 @@
 
 namespace scanbench::app::workbench {
 
-enum class Tool { kSeed, kLasso, kBarrier };
+// The brush selects in the 3D view only; the lasso draws in either view.
+enum class Tool { kSeed, kLasso, kBarrier, kBrush };
 
 class Session {
  public:
@@ -70,7 +72,15 @@ class Session {
   // Closes the lasso (≥ 3 vertices) or ends the barrier being drawn.
   void finish_polyline();
   void clear_constraints();
+  // The selection's pixels in all scans, and the scans it is in (a 3D
+  // selection spans several; the panorama shows the shown scan's part).
   std::size_t selected_pixels() const { return selected_; }
+  std::size_t selected_scans() const { return selected_scans_; }
+  // A selection made in the 3D view (render::LodRenderer::select): pixels
+  // by scan id, combined with the selection by `mode` as one step Ctrl+Z
+  // takes back. `what` names the tool for the status ("lasso").
+  void select_pixels(const std::map<std::int64_t, std::vector<std::uint32_t>>& region,
+                     const std::string& what);
   // Keeps the selections this session changed in the project, as one
   // command (modeling::SelectionTools::keep): on request, and `at_close`,
   // when the session ends, unless that would end the redo chain. False
@@ -89,6 +99,7 @@ class Session {
   std::optional<Eigen::Vector2d> image_point(const Eigen::Vector3d& p) const;
 
   // ---- Commands: each one journal entry; false (and status()) when refused
+  // Commits the selection of every scan as one object.
   bool commit(const std::string& name, std::optional<std::int64_t> parent);
   bool group(const std::string& name, const std::vector<std::int64_t>& children);
   bool rename(std::int64_t node, const std::string& name);
@@ -185,6 +196,7 @@ class Session {
   std::vector<std::uint32_t> membership_;  // empty: none
   std::vector<std::uint8_t> selection_;    // empty: none
   std::size_t selected_ = 0;
+  std::size_t selected_scans_ = 0;
   modeling::SelectionTools tools_;
   std::vector<store::ObjectNode> nodes_;
   std::optional<modeling::ScanCoverage> coverage_;  // none: to be read again

@@ -10,19 +10,40 @@ namespace {
 // and how a region joins the selection.
 void tools_row(WorkbenchState& s) {
   Session& session = s.session;
-  // An unstructured cloud has no range image to click on.
-  ImGui::BeginDisabled(!session.has_grid());
+  // The lasso and the brush select in the 3D view, whatever the scans.
   int tool = static_cast<int>(session.tool);
   ImGui::RadioButton("seed (S)", &tool, 0);
   s.probe("tool seed");
   ImGui::SameLine();
   ImGui::RadioButton("lasso (L)", &tool, 1);
   s.probe("tool lasso");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "In the panorama: click the vertices of a lasso that bounds the grows.\n"
+        "In the 3D view: drag to select what it encloses (Shift: a box).");
   ImGui::SameLine();
   ImGui::RadioButton("barrier (B)", &tool, 2);
   s.probe("tool barrier");
+  ImGui::SameLine();
+  ImGui::RadioButton("brush (R)", &tool, 3);
+  s.probe("tool brush");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("In the 3D view: drag over surfaces to select the points within the radius");
   session.tool = static_cast<Tool>(tool);
   ImGui::SameLine();
+  if (session.tool == Tool::kLasso) {
+    ImGui::Checkbox("through", &s.select_through);
+    s.probe("select through");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("The 3D lasso takes every depth, not only what is in front");
+  } else if (session.tool == Tool::kBrush) {
+    ImGui::SetNextItemWidth(s.px(80));
+    ImGui::DragFloat("radius", &s.brush_radius_m, 0.01f, 0.02f, 10.0f, "%.2f m");
+    s.probe_slider("brush radius");
+  }
+  ImGui::SameLine();
+  // An unstructured cloud has no range image to grow on.
+  ImGui::BeginDisabled(!session.has_grid());
   ImGui::SetNextItemWidth(s.px(100));
   int channel = static_cast<int>(session.channel);
   if (ImGui::Combo("##channel", &channel, "range\0colour\0intensity\0normal\0")) {
@@ -39,6 +60,7 @@ void tools_row(WorkbenchState& s) {
                        "%.3g"))
     session.tolerance = tolerance;
   ImGui::SameLine();
+  ImGui::EndDisabled();
   int mode = static_cast<int>(session.mode);
   ImGui::RadioButton("new", &mode, 0);
   ImGui::SameLine();
@@ -48,6 +70,7 @@ void tools_row(WorkbenchState& s) {
   ImGui::RadioButton("subtract", &mode, 2);
   session.mode = static_cast<modeling::SelectMode>(mode);
   ImGui::SameLine();
+  ImGui::BeginDisabled(!session.has_grid());
   if (ImGui::Button("Clear lasso")) session.clear_constraints();
   ImGui::EndDisabled();
 }

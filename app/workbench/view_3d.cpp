@@ -1,8 +1,11 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "app/workbench/panels.hpp"
 #include "render/render_view.hpp"
@@ -61,11 +64,41 @@ void redraw(WorkbenchState& s, int width, int height) {
   // for the nodes being read, so that fewer frames draw more each.
   const render::LodFrameResult frame = s.renderer->draw(
       view, settings, moving ? std::chrono::milliseconds(0) : std::chrono::milliseconds(250));
-  if (moving) s.budget.record(frame.frame_ms, frame.plan.submitted);
+  if (moving) {
+    s.budget.record(frame.frame_ms, frame.plan.submitted);
+    ++s.moving_frames;
+    if (settings.culling.budget == 0 || frame.plan.submitted > settings.culling.budget)
+      ++s.frames_over_budget;
+    if (s.moving_frame_ms.size() == WorkbenchState::kMovingFramesKept)
+      s.moving_frame_ms.erase(s.moving_frame_ms.begin());
+    s.moving_frame_ms.push_back(frame.frame_ms);
+  }
   s.last_plan = frame.plan;
   s.last_draw_ms = frame.frame_ms;  // the renderer gives ImGui its GL state back
   s.last_gpu_ms = frame.gpu_ms;
   s.view_dirty = false;
+}
+
+// The 3D selection: a sample of its points marked, while the selection is
+// the one they show, and the lasso or box being drawn.
+void selection_overlay(WorkbenchState& s, ImDrawList* draw) {
+  const ImU32 mark = IM_COL32(255, 230, 40, 220);
+  if (s.marks_revision == s.session.revision() || s.drag == Drag::kBrush3d) {
+    const Eigen::Vector3d origin = s.model_origin();
+    const float half = std::max(1.0f, s.px(1.5f));
+    for (const Eigen::Vector3f& p : s.selection_marks) {
+      if (const std::optional<ImVec2> at = s.screen_of(origin + p.cast<double>()))
+        draw->AddRectFilled(ImVec2(at->x - half, at->y - half), ImVec2(at->x + half, at->y + half),
+                            mark);
+    }
+  }
+  if (s.drag == Drag::kLasso3d && !s.lasso_3d.empty()) {
+    std::vector<ImVec2> line;
+    for (const Eigen::Vector2f& p : s.lasso_3d_polygon())
+      line.emplace_back(s.view3d.x + p.x(), s.view3d.y + p.y());
+    draw->AddPolyline(line.data(), static_cast<int>(line.size()), mark, ImDrawFlags_Closed,
+                      s.px(1.5f));
+  }
 }
 
 }  // namespace
@@ -83,10 +116,14 @@ void view_3d(WorkbenchState& s) {
                    ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h),
                    ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
   }
-  draw->AddText(ImVec2(r.x + s.px(8), r.y + s.px(6)), IM_COL32(255, 255, 255, 200),
-                s.fly ? "walk/fly: W A S D Q E, drag to look"
-                      : "orbit: drag to turn, right-drag to pan, wheel to zoom");
+  draw->AddText(
+      ImVec2(r.x + s.px(8), r.y + s.px(6)), IM_COL32(255, 255, 255, 200),
+      s.fly                            ? "walk/fly: W A S D Q E, drag to look"
+      : s.session.tool == Tool::kLasso ? "lasso: drag to select (Shift: a box), right-drag to pan"
+      : s.session.tool == Tool::kBrush ? "brush: drag over surfaces to select, right-drag to pan"
+                                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
   draw->PushClipRect(ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h), true);
+  selection_overlay(s, draw);
   measurement_overlay(
       s, draw, [&s](const Eigen::Vector3d& p) { return s.screen_of(p); },
       std::numeric_limits<float>::infinity());

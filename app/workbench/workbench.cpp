@@ -187,6 +187,27 @@ class Workbench {
     return std::array<double, 2>{at[0] + place.offset[0], at[1] + place.offset[1]};
   }
 
+  // The 3D view's moving frames: how many, how many broke their point
+  // budget, and their times against the target [ms].
+  nlohmann::json moving_frames() const {
+    const WorkbenchState& s = state_;
+    std::vector<double> ms = s.moving_frame_ms;
+    std::sort(ms.begin(), ms.end());
+    const auto quantile = [&ms](double q) {
+      return ms.empty() ? 0.0
+                        : ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1))];
+    };
+    const auto within =
+        std::count_if(ms.begin(), ms.end(), [&s](double t) { return t <= s.budget.target_ms(); });
+    return {{"moving", s.moving_frames},
+            {"over_budget", s.frames_over_budget},
+            {"target_ms", s.budget.target_ms()},
+            {"frame_ms_p50", quantile(0.5)},
+            {"frame_ms_p95", quantile(0.95)},
+            {"within_target",
+             ms.empty() ? 1.0 : static_cast<double>(within) / static_cast<double>(ms.size())}};
+  }
+
   // The centres of the named widgets, the scan shown, the status line and
   // where the views are, for tests that write replays.
   void write_layout(const std::filesystem::path& file) const {
@@ -206,7 +227,10 @@ class Workbench {
           {"columns", s.session.scan().columns},
           {"rows", s.session.scan().rows}}},
         {"view3d", {s.view3d.x, s.view3d.y, s.view3d.w, s.view3d.h}},
-        {"store", {{"builds", s.session.store_builds()}, {"updates", s.session.store_updates()}}}};
+        {"store", {{"builds", s.session.store_builds()}, {"updates", s.session.store_updates()}}},
+        {"selection",
+         {{"pixels", s.session.selected_pixels()}, {"scans", s.session.selected_scans()}}},
+        {"frames", moving_frames()}};
     std::ofstream stream(file);
     stream << out.dump(1) << "\n";
     if (!stream.flush()) throw core::RuntimeFailure(file.string(), {}, "cannot write the layout");

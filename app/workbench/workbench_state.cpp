@@ -8,7 +8,9 @@
 #include <utility>
 #include <vector>
 
+#include "render/lasso.hpp"
 #include "render/pick.hpp"
+#include "segmentation/pixel_set.hpp"
 
 namespace scanbench::app::workbench {
 
@@ -293,6 +295,79 @@ void WorkbenchState::select_in_3d(double x, double y, bool toggle) {
     selected.clear();
     load_color_editor();
   }
+}
+
+namespace {
+
+// At most this many of a 3D selection's points are marked over the view.
+constexpr std::size_t kSelectionMarks = 20000;
+
+}  // namespace
+
+void WorkbenchState::start_lasso_3d(double x, double y, bool box) {
+  lasso_3d = {Eigen::Vector2f(static_cast<float>(x), static_cast<float>(y))};
+  box_3d = box;
+}
+
+void WorkbenchState::extend_lasso_3d(double x, double y) {
+  const Eigen::Vector2f at(static_cast<float>(x), static_cast<float>(y));
+  if (box_3d) {
+    lasso_3d.resize(1);
+    lasso_3d.push_back(at);
+  } else if (lasso_3d.empty() || (at - lasso_3d.back()).norm() >= 2.0f) {
+    lasso_3d.push_back(at);
+  }
+}
+
+std::vector<Eigen::Vector2f> WorkbenchState::lasso_3d_polygon() const {
+  const Eigen::Vector2f corner(view3d.x, view3d.y);
+  std::vector<Eigen::Vector2f> polygon;
+  if (box_3d && lasso_3d.size() == 2) {
+    const Eigen::Vector2f a = lasso_3d[0] - corner, b = lasso_3d[1] - corner;
+    polygon = {a, {b.x(), a.y()}, b, {a.x(), b.y()}};
+  } else {
+    for (const Eigen::Vector2f& p : lasso_3d) polygon.push_back(p - corner);
+  }
+  return polygon;
+}
+
+void WorkbenchState::finish_lasso_3d() {
+  const std::vector<Eigen::Vector2f> polygon = lasso_3d_polygon();
+  lasso_3d.clear();
+  const int w = static_cast<int>(view3d.w), h = static_cast<int>(view3d.h);
+  if (!renderer || w <= 0 || h <= 0) return;
+  const render::Lasso lasso(polygon);
+  if (lasso.empty()) return;  // a click, not a lasso
+  const render::RenderView view = render::make_render_view(navigation.camera(w, h), model_origin());
+  const render::LodSelection taken = renderer->select(
+      view, lasso, settings, {.visible_only = !select_through, .sample = kSelectionMarks});
+  session.select_pixels(taken.pixels, box_3d ? "box" : "lasso");
+  selection_marks = taken.sample;
+  marks_revision = session.revision();
+}
+
+void WorkbenchState::brush_at(double x, double y) {
+  const std::optional<render::LodPick> pick = point_under(x, y);
+  if (!pick) return;
+  const render::LodSelection dab = renderer->select_sphere(pick->position, brush_radius_m, settings,
+                                                           {.sample = kSelectionMarks / 50});
+  for (const auto& [scan, pixels] : dab.pixels) {
+    std::vector<std::uint32_t>& stroke = brushed[scan];
+    stroke = segmentation::unite(stroke, pixels);
+  }
+  if (selection_marks.size() < kSelectionMarks)
+    selection_marks.insert(selection_marks.end(), dab.sample.begin(), dab.sample.end());
+  marks_revision = session.revision();
+}
+
+void WorkbenchState::finish_brush() {
+  std::map<std::int64_t, std::vector<std::uint32_t>> stroke;
+  stroke.swap(brushed);
+  if (stroke.empty()) return;
+  std::vector<Eigen::Vector3f> marks = std::move(selection_marks);
+  session.select_pixels(stroke, "brush");
+  selection_marks = std::move(marks);
+  marks_revision = session.revision();
 }
 
 void WorkbenchState::pick_at(double x, double y) {

@@ -50,7 +50,7 @@ struct Rect {
 };
 
 // What a mouse drag moves.
-enum class Drag { kNone, kOrbit, kPan3d, kPanPanorama };
+enum class Drag { kNone, kOrbit, kPan3d, kPanPanorama, kLasso3d, kBrush3d };
 
 // A question the workbench asks before an action it cannot simply take
 // back, answered in a modal window (questions_panel).
@@ -90,6 +90,12 @@ struct WorkbenchState {
   render::LodFramePlan last_plan;
   float frame_target_ms = 100.0f;
   render::FrameBudget budget{100.0};
+  // The moving frames so far (the newest kMovingFramesKept): how long each
+  // took, and how many drew more points than their budget or had none.
+  static constexpr std::size_t kMovingFramesKept = 4096;
+  std::vector<double> moving_frame_ms;
+  std::size_t moving_frames = 0;
+  std::size_t frames_over_budget = 0;
   double last_draw_ms = 0.0;  // the last 3D draw: wall time, finished on the device
   double last_gpu_ms = -1.0;  // ... and the device's own time (negative: unknown)
   bool view_dirty = true;     // the camera or what the view shows changed
@@ -110,6 +116,29 @@ struct WorkbenchState {
   std::vector<Eigen::Vector3d> picks;           // world [m], of the measurement being taken
   std::array<double, 2> press_at = {0.0, 0.0};  // where the left button went down
   std::array<char, 4096> csv_path{};            // where Export CSV writes
+
+  // ---- Selecting in the 3D view: the lasso (or a box) and the brush ------
+  std::vector<Eigen::Vector2f> lasso_3d;  // window points of the lasso being drawn
+  bool box_3d = false;                    // a box from the first point to the cursor
+  bool select_through = false;            // the lasso takes every depth, not the front only
+  float brush_radius_m = 0.25f;
+  std::map<std::int64_t, std::vector<std::uint32_t>> brushed;  // the stroke so far
+  // A sample of the last 3D selection's points (model frame), marked over
+  // the view until the selection changes otherwise.
+  std::vector<Eigen::Vector3f> selection_marks;
+  std::int64_t marks_revision = -1;  // the session's revision they show
+  // Starts a lasso (or, with `box`, a box) at window point (x, y) of the 3D view.
+  void start_lasso_3d(double x, double y, bool box);
+  void extend_lasso_3d(double x, double y);
+  // The points the lasso encloses (in front, or every depth with
+  // select_through) join the selection by the session's mode, as one step.
+  void finish_lasso_3d();
+  // The brush at window point (x, y): the points within its radius of the
+  // surface under it join the stroke; finish_brush() selects the stroke.
+  void brush_at(double x, double y);
+  void finish_brush();
+  // The lasso's polygon in the 3D view's picture pixels.
+  std::vector<Eigen::Vector2f> lasso_3d_polygon() const;
 
   // ---- Layout and the panoramic view ------------------------------------
   Rect panorama;

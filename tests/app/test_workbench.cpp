@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "acquisition/formats/image_decoder.hpp"
@@ -159,7 +160,7 @@ json commands(const ScratchDir& dir, const std::filesystem::path& project) {
 void expect_store_as_built(const ScratchDir& dir, const std::filesystem::path& project) {
   const std::filesystem::path copy = dir / "rebuilt" / project.filename();
   std::filesystem::create_directories(copy.parent_path());
-  std::filesystem::copy_file(project, copy);
+  std::filesystem::copy_file(project, copy, std::filesystem::copy_options::overwrite_existing);
   ASSERT_EQ(run_cli(dir, {"lod", copy.string(), "--rebuild"}).exit_code, 0);
   const lod::LodStore updated = lod::LodStore::open(lod::LodStore::path_for(project));
   const lod::LodStore built = lod::LodStore::open(lod::LodStore::path_for(copy));
@@ -215,6 +216,12 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   // then updated in place by each commit, not built again.
   EXPECT_EQ(read_json(dir / "layout_flown.json")["store"]["builds"], 1);
   EXPECT_GE(read_json(dir / "layout_flown.json")["store"]["updates"].get<int>(), 2);
+  // The flight's moving frames kept to their point budget; their times
+  // against the target are reported, not asserted (a loaded machine).
+  const json flown_frames = read_json(dir / "layout_flown.json")["frames"];
+  EXPECT_GE(flown_frames["moving"].get<int>(), 5) << flown_frames.dump();
+  EXPECT_EQ(flown_frames["over_budget"], 0) << flown_frames.dump();
+  std::cout << "moving frames: " << flown_frames.dump() << "\n";
   for (const char* shot : {"workbench_open.png", "workbench_segment.png", "workbench_group.png",
                            "workbench_recolored.png"})
     keep_screenshot(dir / shot);
@@ -289,6 +296,45 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_EQ(after[6]["name"], "edit");
   EXPECT_EQ(after[6]["settings"]["parent"], tree[2]["id"]) << after[6].dump();
   EXPECT_EQ(after[7]["name"], "delete");
+
+  // A box drawn in the 3D view with the lasso tool (Shift held) selects the
+  // points in front inside it, still to be segmented; Enter in the name
+  // field commits them as an object; Ctrl+Z takes the object back and
+  // gives the selection back. The store follows both, in place.
+  const json lasso = {
+      {{"wait", 2}},
+      {{"key", "L"}},
+      {{"drag", {view3d(0.35, 0.35), view3d(0.65, 0.65)}}, {"mods", {"shift"}}, {"steps", 6}},
+      {{"wait", 1}},
+      {{"screenshot", "workbench_lasso_drawn.png"}},
+      {{"layout", "layout_lasso.json"}},
+      {{"click", "name"}},
+      {{"key", "A"}, {"mods", {"ctrl"}}},
+      {{"text", "lassoed"}},
+      {{"key", "Enter"}},
+      {{"wait", 2}},
+      {{"layout", "layout_lasso_committed.json"}},
+      {{"key", "Z"}, {"mods", {"ctrl"}}},
+      {{"wait", 2}},
+      {{"layout", "layout_lasso_undone.json"}}};
+  run_stage(dir, project, "lasso3d", lasso);
+  keep_screenshot(dir / "workbench_lasso_drawn.png");
+  const json selected = read_json(dir / "layout_lasso.json")["selection"];
+  EXPECT_GT(selected["pixels"].get<int>(), 1000) << read_json(dir / "layout_lasso.json")["status"];
+  EXPECT_EQ(selected["scans"], 1);
+  const json committed = read_json(dir / "layout_lasso_committed.json");
+  EXPECT_EQ(committed["selection"]["pixels"], 0);
+  const json undone = read_json(dir / "layout_lasso_undone.json");
+  EXPECT_EQ(undone["selection"]["pixels"], selected["pixels"]);
+  EXPECT_EQ(undone["store"]["builds"], 0);
+  EXPECT_GE(undone["store"]["updates"].get<int>(), 2);
+  json lassoed = commands(dir, project);
+  ASSERT_EQ(lassoed.size(), 9u) << lassoed.dump();
+  EXPECT_EQ(lassoed[8]["name"], "commit");
+  EXPECT_EQ(lassoed[8]["state"], "undone");
+  EXPECT_EQ(lassoed[8]["result"]["points"], selected["pixels"]);
+  EXPECT_TRUE(nodes(dir, project).empty());
+  expect_store_as_built(dir, project);
 }
 
 // Whether a screenshot's pixel (B, G, R) is the 3D view's background.

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -186,6 +187,20 @@ TEST(SegmentCommands, SelectionsAreSessionStateKeptOnRequest) {
   EXPECT_TRUE(kept_selection(project, scan).empty());
 }
 
+// Three setups of the room: two at the same spot, and a third 100 m
+// away (registered there); their scan ids.
+std::array<std::int64_t, 3> two_rooms_and_a_far_one(store::Project& project) {
+  const std::int64_t first = store_room(project);
+  const std::int64_t second = store_room(project);
+  const std::int64_t far = store_room(project);
+  acquisition::Scan moved = test::shared_room().scan;
+  moved.T_world_scan.translation() = Eigen::Vector3d(100.0, 0.0, 0.0);
+  store::Project::Edit edit = project.begin_command("register", "{}");
+  project.set_pose(edit, far, moved);
+  edit.commit("{}");
+  return {first, second, far};
+}
+
 // An object drawn in one scan covers the surface in every scan that saw it:
 // a second setup at the same spot gives the wall its points, in the same
 // command; a setup 100 m away sees other surfaces and gives none; points an
@@ -194,16 +209,7 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
   SelectionTools tools;  // the selections: session state
   const ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
-  const std::int64_t first = store_room(project);
-  const std::int64_t second = store_room(project);
-  const std::int64_t far = store_room(project);
-  acquisition::Scan moved = test::shared_room().scan;
-  moved.T_world_scan.translation() = Eigen::Vector3d(100.0, 0.0, 0.0);
-  {
-    store::Project::Edit edit = project.begin_command("register", "{}");
-    project.set_pose(edit, far, moved);
-    edit.commit("{}");
-  }
+  const auto [first, second, far] = two_rooms_and_a_far_one(project);
   // The poster, flush with the wall, is already an object of the second scan.
   ASSERT_TRUE(tools
                   .select(project, select_at(second, 31, 0, SelectMode::kReplace,
@@ -264,6 +270,66 @@ TEST(SegmentCommands, ACommittedObjectTakesTheOtherScansPointsOnItsSurface) {
   const auto only = static_cast<std::uint32_t>(tools.commit(project, alone).node_id);
   EXPECT_EQ(count_owned(project, first, only), in_first);
   EXPECT_EQ(count_owned(project, second, only), 0u);
+}
+
+// A selection drawn in the 3D view spans scans: it is one step of the
+// selection's undo, and its commit makes one object that each scan
+// completes from the others' parts (the points the merge left out).
+TEST(SegmentCommands, ASelectionSpanningScansIsOneStepAndOneObject) {
+  SelectionTools tools;  // the selections: session state
+  const ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const auto [first, second, far] = two_rooms_and_a_far_one(project);
+  // A wall grown in the first scan, then the same wall drawn in 3D: its
+  // pixels split between the two scans as the merge would keep them.
+  ASSERT_TRUE(tools.select(project, select_at(first, 20, 0)).seed_open);
+  const segmentation::PixelSet wall = tools.selection(first);
+  ASSERT_GT(wall.size(), 200u);
+  const std::size_t half = wall.size() / 2;
+  const segmentation::PixelSet a(wall.begin(), wall.begin() + static_cast<std::ptrdiff_t>(half));
+  const segmentation::PixelSet b(wall.begin() + static_cast<std::ptrdiff_t>(half), wall.end());
+  EXPECT_EQ(tools.select_pixels(project, {{first, a}, {second, b}}, SelectMode::kReplace),
+            wall.size());
+  EXPECT_EQ(tools.selected_scans(), 2u);
+  EXPECT_EQ(tools.selection(first), a);
+  EXPECT_EQ(tools.selection(second), b);
+  // Adding and subtracting change only the scans named.
+  EXPECT_EQ(tools.select_pixels(project, {{second, a}}, SelectMode::kAdd), wall.size() + half);
+  EXPECT_EQ(tools.select_pixels(project, {{second, a}}, SelectMode::kSubtract), wall.size());
+  // One step each: the replace undone gives the grown selection back.
+  ASSERT_TRUE(tools.undo_selection());
+  ASSERT_TRUE(tools.undo_selection());
+  ASSERT_TRUE(tools.undo_selection());
+  EXPECT_EQ(tools.selection(first), wall);
+  EXPECT_TRUE(tools.selection(second).empty());
+  ASSERT_TRUE(tools.redo_selection());
+  EXPECT_EQ(tools.selection(second), b);
+  // A pixel outside a grid is refused, and nothing changes.
+  EXPECT_THROW(tools.select_pixels(project, {{second, {0, 1u << 30}}}, SelectMode::kAdd),
+               core::InputError);
+  EXPECT_THROW(tools.select_pixels(project, {{9999, {0}}}, SelectMode::kAdd), core::InputError);
+  EXPECT_EQ(tools.selection(second), b);
+
+  // One object: each scan takes its part, and the other's from the other.
+  const std::string before = state_of(project);
+  const NodeCommandResult made = tools.commit_all(project, first, "wall +x", std::nullopt);
+  const auto id = static_cast<std::uint32_t>(made.node_id);
+  EXPECT_EQ(count_owned(project, first, id), wall.size());
+  EXPECT_EQ(count_owned(project, second, id), wall.size());
+  EXPECT_EQ(count_owned(project, far, id), 0u);
+  EXPECT_EQ(tools.selected_pixels(), 0u);
+  EXPECT_THAT(project.history().back().result,
+              HasSubstr("\"points\":" + std::to_string(wall.size())));
+  // Undone, the project is as before and both scans' selections are back.
+  project.undo();
+  tools.command_undone(project, made.command_id);
+  EXPECT_EQ(state_of(project), before);
+  EXPECT_EQ(tools.selection(first), a);
+  EXPECT_EQ(tools.selection(second), b);
+  project.redo();
+  tools.command_redone(project, made.command_id);
+  EXPECT_EQ(tools.selected_pixels(), 0u);
+  EXPECT_EQ(count_owned(project, second, id), wall.size());
 }
 
 // When the scans move (a re-registration), the points an object took from
