@@ -25,7 +25,18 @@
 //     the full picture's (every point of the store drawn, no level of
 //     detail: "full_renderer_psnr_db"), and the two pictures against each
 //     other ("against_full_renderer_psnr_db").
-// The figures of edits in place and 3D selection are null until they exist.
+//   - "selection": five objects of the truth (a façade, a tree, a car, a
+//     lamp post, a low wall; of each kind the one the store holds most
+//     points of) selected by lassos traced around their outlines in the
+//     3D view (measure_selection in bench_lod.cpp says how the views are
+//     chosen): "selection_iou" against the truth's points in the store,
+//     what else the lassos took and what they missed by kind, and
+//     "select_ms" for the chosen lassos; with --pictures, each view with
+//     the object's points taken (yellow) and missed (red);
+//   - "edits": a commit, hide, recolour, delete and undo, the store updated
+//     in place ("hide_ms", "recolor_ms", "commit_1m_points_ms"), then a
+//     new scan inserted ("insert_scan_seconds") against building the grown
+//     campaign's store anew ("full_rebuild_seconds").
 #pragma once
 
 #include <nlohmann/json.hpp>

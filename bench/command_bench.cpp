@@ -50,7 +50,8 @@ void add_bench_command(CLI::App& app) {
   command->add_flag("--smoke", options->bench.smoke,
                     "Tiny inputs: checks the suite runs; figures are not meaningful");
   command->add_option("--pictures", options->bench.pictures,
-                      "render: also write each view's truth picture and renders (PNG) here");
+                      "render: also write each view's truth picture and renders (PNG) here; "
+                      "lod: each 3D selection's views, the object's points taken and missed");
   command
       ->add_option("--sizes", options->bench.sizes,
                    "scale: campaign sizes in stations, comma-separated (default 1,4,16,64)")

@@ -483,7 +483,8 @@ LodSelection LodRenderer::select(const RenderView& view, const Lasso& lasso,
     return {};
   // Seeing which points are in front needs the splats that may cover the
   // lasso: those centred up to the widest splat beyond its bounds.
-  const float margin = options.visible_only ? kMaxOccluderRadiusPx : 0.0f;
+  const bool through = std::isinf(options.depth_m);
+  const float margin = through ? 0.0f : kMaxOccluderRadiusPx;
   const Eigen::AlignedBox2f reach_box(lasso.bounds().min().array() - margin,
                                       lasso.bounds().max().array() + margin);
   const Eigen::AlignedBox2f picture(
@@ -502,7 +503,7 @@ LodSelection LodRenderer::select(const RenderView& view, const Lasso& lasso,
   };
   std::vector<Candidate> candidates;
   const float scale = settings.splat_scale;
-  const bool cull_back = options.visible_only && settings.culling.backface;
+  const bool cull_back = !through && settings.culling.backface;
   std::vector<std::size_t> stack = {0};
   while (!stack.empty()) {
     const std::size_t k = stack.back();
@@ -522,22 +523,24 @@ LodSelection LodRenderer::select(const RenderView& view, const Lasso& lasso,
           const std::optional<Eigen::Vector2f> at = project_to_picture(view, position);
           if (!at || !reach_box.contains(*at)) return;
           const bool enclosed = lasso.encloses(*at) && (!options.open_only || object == 0);
-          if (!options.visible_only) {
+          if (through) {
             if (enclosed) taken.push_back({scan_ids_.at(q.scan), q.pixel, position});
             return;
           }
-          if (cull_back && (q.flags & lod::LodPoint::kHasNormal) &&
-              lod::decode_unit(q.normal).dot(view.eye - position) < 0.0f)
-            return;  // the view does not draw it
+          // A point the view does not draw hides nothing; it is taken only
+          // from behind the nearest surface.
+          const bool drawn = !cull_back || !(q.flags & lod::LodPoint::kHasNormal) ||
+                             lod::decode_unit(q.normal).dot(view.eye - position) >= 0.0f;
           const float depth = view_depth(view, position);
           const float radius_m = scale * lod::from_half(q.radii[0]);
-          raster.splat(*at, depth,
-                       std::min(kMaxOccluderRadiusPx, radius_m * view.focal_px / depth));
-          if (enclosed)
+          if (drawn)
+            raster.splat(*at, depth,
+                         std::min(kMaxOccluderRadiusPx, radius_m * view.focal_px / depth));
+          if (enclosed && (drawn || options.depth_m > 0.0f))
             candidates.push_back({{scan_ids_.at(q.scan), q.pixel, position},
                                   *at,
                                   depth,
-                                  2.0f * radius_m + 0.005f * depth});
+                                  2.0f * radius_m + 0.005f * depth + options.depth_m});
         });
   }
   for (const Candidate& c : candidates) {

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -62,11 +63,14 @@ struct LodPick {
 
 // How a selection in the 3D view takes points.
 struct LodSelectOptions {
-  // A lasso takes only the points a person sees inside it, on the nearest
-  // surface (within a tolerance of 2 drawn splat radii and 0.5 % of the
-  // distance), as the view draws them (back faces left out when it culls
-  // them); false: every point inside it, through every depth.
-  bool visible_only = true;
+  // How far behind the nearest surface the view draws at its pixel a
+  // point the lasso encloses may lie and still be taken [m], beyond a
+  // tolerance of 2 drawn splat radii and 0.5 % of the distance. 0: only
+  // what a person sees in front (a lasso over a wall does not take what
+  // lies behind it); a crown's depth: the leaves inside it too;
+  // kEveryDepth: every point inside the lasso. Back faces the view culls
+  // hide nothing, and are taken only with a depth beyond 0.
+  float depth_m = 0.0f;
   // Only points still to be segmented (in no object): those a selection
   // may hold. Points of objects still hide what lies behind them.
   bool open_only = true;
@@ -74,6 +78,7 @@ struct LodSelectOptions {
   // over them, for the view to mark the selection with.
   std::size_t sample = 0;
 };
+inline constexpr float kEveryDepth = std::numeric_limits<float>::infinity();
 
 struct LodSelection {
   // By scan id, each scan's pixels ascending: the per-scan pixel
@@ -152,7 +157,7 @@ class LodRenderer {
                       const LodSelectOptions& options = {});
   // The volumetric brush (seed 002): the points within `radius_m` of
   // `centre` (model frame) among those the view would draw, taken as
-  // `options` says (visible_only does not apply). Walks the nodes whose
+  // `options` says (depth_m does not apply). Walks the nodes whose
   // bounds meet the sphere.
   LodSelection select_sphere(const Eigen::Vector3f& centre, float radius_m,
                              const RenderSettings& settings, const LodSelectOptions& options = {});

@@ -6,8 +6,33 @@ namespace scanbench::app::workbench {
 
 namespace {
 
-// The first row: the tool, the channel a seed grows on and its tolerance,
-// and how a region joins the selection.
+// The channel a seed grows on and its tolerance (the seed tool's only).
+void seed_settings(WorkbenchState& s) {
+  Session& session = s.session;
+  // An unstructured cloud has no range image to grow on.
+  ImGui::BeginDisabled(!session.has_grid());
+  ImGui::SetNextItemWidth(s.px(100));
+  int channel = static_cast<int>(session.channel);
+  if (ImGui::Combo("##channel", &channel, "range\0colour\0intensity\0normal\0")) {
+    session.channel = static_cast<segmentation::Channel>(channel);
+    session.tolerance = segmentation::default_grow_settings(session.channel).tolerance;
+  }
+  s.probe("channel");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(s.px(90));
+  float tolerance = static_cast<float>(session.tolerance);
+  // Units by channel (region_grow.hpp): range in footprints, colour in
+  // ΔE, intensity in shares of the scan's spread, normal in degrees.
+  if (ImGui::DragFloat("tolerance", &tolerance, 0.01f * std::max(tolerance, 0.01f), 0.001f, 100.0f,
+                       "%.3g"))
+    session.tolerance = tolerance;
+  ImGui::SameLine();
+  ImGui::EndDisabled();
+}
+
+// The first row: the tool, its settings (a seed's channel and tolerance,
+// the 3D lasso's depth, the brush's radius), and how a selection joins
+// the selection so far.
 void tools_row(WorkbenchState& s) {
   Session& session = s.session;
   // The lasso and the brush select in the 3D view, whatever the scans.
@@ -36,31 +61,23 @@ void tools_row(WorkbenchState& s) {
     s.probe("select through");
     if (ImGui::IsItemHovered())
       ImGui::SetTooltip("The 3D lasso takes every depth, not only what is in front");
+    if (!s.select_through) {
+      ImGui::SameLine();
+      ImGui::SetNextItemWidth(s.px(70));
+      ImGui::DragFloat("depth", &s.select_depth_m, 0.05f, 0.0f, 50.0f, "%.1f m");
+      s.probe_slider("select depth");
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(
+            "How far behind the surface in front the 3D lasso reaches\n"
+            "(0: only what you see; a tree's depth: its leaves inside)");
+    }
   } else if (session.tool == Tool::kBrush) {
     ImGui::SetNextItemWidth(s.px(80));
     ImGui::DragFloat("radius", &s.brush_radius_m, 0.01f, 0.02f, 10.0f, "%.2f m");
     s.probe_slider("brush radius");
   }
   ImGui::SameLine();
-  // An unstructured cloud has no range image to grow on.
-  ImGui::BeginDisabled(!session.has_grid());
-  ImGui::SetNextItemWidth(s.px(100));
-  int channel = static_cast<int>(session.channel);
-  if (ImGui::Combo("##channel", &channel, "range\0colour\0intensity\0normal\0")) {
-    session.channel = static_cast<segmentation::Channel>(channel);
-    session.tolerance = segmentation::default_grow_settings(session.channel).tolerance;
-  }
-  s.probe("channel");
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(s.px(90));
-  float tolerance = static_cast<float>(session.tolerance);
-  // Units by channel (region_grow.hpp): range in footprints, colour in
-  // ΔE, intensity in shares of the scan's spread, normal in degrees.
-  if (ImGui::DragFloat("tolerance", &tolerance, 0.01f * std::max(tolerance, 0.01f), 0.001f, 100.0f,
-                       "%.3g"))
-    session.tolerance = tolerance;
-  ImGui::SameLine();
-  ImGui::EndDisabled();
+  if (session.tool == Tool::kSeed) seed_settings(s);
   int mode = static_cast<int>(session.mode);
   ImGui::RadioButton("new", &mode, 0);
   ImGui::SameLine();
@@ -69,14 +86,11 @@ void tools_row(WorkbenchState& s) {
   ImGui::SameLine();
   ImGui::RadioButton("subtract", &mode, 2);
   session.mode = static_cast<modeling::SelectMode>(mode);
-  ImGui::SameLine();
-  ImGui::BeginDisabled(!session.has_grid());
-  if (ImGui::Button("Clear lasso")) session.clear_constraints();
-  ImGui::EndDisabled();
 }
 
 // The second row: the name for commits, groups and renames, commit,
-// proposals, the panoramic view's channel, undo and redo.
+// proposals, the panoramic view's channel, undo and redo, and clearing
+// the panorama's lasso and barriers.
 void commands_row(WorkbenchState& s) {
   ImGui::SetNextItemWidth(s.px(220));
   if (ImGui::InputText("name", s.name.data(), s.name.size(),
@@ -117,6 +131,12 @@ void commands_row(WorkbenchState& s) {
   ImGui::SameLine();
   if (ImGui::Button("Redo")) s.redo();
   s.probe("redo");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!s.session.has_grid());
+  if (ImGui::Button("Clear lasso")) s.session.clear_constraints();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("Clear the panorama's lasso and barriers (Esc)");
+  ImGui::EndDisabled();
 }
 
 }  // namespace

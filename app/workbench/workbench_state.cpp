@@ -339,8 +339,10 @@ void WorkbenchState::finish_lasso_3d() {
   const render::Lasso lasso(polygon);
   if (lasso.empty()) return;  // a click, not a lasso
   const render::RenderView view = render::make_render_view(navigation.camera(w, h), model_origin());
-  const render::LodSelection taken = renderer->select(
-      view, lasso, settings, {.visible_only = !select_through, .sample = kSelectionMarks});
+  const render::LodSelection taken =
+      renderer->select(view, lasso, settings,
+                       {.depth_m = select_through ? render::kEveryDepth : select_depth_m,
+                        .sample = kSelectionMarks});
   session.select_pixels(taken.pixels, box_3d ? "box" : "lasso");
   selection_marks = taken.sample;
   marks_revision = session.revision();

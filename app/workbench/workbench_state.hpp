@@ -121,6 +121,7 @@ struct WorkbenchState {
   std::vector<Eigen::Vector2f> lasso_3d;  // window points of the lasso being drawn
   bool box_3d = false;                    // a box from the first point to the cursor
   bool select_through = false;            // the lasso takes every depth, not the front only
+  float select_depth_m = 0.0f;            // else how far behind the front surface it reaches
   float brush_radius_m = 0.25f;
   std::map<std::int64_t, std::vector<std::uint32_t>> brushed;  // the stroke so far
   // A sample of the last 3D selection's points (model frame), marked over
@@ -130,8 +131,9 @@ struct WorkbenchState {
   // Starts a lasso (or, with `box`, a box) at window point (x, y) of the 3D view.
   void start_lasso_3d(double x, double y, bool box);
   void extend_lasso_3d(double x, double y);
-  // The points the lasso encloses (in front, or every depth with
-  // select_through) join the selection by the session's mode, as one step.
+  // The points the lasso encloses (in front, down to select_depth_m
+  // behind, or every depth with select_through) join the selection by the
+  // session's mode, as one step.
   void finish_lasso_3d();
   // The brush at window point (x, y): the points within its radius of the
   // surface under it join the stroke; finish_brush() selects the stroke.

@@ -297,7 +297,15 @@ TEST(BenchLod, SmokeRunMeasuresTheBuildTheStreamingRendererAndEditsInPlace) {
   EXPECT_EQ(bench["edits"]["delete_points"], bench["edits"]["commit_points"]);
   EXPECT_EQ(bench["edits"]["undo_delete_points"], bench["edits"]["commit_points"]);
   EXPECT_GT(bench["insert"]["points_added"].get<double>(), 0.0);
-  EXPECT_TRUE(bench["selection"].empty());  // 3D selection is still to come
+  // Five objects selected by lassos in the 3D view, each measured against
+  // the truth (a smoke run's figures are not meaningful).
+  ASSERT_EQ(bench["selection"].size(), 5u) << bench["selection"].dump();
+  for (const auto& object : bench["selection"]) {
+    EXPECT_GT(object["selection_iou"].get<double>(), 0.3) << object.dump();
+    EXPECT_LE(object["selection_iou"].get<double>(), 1.0) << object.dump();
+    EXPECT_GE(object["lassos"].get<int>(), 1) << object.dump();
+    EXPECT_GT(object["truth_points"].get<int>(), 0) << object.dump();
+  }
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ TEST(LodRendererSelect, SelectsTheShownPointsTheLassoEncloses) {
       test::camera_at(test::kOrigin + Eigen::Vector3d(0, 0, 1.5)), renderer.header().origin);
   RenderSettings settings;
   // Every point, owned or not, through every depth.
-  const LodSelectOptions through{.visible_only = false, .open_only = false};
+  const LodSelectOptions through{.depth_m = kEveryDepth, .open_only = false};
   // The whole picture: the wall is in view, its right half hidden.
   const WallSelection all = count(
       renderer.select(view, Lasso({{0, 0}, {160, 0}, {160, 120}, {0, 120}}), settings, through));
@@ -142,9 +142,9 @@ TEST(LodRendererSelect, ALassoTakesWhatIsInFrontAndTheBrushASphere) {
   const RenderSettings settings;
   const Lasso picture({{0, 0}, {160, 0}, {160, 120}, {0, 120}});
   // Through every depth: the whole wall, and the panel when objects count.
-  EXPECT_EQ(renderer.select(view, picture, settings, {.visible_only = false}).points, 4800u);
+  EXPECT_EQ(renderer.select(view, picture, settings, {.depth_m = kEveryDepth}).points, 4800u);
   EXPECT_EQ(
-      renderer.select(view, picture, settings, {.visible_only = false, .open_only = false}).points,
+      renderer.select(view, picture, settings, {.depth_m = kEveryDepth, .open_only = false}).points,
       5400u);
   // In front: the panel (an object's) is not taken, and hides the wall
   // behind it. Where the panel lands on the picture, from its corners:
@@ -176,6 +176,10 @@ TEST(LodRendererSelect, ALassoTakesWhatIsInFrontAndTheBrushASphere) {
     }
   }
   EXPECT_GT(inside, 100u);
+  // Down to 4.5 m behind the nearest surface: the wall behind the panel
+  // (4 m behind it) too; down to 3 m, not.
+  EXPECT_EQ(renderer.select(view, picture, settings, {.depth_m = 4.5f}).points, 4800u);
+  EXPECT_EQ(renderer.select(view, picture, settings, {.depth_m = 3.0f}).points, taken.size());
   EXPECT_GT(outside, 2500u);
   EXPECT_LE(seen.sample.size(), 100u);
   EXPECT_GE(seen.sample.size(), 50u);
