@@ -299,8 +299,10 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
 
   // A box drawn in the 3D view with the lasso tool (Shift held) selects the
   // points in front inside it, still to be segmented; Enter in the name
-  // field commits them as an object; Ctrl+Z takes the object back and
-  // gives the selection back. The store follows both, in place.
+  // field commits them as an object, which is then hidden; Ctrl+Z twice
+  // shows it again and takes it back, giving the selection back. The
+  // store follows the commit and its undo in place; the hide rewrites
+  // nothing.
   const json lasso = {
       {{"wait", 2}},
       {{"key", "L"}},
@@ -314,6 +316,12 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
       {{"key", "Enter"}},
       {{"wait", 2}},
       {{"layout", "layout_lasso_committed.json"}},
+      {{"click", "node lassoed"}},
+      {{"click", "hide"}},
+      {{"wait", 2}},
+      {{"layout", "layout_lasso_hidden.json"}},
+      {{"key", "Z"}, {"mods", {"ctrl"}}},
+      {{"wait", 2}},
       {{"key", "Z"}, {"mods", {"ctrl"}}},
       {{"wait", 2}},
       {{"layout", "layout_lasso_undone.json"}}};
@@ -324,15 +332,20 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_EQ(selected["scans"], 1);
   const json committed = read_json(dir / "layout_lasso_committed.json");
   EXPECT_EQ(committed["selection"]["pixels"], 0);
+  const json hidden = read_json(dir / "layout_lasso_hidden.json");
+  EXPECT_EQ(hidden["store"], committed["store"]);
   const json undone = read_json(dir / "layout_lasso_undone.json");
   EXPECT_EQ(undone["selection"]["pixels"], selected["pixels"]);
   EXPECT_EQ(undone["store"]["builds"], 0);
   EXPECT_GE(undone["store"]["updates"].get<int>(), 2);
   json lassoed = commands(dir, project);
-  ASSERT_EQ(lassoed.size(), 9u) << lassoed.dump();
+  ASSERT_EQ(lassoed.size(), 10u) << lassoed.dump();
   EXPECT_EQ(lassoed[8]["name"], "commit");
   EXPECT_EQ(lassoed[8]["state"], "undone");
   EXPECT_EQ(lassoed[8]["result"]["points"], selected["pixels"]);
+  EXPECT_EQ(lassoed[9]["name"], "edit");
+  EXPECT_EQ(lassoed[9]["settings"]["hidden"], true) << lassoed[9].dump();
+  EXPECT_EQ(lassoed[9]["state"], "undone");
   EXPECT_TRUE(nodes(dir, project).empty());
   expect_store_as_built(dir, project);
 }
