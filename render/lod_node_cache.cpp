@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <iterator>
 #include <optional>
 
 #include "core/errors.hpp"
@@ -36,6 +37,23 @@ void LodNodeCache::request(const std::vector<std::size_t>& wanted) {
     queue_ = std::move(queue);
   }
   wake_.notify_one();
+}
+
+std::vector<std::pair<std::size_t, std::vector<lod::LodPoint>>> LodNodeCache::release() {
+  std::vector<std::pair<std::size_t, std::vector<lod::LodPoint>>> out;
+  for (const std::size_t node : use_) out.emplace_back(node, std::move(resident_.at(node).points));
+  resident_.clear();
+  use_.clear();
+  bytes_ = 0;
+  return out;
+}
+
+void LodNodeCache::adopt(std::size_t node, std::vector<lod::LodPoint> points) {
+  if (loaded(node)) return;
+  bytes_ += points.size() * sizeof(lod::LodPoint);
+  peak_bytes_ = std::max(peak_bytes_, bytes_);
+  use_.push_back(node);
+  resident_.emplace(node, Resident{std::move(points), std::prev(use_.end())});
 }
 
 std::vector<std::size_t> LodNodeCache::collect(std::span<const std::size_t> in_use) {

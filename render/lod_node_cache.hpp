@@ -48,6 +48,14 @@ class LodNodeCache {
   std::vector<std::size_t> collect(std::span<const std::size_t> in_use);
 
   bool loaded(std::size_t node) const { return resident_.count(node) > 0; }
+  // The nodes in memory, most recently used first, given up (the cache is
+  // then empty): a renderer following an update hands those the update
+  // left alone to the cache of the new hierarchy (adopt).
+  std::vector<std::pair<std::size_t, std::vector<lod::LodPoint>>> release();
+  // Takes node `node`'s points in as if the loader had read them, least
+  // recently used (adopt the most recent first); ignored when it is in
+  // memory already.
+  void adopt(std::size_t node, std::vector<lod::LodPoint> points);
   // The points of a node in memory (asserted), marking it used now.
   std::span<const lod::LodPoint> points(std::size_t node);
 

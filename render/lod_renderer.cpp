@@ -9,6 +9,7 @@
 #include <queue>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/errors.hpp"
 #include "modeling/color_pipeline.hpp"
@@ -106,15 +107,25 @@ struct LodRenderer::Gpu {
 
 LodRenderer::LodRenderer(const std::filesystem::path& store_file, const LodRendererLimits& limits)
     : store_file_(store_file), limits_(limits), gpu_(std::make_unique<Gpu>()) {
-  const lod::LodStore store = lod::LodStore::open(store_file);
+  read_hierarchy();
+  gpu_->points = make_vertex_array();
+  describe_stored_points(gpu_->points.get());
+  set_objects({});
+  set_scan_corrections({});
+}
+
+void LodRenderer::read_hierarchy() {
+  const lod::LodStore store = lod::LodStore::open(store_file_);
   hierarchy_ = LodHierarchy::of(store);
+  scan_of_id_.clear();
+  scan_ids_.clear();
   for (const lod::LodScan& scan : store.scans()) {
     scan_of_id_[scan.scan_id] = scan.index;
     scan_ids_.push_back(scan.scan_id);
   }
   // Children after parents: backwards, each subtree's radius is whole
   // before its parent takes it in.
-  subtree_radius_.resize(hierarchy_.nodes.size());
+  subtree_radius_.assign(hierarchy_.nodes.size(), 0.0f);
   for (std::size_t k = hierarchy_.nodes.size(); k-- > 0;) {
     subtree_radius_[k] = std::max(subtree_radius_[k], hierarchy_.nodes[k].max_radius_m);
     for (const std::int32_t child : hierarchy_.children[k]) {
@@ -128,11 +139,43 @@ LodRenderer::LodRenderer(const std::filesystem::path& store_file, const LodRende
   std::vector<lod::NodeKey> keys;
   keys.reserve(hierarchy_.nodes.size());
   for (const lod::LodNodeInfo& node : hierarchy_.nodes) keys.push_back(node.key);
-  gpu_->memory = std::make_unique<LodNodeCache>(store_file, std::move(keys), limits.memory_bytes);
-  gpu_->points = make_vertex_array();
-  describe_stored_points(gpu_->points.get());
-  set_objects({});
-  set_scan_corrections({});
+  gpu_->memory.reset();  // its loader stops first
+  gpu_->memory = std::make_unique<LodNodeCache>(store_file_, std::move(keys), limits_.memory_bytes);
+  last_plan_ = {};
+  gpu_->pending.clear();
+  reader_.reset();
+}
+
+void LodRenderer::follow_update(std::span<const std::uint64_t> rewritten) {
+  const std::unordered_set<std::uint64_t> changed(rewritten.begin(), rewritten.end());
+  std::vector<std::uint64_t> old_codes;
+  old_codes.reserve(hierarchy_.nodes.size());
+  for (const lod::LodNodeInfo& node : hierarchy_.nodes) old_codes.push_back(node.key.code());
+  std::vector<std::pair<std::size_t, std::vector<lod::LodPoint>>> in_memory =
+      gpu_->memory->release();
+  read_hierarchy();
+  std::unordered_map<std::uint64_t, std::size_t> index_of;
+  for (std::size_t k = 0; k < hierarchy_.nodes.size(); ++k)
+    index_of.emplace(hierarchy_.nodes[k].key.code(), k);
+  // A node the update left alone, at its new index.
+  const auto kept = [&](std::size_t old) -> std::optional<std::size_t> {
+    if (changed.count(old_codes[old]) != 0) return std::nullopt;
+    const auto found = index_of.find(old_codes[old]);
+    if (found == index_of.end()) return std::nullopt;
+    return found->second;
+  };
+  for (auto& [old, points] : in_memory) {
+    if (const auto k = kept(old)) gpu_->memory->adopt(*k, std::move(points));
+  }
+  std::unordered_map<std::size_t, Gpu::DeviceNode> device;
+  for (auto& [old, node] : gpu_->device) {
+    if (const auto k = kept(old)) {
+      device.emplace(*k, std::move(node));
+    } else {
+      gpu_->device_bytes -= node.bytes;
+    }
+  }
+  gpu_->device = std::move(device);
 }
 
 LodRenderer::~LodRenderer() = default;

@@ -146,6 +146,13 @@ class LodRenderer {
   std::optional<LodPick> pick(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                               const RenderSettings& settings);
 
+  // The store was updated in place (modeling/lod/update_lod.hpp): reads its
+  // hierarchy again, and drops what the caches hold of the nodes
+  // `rewritten` (by code: rewritten, new or removed), keeping every other
+  // node in memory and on the device, so the next frame redraws the
+  // picture but the changed nodes from what it holds.
+  void follow_update(std::span<const std::uint64_t> rewritten);
+
   // The points whose centres `lasso` (picture pixels of `view`) encloses,
   // among those the view would draw (shown objects, within the clipping box
   // and slice), taken as `options` says. Every point of the store counts,
@@ -177,6 +184,9 @@ class LodRenderer {
 
  private:
   struct Gpu;
+  // Reads the store's hierarchy and what follows from it (the nodes'
+  // subtree radii, the scans), with an empty memory cache for it.
+  void read_hierarchy();
   LodFramePlan plan(const RenderView& banded_view, const RenderSettings& settings) const;
   // A frame: plans, uploads (at most `upload_limit` bytes; 0: no limit)
   // and waits for the loader until `until` (none: until the view has

@@ -452,9 +452,13 @@ std::optional<Eigen::Vector2d> Session::image_point(const Eigen::Vector3d& p) co
 void Session::prepare_views() {
   if (!store_current()) {
     view_problem_.clear();
+    rewritten_.reset();
     try {
       core::Progress quiet;  // the window shows the command running
       const lod::LodRefreshResult refreshed = lod::refresh_lod(project_, {}, quiet);
+      // A store found at another path is another store.
+      if (refreshed.updated && refreshed.store() == store_)
+        rewritten_ = refreshed.updated->rewritten;
       store_ = refreshed.store();
       if (refreshed.built) ++store_builds_;
       if (refreshed.updated &&

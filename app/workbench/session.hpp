@@ -160,6 +160,11 @@ class Session {
   // Changes each time the store is updated or built anew: a renderer of
   // another generation draws nodes that changed.
   std::int64_t store_generation() const { return store_generation_; }
+  // What this generation changed of the one before: the codes of the nodes
+  // the update in place rewrote (render::LodRenderer::follow_update keeps
+  // the others); none after a build or a failure, when a renderer must
+  // start anew.
+  const std::optional<std::vector<std::uint64_t>>& rewritten() const { return rewritten_; }
   // Whether the store reflects the project as it is (reads the store's
   // header and the project's change marks: after a command, not each frame).
   bool store_current() const;
@@ -205,6 +210,7 @@ class Session {
   std::int64_t revision_ = 0;
   std::filesystem::path store_;
   std::int64_t store_generation_ = 0;  // stores built or found so far
+  std::optional<std::vector<std::uint64_t>> rewritten_;
   std::string view_problem_;
   int store_builds_ = 0, store_updates_ = 0;
   std::int64_t measurements_revision_ = 0;  // the project's revision they were read at

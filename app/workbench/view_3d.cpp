@@ -14,18 +14,29 @@ namespace scanbench::app::workbench {
 
 namespace {
 
-// A renderer for the session's store, when it has a new one.
+// The renderer follows the session's store: an update in place of the one
+// it draws keeps the nodes it did not rewrite in both caches; another
+// store gets a renderer of its own.
 void follow_the_store(WorkbenchState& s) {
   Session& session = s.session;
   if (s.renderer_generation == session.store_generation()) return;
-  s.renderer.reset();
+  const bool updated = s.renderer && s.renderer_generation + 1 == session.store_generation() &&
+                       session.rewritten().has_value();
   s.renderer_generation = session.store_generation();
   s.shown_revision = -1;
   s.shown_objects.clear();
   s.view_dirty = true;
-  if (!session.store().empty())
+  if (updated) {
+    s.renderer->follow_update(*session.rewritten());
+    ++s.renderer_follows;
+    return;
+  }
+  s.renderer.reset();
+  if (!session.store().empty()) {
     s.renderer =
         std::make_unique<render::LodRenderer>(session.store(), render::LodRendererLimits{});
+    ++s.renderers_opened;
+  }
 }
 
 // The objects' visibility and colours, and the scans' corrections, into

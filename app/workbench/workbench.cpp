@@ -228,6 +228,7 @@ class Workbench {
           {"rows", s.session.scan().rows}}},
         {"view3d", {s.view3d.x, s.view3d.y, s.view3d.w, s.view3d.h}},
         {"store", {{"builds", s.session.store_builds()}, {"updates", s.session.store_updates()}}},
+        {"renderer", {{"opened", s.renderers_opened}, {"follows", s.renderer_follows}}},
         {"selection",
          {{"pixels", s.session.selected_pixels()}, {"scans", s.session.selected_scans()}}},
         {"frames", moving_frames()}};

@@ -81,6 +81,9 @@ struct WorkbenchState {
   // frames refine until the picture is complete.
   std::unique_ptr<render::LodRenderer> renderer;
   std::int64_t renderer_generation = -1;  // of the store it draws
+  // Renderers opened, and updates in place the renderer followed keeping
+  // its caches.
+  int renderers_opened = 0, renderer_follows = 0;
   std::int64_t shown_revision = -1;       // the session's revision it was last told of
   // What it shows of the tree (ids, parents, visibility, colour edits) and
   // when the scans' corrections last changed.

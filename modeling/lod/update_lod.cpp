@@ -380,6 +380,7 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
                        BuiltNode{info.key, info.leaf, info.points_below, std::move(points.at(code)),
                                  info.level_ends});
       ++result.nodes_written;
+      result.rewritten.push_back(code);
     }
     for (const LodScan& scan : lod_scans) schema::put_scan(db, name, scan);
     for (std::size_t k = 0; k < changes.size(); ++k) {
@@ -404,6 +405,8 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
   result.points_removed = removed.size();
   result.nodes_written += edit.changed.size();
   result.nodes_removed = edit.removed.size();
+  result.rewritten.insert(result.rewritten.end(), edit.changed.begin(), edit.changed.end());
+  result.rewritten.insert(result.rewritten.end(), edit.removed.begin(), edit.removed.end());
   result.seconds = seconds_since(start);
   result.write_seconds = result.seconds - result.read_seconds - result.edit_seconds;
   return result;

@@ -42,6 +42,9 @@ struct LodUpdateResult {
   std::uint64_t nodes_read = 0;     // nodes whose points the edit read
   std::uint64_t nodes_written = 0;  // nodes rewritten or new
   std::uint64_t nodes_removed = 0;
+  // The codes of the nodes rewritten, new or removed: a renderer of the
+  // store keeps what it holds of every other node.
+  std::vector<std::uint64_t> rewritten;
   std::uint64_t points = 0, nodes = 0;  // in the store after
   double seconds = 0.0;
   // Of which: reading the changed scans; reading the nodes and editing the

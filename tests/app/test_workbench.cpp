@@ -338,6 +338,10 @@ TEST(Workbench, ANewUserSegmentsGroupsRecoloursUndoesAndFlies) {
   EXPECT_EQ(undone["selection"]["pixels"], selected["pixels"]);
   EXPECT_EQ(undone["store"]["builds"], 0);
   EXPECT_GE(undone["store"]["updates"].get<int>(), 2);
+  // One renderer, which followed the commit and the undo keeping the nodes
+  // they did not rewrite.
+  EXPECT_EQ(undone["renderer"]["opened"], 1);
+  EXPECT_GE(undone["renderer"]["follows"].get<int>(), 2);
   json lassoed = commands(dir, project);
   ASSERT_EQ(lassoed.size(), 10u) << lassoed.dump();
   EXPECT_EQ(lassoed[8]["name"], "commit");

@@ -12,6 +12,7 @@
 #include "modeling/color_commands.hpp"
 #include "modeling/color_pipeline.hpp"
 #include "modeling/lod/build_lod.hpp"
+#include "modeling/lod/update_lod.hpp"
 #include "modeling/room_project.hpp"
 #include "modeling/selection_tools.hpp"
 #include "modeling/tree_commands.hpp"
@@ -58,6 +59,13 @@ std::vector<std::pair<std::array<int, 2>, LodPick>> picked_pixels(LodRenderer& r
   return out;
 }
 
+// The room's -x wall grown and committed as object "wall".
+modeling::NodeCommandResult commit_wall(store::Project& project, std::int64_t scan) {
+  modeling::SelectionTools tools;
+  static_cast<void>(tools.select(project, modeling::select_at(scan, -20, 0)));
+  return tools.commit(project, {scan, "wall", std::nullopt});
+}
+
 std::array<int, 3> pixel(const RenderedImage& image, int x, int y) {
   const std::uint8_t* p = &image.rgba[4 * (static_cast<std::size_t>(y) * image.width + x)];
   return {p[0], p[1], p[2]};
@@ -71,12 +79,10 @@ std::array<int, 3> pixel(const RenderedImage& image, int x, int y) {
 // colour whatever blends there.
 TEST(LodRenderer, ShowsThePipelinesColoursHidesAndRecoloursWithoutUploads) {
   test::shared_device();
-  modeling::SelectionTools tools;
   const scanbench::test::ScratchDir dir;
   store::Project project = store::Project::create(dir / "p.sbproj");
   const std::int64_t scan = modeling::store_room(project);
-  static_cast<void>(tools.select(project, modeling::select_at(scan, -20, 0)));
-  const modeling::NodeCommandResult wall = tools.commit(project, {scan, "wall", std::nullopt});
+  const modeling::NodeCommandResult wall = commit_wall(project, scan);
   modeling::RecolorSettings recolor;
   recolor.node = wall.node_id;
   recolor.set.hue_deg = 90.0;
@@ -156,6 +162,7 @@ TEST(LodRenderer, ShowsThePipelinesColoursHidesAndRecoloursWithoutUploads) {
 
   // Points that change hands make it out of date, and undoing that does
   // not make it current again (the project changed after it was built).
+  modeling::SelectionTools tools;
   static_cast<void>(tools.select(project, modeling::select_at(scan, 0, -45)));
   tools.commit(project, {scan, "floor", std::nullopt});
   EXPECT_FALSE(lod::current_lod_store(project));
@@ -198,6 +205,55 @@ TEST(LodRenderer, RefinesFrameByFrameToTheCompletePicture) {
   at_once.draw_complete(view, settings);
   EXPECT_EQ(refined.rgba, at_once.read_image().rgba);
   EXPECT_LE(streaming.device_peak_bytes(), at_once.device_peak_bytes());
+}
+
+// A renderer follows an update of its store in place: it uploads only the
+// nodes the update rewrote, and draws what a renderer opened on the
+// updated store draws, pixel for pixel, the committed object's hide too.
+TEST(LodRenderer, FollowsAnUpdateInPlaceKeepingTheNodesItDidNotRewrite) {
+  test::shared_device();
+  const scanbench::test::ScratchDir dir;
+  store::Project project = store::Project::create(dir / "p.sbproj");
+  const std::int64_t scan = modeling::store_room(project);
+  core::Progress quiet;
+  lod::LodBuildSettings build;
+  build.threads = 1;
+  build.octree.max_leaf_points = 2000;
+  const std::filesystem::path store = lod::build_lod(project, build, quiet).store;
+  LodRenderer follower(store, {});
+  follower.show_project_state(project);
+  const RenderView view = make_render_view(room_camera(), follower.header().origin);
+  const LodFrameResult before = follower.draw_complete(view, every_point());
+  ASSERT_GT(before.uploaded_nodes, 4u);
+
+  const modeling::NodeCommandResult wall = commit_wall(project, scan);
+  std::string why_not;
+  const std::optional<lod::LodUpdateResult> updated =
+      lod::update_lod(project, build, quiet, why_not);
+  ASSERT_TRUE(updated) << why_not;
+  ASSERT_FALSE(updated->rewritten.empty());
+  ASSERT_LT(updated->rewritten.size(), follower.hierarchy().nodes.size());
+  follower.follow_update(updated->rewritten);
+  follower.show_project_state(project);
+  const LodFrameResult after = follower.draw_complete(view, every_point());
+  EXPECT_GT(after.uploaded_nodes, 0u);
+  EXPECT_LE(after.uploaded_nodes, updated->rewritten.size());
+  LodRenderer fresh(store, {});
+  fresh.show_project_state(project);
+  fresh.draw_complete(view, every_point());
+  EXPECT_EQ(follower.read_image().rgba, fresh.read_image().rgba);
+  // The relabelled nodes carry the new object: hiding it hides its points.
+  modeling::NodeEdit hide;
+  hide.node = wall.node_id;
+  hide.hidden = true;
+  modeling::edit_node(project, hide);
+  follower.show_project_state(project);
+  fresh.show_project_state(project);
+  const RenderedImage shown = follower.read_image();
+  EXPECT_EQ(follower.draw_complete(view, every_point()).uploaded_nodes, 0u);
+  fresh.draw_complete(view, every_point());
+  EXPECT_EQ(follower.read_image().rgba, fresh.read_image().rgba);
+  EXPECT_NE(follower.read_image().rgba, shown.rgba);
 }
 
 }  // namespace
