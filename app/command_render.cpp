@@ -139,13 +139,14 @@ void render_path(RenderOptions& options) {
   render::LodRenderer& renderer = *session.renderer;
   const Eigen::Vector3d origin = renderer.header().origin;
   render::FrameBudget budget(options.target_ms);
-  std::vector<double> frame_ms, points, gpu_ms, plan_ms, upload_ms;
+  std::vector<double> frame_ms, points, gpu_ms, plan_ms, upload_ms, scales;
   double first_frame_s = -1.0;
   render::RenderSettings settings = options.settings;
   for (const acquisition::CameraView& camera : cameras) {
     settings.culling.budget = budget.next(true);
-    const render::LodFrameResult frame =
-        renderer.draw(render::make_render_view(camera, origin), settings);
+    scales.push_back(budget.scale(true));
+    const render::LodFrameResult frame = renderer.draw(
+        render::make_render_view(render::at_scale(camera, scales.back()), origin), settings);
     budget.record(frame.frame_ms, frame.plan.submitted);
     frame_ms.push_back(frame.frame_ms);
     gpu_ms.push_back(frame.gpu_ms);
@@ -172,6 +173,8 @@ void render_path(RenderOptions& options) {
               {"frame_ms_p95", percentile(frame_ms, 0.95)},
               {"frame_ms_max", *std::max_element(frame_ms.begin(), frame_ms.end())},
               {"points_per_frame_p50", percentile(points, 0.5)},
+              {"moving_scale_p50", percentile(scales, 0.5)},
+              {"moving_scale_min", *std::min_element(scales.begin(), scales.end())},
               {"gpu_ms_p50", percentile(gpu_ms, 0.5)},
               {"plan_ms_p50", percentile(plan_ms, 0.5)},
               {"upload_ms_p50", percentile(upload_ms, 0.5)},

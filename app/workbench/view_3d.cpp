@@ -69,8 +69,10 @@ void redraw(WorkbenchState& s, int width, int height) {
   if (!moving && s.last_plan.stopped_by_budget == 0 && !s.renderer->has_more_to_draw()) return;
   render::RenderSettings settings = s.settings;
   settings.culling.budget = s.budget.next(moving);
-  const render::RenderView view =
-      render::make_render_view(s.navigation.camera(width, height), s.renderer->header().origin);
+  // Moving, the frame may be drawn smaller (render/frame_budget.hpp).
+  const render::RenderView view = render::make_render_view(
+      render::at_scale(s.navigation.camera(width, height), s.budget.scale(moving)),
+      s.renderer->header().origin);
   // Refining, each frame draws the whole picture again: it waits a little
   // for the nodes being read, so that fewer frames draw more each.
   const render::LodFrameResult frame = s.renderer->draw(
