@@ -118,17 +118,20 @@ void WorkbenchInput::button(int button, bool pressed, int mods) {
     }
   } else if (s.view3d.contains(x, y)) {
     s.press_at = s.cursor;
-    // The lasso and the brush select with the left button; the right one
-    // still pans.
-    const bool selecting = button == 0 && !s.measuring && !s.fly;
-    if (selecting && s.session.tool == Tool::kLasso) {
+    // The lasso and the brush select with the left button; the middle one
+    // then turns the view, and the right one still pans.
+    const bool tool_3d = (s.session.tool == Tool::kLasso || s.session.tool == Tool::kBrush) &&
+                         !s.measuring && !s.fly;
+    if (tool_3d && button == 0 && s.session.tool == Tool::kLasso) {
       s.drag = Drag::kLasso3d;
       s.start_lasso_3d(x, y, (mods & keys::kModShift) != 0);
-    } else if (selecting && s.session.tool == Tool::kBrush) {
+    } else if (tool_3d && button == 0) {
       s.drag = Drag::kBrush3d;
       s.brushed.clear();
       s.selection_marks.clear();
       s.brush_at(x, y);
+    } else if (tool_3d && button == 2) {
+      s.drag = Drag::kOrbit;
     } else {
       s.drag = button == 0 ? Drag::kOrbit : Drag::kPan3d;
     }

@@ -129,12 +129,13 @@ void view_3d(WorkbenchState& s) {
                    ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h),
                    ImVec2(picture.uv[0], picture.uv[3]), ImVec2(picture.uv[2], picture.uv[1]));
   }
-  draw->AddText(
-      ImVec2(r.x + s.px(8), r.y + s.px(6)), IM_COL32(255, 255, 255, 200),
-      s.fly                            ? "walk/fly: W A S D Q E, drag to look"
-      : s.session.tool == Tool::kLasso ? "lasso: drag to select (Shift: a box), right-drag to pan"
-      : s.session.tool == Tool::kBrush ? "brush: drag over surfaces to select, right-drag to pan"
-                                       : "orbit: drag to turn, right-drag to pan, wheel to zoom");
+  draw->AddText(ImVec2(r.x + s.px(8), r.y + s.px(6)), IM_COL32(255, 255, 255, 200),
+                s.fly ? "walk/fly: W A S D Q E, drag to look"
+                : s.session.tool == Tool::kLasso
+                    ? "lasso: drag to select (Shift: a box), middle-drag to turn, right-drag to pan"
+                : s.session.tool == Tool::kBrush
+                    ? "brush: drag over surfaces to select, middle-drag to turn, right-drag to pan"
+                    : "orbit: drag to turn, right-drag to pan, wheel to zoom");
   draw->PushClipRect(ImVec2(r.x, r.y), ImVec2(r.x + r.w, r.y + r.h), true);
   selection_overlay(s, draw);
   measurement_overlay(
