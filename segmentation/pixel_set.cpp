@@ -5,22 +5,13 @@
 #include <cassert>
 #include <iterator>
 
+#include "core/radix_sort.hpp"
+
 namespace scanbench::segmentation {
 
 void sort_pixels(std::vector<std::uint32_t>& pixels) {
-  if (pixels.size() < 256) {
-    std::sort(pixels.begin(), pixels.end());
-    return;
-  }
-  // Two passes of 16 bits, least significant first; each pass is stable.
-  std::vector<std::uint32_t> scratch(pixels.size());
-  for (const int shift : {0, 16}) {
-    std::vector<std::size_t> start(65537, 0);
-    for (const std::uint32_t v : pixels) ++start[((v >> shift) & 0xffffu) + 1];
-    for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-    for (const std::uint32_t v : pixels) scratch[start[(v >> shift) & 0xffffu]++] = v;
-    pixels.swap(scratch);
-  }
+  std::vector<std::uint32_t> scratch;
+  core::radix_sort(pixels, scratch, 32, [](std::uint32_t v) { return v; });
 }
 
 PixelSet unite(std::span<const std::uint32_t> a, std::span<const std::uint32_t> b) {

@@ -1,9 +1,11 @@
 #include "modeling/lod/build_lod.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <limits>
 #include <mutex>
+#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -128,11 +130,16 @@ class ChunkRouter {
 
   void add(std::span<const BuildPoint> points) {
     for (const BuildPoint& p : points) {
+      // Neighbours in a scan's rows mostly share a cell: the last one's
+      // chunk is looked up again only when the cell changes.
       const std::uint64_t code = cube_.morton_of(p.point.offset, counts_.depth);
-      const auto at = std::lower_bound(counts_.codes.begin(), counts_.codes.end(), code);
-      assert(at != counts_.codes.end() && *at == code && "the survey counted every cell");
-      const std::uint32_t chunk =
-          counts_.chunk[static_cast<std::size_t>(at - counts_.codes.begin())];
+      if (code != last_code_) {
+        const auto at = std::lower_bound(counts_.codes.begin(), counts_.codes.end(), code);
+        assert(at != counts_.codes.end() && *at == code && "the survey counted every cell");
+        last_code_ = code;
+        last_chunk_ = counts_.chunk[static_cast<std::size_t>(at - counts_.codes.begin())];
+      }
+      const std::uint32_t chunk = last_chunk_;
       waiting_[chunk].push_back(p);
       if (waiting_[chunk].size() >= kParkingBatch) park(chunk);
     }
@@ -152,6 +159,8 @@ class ChunkRouter {
   const CellCounts& counts_;
   ParkedPoints& parked_;
   std::vector<std::vector<BuildPoint>> waiting_;
+  std::uint64_t last_code_ = ~std::uint64_t{0};  // no cell's
+  std::uint32_t last_chunk_ = 0;
 };
 
 // Builds the nodes above the chunks from the chunks' roots, depth first.
@@ -201,33 +210,54 @@ std::uint64_t chunk_points_for(const LodBuildSettings& settings, std::uint64_t l
   return std::clamp<std::uint64_t>(std::min(fit, shared), kMinChunkPoints, 1u << 23);
 }
 
-// Calls body(k, connection) for every scan k on the workers, a batch of
-// one scan per worker at a time, reporting each batch as `stage` and
-// checking for a cancel between batches (on the calling thread, as
-// Progress wants). A project's connection serves one thread: each worker
-// reads through a connection of its own, at the revision `project` read.
-// Throws core::RuntimeFailure when the project changed since.
+// Calls body(k) for k in [0, count) on `workers` workers, each taking the
+// next k as soon as it is free: one long item does not hold the others
+// back, as batches would. A cancel throws before an item starts. Progress
+// reports `stage` (an item's `label`) after the items the calling thread
+// runs, and at the end: on the calling thread, as Progress wants.
+template <typename Body>
+void for_each_item(std::size_t count, int workers, core::Progress& progress, std::string_view stage,
+                   const std::function<std::string(std::size_t)>& label, Body&& body) {
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<std::size_t> finished{0};
+  tbb::task_arena arena = core::worker_arena(workers);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, count, 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t k = range.begin(); k < range.end(); ++k) {
+            progress.throw_if_cancelled("lod");
+            body(k);
+            const std::size_t n = finished.fetch_add(1) + 1;
+            if (std::this_thread::get_id() == caller) progress.update({stage, n, count, label(k)});
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  if (count > 0) progress.update({stage, count, count, label(count - 1)});
+}
+
+// Calls body(k, connection) for every scan k on the workers (for_each_item).
+// A project's connection serves one thread: each scan is read through a
+// connection of its own, at the revision `project` read. Throws
+// core::RuntimeFailure when the project changed since.
 template <typename Body>
 void for_each_scan(const store::Project& project, std::int64_t revision,
                    const std::vector<store::StoredScanSummary>& scans, int workers,
                    core::Progress& progress, std::string_view stage, Body&& body) {
-  const auto w = static_cast<std::size_t>(workers);
-  for (std::size_t batch = 0; batch < scans.size(); batch += w) {
-    progress.throw_if_cancelled("lod");
-    const std::size_t end = std::min(scans.size(), batch + w);
-    core::parallel_for_index(static_cast<int>(end - batch), workers, [&](int k) {
-      const store::Project own = store::Project::open_read_only(project.path());
-      const store::Project::ReadSnapshot snapshot = own.read_snapshot();
-      if (own.revision() != revision) {
-        core::FilePosition position;
-        position.detail = "building the level-of-detail store";
-        throw core::RuntimeFailure(project.path().string(), position,
-                                   "the project changed meanwhile: run `scanbench lod` again");
-      }
-      body(batch + static_cast<std::size_t>(k), own);
-    });
-    progress.update({stage, end, scans.size(), scans[end - 1].summary.name});
-  }
+  for_each_item(
+      scans.size(), workers, progress, stage, [&](std::size_t k) { return scans[k].summary.name; },
+      [&](std::size_t k) {
+        const store::Project own = store::Project::open_read_only(project.path());
+        const store::Project::ReadSnapshot snapshot = own.read_snapshot();
+        if (own.revision() != revision) {
+          core::FilePosition position;
+          position.detail = "building the level-of-detail store";
+          throw core::RuntimeFailure(project.path().string(), position,
+                                     "the project changed meanwhile: run `scanbench lod` again");
+        }
+        body(k, own);
+      });
 }
 
 }  // namespace
@@ -272,11 +302,20 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
     for_each_scan(project, result.project_revision, scans, result.threads, progress, "lod: survey",
                   [&](std::size_t s, const store::Project& own_project) {
                     std::unordered_map<std::uint64_t, std::uint64_t> own;
-                    const ScanSurvey survey =
-                        survey_scan(own_project, scans[s], cube, header.origin, settings.points,
-                                    [&](std::span<const std::array<std::uint32_t, 3>> positions) {
-        for (const auto& q : positions) ++own[cube.morton_of(q, counts.depth)];
-                                    });
+                    const ScanSurvey survey = survey_scan(
+                        own_project, scans[s], cube, header.origin, settings.points,
+                        [&](std::span<const std::array<std::uint32_t, 3>> positions) {
+                          // Runs of a cell (neighbours in a row mostly share one) count at once.
+                          for (std::size_t i = 0; i < positions.size();) {
+                            const std::uint64_t code = cube.morton_of(positions[i], counts.depth);
+                            std::size_t end = i + 1;
+                            while (end < positions.size() &&
+                                   cube.morton_of(positions[end], counts.depth) == code)
+                              ++end;
+                            own[code] += end - i;
+                            i = end;
+                          }
+                        });
                     const ScanSources sources = scan_sources(own_project, scans[s].id);
                     lod_scans[s] = {static_cast<std::uint16_t>(s),
                                     scans[s].id,
@@ -359,22 +398,17 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
                 });
   result.distribute_seconds = lap();
 
-  // 4. Chunks, a batch of one per worker at a time; their roots wait.
+  // 4. Chunks, at most one a worker at a time; their roots wait.
   ParkedPoints roots(chunks.size(), in_memory);
-  const auto workers = static_cast<std::size_t>(chunk_workers);
-  for (std::size_t batch = 0; batch < chunks.size(); batch += workers) {
-    progress.throw_if_cancelled("lod");
-    const std::size_t end = std::min(chunks.size(), batch + workers);
-    core::parallel_for_index(static_cast<int>(end - batch), chunk_workers, [&](int k) {
-      const std::size_t c = batch + static_cast<std::size_t>(k);
-      Subtree root = build_subtree(cube, chunks[c].key, parked.take(c), settings.octree,
-                                   [&](BuiltNode&& node) { writer.put(node); });
-      roots.add(c, root.sample);
-      root.sample = {};
-      chunks[c].root = std::move(root);
-    });
-    progress.update({"lod: build", end, chunks.size(), ""});
-  }
+  for_each_item(
+      chunks.size(), chunk_workers, progress, "lod: build", [](std::size_t) { return ""; },
+      [&](std::size_t c) {
+        Subtree root = build_subtree(cube, chunks[c].key, parked.take(c), settings.octree,
+                                     [&](BuiltNode&& node) { writer.put(node); });
+        roots.add(c, root.sample);
+        root.sample = {};
+        chunks[c].root = std::move(root);
+      });
   result.chunk_seconds = lap();
 
   // 5. The nodes above the chunks, and the root.

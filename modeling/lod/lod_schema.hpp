@@ -5,10 +5,12 @@
 
 #include <sqlite3.h>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "modeling/lod/lod_store.hpp"
@@ -90,22 +92,35 @@ inline sqlite3* connect(const std::filesystem::path& file, int flags) {
   return db;
 }
 
-// Writes `node` (finished: offsets from its corner, in level order) with its
-// bounds, largest radius and the scan tiles its points come from
-// (tile_of), replacing the rows of its code. `name` names the file in
+// A node as its rows hold it: its points compressed, with its bounds,
+// largest radius and the scan tiles its points come from (tile_of).
+// Encoding takes no connection, so threads encode while one writes.
+struct EncodedNode {
+  NodeKey key;
+  bool leaf = false;
+  std::uint64_t points_below = 0;
+  std::uint64_t points = 0;
+  std::array<std::uint32_t, kNodeLevels> level_ends{};
+  std::array<float, 6> bounds{};  // min, max; zeros without points
+  float max_radius = 0.0f;
+  std::vector<std::uint8_t> data;   // the points, a zstd frame
+  std::uint64_t tiles = 0;          // distinct tiles
+  std::vector<std::uint8_t> tiled;  // their codes, sorted, a zstd frame
+};
+
+// `node` (finished: offsets from its corner, in level order) encoded.
+EncodedNode encode_node(const OctreeCube& cube, const std::vector<LodScan>& scans,
+                        const BuiltNode& node);
+
+// Writes `node`, replacing the rows of its code. `name` names the file in
 // errors.
-void put_node(sqlite3* db, const std::string& name, const OctreeCube& cube,
-              const std::vector<LodScan>& scans, const BuiltNode& node);
+void put_node(sqlite3* db, const std::string& name, const EncodedNode& node);
 
-// Writes the owners of band `band` of the store's scan `scan` (one a
-// pixel, as LodStore::owners gives them), replacing
-// the band's row.
-void put_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
-                std::span<const std::uint32_t> owners);
-
-// The owners of a band as the store keeps them: one zstd frame.
+// The owners of band of a scan (one a pixel, as LodStore::owners gives
+// them) as the store keeps them: one zstd frame.
 std::vector<std::uint8_t> compress_owners(std::span<const std::uint32_t> owners);
-// put_owners of owners compress_owners compressed.
+// Writes the owners of band `band` of the store's scan `scan`, as
+// compress_owners compressed them, replacing the band's row.
 void put_compressed_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
                            std::span<const std::uint8_t> compressed);
 

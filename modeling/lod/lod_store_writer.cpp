@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "core/errors.hpp"
+#include "core/radix_sort.hpp"
 #include "modeling/lod/lod_schema.hpp"
 #include "modeling/lod/lod_store.hpp"
 #include "modeling/store/zstd_blob.hpp"
@@ -45,23 +46,40 @@ void sync_folder(const std::filesystem::path& file) {
 
 namespace schema {
 
-void put_node(sqlite3* db, const std::string& name, const OctreeCube& cube,
-              const std::vector<LodScan>& scans, const BuiltNode& node) {
+EncodedNode encode_node(const OctreeCube& cube, const std::vector<LodScan>& scans,
+                        const BuiltNode& node) {
+  EncodedNode out;
+  out.key = node.key;
+  out.leaf = node.leaf;
+  out.points_below = node.points_below;
+  out.points = node.points.size();
+  out.level_ends = node.level_ends;
   // Bounds and the largest radius, from the points' quanta.
   const Eigen::AlignedBox3d box = cube.node_box(node.key);
   Eigen::AlignedBox3f bounds;
-  float max_radius = 0.0f;
   for (const LodPoint& p : node.points) {
     const Eigen::Vector3d offset(p.offset[0], p.offset[1], p.offset[2]);
     bounds.extend((box.min() + offset * kQuantumM).cast<float>());
-    max_radius = std::max({max_radius, from_half(p.radii[0]), from_half(p.radii[1])});
+    out.max_radius = std::max({out.max_radius, from_half(p.radii[0]), from_half(p.radii[1])});
   }
-  const std::array<float, 6> corners =
-      bounds.isEmpty() ? std::array<float, 6>{}
-                       : std::array<float, 6>{bounds.min().x(), bounds.min().y(), bounds.min().z(),
-                                              bounds.max().x(), bounds.max().y(), bounds.max().z()};
-  const std::vector<std::uint8_t> data =
+  if (!bounds.isEmpty()) {
+    out.bounds = {bounds.min().x(), bounds.min().y(), bounds.min().z(),
+                  bounds.max().x(), bounds.max().y(), bounds.max().z()};
+  }
+  out.data =
       store::compress(std::as_bytes(std::span<const LodPoint>(node.points)), kNodeCompressionLevel);
+  std::vector<std::uint64_t> tiles, scratch;
+  tiles.reserve(node.points.size());
+  for (const LodPoint& p : node.points) tiles.push_back(tile_of(scans.at(p.scan), p.pixel));
+  core::radix_sort(tiles, scratch, 64, [](std::uint64_t t) { return t; });
+  tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
+  out.tiles = tiles.size();
+  out.tiled =
+      store::compress(std::as_bytes(std::span<const std::uint64_t>(tiles)), kNodeCompressionLevel);
+  return out;
+}
+
+void put_node(sqlite3* db, const std::string& name, const EncodedNode& node) {
   Statement insert(db,
                    "INSERT OR REPLACE INTO lod_nodes (code, leaf, points_below, points, "
                    "level_ends, bounds, max_radius, data) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
@@ -69,23 +87,17 @@ void put_node(sqlite3* db, const std::string& name, const OctreeCube& cube,
   insert.bind_int(1, static_cast<std::int64_t>(node.key.code()))
       .bind_int(2, node.leaf ? 1 : 0)
       .bind_int(3, static_cast<std::int64_t>(node.points_below))
-      .bind_int(4, static_cast<std::int64_t>(node.points.size()))
+      .bind_int(4, static_cast<std::int64_t>(node.points))
       .bind_blob(5, bytes_of(node.level_ends.data(), node.level_ends.size()))
-      .bind_blob(6, bytes_of(corners.data(), corners.size()))
-      .bind_double(7, max_radius)
-      .bind_blob(8, data)
+      .bind_blob(6, bytes_of(node.bounds.data(), node.bounds.size()))
+      .bind_double(7, node.max_radius)
+      .bind_blob(8, node.data)
       .run();
-  std::vector<std::uint64_t> tiles;
-  tiles.reserve(node.points.size());
-  for (const LodPoint& p : node.points) tiles.push_back(tile_of(scans.at(p.scan), p.pixel));
-  std::sort(tiles.begin(), tiles.end());
-  tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
   Statement tiled(
       db, "INSERT OR REPLACE INTO lod_node_tiles (code, count, tiles) VALUES (?1, ?2, ?3)", name);
   tiled.bind_int(1, static_cast<std::int64_t>(node.key.code()))
-      .bind_int(2, static_cast<std::int64_t>(tiles.size()))
-      .bind_blob(3, store::compress(std::as_bytes(std::span<const std::uint64_t>(tiles)),
-                                    kNodeCompressionLevel))
+      .bind_int(2, static_cast<std::int64_t>(node.tiles))
+      .bind_blob(3, node.tiled)
       .run();
 }
 
@@ -98,11 +110,6 @@ void put_compressed_owners(sqlite3* db, const std::string& name, std::uint16_t s
   Statement insert(
       db, "INSERT OR REPLACE INTO lod_pixels (point_scan, band, owners) VALUES (?1, ?2, ?3)", name);
   insert.bind_int(1, scan).bind_int(2, band).bind_blob(3, compressed).run();
-}
-
-void put_owners(sqlite3* db, const std::string& name, std::uint16_t scan, int band,
-                std::span<const std::uint32_t> owners) {
-  put_compressed_owners(db, name, scan, band, compress_owners(owners));
 }
 
 void put_scan(sqlite3* db, const std::string& name, const LodScan& scan) {
@@ -138,7 +145,11 @@ LodStoreWriter::LodStoreWriter(const std::filesystem::path& file, const LodHeade
   try {
     const std::string name = partial_.string();
     // The partial file is thrown away on any failure: no journal needed.
-    store::sqlite::execute(db_, "PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;", name);
+    // Pages of 64 KiB: a node's points (tens to hundreds of kilobytes) are
+    // then read and written a few pages at a time, not page by page.
+    store::sqlite::execute(
+        db_, "PRAGMA page_size = 65536; PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;",
+        name);
     store::sqlite::execute(db_, schema::kSchema, name);
     store::sqlite::execute(
         db_, ("PRAGMA application_id = " + std::to_string(schema::kLodApplicationId)).c_str(),
@@ -162,8 +173,9 @@ LodStoreWriter::~LodStoreWriter() {
 
 void LodStoreWriter::put(const BuiltNode& node) {
   assert(!committed_ && "put before commit");
+  const schema::EncodedNode encoded = schema::encode_node(header_.cube, scans_, node);
   const std::lock_guard lock(mutex_);
-  schema::put_node(db_, partial_.string(), header_.cube, scans_, node);
+  schema::put_node(db_, partial_.string(), encoded);
   points_ += node.points.size();
   ++nodes_;
 }
@@ -171,8 +183,9 @@ void LodStoreWriter::put(const BuiltNode& node) {
 void LodStoreWriter::put_owners(std::uint16_t scan, int band,
                                 std::span<const std::uint32_t> owners) {
   assert(!committed_ && "put_owners before commit");
+  const std::vector<std::uint8_t> compressed = schema::compress_owners(owners);
   const std::lock_guard lock(mutex_);
-  schema::put_owners(db_, partial_.string(), scan, band, owners);
+  schema::put_compressed_owners(db_, partial_.string(), scan, band, compressed);
 }
 
 void LodStoreWriter::commit() {

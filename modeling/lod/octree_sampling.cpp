@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/memory.hpp"
+#include "core/radix_sort.hpp"
 
 namespace scanbench::lod {
 namespace {
@@ -51,16 +52,22 @@ std::vector<std::uint8_t> levels_of(std::span<const std::uint32_t> cells) {
 // depth: a node's points are then one run, its children's consecutive runs.
 class SubtreeBuilder {
  public:
-  SubtreeBuilder(const OctreeCube& cube, const OctreeSettings& settings,
+  // `points` all lie in `region`.
+  SubtreeBuilder(const OctreeCube& cube, const NodeKey& region, const OctreeSettings& settings,
                  const std::function<void(BuiltNode&&)>& emit, std::vector<BuildPoint>& points)
       : cube_(cube), settings_(settings), emit_(emit), points_(points) {
     const int depth = cube_.max_depth();
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> order;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> order, scratch;
     core::reserve_mapped(order, points_.size());
     for (std::size_t i = 0; i < points_.size(); ++i)
       order.emplace_back(cube_.morton_of(points_[i].point.offset, depth),
                          static_cast<std::uint32_t>(i));
-    std::sort(order.begin(), order.end());
+    // The codes share the region's digits: only those below them differ.
+    const int bits = 3 * std::max(0, depth - region.depth);
+    const std::uint64_t below = bits >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
+    core::radix_sort(
+        order, scratch, bits,
+        [below](const std::pair<std::uint64_t, std::uint32_t>& o) { return o.first & below; });
     std::vector<BuildPoint> sorted;
     core::reserve_mapped(sorted, points_.size());
     core::reserve_mapped(codes_, points_.size());
@@ -152,9 +159,11 @@ BuiltNode finish_node(const OctreeCube& cube, Subtree&& subtree) {
   node.points_below = subtree.points_below;
   const std::vector<BuildPoint>& sample = subtree.sample;
   // Priority order, as (priority, index) pairs: cheaper to sort than points.
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(sample.size());
+  // Priorities are distinct (a bijection of the points' identities).
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(sample.size()), scratch;
   for (std::uint32_t i = 0; i < sample.size(); ++i) order[i] = {sample[i].priority, i};
-  std::sort(order.begin(), order.end());
+  core::radix_sort(order, scratch, 64,
+                   [](const std::pair<std::uint64_t, std::uint32_t>& o) { return o.first; });
   std::vector<std::uint32_t> cells(sample.size());
   for (std::size_t k = 0; k < sample.size(); ++k)
     cells[k] = cube.cell_in_node(node.key, sample[order[k].second].point.offset);
@@ -180,7 +189,7 @@ Subtree build_subtree(const OctreeCube& cube, const NodeKey& region, std::vector
   assert(settings.max_leaf_points >= 1 && "a leaf holds a point at least");
   for ([[maybe_unused]] const BuildPoint& p : points)
     assert(cube.node_of(p.point.offset, region.depth) == region && "points inside the region");
-  SubtreeBuilder builder(cube, settings, emit, points);
+  SubtreeBuilder builder(cube, region, settings, emit, points);
   return builder.build(region, 0, builder.size());
 }
 

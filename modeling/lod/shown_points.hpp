@@ -26,7 +26,7 @@ namespace scanbench::lod {
 struct ShownPointsSettings {
   // The largest stretch of a splat along its major axis (splat_shape.hpp).
   float max_stretch = 64.0f;
-  std::size_t band_pixels = std::size_t{1} << 22;  // rows read at a time, in pixels
+  std::size_t band_pixels = std::size_t{1} << 20;  // rows read at a time, in pixels
 };
 
 // Throws core::InputError naming the project and scan `stored` ("scan ID

@@ -13,22 +13,21 @@ ScanSplats::ScanSplats(const acquisition::Scan& description, float max_stretch)
       up_(description.T_world_scan.linear().transpose().col(2).cast<float>()),
       wraps_(acquisition::wraps_around(description)) {
   if (description.is_spherical()) spherical_.emplace(description);
+  if (const auto* a = std::get_if<acquisition::SphericalAngles>(&description_.angles)) {
+    half_cell_rad_.resize(static_cast<std::size_t>(description.rows));
+    for (int row = 0; row < description.rows; ++row) {
+      const double across =
+          a->azimuth_step_rad * std::cos(a->elevation_start_rad + row * a->elevation_step_rad);
+      half_cell_rad_[static_cast<std::size_t>(row)] =
+          static_cast<float>(0.5 * std::hypot(across, a->elevation_step_rad));
+    }
+  }
 }
 
 Eigen::Vector3d ScanSplats::direction(const acquisition::Scan& held, int first_row, int row,
                                       int col) const {
   if (spherical_) return spherical_->precise(first_row + row, col);
   return acquisition::direction_precise(held, row, col, first_row);
-}
-
-// Half the diagonal of a grid row's cell [rad]: a sample's footprint per
-// metre of range seen head on. Per-pixel grids have no cell: none.
-std::optional<float> ScanSplats::half_cell_rad(int grid_row) const {
-  const auto* a = std::get_if<acquisition::SphericalAngles>(&description_.angles);
-  if (a == nullptr) return std::nullopt;
-  const double across =
-      a->azimuth_step_rad * std::cos(a->elevation_start_rad + grid_row * a->elevation_step_rad);
-  return static_cast<float>(0.5 * std::hypot(across, a->elevation_step_rad));
 }
 
 // How far the pixel's samples reach along its surface, when the pixel lies
@@ -86,9 +85,10 @@ Splat ScanSplats::splat(const acquisition::Scan& held, int first_row,
       direction(held, first_row, row, col).cast<float>();  // scanner → point
   constexpr float kEdgeOnStretch = 4.0f;                   // the geometry stage's footprint limit
   float cos_incidence = std::clamp(std::abs(n.dot(beam)), 1.0f / max_stretch_, 1.0f);
-  const std::optional<float> half_cell = half_cell_rad(first_row + row);
-  const float head_on =
-      half_cell ? held.range_m[held.index(row, col)] * *half_cell : footprint * cos_incidence;
+  const float head_on = half_cell_rad_.empty()
+                            ? footprint * cos_incidence
+                            : held.range_m[held.index(row, col)] *
+                                  half_cell_rad_[static_cast<std::size_t>(first_row + row)];
   if (cos_incidence < 1.0f / kEdgeOnStretch) {
     const std::optional<float> along =
         sample_reach(held, first_row, n, row, col, 2.0f * head_on / cos_incidence);

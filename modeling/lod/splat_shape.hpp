@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 #include "acquisition/geometry/scan_geometry.hpp"
 #include "acquisition/scan.hpp"
@@ -45,7 +46,6 @@ class ScanSplats {
               const acquisition::ScanGeometry& geometry, std::size_t g, int row, int col) const;
 
  private:
-  std::optional<float> half_cell_rad(int grid_row) const;
   std::optional<float> sample_reach(const acquisition::Scan& held, int first_row,
                                     const Eigen::Vector3f& normal, int row, int col,
                                     float reach) const;
@@ -56,6 +56,9 @@ class ScanSplats {
   Eigen::Matrix3f rotation_;  // scan frame → world
   Eigen::Vector3f up_;        // the world's up in the scan frame
   bool wraps_ = false;
+  // Per grid row, half the diagonal of its cell [rad]: a sample's footprint
+  // per metre of range seen head on. Empty for per-pixel grids (no cell).
+  std::vector<float> half_cell_rad_;
 };
 
 }  // namespace scanbench::lod

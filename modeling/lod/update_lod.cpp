@@ -369,16 +369,19 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
     for (const std::uint64_t code : edit.changed) {
       const EditableNode& node = tree.at(code);
       schema::put_node(
-          db, name, header.cube, lod_scans,
-          finish_node(header.cube, Subtree{node.key, node.leaf, node.points_below, node.points}));
+          db, name,
+          schema::encode_node(header.cube, lod_scans,
+                              finish_node(header.cube, Subtree{node.key, node.leaf,
+                                                               node.points_below, node.points})));
     }
     // Nodes only relabelled keep their order.
     for (const std::uint64_t code : relabelled) {
       if (edit.changed.count(code) || edit.removed.count(code)) continue;
       const LodNodeInfo& info = infos.at(code);
-      schema::put_node(db, name, header.cube, lod_scans,
-                       BuiltNode{info.key, info.leaf, info.points_below, std::move(points.at(code)),
-                                 info.level_ends});
+      schema::put_node(db, name,
+                       schema::encode_node(header.cube, lod_scans,
+                                           BuiltNode{info.key, info.leaf, info.points_below,
+                                                     std::move(points.at(code)), info.level_ends}));
       ++result.nodes_written;
       result.rewritten.push_back(code);
     }

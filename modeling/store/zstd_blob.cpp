@@ -63,9 +63,12 @@ void check_blob_size(std::span<const std::uint8_t> blob, std::size_t expected_by
 }
 
 std::vector<std::uint8_t> compress(std::span<const std::byte> raw, int level) {
-  const std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> context(ZSTD_createCCtx(),
-                                                                     &ZSTD_freeCCtx);
+  // A context a thread, kept: creating one allocates and clears zstd's
+  // tables, which costs more than compressing a small blob.
+  thread_local const std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> context(ZSTD_createCCtx(),
+                                                                                  &ZSTD_freeCCtx);
   if (!context) throw std::bad_alloc();
+  ZSTD_CCtx_reset(context.get(), ZSTD_reset_session_and_parameters);
   ZSTD_CCtx_setParameter(context.get(), ZSTD_c_compressionLevel, level);
   // SQLite does not checksum its pages; the frame checksum (4 bytes) lets a
   // damaged blob be reported instead of loading as silently wrong ranges.
@@ -84,7 +87,11 @@ std::vector<std::uint8_t> compress(std::span<const std::byte> raw, int level) {
 void decompress_into(std::span<const std::uint8_t> blob, std::span<std::byte> out,
                      const BlobContext& context) {
   check_recorded_size(blob, out.size(), context);
-  const std::size_t produced = ZSTD_decompress(out.data(), out.size(), blob.data(), blob.size());
+  thread_local const std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> zstd(ZSTD_createDCtx(),
+                                                                               &ZSTD_freeDCtx);
+  if (!zstd) throw std::bad_alloc();
+  const std::size_t produced =
+      ZSTD_decompressDCtx(zstd.get(), out.data(), out.size(), blob.data(), blob.size());
   if (ZSTD_isError(produced)) throw_bad_blob(context, ZSTD_getErrorName(produced));
   if (produced != out.size()) {
     throw_bad_blob(context, "decoded " + std::to_string(produced) + " bytes, expected " +
