@@ -1,18 +1,59 @@
 #include "core/project_file.hpp"
 
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
-#include <fstream>
+#include <cstdlib>
+#include <optional>
 
 namespace scanbench::core {
+namespace {
+
+// A descriptor this process already has open on the file of `status`, from
+// /proc/self/fd; none on systems without it.
+std::optional<int> open_already(const struct stat& status) {
+  DIR* const folder = ::opendir("/proc/self/fd");
+  if (folder == nullptr) return std::nullopt;
+  std::optional<int> found;
+  const int own = ::dirfd(folder);
+  while (const dirent* entry = ::readdir(folder)) {
+    char* end = nullptr;
+    const long fd = std::strtol(entry->d_name, &end, 10);
+    if (end == entry->d_name || *end != '\0' || fd == own) continue;
+    struct stat other {};
+    if (::fstat(static_cast<int>(fd), &other) == 0 && other.st_dev == status.st_dev &&
+        other.st_ino == status.st_ino) {
+      found = static_cast<int>(fd);
+      break;
+    }
+  }
+  ::closedir(folder);
+  return found;
+}
+
+}  // namespace
 
 bool is_project_file(const std::filesystem::path& file) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(file, error)) return false;
+  struct stat status {};
+  if (::stat(file.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return false;
   std::array<unsigned char, 100> header{};
-  std::ifstream in(file, std::ios::binary);
-  in.read(reinterpret_cast<char*>(header.data()), header.size());
-  if (in.gcount() != static_cast<std::streamsize>(header.size())) return false;
+  // A file this process has open (a project an SQLite connection holds) is
+  // read through that descriptor: closing one of our own would drop the
+  // POSIX locks the connection holds on it, which belong to the process.
+  ssize_t got = 0;
+  if (const std::optional<int> held = open_already(status)) {
+    got = ::pread(*held, header.data(), header.size(), 0);
+  } else {
+    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;
+    got = ::pread(fd, header.data(), header.size(), 0);
+    ::close(fd);
+  }
+  if (got != static_cast<ssize_t>(header.size())) return false;
   constexpr char kMagic[16] = "SQLite format 3";  // with its terminating NUL: 16 bytes
   const std::uint32_t application_id = (std::uint32_t{header[68]} << 24) |
                                        (std::uint32_t{header[69]} << 16) |

@@ -13,7 +13,9 @@ inline constexpr std::uint32_t kProjectApplicationId = 0x53424E43;
 
 // True when `file` is a regular file that starts like a scanbench project:
 // the SQLite header with kProjectApplicationId (bytes 68 to 71, big-endian).
-// Reads the 100-byte header only; false for anything unreadable.
+// Reads the 100-byte header only, through a descriptor this process has
+// open on the file where there is one (never dropping an SQLite
+// connection's locks); false for anything unreadable.
 bool is_project_file(const std::filesystem::path& file);
 
 }  // namespace scanbench::core

@@ -154,13 +154,14 @@ sqlite3* Project::db() const {
 }
 
 Project Project::open(const std::filesystem::path& file) {
-  schema::check_file_header(file);
+  schema::check_file_kind(file);
   if (!writable(file)) {
     throw core::RuntimeFailure(file.string(), {},
                                "cannot write the project: it, or its folder, is read-only here "
                                "(info, export and history still read it)");
   }
   Project project(file, Connection(connect(file)));
+  schema::check_file_header(project.db(), file);
   schema::configure_connection(project.db(), project.file_name());
   schema::check_and_migrate(project.db(), project.file_name());
   return project;
@@ -224,12 +225,13 @@ Project Project::open_for_reading(const std::filesystem::path& file) {
 }
 
 Project Project::open_read_only(const std::filesystem::path& file) {
-  schema::check_file_header(file);
+  schema::check_file_kind(file);
   // Read-only: SQLite still needs the shared-memory file of the write-ahead
   // log. Where it cannot make one (a write-protected medium) and the log is
   // empty, the file holds every change and is read as immutable; a log with
   // changes in it cannot be read safely without that file.
   Connection db(connect(file, SQLITE_OPEN_READONLY));
+  schema::check_file_header(db.get(), file);
   const int probe = sqlite3_exec(db.get(), "PRAGMA user_version", nullptr, nullptr, nullptr);
   if ((probe & 0xff) == SQLITE_CANTOPEN || (probe & 0xff) == SQLITE_READONLY) {
     std::error_code error;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cassert>
-#include <fstream>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -481,23 +480,32 @@ void enable_wal(sqlite3* db, const std::string& file) {
 
 }  // namespace
 
-void check_file_header(const std::filesystem::path& file) {
+void check_file_kind(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code error;
   const auto status = std::filesystem::status(file, error);
   if (!std::filesystem::exists(status)) refuse(name, "project file does not exist");
   if (std::filesystem::is_directory(status)) refuse(name, "is a directory, not a project file");
   if (!std::filesystem::is_regular_file(status)) refuse(name, "is not a regular file");
+}
 
+void check_file_header(sqlite3* db, const std::filesystem::path& file) {
+  const std::string name = file.string();
+  sqlite3_file* handle = nullptr;
+  if (sqlite3_file_control(db, "main", SQLITE_FCNTL_FILE_POINTER, &handle) != SQLITE_OK ||
+      handle == nullptr || handle->pMethods == nullptr) {
+    throw core::RuntimeFailure(name, {}, "cannot read the project file");
+  }
+  std::error_code error;
+  if (std::filesystem::file_size(file, error) == 0 && !error)
+    refuse(name, "file is empty, not a scanbench project");
   std::array<char, 100> header{};
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw core::RuntimeFailure(name, {}, "cannot read the project file");
-  in.read(header.data(), header.size());
-  const auto got = in.gcount();
-  if (got == 0) refuse(name, "file is empty, not a scanbench project");
+  // A short read fills the rest with zeros: no magic, refused below.
+  const int read = handle->pMethods->xRead(handle, header.data(), header.size(), 0);
+  if (read != SQLITE_OK && read != SQLITE_IOERR_SHORT_READ)
+    throw core::RuntimeFailure(name, {}, "cannot read the project file");
   constexpr char kMagic[16] = "SQLite format 3";  // with its terminating NUL: 16 bytes
-  if (got < static_cast<std::streamsize>(header.size()) ||
-      !std::equal(kMagic, kMagic + 16, header.begin())) {
+  if (read == SQLITE_IOERR_SHORT_READ || !std::equal(kMagic, kMagic + 16, header.begin())) {
     refuse(name, "not a scanbench project (not an SQLite database)");
   }
   // SQLite's file format versions (bytes 18 and 19) are 1 or 2; with a

@@ -27,12 +27,21 @@
 
 namespace scanbench::store::schema {
 
-// Reads the 100-byte SQLite header of `file` without SQLite, so that nothing
-// (not even a -wal or -shm file) is created beside files we refuse. Throws
-// core::InputError when the file is missing, not a regular file,
-// empty, not an SQLite database, another application's database, or a
-// project of a schema version newer than kProjectSchemaVersion or below 1.
-void check_file_header(const std::filesystem::path& file);
+// Throws core::InputError when `file` is missing or not a regular file
+// (without opening it).
+void check_file_kind(const std::filesystem::path& file);
+
+// Reads the 100-byte SQLite header of `file` through the descriptor of
+// `db`, a connection to it that has read nothing yet: so nothing (not even
+// a -wal or -shm file) is created beside files we refuse. Never through a
+// descriptor of its own: closing that would drop the POSIX locks this
+// process's connections hold on the file (they are the process's, not the
+// descriptor's), and another process could then checkpoint and delete the
+// write-ahead log under them, losing what they write next. Throws
+// core::InputError when the file is empty, not an SQLite database, another
+// application's database, or a project of a schema version newer than
+// kProjectSchemaVersion or below 1.
+void check_file_header(sqlite3* db, const std::filesystem::path& file);
 
 // Sets the per-connection settings every project connection needs: foreign
 // keys on, synchronous=FULL, busy timeout. Throws as sqlite::throw_error.

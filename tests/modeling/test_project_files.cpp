@@ -2,12 +2,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <fstream>
 #include <functional>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "core/errors.hpp"
 #include "modeling/project_test_support.hpp"
@@ -55,6 +58,48 @@ void make_foreign_database(const std::filesystem::path& file, const char* journa
   raw.execute("PRAGMA application_id = 1179537988; PRAGMA user_version = 1");
   raw.execute("CREATE TABLE scans (id INTEGER PRIMARY KEY, payload TEXT)");
   raw.execute("INSERT INTO scans (payload) VALUES ('not ours')");
+}
+
+// The POSIX locks this process holds on `file`, from /proc/locks: the
+// locks SQLite takes, which other processes' connections respect.
+std::size_t locks_held_on(const std::filesystem::path& file) {
+  struct stat status {};
+  if (::stat(file.c_str(), &status) != 0) return 0;
+  std::ifstream locks("/proc/locks");
+  std::size_t held = 0;
+  std::string line;
+  while (std::getline(locks, line)) {
+    // "1: POSIX  ADVISORY  READ 1234 08:01:5678 128 128"; waiters carry "->".
+    if (line.find("->") != std::string::npos) continue;
+    std::istringstream fields(line);
+    std::string index, kind, mode, access, pid, device;
+    fields >> index >> kind >> mode >> access >> pid >> device;
+    if (kind != "POSIX" || pid != std::to_string(::getpid())) continue;
+    const std::string inode = device.substr(device.rfind(':') + 1);
+    if (std::stoull(inode) == static_cast<unsigned long long>(status.st_ino)) ++held;
+  }
+  return held;
+}
+
+// SQLite's locks belong to the process, not to a descriptor: had opening a
+// project read its header through a descriptor of its own, closing that
+// would drop the locks of the connections already open, and another
+// process could then checkpoint and delete the write-ahead log they still
+// write to (their next commands lost). A bench run lost them so.
+TEST(ProjectFiles, OpeningAProjectAgainKeepsTheLocksOfItsOpenConnections) {
+  const ScratchDir dir;
+  const auto file = dir / "shared.sbproj";
+  store::Project project = store::Project::create(file);
+  project.revision();  // reading the log: a lock held while the connection lives
+  const std::size_t held = locks_held_on(file);
+  ASSERT_GT(held, 0u) << "no lock to keep: /proc/locks lists none for the project";
+  { store::Project::open_read_only(file).revision(); }
+  EXPECT_EQ(locks_held_on(file), held);
+  { store::Project::open(file).revision(); }
+  EXPECT_EQ(locks_held_on(file), held);
+  // Outputs are checked not to be projects (never overwritten) the same way.
+  EXPECT_TRUE(core::is_project_file(file));
+  EXPECT_EQ(locks_held_on(file), held);
 }
 
 TEST(ProjectFiles, RefusesATextFile) {
