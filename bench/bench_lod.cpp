@@ -74,25 +74,89 @@ double ms_since(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-// The truth object of `site`'s first scan whose pixels there come nearest
-// a million points over the whole campaign (a scan of 3600 × 900 holds
-// 3.24 M pixels; the other scans carry about as many again): its id and
-// its in-model pixels.
+namespace sim = acquisition::sim;
+
+// A store point by where it came from, and where it is (model frame).
+struct StorePoint {
+  std::int64_t scan_id = 0;
+  std::uint32_t pixel = 0;
+  Eigen::Vector3f position;
+};
+
+// The truth object each store point samples: its id in the site's truth
+// (0: none), found through its scan and pixel.
+class StoreTruth {
+ public:
+  StoreTruth(const lod::LodStore& store, const store::Project& project, const SimulatedSite& site) {
+    const std::vector<store::StoredScanSummary> scans = project.scans();
+    for (const lod::LodScan& scan : store.scans()) {
+      for (std::size_t k = 0; k < scans.size(); ++k) {
+        if (scans[k].id == scan.scan_id) site_scan_[scan.index] = k;
+      }
+      scan_ids_[scan.index] = scan.scan_id;
+    }
+    truth_ = &site.truth;
+  }
+  std::uint32_t truth_of(const lod::LodPoint& q) const {
+    return (*truth_)[site_scan_.at(q.scan)].object_id[q.pixel];
+  }
+  std::int64_t scan_id(const lod::LodPoint& q) const { return scan_ids_.at(q.scan); }
+  std::size_t site_scan(const lod::LodPoint& q) const { return site_scan_.at(q.scan); }
+  std::size_t site_scan_of(std::int64_t scan_id) const {
+    for (const auto& [index, id] : scan_ids_) {
+      if (id == scan_id) return site_scan_.at(index);
+    }
+    throw std::logic_error("bench lod: a selection of a scan the store does not hold");
+  }
+
+ private:
+  std::map<std::uint16_t, std::size_t> site_scan_;
+  std::map<std::uint16_t, std::int64_t> scan_ids_;
+  const std::vector<sim::ScanTruth>* truth_ = nullptr;
+};
+
+// Calls `use` with every point of the store, its position in the model frame.
+void for_each_store_point(
+    const lod::LodStore& store,
+    const std::function<void(const lod::LodPoint&, const Eigen::Vector3f&)>& use) {
+  for (const lod::LodNodeInfo& node : store.nodes()) {
+    const Eigen::Vector3f corner = store.header().cube.node_box(node.key).min().cast<float>();
+    for (const lod::LodPoint& q : store.read_points(node.key)) {
+      use(q,
+          corner + Eigen::Vector3f(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
+                                   static_cast<float>(q.offset[2])) *
+                       static_cast<float>(lod::kQuantumM));
+    }
+  }
+}
+
+// The truth object seen by `site`'s first scan whose points in the store
+// of `file` come nearest a million: its id, and its in-model pixels in
+// that scan (the commit carries them into the other scans).
 std::pair<std::uint32_t, std::vector<std::uint32_t>> object_of_a_million(
-    const SimulatedSite& site) {
+    const std::filesystem::path& file, const SimulatedSite& site) {
   const acquisition::Scan& scan = site.scans.front();
-  const double target = 0.5e6 * static_cast<double>(scan.pixel_count()) / (3600.0 * 900.0);
   std::map<std::uint32_t, std::vector<std::uint32_t>> pixels;
   for (std::size_t i = 0; i < scan.pixel_count(); ++i) {
     const std::uint32_t id = site.truth.front().object_id[i];
     if (id != 0 && acquisition::in_model(scan, site.geometry.front(), i))
       pixels[id].push_back(static_cast<std::uint32_t>(i));
   }
+  std::map<std::uint32_t, std::uint64_t> in_store;
+  {
+    const store::Project project = store::Project::open_read_only(file);
+    const lod::LodStore store = lod::LodStore::open(lod::LodStore::path_for(file));
+    const StoreTruth truth(store, project, site);
+    for_each_store_point(store, [&](const lod::LodPoint& q, const Eigen::Vector3f&) {
+      ++in_store[truth.truth_of(q)];
+    });
+  }
+  const auto off_a_million = [&](std::uint32_t id) {
+    return std::abs(static_cast<double>(in_store[id]) - 1e6);
+  };
   auto best = pixels.begin();
   for (auto at = pixels.begin(); at != pixels.end(); ++at) {
-    if (std::abs(static_cast<double>(at->second.size()) - target) <
-        std::abs(static_cast<double>(best->second.size()) - target))
-      best = at;
+    if (off_a_million(at->first) < off_a_million(best->first)) best = at;
   }
   return *best;
 }
@@ -107,7 +171,7 @@ nlohmann::json measure_edits(const std::filesystem::path& file, const SimulatedS
   store::Project project = store::Project::open(file);
   const std::int64_t scan_id = project.scans().front().id;
   nlohmann::json out;
-  const auto [truth_id, selection] = object_of_a_million(site);
+  const auto [truth_id, selection] = object_of_a_million(file, site);
   auto start = std::chrono::steady_clock::now();
   modeling::CommitSettings commit;
   commit.scan_id = scan_id;
@@ -175,8 +239,6 @@ nlohmann::json measure_edits(const std::filesystem::path& file, const SimulatedS
   out["undo_delete_points"] = undone["points_added"];
   return out;
 }
-
-namespace sim = acquisition::sim;
 
 // Each view of the project of the site's first `stations` scans as the
 // streaming renderer draws it once the camera stops,
@@ -272,60 +334,6 @@ nlohmann::json measure_path(const std::filesystem::path& project, const std::fil
 }
 
 // ---- 3D selection -----------------------------------------------------------
-
-// A store point by where it came from, and where it is (model frame).
-struct StorePoint {
-  std::int64_t scan_id = 0;
-  std::uint32_t pixel = 0;
-  Eigen::Vector3f position;
-};
-
-// The truth object each store point samples: its id in the site's truth
-// (0: none), found through its scan and pixel.
-class StoreTruth {
- public:
-  StoreTruth(const lod::LodStore& store, const store::Project& project, const SimulatedSite& site) {
-    const std::vector<store::StoredScanSummary> scans = project.scans();
-    for (const lod::LodScan& scan : store.scans()) {
-      for (std::size_t k = 0; k < scans.size(); ++k) {
-        if (scans[k].id == scan.scan_id) site_scan_[scan.index] = k;
-      }
-      scan_ids_[scan.index] = scan.scan_id;
-    }
-    truth_ = &site.truth;
-  }
-  std::uint32_t truth_of(const lod::LodPoint& q) const {
-    return (*truth_)[site_scan_.at(q.scan)].object_id[q.pixel];
-  }
-  std::int64_t scan_id(const lod::LodPoint& q) const { return scan_ids_.at(q.scan); }
-  std::size_t site_scan(const lod::LodPoint& q) const { return site_scan_.at(q.scan); }
-  std::size_t site_scan_of(std::int64_t scan_id) const {
-    for (const auto& [index, id] : scan_ids_) {
-      if (id == scan_id) return site_scan_.at(index);
-    }
-    throw std::logic_error("bench lod: a selection of a scan the store does not hold");
-  }
-
- private:
-  std::map<std::uint16_t, std::size_t> site_scan_;
-  std::map<std::uint16_t, std::int64_t> scan_ids_;
-  const std::vector<sim::ScanTruth>* truth_ = nullptr;
-};
-
-// Calls `use` with every point of the store, its position in the model frame.
-void for_each_store_point(
-    const lod::LodStore& store,
-    const std::function<void(const lod::LodPoint&, const Eigen::Vector3f&)>& use) {
-  for (const lod::LodNodeInfo& node : store.nodes()) {
-    const Eigen::Vector3f corner = store.header().cube.node_box(node.key).min().cast<float>();
-    for (const lod::LodPoint& q : store.read_points(node.key)) {
-      use(q,
-          corner + Eigen::Vector3f(static_cast<float>(q.offset[0]), static_cast<float>(q.offset[1]),
-                                   static_cast<float>(q.offset[2])) *
-                       static_cast<float>(lod::kQuantumM));
-    }
-  }
-}
 
 // The objects the bench selects: of each kind, the one with the most
 // points in the store (counting its parts: a tree's crown and trunk, a

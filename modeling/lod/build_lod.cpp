@@ -1,11 +1,9 @@
 #include "modeling/lod/build_lod.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <limits>
 #include <mutex>
-#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -14,6 +12,7 @@
 #include "core/parallel.hpp"
 #include "modeling/lod/lod_store.hpp"
 #include "modeling/lod/parked_points.hpp"
+#include "modeling/lod/scan_workers.hpp"
 #include "modeling/scan_cache.hpp"
 
 namespace scanbench::lod {
@@ -210,56 +209,6 @@ std::uint64_t chunk_points_for(const LodBuildSettings& settings, std::uint64_t l
   return std::clamp<std::uint64_t>(std::min(fit, shared), kMinChunkPoints, 1u << 23);
 }
 
-// Calls body(k) for k in [0, count) on `workers` workers, each taking the
-// next k as soon as it is free: one long item does not hold the others
-// back, as batches would. A cancel throws before an item starts. Progress
-// reports `stage` (an item's `label`) after the items the calling thread
-// runs, and at the end: on the calling thread, as Progress wants.
-template <typename Body>
-void for_each_item(std::size_t count, int workers, core::Progress& progress, std::string_view stage,
-                   const std::function<std::string(std::size_t)>& label, Body&& body) {
-  const std::thread::id caller = std::this_thread::get_id();
-  std::atomic<std::size_t> finished{0};
-  tbb::task_arena arena = core::worker_arena(workers);
-  arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, count, 1),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t k = range.begin(); k < range.end(); ++k) {
-            progress.throw_if_cancelled("lod");
-            body(k);
-            const std::size_t n = finished.fetch_add(1) + 1;
-            if (std::this_thread::get_id() == caller) progress.update({stage, n, count, label(k)});
-          }
-        },
-        tbb::simple_partitioner());
-  });
-  if (count > 0) progress.update({stage, count, count, label(count - 1)});
-}
-
-// Calls body(k, connection) for every scan k on the workers (for_each_item).
-// A project's connection serves one thread: each scan is read through a
-// connection of its own, at the revision `project` read. Throws
-// core::RuntimeFailure when the project changed since.
-template <typename Body>
-void for_each_scan(const store::Project& project, std::int64_t revision,
-                   const std::vector<store::StoredScanSummary>& scans, int workers,
-                   core::Progress& progress, std::string_view stage, Body&& body) {
-  for_each_item(
-      scans.size(), workers, progress, stage, [&](std::size_t k) { return scans[k].summary.name; },
-      [&](std::size_t k) {
-        const store::Project own = store::Project::open_read_only(project.path());
-        const store::Project::ReadSnapshot snapshot = own.read_snapshot();
-        if (own.revision() != revision) {
-          core::FilePosition position;
-          position.detail = "building the level-of-detail store";
-          throw core::RuntimeFailure(project.path().string(), position,
-                                     "the project changed meanwhile: run `scanbench lod` again");
-        }
-        body(k, own);
-      });
-}
-
 }  // namespace
 
 // Longer than 60 lines, but flat: the five phases in order, sharing the
@@ -299,8 +248,8 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   {
     std::unordered_map<std::uint64_t, std::uint64_t> cells;
     std::mutex merging;
-    for_each_scan(project, result.project_revision, scans, result.threads, progress, "lod: survey",
-                  [&](std::size_t s, const store::Project& own_project) {
+    for_each_scan(project, result.project_revision, scans, every_scan(scans), result.threads,
+                  progress, "lod: survey", [&](std::size_t s, const store::Project& own_project) {
                     std::unordered_map<std::uint64_t, std::uint64_t> own;
                     const ScanSurvey survey = survey_scan(
                         own_project, scans[s], cube, header.origin, settings.points,
@@ -375,8 +324,8 @@ LodBuildResult build_lod(const store::Project& project, const LodBuildSettings& 
   LodStoreWriter writer(result.store, header, lod_scans);
   ParkedPoints parked(chunks.size(), in_memory);
   for (std::size_t c = 0; c < chunks.size(); ++c) parked.reserve(c, chunks[c].points);
-  for_each_scan(project, result.project_revision, scans, result.threads, progress,
-                "lod: distribute", [&](std::size_t s, const store::Project& own_project) {
+  for_each_scan(project, result.project_revision, scans, every_scan(scans), result.threads,
+                progress, "lod: distribute", [&](std::size_t s, const store::Project& own_project) {
                   ChunkRouter router(cube, counts, parked, chunks.size());
                   const LodScan& scan = lod_scans[s];
                   std::vector<BuildPoint> points;

@@ -177,18 +177,23 @@ std::vector<LodNodeInfo> LodStore::nodes() const {
   return nodes;
 }
 
-std::vector<LodPoint> LodStore::read_points(const NodeKey& node) const {
+LodStore::StoredPoints LodStore::read_stored_points(const NodeKey& node) const {
   Statement s(db_, "SELECT points, data FROM lod_nodes WHERE code = ?1", file_.string());
   s.bind_int(1, static_cast<std::int64_t>(node.code()));
   if (!s.step()) damaged(file_, node_name(node), "is missing");
-  const auto count = static_cast<std::uint64_t>(std::max<std::int64_t>(0, s.column_int(0)));
+  const std::span<const std::uint8_t> data = s.column_blob(1);
+  return {node, static_cast<std::uint64_t>(std::max<std::int64_t>(0, s.column_int(0))),
+          std::vector<std::uint8_t>(data.begin(), data.end())};
+}
+
+std::vector<LodPoint> LodStore::decode_points(const StoredPoints& stored) const {
+  const NodeKey& node = stored.key;
   const store::BlobContext context{file_.string(), node_name(node)};
   // Checked before anything is allocated for it: a damaged count must not
   // ask for the machine's memory.
-  store::check_blob_size(s.column_blob(1), count * sizeof(LodPoint), context);
-  std::vector<LodPoint> points(count);
-  store::decompress_into(s.column_blob(1), std::as_writable_bytes(std::span<LodPoint>(points)),
-                         context);
+  store::check_blob_size(stored.data, stored.count * sizeof(LodPoint), context);
+  std::vector<LodPoint> points(stored.count);
+  store::decompress_into(stored.data, std::as_writable_bytes(std::span<LodPoint>(points)), context);
   // What the renderer will index with: within the node and the scans.
   const std::uint64_t edge = header_.cube.node_edge(node.depth);
   for (const LodPoint& p : points) {

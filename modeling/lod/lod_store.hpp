@@ -122,7 +122,19 @@ class LodStore {
 
   // The points of `node`, in level order (offsets from its corner). Throws
   // core::InputError naming the node when its data is missing or damaged.
-  std::vector<LodPoint> read_points(const NodeKey& node) const;
+  std::vector<LodPoint> read_points(const NodeKey& node) const {
+    return decode_points(read_stored_points(node));
+  }
+
+  // read_points in two steps: the node's row read (a connection serves
+  // one thread), then its points decoded, on any thread.
+  struct StoredPoints {
+    NodeKey key;
+    std::uint64_t count = 0;
+    std::vector<std::uint8_t> data;  // compressed
+  };
+  StoredPoints read_stored_points(const NodeKey& node) const;
+  std::vector<LodPoint> decode_points(const StoredPoints& stored) const;
 
   // The owner of every pixel of band `band` of scan `scan` (rows
   // [band · digest_rows, …)): the object of its point, kNotShown or

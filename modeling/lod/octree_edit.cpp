@@ -3,13 +3,33 @@
 #include <algorithm>
 #include <cassert>
 #include <optional>
+#include <unordered_map>
+
+#include "core/parallel.hpp"
 
 namespace scanbench::lod {
 namespace {
 
-PointId id_of(const BuildPoint& p) {
-  return {p.point.scan, p.point.pixel};
-}
+// A set of points by identity: a bit a pixel, for the scans that have one
+// in it (as large as those scans' grids up to their last such pixel).
+class PointSet {
+ public:
+  void insert(const BuildPoint& p) {
+    if (p.point.scan >= bits_.size()) bits_.resize(p.point.scan + std::size_t{1});
+    std::vector<std::uint64_t>& words = bits_[p.point.scan];
+    if (p.point.pixel / 64 >= words.size()) words.resize(p.point.pixel / 64 + std::size_t{1}, 0);
+    words[p.point.pixel / 64] |= std::uint64_t{1} << (p.point.pixel % 64);
+  }
+  bool contains(const BuildPoint& p) const {
+    if (p.point.scan >= bits_.size()) return false;
+    const std::vector<std::uint64_t>& words = bits_[p.point.scan];
+    return p.point.pixel / 64 < words.size() &&
+           ((words[p.point.pixel / 64] >> (p.point.pixel % 64)) & 1u) != 0;
+  }
+
+ private:
+  std::vector<std::vector<std::uint64_t>> bits_;  // by the store's scan index
+};
 
 bool in_region(const OctreeCube& cube, const NodeKey& region, const BuildPoint& p) {
   return cube.node_of(p.point.offset, region.depth) == region;
@@ -127,31 +147,63 @@ class EditPlanner {
 class Editor {
  public:
   Editor(const OctreeCube& cube, const OctreeSettings& settings, EditableTree& tree,
-         std::span<const std::int64_t> scan_ids)
-      : cube_(cube), settings_(settings), tree_(tree), scan_ids_(scan_ids) {}
+         std::span<const std::int64_t> scan_ids, int threads)
+      : cube_(cube), settings_(settings), tree_(tree), scan_ids_(scan_ids), threads_(threads) {}
 
   OctreeEditResult run(std::span<const BuildPoint> added, std::span<const BuildPoint> removed) {
-    for (const BuildPoint& p : removed) removed_ids_.insert(id_of(p));
+    for (const BuildPoint& p : removed) removed_ids_.insert(p);
     const auto [regions, ancestors] = EditPlanner(cube_, settings_, tree_).plan(added, removed);
     for (const std::uint64_t code : ancestors) old_sample(NodeKey::from_code(code));
     // The added points by the region they fall in (the regions are
     // disjoint, and each added point's descent ends in one).
-    std::map<std::uint64_t, std::vector<BuildPoint>> added_to;
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> added_to;  // indices in `added`
+    int shallowest = cube_.max_depth();
+    for (const std::uint64_t code : regions) {
+      added_to[code];
+      shallowest = std::min(shallowest, NodeKey::from_code(code).depth);
+    }
     std::optional<NodeKey> last;  // as the anchors, in runs
-    std::vector<BuildPoint>* to = nullptr;
-    for (const BuildPoint& p : added) {
+    std::vector<std::uint32_t>* to = nullptr;
+    for (std::uint32_t i = 0; i < added.size(); ++i) {
+      const BuildPoint& p = added[i];
       if (!last || cube_.node_of(p.point.offset, last->depth) != *last) {
-        int depth = 0;
-        while (!regions.count(cube_.node_of(p.point.offset, depth).code())) {
+        int depth = shallowest;
+        auto region = added_to.end();
+        while ((region = added_to.find(cube_.node_of(p.point.offset, depth).code())) ==
+               added_to.end()) {
           ++depth;
           assert(depth <= cube_.max_depth() && "an added point in no region");
         }
         last = cube_.node_of(p.point.offset, depth);
-        to = &added_to[last->code()];
+        to = &region->second;
       }
-      to->push_back(p);
+      to->push_back(i);
     }
-    for (const std::uint64_t code : regions) rebuild(NodeKey::from_code(code), added_to[code]);
+    // Each region's points gathered from the tree in turn, its subtree
+    // built on the workers, then stored in turn.
+    struct Rebuilt {
+      NodeKey region;
+      std::vector<BuildPoint> points;
+      std::vector<EditableNode> nodes;  // below the region
+      Subtree top;                      // the region's, unfinished
+    };
+    std::vector<Rebuilt> rebuilt;
+    for (const std::uint64_t code : regions) {
+      const NodeKey region = NodeKey::from_code(code);
+      std::vector<BuildPoint> points = gather(region, added, added_to[code]);
+      if (!points.empty()) rebuilt.push_back({region, std::move(points), {}, {}});
+    }
+    core::parallel_for_index(static_cast<int>(rebuilt.size()), threads_, [&](int k) {
+      Rebuilt& r = rebuilt[static_cast<std::size_t>(k)];
+      r.top = build_subtree(cube_, r.region, std::move(r.points), settings_, [&](BuiltNode&& node) {
+        r.nodes.push_back({node.key, node.leaf, node.points_below, restored_points(node)});
+      });
+    });
+    for (Rebuilt& r : rebuilt) {
+      for (EditableNode& node : r.nodes)
+        store_node(node.key, node.leaf, node.points_below, std::move(node.points));
+      samples_.emplace(r.region.code(), std::move(r.top));
+    }
     redraw_ancestors(ancestors);
     return std::move(result_);
   }
@@ -171,9 +223,11 @@ class Editor {
     return old_samples_.emplace(key.code(), std::move(sample)).first->second;
   }
 
-  // Region `region` built again from its points after the edit, `added`
-  // (those of the added points inside it) among them.
-  void rebuild(const NodeKey& region, std::span<const BuildPoint> added) {
+  // The points of region `region` after the edit, among them the added
+  // points `inside` it (indices in `added`); the nodes below it leave the
+  // tree.
+  std::vector<BuildPoint> gather(const NodeKey& region, std::span<const BuildPoint> added,
+                                 std::span<const std::uint32_t> inside) {
     std::vector<BuildPoint> points;
     if (region.depth > 0) {
       for (const BuildPoint& p : old_sample(region.parent())) {
@@ -190,16 +244,11 @@ class Editor {
       at = tree_.erase(at);
     }
     const std::size_t before = points.size();
-    std::erase_if(points, [&](const BuildPoint& p) { return removed_ids_.count(id_of(p)) > 0; });
+    std::erase_if(points, [&](const BuildPoint& p) { return removed_ids_.contains(p); });
     result_.removed_points += before - points.size();
-    points.insert(points.end(), added.begin(), added.end());
-    result_.added_points += added.size();
-    if (points.empty()) return;
-    Subtree top = build_subtree(cube_, region, std::move(points), settings_, [&](BuiltNode&& node) {
-      store_node(node.key, node.leaf, node.points_below, {});
-      restore_points(node);
-    });
-    samples_.emplace(region.code(), std::move(top));
+    for (const std::uint32_t i : inside) points.push_back(added[i]);
+    result_.added_points += inside.size();
+    return points;
   }
 
   // The nodes above the rebuilt regions, deepest first: each drawn again
@@ -252,9 +301,10 @@ class Editor {
   }
 
   // A built node's points back in the cube's frame.
-  void restore_points(const BuiltNode& node) {
+  std::vector<BuildPoint> restored_points(const BuiltNode& node) const {
     const std::array<std::uint64_t, 3> corner = cube_.node_corner(node.key);
-    std::vector<BuildPoint>& points = tree_.at(node.key.code()).points;
+    std::vector<BuildPoint> points;
+    points.reserve(node.points.size());
     for (const LodPoint& p : node.points) {
       BuildPoint b;
       b.point = p;
@@ -263,13 +313,15 @@ class Editor {
         b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
       points.push_back(b);
     }
+    return points;
   }
 
   const OctreeCube& cube_;
   const OctreeSettings& settings_;
   EditableTree& tree_;
   std::span<const std::int64_t> scan_ids_;
-  std::set<PointId> removed_ids_;
+  int threads_;
+  PointSet removed_ids_;
   std::map<std::uint64_t, std::vector<BuildPoint>> old_samples_;
   std::map<std::uint64_t, Subtree> samples_;  // new samples of rebuilt regions and redrawn nodes
   OctreeEditResult result_;
@@ -311,8 +363,8 @@ std::set<std::uint64_t> edit_reads(const OctreeCube& cube, const OctreeSettings&
 OctreeEditResult edit_octree(const OctreeCube& cube, const OctreeSettings& settings,
                              EditableTree& tree, std::span<const BuildPoint> added,
                              std::span<const BuildPoint> removed,
-                             std::span<const std::int64_t> scan_ids) {
-  return Editor(cube, settings, tree, scan_ids).run(added, removed);
+                             std::span<const std::int64_t> scan_ids, int threads) {
+  return Editor(cube, settings, tree, scan_ids, threads).run(added, removed);
 }
 
 }  // namespace scanbench::lod

@@ -35,13 +35,6 @@ struct EditableNode {
 // A tree by locational code.
 using EditableTree = std::map<std::uint64_t, EditableNode>;
 
-// A point's identity: its scan's store index and its pixel.
-struct PointId {
-  std::uint16_t scan = 0;
-  std::uint32_t pixel = 0;
-  auto operator<=>(const PointId&) const = default;
-};
-
 struct OctreeEditResult {
   std::set<std::uint64_t> changed;  // nodes whose description or points changed, or new
   std::set<std::uint64_t> removed;  // nodes gone
@@ -60,11 +53,12 @@ EditableTree build_editable_tree(const OctreeCube& cube, const std::vector<Build
 // holds each as it was added) and adds `added` (offsets from the cube's
 // corner, inside it; identities not in the tree), leaving `tree` as a
 // build from scratch of the resulting points gives it. `scan_ids` as for
-// build_editable_tree.
+// build_editable_tree. The regions it builds again are built on `threads`
+// workers (core::worker_count); the result does not depend on them.
 OctreeEditResult edit_octree(const OctreeCube& cube, const OctreeSettings& settings,
                              EditableTree& tree, std::span<const BuildPoint> added,
                              std::span<const BuildPoint> removed,
-                             std::span<const std::int64_t> scan_ids);
+                             std::span<const std::int64_t> scan_ids, int threads = 1);
 
 // The nodes whose points edit_octree(cube, settings, tree, added, removed)
 // reads, from `skeleton`: the tree's nodes without their points. An edit

@@ -227,9 +227,9 @@ ScanSurvey survey_scan(
                         if (has_intensity) intensities.add(band.held.intensity[i]);
                       },
                       [&](std::size_t, int r, int c) {
-                        positions.push_back(place.at(band, *directions, r, c));
+                        if (visit) positions.push_back(place.at(band, *directions, r, c));
                       });
-                  visit(positions);
+                  if (visit) visit(positions);
                 });
   if (const auto low = intensities.at(0.02)) {
     survey.intensity_low = *low;

@@ -49,9 +49,10 @@ struct ScanSurvey {
 
 // The shown points of scan `stored`, positions only: `visit` gets each band's
 // positions in quanta from `cube`'s corner (the cube holds the model,
-// relative to `origin` in world metres). Throws core::InputError naming the
-// scan when it has no geometry or a layer is damaged, or a point lies
-// outside the cube.
+// relative to `origin` in world metres); an empty `visit` asks for the
+// survey alone (no position is computed). Throws core::InputError naming
+// the scan when it has no geometry or a layer is damaged, or a point lies
+// outside the cube (when positions are computed).
 ScanSurvey survey_scan(
     const store::Project& project, const store::StoredScanSummary& stored, const OctreeCube& cube,
     const Eigen::Vector3d& origin, const ShownPointsSettings& settings,
