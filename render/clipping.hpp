@@ -31,6 +31,10 @@ struct CullSettings {
   bool level_of_detail = true;  // nodes drawn as the prefix whose cells are lod_pixels wide
   float lod_pixels = 1.0f;      // [pixels] on screen
   std::size_t budget = 0;       // points per frame; 0: no budget
+  // Points a frame draws while nodes it wants are still being read (a
+  // still camera refining: a quick preview, then the whole picture once
+  // they are in, rather than every partial picture in full); 0: all it can.
+  std::size_t preview_budget = 0;
 };
 
 }  // namespace scanbench::render

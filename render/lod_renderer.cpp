@@ -410,6 +410,18 @@ LodFrameResult LodRenderer::frame(const RenderView& picture_view, const RenderSe
       gpu.memory->wait_idle();
     }
   }
+  // Nodes it wants are still being read: a preview within its budget, their
+  // requests standing.
+  const CullSettings& cull = settings.culling;
+  if (!result.plan.wanted.empty() && cull.preview_budget > 0 &&
+      (cull.budget == 0 || cull.budget > cull.preview_budget)) {
+    RenderSettings preview = settings;
+    preview.culling.budget = cull.preview_budget;
+    std::vector<std::size_t> wanted = std::move(result.plan.wanted);
+    result.plan = plan(view, preview);
+    result.plan.wanted = std::move(wanted);
+    result.preview = true;
+  }
   result.gpu_ms = issue(view, settings, result.plan);
   gpu.evict(limits_.device_bytes);
   result.frame_ms = ms_since(start);

@@ -48,6 +48,9 @@ struct LodFrameResult {
   double upload_ms = 0.0;  // of frame_ms: uploading nodes to the device
   std::size_t uploaded_nodes = 0;
   std::uint64_t uploaded_bytes = 0;
+  // The frame drew a preview within CullSettings::preview_budget, nodes
+  // it wants being still read.
+  bool preview = false;
   // Every node the view wants is drawn (plan.wanted is empty): the
   // picture will not refine further.
   bool complete() const { return plan.wanted.empty(); }

@@ -69,6 +69,9 @@ void redraw(WorkbenchState& s, int width, int height) {
   if (!moving && s.last_plan.stopped_by_budget == 0 && !s.renderer->has_more_to_draw()) return;
   render::RenderSettings settings = s.settings;
   settings.culling.budget = s.budget.next(moving);
+  // Refining while nodes are read, a preview within the moving frames'
+  // budget: the whole picture is drawn once, when they are in.
+  settings.culling.preview_budget = s.budget.next(true);
   // Moving, the frame may be drawn smaller (render/frame_budget.hpp).
   const render::RenderView view = render::make_render_view(
       render::at_scale(s.navigation.camera(width, height), s.budget.scale(moving)),

@@ -207,6 +207,37 @@ TEST(LodRenderer, RefinesFrameByFrameToTheCompletePicture) {
   EXPECT_LE(streaming.device_peak_bytes(), at_once.device_peak_bytes());
 }
 
+// A still camera refining while nodes are read draws previews within the
+// preview budget, then the whole picture once every node is in.
+TEST(LodRenderer, RefiningWhileNodesAreReadDrawsPreviewsThenTheWholePicture) {
+  test::shared_device();
+  const LodRoomStore& room = lod_room_store();
+  const std::uint32_t root_points = room.hierarchy.nodes[0].points;
+  LodRendererLimits limits;
+  limits.upload_bytes_per_frame = root_points * sizeof(lod::LodPoint);  // a node or so a frame
+  LodRenderer streaming(room.store, limits);
+  const RenderView view = make_render_view(room_camera(), streaming.header().origin);
+  RenderSettings settings;
+  settings.culling.preview_budget = root_points;
+  LodFrameResult frame = streaming.draw(view, settings);
+  std::size_t previews = 0, frames = 1;
+  while (!frame.complete() && frames < 2000) {
+    EXPECT_TRUE(frame.preview);
+    EXPECT_LE(frame.plan.submitted, root_points);
+    ++previews;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));  // the loader's turn
+    frame = streaming.draw(view, settings);
+    ++frames;
+  }
+  ASSERT_TRUE(frame.complete()) << frames << " frames";
+  EXPECT_FALSE(frame.preview);
+  EXPECT_GT(previews, 0u);
+  EXPECT_GT(frame.plan.submitted, std::size_t{root_points});
+  LodRenderer at_once(room.store, {});
+  at_once.draw_complete(view, settings);
+  EXPECT_EQ(streaming.read_image().rgba, at_once.read_image().rgba);
+}
+
 // A renderer follows an update of its store in place: it uploads only the
 // nodes the update rewrote, and draws what a renderer opened on the
 // updated store draws, pixel for pixel, the committed object's hide too.
