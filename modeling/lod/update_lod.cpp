@@ -102,6 +102,9 @@ void compare_owners(const store::Project& project, const store::StoredScanSummar
     }
   };
   if (!store) {  // every point new: their owners need the points' validity
+    // At most its valid points: room reserved, not touched (no copies as
+    // the array grows).
+    changes.added.reserve(changes.added.size() + stored.summary.valid_points);
     read_shown_bands(project, stored, scan, header.cube, header.origin, settings,
                      [&](const ShownBand& band) {
                        const std::vector<std::uint32_t> none(band.owners.size(), kNotInModel);
@@ -318,7 +321,11 @@ std::optional<LodUpdateResult> update_lod(const store::Project& project,
   std::set<std::uint64_t> tiles;
   std::uint64_t to_relabel = 0, to_remove = 0;
   for (ScanChanges& scan : changes) {
-    added.insert(added.end(), scan.added.begin(), scan.added.end());
+    if (added.empty()) {
+      added = std::move(scan.added);
+    } else {
+      added.insert(added.end(), scan.added.begin(), scan.added.end());
+    }
     scan.added = {};
     tiles.insert(scan.tiles.begin(), scan.tiles.end());
     to_relabel += scan.relabelled;
