@@ -254,6 +254,16 @@ LodFramePlan LodRenderer::plan(const RenderView& banded_view,
   plan_settings.frustum = cull.frustum;
   plan_settings.lod_pixels = cull.level_of_detail ? cull.lod_pixels : 0.0f;
   plan_settings.budget = cull.budget;
+  // A still picture refines to the finer cells where the whole of it at
+  // that fineness (every node in memory or not) stays within fine_points.
+  if (cull.level_of_detail && cull.budget == 0 && cull.fine_lod_pixels > 0.0f &&
+      cull.fine_lod_pixels < cull.lod_pixels) {
+    LodPlanSettings fine = plan_settings;
+    fine.lod_pixels = cull.fine_lod_pixels;
+    const LodFramePlan whole =
+        plan_lod_frame(hierarchy_, banded_view, fine, [](std::size_t) { return true; });
+    if (whole.submitted <= cull.fine_points) plan_settings = fine;
+  }
   return plan_lod_frame(hierarchy_, banded_view, plan_settings,
                         [&](std::size_t k) { return gpu_->device.count(k) > 0; });
 }

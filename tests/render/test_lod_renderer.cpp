@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include "modeling/color_commands.hpp"
@@ -236,6 +237,30 @@ TEST(LodRenderer, RefiningWhileNodesAreReadDrawsPreviewsThenTheWholePicture) {
   LodRenderer at_once(room.store, {});
   at_once.draw_complete(view, settings);
   EXPECT_EQ(streaming.read_image().rgba, at_once.read_image().rgba);
+}
+
+// A still picture refines to the finer cells where the whole picture stays
+// within its points; else it keeps the coarser ones.
+TEST(LodRenderer, AStillPictureRefinesToFinerCellsWithinItsPoints) {
+  test::shared_device();
+  const LodRoomStore& room = lod_room_store();
+  LodRenderer renderer(room.store, {});
+  const RenderView view = make_render_view(room_camera(), renderer.header().origin);
+  const auto drawn = [&](float fine_lod_pixels, std::size_t fine_points, std::size_t budget) {
+    RenderSettings settings;
+    settings.culling.lod_pixels = 4.0f;  // coarse enough for the room to have finer cells
+    settings.culling.fine_lod_pixels = fine_lod_pixels;
+    settings.culling.fine_points = fine_points;
+    settings.culling.budget = budget;
+    return renderer.draw_complete(view, settings).plan.submitted;
+  };
+  const std::size_t coarse = drawn(0.0f, 0, 0);
+  const std::size_t fine = drawn(1.0f, std::numeric_limits<std::size_t>::max(), 0);
+  EXPECT_GT(fine, coarse);
+  EXPECT_EQ(drawn(1.0f, fine - 1, 0), coarse);  // the finer picture would hold too many
+  EXPECT_EQ(drawn(1.0f, fine, 0), fine);
+  // A frame with a budget (a moving one) keeps the coarser cells.
+  EXPECT_EQ(drawn(1.0f, fine, fine + coarse), coarse);
 }
 
 // A renderer follows an update of its store in place: it uploads only the
