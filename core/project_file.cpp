@@ -8,17 +8,17 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
-#include <optional>
+#include <vector>
 
 namespace scanbench::core {
 namespace {
 
-// A descriptor this process already has open on the file of `status`, from
+// The descriptors this process has open on the file of `status`, from
 // /proc/self/fd; none on systems without it.
-std::optional<int> open_already(const struct stat& status) {
+std::vector<int> open_already(const struct stat& status) {
+  std::vector<int> found;
   DIR* const folder = ::opendir("/proc/self/fd");
-  if (folder == nullptr) return std::nullopt;
-  std::optional<int> found;
+  if (folder == nullptr) return found;
   const int own = ::dirfd(folder);
   while (const dirent* entry = ::readdir(folder)) {
     char* end = nullptr;
@@ -27,8 +27,7 @@ std::optional<int> open_already(const struct stat& status) {
     struct stat other {};
     if (::fstat(static_cast<int>(fd), &other) == 0 && other.st_dev == status.st_dev &&
         other.st_ino == status.st_ino) {
-      found = static_cast<int>(fd);
-      break;
+      found.push_back(static_cast<int>(fd));
     }
   }
   ::closedir(folder);
@@ -44,10 +43,14 @@ bool is_project_file(const std::filesystem::path& file) {
   // A file this process has open (a project an SQLite connection holds) is
   // read through that descriptor: closing one of our own would drop the
   // POSIX locks the connection holds on it, which belong to the process.
-  ssize_t got = 0;
-  if (const std::optional<int> held = open_already(status)) {
-    got = ::pread(*held, header.data(), header.size(), 0);
-  } else {
+  // (An SQLite connection's descriptors are readable; only where none of
+  // this process's is, a descriptor of our own is opened and closed.)
+  ssize_t got = -1;
+  for (const int held : open_already(status)) {
+    got = ::pread(held, header.data(), header.size(), 0);
+    if (got >= 0) break;
+  }
+  if (got < 0) {
     const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return false;
     got = ::pread(fd, header.data(), header.size(), 0);

@@ -31,9 +31,9 @@ void radix_sort(std::vector<T>& items, std::vector<T>& scratch, int bits, Key&& 
   for (int shift = 0; shift < bits; shift += kDigitBits) {
     start.fill(0);
     for (const T& item : items) {
-      assert((bits == 64 || static_cast<std::uint64_t>(key(item)) >> bits == 0) &&
-             "keys below 2^bits");
-      ++start[(static_cast<std::uint64_t>(key(item)) >> shift) & (kDigits - 1)];
+      const auto k = static_cast<std::uint64_t>(key(item));
+      assert((bits == 64 || k >> bits == 0) && "keys below 2^bits");
+      ++start[(k >> shift) & (kDigits - 1)];
     }
     if (std::find(start.begin(), start.end(), items.size()) != start.end()) continue;
     std::size_t below = 0;

@@ -21,8 +21,9 @@ namespace {
 // The survey counts points in the cells of this depth (1024 an edge), or
 // of the cube's deepest: a chunk is at least one of them.
 constexpr int kSurveyDepth = 10;
-// What building a chunk takes per point: the point read back, its sort
-// order, the sorted copy and its code, and the samples drawn from it.
+// What building a chunk takes per point: the point read back (48 bytes),
+// its sort order and the radix sort's scratch (16 each), the sorted copy
+// and its code (56), the samples drawn from it and the finished nodes.
 constexpr std::uint64_t kChunkBytesPerPoint = 256;
 // Points a worker collects for a chunk before parking them.
 constexpr std::size_t kParkingBatch = 1024;

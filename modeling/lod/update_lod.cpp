@@ -29,11 +29,12 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 // What changed between the store's digest and a scan's pixels: as large as
-// the change, not as the scan.
+// the digest bands the change touches, not as the scan.
 struct ScanChanges {
-  // The owners now of each digest band where a point the store holds is
-  // relabelled (an object) or removed (kNotShown), a pixel at a time: a
-  // held point whose object differs from its pixel's owner here changed.
+  // For each digest band where a point the store holds is relabelled or
+  // removed, every pixel's owner now (an object, or kNotShown for a point
+  // that leaves the store). A held point changed where its object differs
+  // from its pixel's owner here.
   std::map<int, std::vector<std::uint32_t>> now;
   std::vector<std::uint32_t> added_pixels;  // whose points the store must now hold
   std::vector<BuildPoint> added;            // those points, read
@@ -44,8 +45,8 @@ struct ScanChanges {
   // The digest's bands that changed, as they are now (compress_owners).
   std::vector<std::pair<int, std::vector<std::uint8_t>>> bands;
 
-  // The owner now of the point `p` of this scan (`scan`) holds, when it
-  // changed.
+  // The new owner of point `p`, which the store holds of this scan
+  // (`scan`); none when it did not change.
   std::optional<std::uint32_t> changed_owner(const LodScan& scan, const LodPoint& p) const {
     const std::size_t band_pixels = static_cast<std::size_t>(scan.digest_rows) *
                                     static_cast<std::size_t>(std::max(scan.columns, 1));

@@ -28,8 +28,8 @@ std::vector<Keyed> random_items(std::size_t n, int bits, std::uint64_t seed) {
 
 TEST(RadixSort, SortsStablyByKeyAsAComparisonSortDoes) {
   for (const int bits : {0, 5, 11, 22, 37, 51, 64}) {
-    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{200}, std::size_t{5000},
-                                std::size_t{100000}}) {
+    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{200}, std::size_t{255},
+                                std::size_t{256}, std::size_t{5000}, std::size_t{100000}}) {
       SCOPED_TRACE(testing::Message() << bits << " bits, " << n << " items");
       std::vector<Keyed> items = random_items(n, bits, 7u * n + static_cast<unsigned>(bits));
       std::vector<Keyed> expected = items;
@@ -51,8 +51,15 @@ TEST(RadixSort, SkipsADigitEveryKeyShares) {
   std::vector<std::uint64_t> expected = keys;
   std::sort(expected.begin(), expected.end());
   std::vector<std::uint64_t> scratch;
-  radix_sort(keys, scratch, 48, [](std::uint64_t k) { return k; });
+  std::size_t keys_read = 0;
+  radix_sort(keys, scratch, 48, [&](std::uint64_t k) {
+    ++keys_read;
+    return k;
+  });
   EXPECT_EQ(keys, expected);
+  // Five digits of 11 bits cover 48 bits; each is counted (a read a key),
+  // and only the two that differ are distributed (another read a key).
+  EXPECT_EQ(keys_read, (5 + 2) * keys.size());
 }
 
 }  // namespace

@@ -127,6 +127,9 @@ TEST(LodUpdate, RandomCommandSequencesGiveTheStoreABuildFromScratchGives) {
   build_quietly(project, settings);
   LodBuildSettings from_scratch = settings;
   from_scratch.output = dir / "scratch.lod";
+  // Updates on two workers, builds on one: the store must not depend on it.
+  LodBuildSettings updating = settings;
+  updating.threads = 2;
   const std::size_t pixels = test::shared_room().scan.pixel_count();
 
   std::mt19937 random(2029);
@@ -154,7 +157,7 @@ TEST(LodUpdate, RandomCommandSequencesGiveTheStoreABuildFromScratchGives) {
       project.redo();
     }
     std::string why_not;
-    const std::optional<LodUpdateResult> update = update_lod(project, settings, quiet, why_not);
+    const std::optional<LodUpdateResult> update = update_lod(project, updating, quiet, why_not);
     ASSERT_TRUE(update) << "step " << step << ": " << why_not;
     EXPECT_EQ(update->project_revision, project.revision());
     added += update->points_added;
