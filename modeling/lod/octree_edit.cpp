@@ -305,14 +305,7 @@ class Editor {
     const std::array<std::uint64_t, 3> corner = cube_.node_corner(node.key);
     std::vector<BuildPoint> points;
     points.reserve(node.points.size());
-    for (const LodPoint& p : node.points) {
-      BuildPoint b;
-      b.point = p;
-      b.priority = point_priority(scan_ids_[p.scan], p.pixel);
-      for (int a = 0; a < 3; ++a)
-        b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
-      points.push_back(b);
-    }
+    for (const LodPoint& p : node.points) points.push_back(editable_point(p, corner, scan_ids_));
     return points;
   }
 
@@ -328,6 +321,16 @@ class Editor {
 };
 
 }  // namespace
+
+BuildPoint editable_point(const LodPoint& p, const std::array<std::uint64_t, 3>& corner,
+                          std::span<const std::int64_t> scan_ids) {
+  BuildPoint b;
+  b.point = p;
+  for (int a = 0; a < 3; ++a)
+    b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
+  b.priority = point_priority(scan_ids[p.scan], p.pixel);
+  return b;
+}
 
 EditableTree build_editable_tree(const OctreeCube& cube, const std::vector<BuildPoint>& points,
                                  const OctreeSettings& settings,

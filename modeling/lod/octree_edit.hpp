@@ -13,6 +13,7 @@
 // paths up to the root again.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <set>
@@ -41,6 +42,12 @@ struct OctreeEditResult {
   std::size_t added_points = 0;
   std::size_t removed_points = 0;  // of those asked for, those the tree held
 };
+
+// Point `p` of a node whose corner is `corner` (as the store keeps it:
+// offsets from the corner) as an edit holds it: offsets from the cube's
+// corner, with its priority. `scan_ids` as for build_editable_tree.
+BuildPoint editable_point(const LodPoint& p, const std::array<std::uint64_t, 3>& corner,
+                          std::span<const std::int64_t> scan_ids);
 
 // The tree of `points` built from scratch: every node by code.
 // `scan_ids[k]` is the project's id of the store's scan k (what the

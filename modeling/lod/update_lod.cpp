@@ -209,18 +209,6 @@ std::string why_not_in_place(const store::Project& project,
   return {};
 }
 
-// Point `p` of a node whose corner is `corner`, as an edit holds it:
-// offsets from the cube's corner, with its priority.
-BuildPoint editable_point(const LodPoint& p, const std::array<std::uint64_t, 3>& corner,
-                          const std::vector<std::int64_t>& scan_ids) {
-  BuildPoint b;
-  b.point = p;
-  for (int a = 0; a < 3; ++a)
-    b.point.offset[a] = static_cast<std::uint32_t>(p.offset[a] + corner[a]);
-  b.priority = point_priority(scan_ids[p.scan], p.pixel);
-  return b;
-}
-
 // Node `info` with `points` (as stored) as an edit holds it.
 EditableNode editable_node(const OctreeCube& cube, const LodNodeInfo& info,
                            const std::vector<LodPoint>& points,
